@@ -1,0 +1,660 @@
+// Implementation of the truncated family. Compiled with -fno-trapping-math -fno-math-errno (see
+// CMakeLists.txt): without them GCC will not if-convert Eigen's select() chains or inline sqrt,
+// and the chunk kernel below falls back to scalar code. Neither flag changes IEEE results.
+
+#include "hovering/truncated_map.hpp"
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_spline.h>
+#include <sleef.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#if defined(__AVX2__) || defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace hovering {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kInvTwoPi = 1.0 / kTwoPi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+
+void require_finite(double v, const std::string& name) {
+    if (!std::isfinite(v)) bad(name + " must be finite, got " + fmt(v));
+}
+
+// SIMD lane count of the vector sin; chunk buffers are padded to a multiple of it.
+#if defined(__AVX2__)
+constexpr Eigen::Index kLanes = 4;
+#else
+constexpr Eigen::Index kLanes = 2;
+#endif
+
+Eigen::Index round_up(Eigen::Index n) { return (n + kLanes - 1) / kLanes * kLanes; }
+
+// y = sin(x) on n entries (n a multiple of kLanes) with SLEEF's 1-ulp vector sin.
+void vsin(const double* x, double* y, Eigen::Index n) {
+#if defined(__AVX2__)
+    for (Eigen::Index i = 0; i < n; i += 4)
+        _mm256_storeu_pd(y + i, Sleef_sind4_u10avx2(_mm256_loadu_pd(x + i)));
+#elif defined(__SSE4_1__)
+    for (Eigen::Index i = 0; i < n; i += 2)
+        _mm_storeu_pd(y + i, Sleef_sind2_u10sse4(_mm_loadu_pd(x + i)));
+#elif defined(__SSE2__)
+    for (Eigen::Index i = 0; i < n; i += 2)
+        _mm_storeu_pd(y + i, Sleef_sind2_u10sse2(_mm_loadu_pd(x + i)));
+#else
+    for (Eigen::Index i = 0; i < n; ++i) y[i] = Sleef_sin_u10(x[i]);
+#endif
+}
+
+// Turn GSL's abort-on-error handler off once: every GSL call here has its inputs validated first,
+// and a library must never abort its host process.
+void gsl_quiet() {
+    static std::once_flag once;
+    std::call_once(once, [] { gsl_set_error_handler_off(); });
+}
+
+struct Classified {
+    Region region;
+    double omega;
+};
+
+// The one place where a point is assigned to an arc; the SIMD kernel repeats exactly this arithmetic.
+Classified classify(double phi, double K, const ArcLengths& a) {
+    if (!(K < 0.0)) return {Region::Beside, a.Omega};
+    double d = phi - (kPi - 0.5 * (a.Omega + a.JR + a.J1));  // offset from the left end of J_1
+    d -= kTwoPi * std::floor(d * kInvTwoPi);
+    if (d < a.J1) return {Region::Upper, a.Omega + a.JR};
+    if (d < a.J1 + a.JR) return {Region::Right, a.Omega - a.J1};
+    return {Region::Above, a.Omega};
+}
+
+// Chunk-wide arc lengths: Eigen expressions for the analytic model ...
+template <class Arr>
+void arcs_chunk(const AnalyticArcs& p, const Arr& K, Arr& Om, Arr& JR, Arr& J1, Eigen::Index m) {
+    const auto k = K.head(m);
+    Om.head(m) = p.Omega0 + p.tau0 * k;
+    J1.head(m) = (2.0 * p.lam) * (-k).cwiseMax(0.0).sqrt();
+    JR.head(m) = (k < 0.0).select(2.0 * (kPi - p.theta_w) + p.tau1 * k, 0.0);
+}
+
+// ... and a scalar loop for tables (spline lookups are gathers; this model is not the hot path).
+template <class Arr>
+void arcs_chunk(const TabulatedArcs& p, const Arr& K, Arr& Om, Arr& JR, Arr& J1, Eigen::Index m) {
+    for (Eigen::Index j = 0; j < m; ++j) {
+        const ArcLengths a = p.at(K[j]);
+        Om[j] = a.Omega;
+        JR[j] = a.JR;
+        J1[j] = a.J1;
+    }
+}
+
+template <class Arr>
+void forcing_chunk(const SineForcing&, const Arr& phi, Arr& f, Arr&, Eigen::Index m) {
+    vsin(phi.data(), f.data(), round_up(m));
+}
+
+template <class Arr>
+void forcing_chunk(const FourierForcing& fc, const Arr& phi, Arr& f, Arr& tmp, Eigen::Index m) {
+    const Eigen::Index mp = round_up(m);
+    f.head(mp).setZero();
+    for (std::size_t k = 0; k < fc.b.size(); ++k) {
+        if (fc.b[k] == 0.0) continue;
+        tmp.head(mp) = phi.head(mp) * double(k + 1);
+        vsin(tmp.data(), tmp.data(), mp);
+        f.head(mp) += fc.b[k] * tmp.head(mp);
+    }
+}
+
+}  // namespace
+
+double wrap_angle(double x) {
+    double y = x - kTwoPi * std::floor((x + kPi) * kInvTwoPi);
+    if (y >= kPi) y -= kTwoPi;
+    if (y < -kPi) y += kTwoPi;
+    return y;
+}
+
+bool simd_is_avx2() {
+#if defined(__AVX2__)
+    return true;
+#else
+    return false;
+#endif
+}
+
+// ---------------------------------------------------------------------------------------------
+// Analytic arcs
+
+void AnalyticArcs::validate() const {
+    require_finite(Omega0, "Omega0");
+    require_finite(theta_w, "theta_w");
+    require_finite(tau0, "tau0");
+    require_finite(tau1, "tau1");
+    require_finite(lam, "lam");
+    if (!(theta_w > 0.0 && theta_w < kPi))
+        bad("theta_w must lie in (0, pi) = (0, 3.141592653589793), got " + fmt(theta_w));
+    if (!(lam > 0.0)) bad("lam must be > 0, got " + fmt(lam));
+}
+
+ArcLengths AnalyticArcs::at(double K) const {
+    if (!(K < 0.0)) return {Omega0 + tau0 * K, 0.0, 0.0};
+    return {Omega0 + tau0 * K, 2.0 * (kPi - theta_w) + tau1 * K, 2.0 * lam * std::sqrt(-K)};
+}
+
+double AnalyticArcs::band_lo() const {
+    // With K = -s^2 the three lengths are |J_1| = 2 lam s, |J_R| = 2(pi - theta_w) - tau1 s^2 and
+    // |J_0| = 2 pi - |J_1| - |J_R|; all lie in (0, 2 pi) iff |J_R| > 0 and |J_0| > 0.
+    double lo = -kInf;
+    // |J_0| > 0  <=>  g(s) = tau1 s^2 - 2 lam s + 2 theta_w > 0; g(0) > 0, first root (if any) is
+    // 2 theta_w / (lam + sqrt(lam^2 - 2 tau1 theta_w)), written this way to avoid cancellation.
+    const double disc = lam * lam - 2.0 * tau1 * theta_w;
+    if (disc >= 0.0) {
+        const double s1 = 2.0 * theta_w / (lam + std::sqrt(disc));
+        lo = std::max(lo, -s1 * s1);
+    }
+    if (tau1 > 0.0) lo = std::max(lo, -2.0 * (kPi - theta_w) / tau1);  // |J_R| > 0
+    return lo;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Splines and tabulated arcs
+
+Spline::Spline(std::vector<double> x, std::vector<double> y, const char* name)
+    : x_(std::move(x)), y_(std::move(y)), name_(name), spline_(nullptr) {
+    gsl_quiet();
+    const std::string n(name);
+    if (x_.size() != y_.size())
+        bad(n + ": grid and values differ in length (" + std::to_string(x_.size()) + " vs " +
+            std::to_string(y_.size()) + ")");
+    if (x_.size() < 3) bad(n + ": needs at least 3 grid points, got " + std::to_string(x_.size()));
+    for (std::size_t i = 0; i < x_.size(); ++i) {
+        require_finite(x_[i], n + " grid[" + std::to_string(i) + "]");
+        require_finite(y_[i], n + " value[" + std::to_string(i) + "]");
+        if (i > 0 && !(x_[i] > x_[i - 1]))
+            bad(n + ": grid must be strictly increasing, but grid[" + std::to_string(i) + "] = " +
+                fmt(x_[i]) + " <= grid[" + std::to_string(i - 1) + "] = " + fmt(x_[i - 1]));
+    }
+    gsl_spline* s = gsl_spline_alloc(gsl_interp_cspline, x_.size());
+    if (!s) throw std::bad_alloc();
+    if (gsl_spline_init(s, x_.data(), y_.data(), x_.size()) != GSL_SUCCESS) {
+        gsl_spline_free(s);
+        bad(n + ": GSL could not build the cubic spline");
+    }
+    spline_ = s;
+}
+
+Spline::Spline(const Spline& o) : Spline(o.x_, o.y_, o.name_) {}
+
+Spline::~Spline() {
+    if (spline_) gsl_spline_free(static_cast<gsl_spline*>(spline_));
+}
+
+double Spline::operator()(double x) const {
+    // Clamp rounding-level excursions; callers keep x inside the grid (the band is inside it).
+    x = std::min(std::max(x, x_.front()), x_.back());
+    return gsl_spline_eval(static_cast<const gsl_spline*>(spline_), x, nullptr);
+}
+
+namespace {
+
+std::vector<double> nonpositive_part(const std::vector<double>& K, const std::vector<double>& v,
+                                     bool in_s) {
+    // Points with K <= 0; in s = sqrt(-K) they must be reversed to stay increasing.
+    std::vector<double> out;
+    for (std::size_t i = 0; i < K.size(); ++i)
+        if (K[i] <= 0.0) out.push_back(in_s ? std::sqrt(-K[i]) : v[i]);
+    if (in_s) std::reverse(out.begin(), out.end());
+    return out;
+}
+
+std::vector<double> nonpositive_values_reversed(const std::vector<double>& K,
+                                                const std::vector<double>& v) {
+    std::vector<double> out;
+    for (std::size_t i = 0; i < K.size(); ++i)
+        if (K[i] <= 0.0) out.push_back(v[i]);
+    std::reverse(out.begin(), out.end());
+    return out;
+}
+
+void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
+                 const std::vector<double>& JR, const std::vector<double>& J1) {
+    if (Omega.size() != K.size() || JR.size() != K.size() || J1.size() != K.size())
+        bad("K, Omega, JR and J1 must have the same length, got " + std::to_string(K.size()) + ", " +
+            std::to_string(Omega.size()) + ", " + std::to_string(JR.size()) + ", " +
+            std::to_string(J1.size()));
+    bool has_zero = false;
+    std::size_t n_nonpos = 0;
+    for (std::size_t i = 0; i < K.size(); ++i) {
+        if (K[i] == 0.0) {
+            has_zero = true;
+            // |J_1| = O(sqrt(-K)) closes at the tangency circle; a table that says otherwise is not
+            // a near-tangency model.
+            if (std::abs(J1[i]) > 1e-9)
+                bad("J1 must vanish at K = 0 (|J_1| closes on the tangency circle), got " + fmt(J1[i]));
+        }
+        if (K[i] <= 0.0) ++n_nonpos;
+    }
+    if (!has_zero) bad("the K grid must contain K = 0 exactly (the tangency circle)");
+    if (n_nonpos < 3)
+        bad("the K grid needs at least 3 points with K <= 0, got " + std::to_string(n_nonpos));
+    if (!(K.back() > 0.0)) bad("the K grid must extend above K = 0, got max K = " + fmt(K.back()));
+}
+
+}  // namespace
+
+TabulatedArcs::TabulatedArcs(const std::vector<double>& K, const std::vector<double>& Omega_v,
+                             const std::vector<double>& JR_v, const std::vector<double>& J1_v)
+    : Omega((check_table(K, Omega_v, JR_v, J1_v), K), Omega_v, "Omega"),
+      JR(nonpositive_part(K, K, false), nonpositive_part(K, JR_v, false), "JR"),
+      J1s(nonpositive_part(K, K, true), nonpositive_values_reversed(K, J1_v), "J1") {}
+
+ArcLengths TabulatedArcs::at(double K) const {
+    if (!(K < 0.0)) return {Omega(K), 0.0, 0.0};
+    return {Omega(K), JR(K), J1s(std::sqrt(-K))};
+}
+
+double TabulatedArcs::band_lo() const {
+    auto ok = [this](double s) {
+        const ArcLengths a = at(-s * s);
+        return a.J1 > 0.0 && a.JR > 0.0 && a.J1 + a.JR < kTwoPi;
+    };
+    const double smax = J1s.xmax();
+    const std::size_t n = 64 * J1s.x().size();
+    double good = 0.0;
+    for (std::size_t i = 1; i <= n; ++i) {
+        const double s = smax * double(i) / double(n);
+        if (ok(s)) {
+            good = s;
+            continue;
+        }
+        if (good == 0.0)
+            bad("the tabulated arcs give no valid band below K = 0: at K = " + fmt(-s * s) +
+                " the arc lengths (|J_R|, |J_1|) = (" + fmt(at(-s * s).JR) + ", " +
+                fmt(at(-s * s).J1) + ") are not all in (0, 2 pi)");
+        double badv = s;  // bisect the first failure between the last good and first bad sample
+        for (int it = 0; it < 200 && badv - good > 1e-15 * badv; ++it) {
+            const double mid = 0.5 * (good + badv);
+            (ok(mid) ? good : badv) = mid;
+        }
+        return -good * good;
+    }
+    return -smax * smax;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Forcings
+
+double SineForcing::at(double phi) const { return std::sin(phi); }
+
+double FourierForcing::at(double phi) const {
+    double f = 0.0;
+    for (std::size_t k = 0; k < b.size(); ++k)
+        if (b[k] != 0.0) f += b[k] * std::sin(double(k + 1) * phi);
+    return f;
+}
+
+// ---------------------------------------------------------------------------------------------
+// MapCore
+
+namespace {
+double arcs_kmax(const AnalyticArcs&) { return kInf; }
+double arcs_kmax(const TabulatedArcs& a) { return a.kmax(); }
+void validate_arcs(const AnalyticArcs& a) { a.validate(); }
+void validate_arcs(const TabulatedArcs&) {}
+void validate_forcing(const SineForcing&) {}
+void validate_forcing(const FourierForcing& f) {
+    if (f.b.empty()) bad("forcing needs at least one sine coefficient, got none");
+    for (std::size_t k = 0; k < f.b.size(); ++k)
+        require_finite(f.b[k], "forcing[" + std::to_string(k) + "]");
+}
+}  // namespace
+
+template <class A, class F>
+MapCore<A, F>::MapCore(double eps, A arcs, F forcing, double K_max)
+    : eps_(eps), arcs_(std::move(arcs)), forcing_(std::move(forcing)) {
+    require_finite(eps, "eps");
+    validate_arcs(arcs_);
+    validate_forcing(forcing_);
+    if (std::isnan(K_max) || !(K_max > 0.0)) bad("K_max must be > 0 (or inf), got " + fmt(K_max));
+    band_ = {arcs_.band_lo(), std::min(K_max, arcs_kmax(arcs_))};
+}
+
+template <class A, class F>
+void MapCore<A, F>::check_point(double phi, double K, const char* who) const {
+    require_finite(phi, std::string(who) + ": phi");
+    require_finite(K, std::string(who) + ": K");
+    if (!(K > band_.lo && K < band_.hi))
+        bad(std::string(who) + ": K = " + fmt(K) + " is outside the band (" + fmt(band_.lo) + ", " +
+            fmt(band_.hi) + ") where the map is defined");
+}
+
+template <class A, class F>
+ArcLengths MapCore<A, F>::arc_lengths(double K) const {
+    check_point(0.0, K, "arc_lengths");
+    return arcs_.at(K);
+}
+
+template <class A, class F>
+Region MapCore<A, F>::region(double phi, double K) const {
+    check_point(phi, K, "region");
+    return classify(phi, K, arcs_.at(K)).region;
+}
+
+template <class A, class F>
+double MapCore<A, F>::rotation(double phi, double K) const {
+    check_point(phi, K, "rotation");
+    return classify(phi, K, arcs_.at(K)).omega;
+}
+
+template <class A, class F>
+std::pair<double, double> MapCore<A, F>::step(double phi, double K) const {
+    check_point(phi, K, "step");
+    const double p = wrap_angle(phi + classify(phi, K, arcs_.at(K)).omega);
+    return {p, K + eps_ * forcing_.at(p)};
+}
+
+template <class A, class F>
+std::pair<double, double> MapCore<A, F>::step_inverse(double phi, double K) const {
+    require_finite(phi, "step_inverse: phi");
+    require_finite(K, "step_inverse: K");
+    const double K0 = K - eps_ * forcing_.at(phi);
+    check_point(phi, K0, "step_inverse (preimage)");
+    // The exchange maps J_a(K) onto the reflected arc -J_a(K) (lem:truncreturnmap), so the region
+    // of the preimage is the region of -phi.
+    return {wrap_angle(phi - classify(-phi, K0, arcs_.at(K0)).omega), K0};
+}
+
+template <class A, class F>
+std::vector<double> MapCore<A, F>::arc_starts(double K) const {
+    check_point(0.0, K, "arc_starts");
+    if (!(K < 0.0)) bad("arc_starts: the arcs exist only for K < 0, got K = " + fmt(K));
+    const ArcLengths a = arcs_.at(K);
+    const double p01 = kPi - 0.5 * (a.Omega + a.JR + a.J1);
+    return {wrap_angle(p01), wrap_angle(p01 + a.J1), wrap_angle(p01 + a.J1 + a.JR)};
+}
+
+// ------------------------------------------------------------------ batch iteration
+
+namespace {
+
+// Writes an orbit's outputs once it stops, and the NaN / None tail of its recorded arrays.
+struct Finisher {
+    const IterateOptions& opt;
+    const IterateOutput& out;
+    void operator()(std::int64_t i, double phi, double K, double rotsum, std::int64_t steps,
+                    Status st) const {
+        const std::int64_t ns = opt.n_steps;
+        if (out.phi_final) out.phi_final[i] = phi;
+        if (out.K_final) out.K_final[i] = K;
+        if (out.rotation) out.rotation[i] = steps > 0 ? rotsum / double(steps) : kNaN;
+        if (out.status) out.status[i] = static_cast<std::int8_t>(st);
+        if (out.steps_done) out.steps_done[i] = steps;
+        if (out.orbit_phi)
+            std::fill(out.orbit_phi + i * (ns + 1) + steps + 1, out.orbit_phi + (i + 1) * (ns + 1), kNaN);
+        if (out.orbit_K)
+            std::fill(out.orbit_K + i * (ns + 1) + steps + 1, out.orbit_K + (i + 1) * (ns + 1), kNaN);
+        if (out.regions)
+            std::fill(out.regions + i * ns + steps, out.regions + (i + 1) * ns,
+                      static_cast<std::int8_t>(Region::None));
+    }
+};
+
+bool cancelled(const IterateOptions& opt) {
+    return opt.cancel && opt.cancel->load(std::memory_order_relaxed);
+}
+
+}  // namespace
+
+template <class A, class F>
+struct MapCore<A, F>::Chunk {
+    using Arr = Eigen::ArrayXd;
+    // Per-orbit state (kept compact: finished orbits are swapped out) and per-step scratch.
+    Arr phi, K, rot, exited, Om, JR, J1, d, reg, omega, allowed, f, tmp;
+    std::vector<std::int64_t> idx;
+    explicit Chunk(Eigen::Index cap) {
+        const Eigen::Index c = round_up(cap);
+        for (Arr* a : {&phi, &K, &rot, &exited, &Om, &JR, &J1, &d, &reg, &omega, &allowed, &f, &tmp})
+            a->setZero(c);
+        idx.resize(std::size_t(c));
+    }
+    // Move orbit `last` into slot j (j's orbit has been finished).
+    void move(Eigen::Index j, Eigen::Index last) {
+        for (Arr* a : {&phi, &K, &rot, &exited, &reg, &omega}) (*a)[j] = (*a)[last];
+        idx[std::size_t(j)] = idx[std::size_t(last)];
+    }
+};
+
+template <class A, class F>
+void MapCore<A, F>::run_simd(const double* phi0, const double* K0, std::int64_t begin,
+                             std::int64_t end, const IterateOptions& opt, const IterateOutput& out,
+                             Chunk& c) const {
+    const Finisher finish{opt, out};
+    const std::int64_t ns = opt.n_steps;
+    const double lo = band_.lo, hi = band_.hi;
+    const bool watch = opt.exit_mask != 0;
+    double allow[4];
+    for (int r = 0; r < 4; ++r) allow[r] = (opt.exit_mask >> r) & 1u ? 1.0 : 0.0;
+
+    Eigen::Index m = 0;
+    for (std::int64_t i = begin; i < end; ++i) {
+        if (out.orbit_phi) out.orbit_phi[i * (ns + 1)] = phi0[i];
+        if (out.orbit_K) out.orbit_K[i * (ns + 1)] = K0[i];
+        if (out.exit_step) out.exit_step[i] = -1;
+        if (!(K0[i] > lo && K0[i] < hi)) {
+            finish(i, phi0[i], K0[i], 0.0, 0, Status::Escaped);
+            continue;
+        }
+        c.phi[m] = phi0[i];
+        c.K[m] = K0[i];
+        c.rot[m] = 0.0;
+        c.exited[m] = 0.0;
+        c.idx[std::size_t(m)] = i;
+        ++m;
+    }
+
+    for (std::int64_t n = 0; n < ns && m > 0; ++n) {
+        if ((n & 63) == 0 && cancelled(opt)) {
+            for (Eigen::Index j = 0; j < m; ++j)
+                finish(c.idx[std::size_t(j)], c.phi[j], c.K[j], c.rot[j], n, Status::Interrupted);
+            return;
+        }
+        const auto K = c.K.head(m);
+        const auto phi = c.phi.head(m);
+        arcs_chunk(arcs_, c.K, c.Om, c.JR, c.J1, m);
+        const auto Om = c.Om.head(m);
+        const auto JR = c.JR.head(m);
+        const auto J1 = c.J1.head(m);
+        auto d = c.d.head(m);
+        d = phi - (kPi - 0.5 * (Om + JR + J1));
+        d -= kTwoPi * (d * kInvTwoPi).floor();
+        auto reg = c.reg.head(m);
+        const auto cst = [m](double v) { return Eigen::ArrayXd::Constant(m, v); };
+        reg = (K < 0.0).select((d < J1).select(cst(2.0), (d < J1 + JR).select(cst(3.0), cst(1.0))), 0.0);
+        c.omega.head(m) = Om + (reg == 2.0).select(JR, 0.0) - (reg == 3.0).select(J1, 0.0);
+
+        if (watch) {
+            auto al = c.allowed.head(m);
+            al = (reg == 0.0).select(cst(allow[0]),
+                 (reg == 1.0).select(cst(allow[1]), (reg == 2.0).select(cst(allow[2]), cst(allow[3]))));
+            al = al.max(c.exited.head(m));  // already-reported orbits no longer count as new exits
+            if (al.minCoeff() == 0.0) {
+                for (Eigen::Index j = m - 1; j >= 0; --j) {
+                    if (c.allowed[j] != 0.0) continue;
+                    const std::int64_t i = c.idx[std::size_t(j)];
+                    if (out.exit_step) out.exit_step[i] = n;
+                    c.exited[j] = 1.0;
+                    if (opt.stop_on_exit) {
+                        finish(i, c.phi[j], c.K[j], c.rot[j], n, Status::Exited);
+                        c.move(j, --m);
+                    }
+                }
+                if (m == 0) break;
+            }
+        }
+        if (out.regions)
+            for (Eigen::Index j = 0; j < m; ++j)
+                out.regions[c.idx[std::size_t(j)] * ns + n] = static_cast<std::int8_t>(c.reg[j]);
+
+        auto p = c.phi.head(m);
+        auto k = c.K.head(m);
+        c.rot.head(m) += c.omega.head(m);
+        p += c.omega.head(m);
+        p -= kTwoPi * ((p + kPi) * kInvTwoPi).floor();
+        p = (p >= kPi).select(p - kTwoPi, p);
+        p = (p < -kPi).select(p + kTwoPi, p);
+        forcing_chunk(forcing_, c.phi, c.f, c.tmp, m);
+        k += eps_ * c.f.head(m);
+
+        if (out.orbit_phi || out.orbit_K)
+            for (Eigen::Index j = 0; j < m; ++j) {
+                const std::int64_t at = c.idx[std::size_t(j)] * (ns + 1) + n + 1;
+                if (out.orbit_phi) out.orbit_phi[at] = c.phi[j];
+                if (out.orbit_K) out.orbit_K[at] = c.K[j];
+            }
+        if (!((k > lo) && (k < hi)).all()) {
+            for (Eigen::Index j = m - 1; j >= 0; --j) {
+                if (c.K[j] > lo && c.K[j] < hi) continue;
+                finish(c.idx[std::size_t(j)], c.phi[j], c.K[j], c.rot[j], n + 1, Status::Escaped);
+                c.move(j, --m);
+            }
+        }
+    }
+    for (Eigen::Index j = 0; j < m; ++j)
+        finish(c.idx[std::size_t(j)], c.phi[j], c.K[j], c.rot[j], ns, Status::Ok);
+}
+
+template <class A, class F>
+void MapCore<A, F>::run_scalar(const double* phi0, const double* K0, std::int64_t begin,
+                               std::int64_t end, const IterateOptions& opt,
+                               const IterateOutput& out) const {
+    const Finisher finish{opt, out};
+    const std::int64_t ns = opt.n_steps;
+    for (std::int64_t i = begin; i < end; ++i) {
+        double phi = phi0[i], K = K0[i], rot = 0.0;
+        if (out.orbit_phi) out.orbit_phi[i * (ns + 1)] = phi;
+        if (out.orbit_K) out.orbit_K[i * (ns + 1)] = K;
+        if (out.exit_step) out.exit_step[i] = -1;
+        bool reported = false;
+        std::int64_t n = 0;
+        Status st = Status::Ok;
+        if (!(K > band_.lo && K < band_.hi)) {
+            finish(i, phi, K, 0.0, 0, Status::Escaped);
+            continue;
+        }
+        for (; n < ns; ++n) {
+            if ((n & 63) == 0 && cancelled(opt)) {
+                st = Status::Interrupted;
+                break;
+            }
+            const Classified c = classify(phi, K, arcs_.at(K));
+            if (opt.exit_mask && !reported && !((opt.exit_mask >> int(c.region)) & 1u)) {
+                if (out.exit_step) out.exit_step[i] = n;
+                reported = true;
+                if (opt.stop_on_exit) {
+                    st = Status::Exited;
+                    break;
+                }
+            }
+            if (out.regions) out.regions[i * ns + n] = static_cast<std::int8_t>(c.region);
+            rot += c.omega;
+            phi = wrap_angle(phi + c.omega);
+            K += eps_ * forcing_.at(phi);
+            if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
+            if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
+            if (!(K > band_.lo && K < band_.hi)) {
+                st = Status::Escaped;
+                ++n;
+                break;
+            }
+        }
+        finish(i, phi, K, rot, n, st);
+    }
+}
+
+template <class A, class F>
+void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n,
+                            const IterateOptions& opt, const IterateOutput& out) const {
+    if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
+    if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
+    if (opt.exit_mask > 15u)
+        bad("exit_mask must be a set of regions 0..3 (a bit mask <= 15), got " +
+            std::to_string(opt.exit_mask));
+    if (opt.stop_on_exit && opt.exit_mask == 0u)
+        bad("stop_on_exit needs a non-empty set of regions to stay in");
+    if (opt.n_threads < 0) bad("n_threads must be >= 0 (0 = all cores), got " + std::to_string(opt.n_threads));
+    for (std::int64_t i = 0; i < n; ++i) {
+        require_finite(phi0[i], "phi0[" + std::to_string(i) + "]");
+        require_finite(K0[i], "K0[" + std::to_string(i) + "]");
+    }
+    if (n == 0) return;
+
+    int threads = opt.n_threads > 0 ? opt.n_threads : int(std::thread::hardware_concurrency());
+    threads = std::max(1, threads);
+    // Several chunks per thread keep the load balanced when orbits stop at different times.
+    const std::int64_t chunk = std::clamp<std::int64_t>((n + 4 * threads - 1) / (4 * threads), 8, 512);
+    threads = int(std::min<std::int64_t>(threads, (n + chunk - 1) / chunk));
+
+    std::atomic<std::int64_t> next{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto worker = [&] {
+        try {
+            std::unique_ptr<Chunk> work;
+            if (opt.kernel == Kernel::Simd) work = std::make_unique<Chunk>(Eigen::Index(chunk));
+            for (std::int64_t b; (b = next.fetch_add(chunk)) < n;) {
+                const std::int64_t e = std::min(n, b + chunk);
+                if (opt.kernel == Kernel::Simd)
+                    run_simd(phi0, K0, b, e, opt, out, *work);
+                else
+                    run_scalar(phi0, K0, b, e, opt, out);
+            }
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(error_mutex);
+            if (!error) error = std::current_exception();
+            next.store(n);
+        }
+    };
+    if (threads == 1) {
+        worker();
+    } else {
+        std::vector<std::thread> pool;
+        pool.reserve(std::size_t(threads));
+        for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+        for (auto& t : pool) t.join();
+    }
+    if (error) std::rethrow_exception(error);
+}
+
+template class MapCore<AnalyticArcs, SineForcing>;
+template class MapCore<TabulatedArcs, FourierForcing>;
+
+TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, double tau0, double tau1,
+                                double lam, double K_max) {
+    return TruncatedMap(eps, AnalyticArcs{Omega0, theta_w, tau0, tau1, lam}, SineForcing{}, K_max);
+}
+
+}  // namespace hovering

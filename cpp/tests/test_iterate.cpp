@@ -1,0 +1,138 @@
+// Batch iteration: SIMD kernel vs scalar kernel, thread-count invariance, statuses and recording.
+#include <algorithm>
+#include <atomic>
+#include <random>
+#include <vector>
+
+#include "check.hpp"
+#include "hovering/truncated_map.hpp"
+
+using namespace hovering;
+namespace {
+const double kPi = 3.14159265358979323846;
+
+struct Run {
+    std::vector<double> pf, kf, op, ok, rot;
+    std::vector<std::int8_t> reg, st;
+    std::vector<std::int64_t> done, ex;
+};
+
+Run run(const TruncatedMap& m, const std::vector<double>& p0, const std::vector<double>& k0, std::int64_t ns,
+        Kernel kern, int threads, unsigned mask = 0, bool stop = false, const std::atomic<bool>* cancel = nullptr) {
+    const std::size_t n = p0.size();
+    Run r;
+    r.pf.resize(n); r.kf.resize(n); r.rot.resize(n); r.st.resize(n); r.done.resize(n); r.ex.resize(n);
+    r.op.resize(n * (ns + 1)); r.ok.resize(n * (ns + 1)); r.reg.resize(n * ns);
+    IterateOptions o;
+    o.n_steps = ns; o.kernel = kern; o.n_threads = threads; o.exit_mask = mask; o.stop_on_exit = stop; o.cancel = cancel;
+    IterateOutput out;
+    out.phi_final = r.pf.data(); out.K_final = r.kf.data(); out.orbit_phi = r.op.data(); out.orbit_K = r.ok.data();
+    out.regions = r.reg.data(); out.rotation = r.rot.data(); out.status = r.st.data(); out.steps_done = r.done.data();
+    out.exit_step = r.ex.data();
+    m.iterate(p0.data(), k0.data(), std::int64_t(n), o, out);
+    return r;
+}
+}  // namespace
+
+int main() {
+    const double OmegaG = kPi * (std::sqrt(5.0) - 1.0);
+    TruncatedMap m = make_truncated_map(0.3, OmegaG, 3 * kPi / 4, 1.0, 0.5, 0.5);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> uphi(-kPi, kPi), uK(-0.3, 0.3);
+    const std::size_t n = 1003;  // not a multiple of the chunk or lane width on purpose
+    std::vector<double> p0(n), k0(n);
+    for (std::size_t i = 0; i < n; ++i) { p0[i] = uphi(rng); k0[i] = uK(rng); }
+
+    // Same kernel, 1 vs 2 threads: bit-identical (orbits are independent).
+    Run a = run(m, p0, k0, 200, Kernel::Simd, 1), b = run(m, p0, k0, 200, Kernel::Simd, 2);
+    CHECK(a.pf == b.pf && a.kf == b.kf && a.reg == b.reg && a.st == b.st, "thread count changed SIMD results");
+
+    // SIMD vs scalar over 5 steps: SLEEF sin and libm sin differ by ~1 ulp, so states agree to
+    // ~1e-15 per step; 1e-12 allows the ~5 steps of growth. (Longer orbits diverge: the map is chaotic.)
+    Run s = run(m, p0, k0, 5, Kernel::Scalar, 1), v = run(m, p0, k0, 5, Kernel::Simd, 1);
+    double worst = 0;
+    int reg_diff = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        worst = std::max({worst, std::fabs(wrap_angle(s.pf[i] - v.pf[i])), std::fabs(s.kf[i] - v.kf[i])});
+        for (int j = 0; j < 5; ++j) reg_diff += s.reg[i * 5 + j] != v.reg[i * 5 + j];
+    }
+    CHECK(worst < 1e-12, "SIMD vs scalar after 5 steps: %.3g", worst);
+    CHECK(reg_diff == 0, "SIMD and scalar regions differ at %d steps", reg_diff);
+
+    // Recorded orbit = repeated single steps; rotation = mean omega of the recorded steps.
+    Run r = run(m, p0, k0, 50, Kernel::Scalar, 2);
+    double worst_orbit = 0, worst_rot = 0;
+    for (std::size_t i = 0; i < 50; ++i) {
+        double p = p0[i], k = k0[i], sum = 0;
+        std::int64_t nd = r.done[i];
+        for (std::int64_t j = 0; j < nd; ++j) {
+            sum += m.rotation(p, k);
+            CHECK(r.reg[i * 50 + j] == static_cast<std::int8_t>(m.region(p, k)), "recorded region");
+            auto nx = m.step(p, k);
+            p = nx.first; k = nx.second;
+            worst_orbit = std::max(worst_orbit, std::fabs(r.op[i * 51 + j + 1] - p) + std::fabs(r.ok[i * 51 + j + 1] - k));
+        }
+        if (nd > 0) worst_rot = std::max(worst_rot, std::fabs(r.rot[i] - sum / double(nd)));
+    }
+    CHECK(worst_orbit == 0.0, "scalar orbit differs from repeated step(): %.3g", worst_orbit);
+    CHECK(worst_rot < 1e-12, "rotation mean off by %.3g", worst_rot);
+
+    // Escape: an orbit started just above the band floor with a downward kick leaves the band;
+    // it stops with Escaped, keeps the escaped image, and the tail of its orbit is NaN.
+    const double lo = m.band().lo;
+    std::vector<double> pe, ke;
+    for (int i = 0; i < 64; ++i) { pe.push_back(-kPi + i * 0.098); ke.push_back(lo + 1e-3); }
+    pe.push_back(0.0); ke.push_back(lo - 1.0);  // starts outside: Escaped with 0 steps
+    for (Kernel kern : {Kernel::Simd, Kernel::Scalar}) {
+        Run e = run(m, pe, ke, 1000, kern, 2);
+        int esc = 0;
+        for (std::size_t i = 0; i < pe.size(); ++i) {
+            if (e.st[i] != static_cast<std::int8_t>(Status::Escaped)) continue;
+            ++esc;
+            std::int64_t d = e.done[i];
+            CHECK(!(e.kf[i] > lo), "escaped orbit %zu has K=%g inside the band", i, e.kf[i]);
+            if (d < 1000) CHECK(std::isnan(e.op[i * 1001 + d + 1]), "tail must be NaN");
+            if (d < 1000) CHECK(e.reg[i * 1000 + d] == -1, "region tail must be None");
+            CHECK(e.op[i * 1001 + d] == e.pf[i], "last recorded point is the final state");
+        }
+        CHECK(esc >= 2, "expected escapes near the band floor, got %d", esc);
+        CHECK(e.st.back() == static_cast<std::int8_t>(Status::Escaped) && e.done.back() == 0, "outside start");
+    }
+
+    // Exit watch: stay in {Beside, Above}; the first exit step matches a direct scan, in both kernels.
+    unsigned mask = (1u << 0) | (1u << 1);
+    for (Kernel kern : {Kernel::Simd, Kernel::Scalar}) {
+        Run w = run(m, p0, k0, 300, kern, 2, mask, false);
+        Run st = run(m, p0, k0, 300, kern, 2, mask, true);
+        int checked = 0;
+        for (std::size_t i = 0; i < 200; ++i) {
+            std::int64_t first = -1;
+            for (std::int64_t j = 0; j < w.done[i]; ++j)
+                if (w.reg[i * 300 + j] >= 2) { first = j; break; }
+            CHECK(w.ex[i] == first, "orbit %zu: exit_step %lld vs scan %lld", i, (long long)w.ex[i], (long long)first);
+            if (first >= 0) {
+                ++checked;
+                CHECK(st.st[i] == static_cast<std::int8_t>(Status::Exited) && st.done[i] == first, "stop_on_exit");
+            }
+        }
+        CHECK(checked > 20, "too few exits to test: %d", checked);
+    }
+
+    // Cancellation before the start: every orbit Interrupted at step 0, nothing lost or garbage.
+    std::atomic<bool> cancel{true};
+    Run c = run(m, p0, k0, 100, Kernel::Simd, 2, 0, false, &cancel);
+    bool all_int = true;
+    for (std::size_t i = 0; i < n; ++i) all_int &= c.st[i] == static_cast<std::int8_t>(Status::Interrupted) && c.done[i] == 0 && c.pf[i] == p0[i];
+    CHECK(all_int, "cancelled run must report Interrupted with the initial state");
+
+    // Bad options.
+    IterateOptions o; o.n_steps = -1;
+    IterateOutput out;
+    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "n_steps must be >= 0");
+    o.n_steps = 1; o.exit_mask = 16;
+    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "exit_mask");
+    std::vector<double> pn = {0.0, NAN};
+    o.exit_mask = 0;
+    CHECK_THROWS(m.iterate(pn.data(), k0.data(), 2, o, out), "phi0[1] must be finite");
+    return test_summary("test_iterate");
+}
