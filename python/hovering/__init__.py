@@ -1,0 +1,57 @@
+"""hovering: a simulator for Hamiltonian impact systems near the onset of impacts.
+
+The truncated near-tangency map of Pazi, Zobova and Rom-Kedar, "Hovering Sets in Near
+Pseudo-Integrable Hamiltonian Impact Systems" (eq:truncatedmap), and its general family, with a
+multi-threaded SIMD C++ core.
+
+>>> import hovering
+>>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * 3.141592653589793 / 4)
+>>> res = m.iterate([m.L1(0.0)], [0.0], 1000, record=("rotation",))
+"""
+
+from __future__ import annotations
+
+from . import _core, geometry
+from ._types import Region, Status, region_mask
+from .geometry import (
+    OMEGA_G,
+    K_crit,
+    L1,
+    L2,
+    golden_family,
+    hovering_area_theory,
+    k_eps1,
+    k_eps2,
+    rho1,
+    rho2,
+    rho_crit,
+    wrap,
+)
+from .maps import IterateResult, TruncatedFamily, TruncatedMap
+
+__version__ = "0.1.0"
+
+simd_is_avx2 = _core.simd_is_avx2
+
+__all__ = [
+    "TruncatedMap",
+    "TruncatedFamily",
+    "IterateResult",
+    "Region",
+    "Status",
+    "region_mask",
+    "geometry",
+    "OMEGA_G",
+    "L1",
+    "L2",
+    "k_eps1",
+    "k_eps2",
+    "rho1",
+    "rho2",
+    "K_crit",
+    "rho_crit",
+    "hovering_area_theory",
+    "golden_family",
+    "wrap",
+    "simd_is_avx2",
+]

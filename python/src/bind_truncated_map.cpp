@@ -1,0 +1,234 @@
+// Bindings of MapCore<...>: vectorised single steps and the batch iteration.
+//
+// Every loop over user arrays runs with the GIL released: the core only reads the input buffers
+// (owned by the caller's arrays, kept alive by this frame) and writes freshly allocated outputs.
+
+#include <Python.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include "hovering/truncated_map.hpp"
+#include "pybind.hpp"
+
+using namespace hovering;
+
+namespace {
+
+std::vector<py::ssize_t> shape_of(const darray& a) { return {a.shape(), a.shape() + a.ndim()}; }
+
+void same_shape(const darray& a, const darray& b, const char* an, const char* bn) {
+    if (shape_of(a) != shape_of(b))
+        throw py::value_error(std::string(an) + " and " + bn + " must have the same shape");
+}
+
+// Apply a scalar (phi, K) -> (x, y) member elementwise.
+template <class Map, class Fn>
+py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
+    same_shape(phi, K, "phi", "K");
+    darray o1(shape_of(phi)), o2(shape_of(phi));
+    const double *p = phi.data(), *k = K.data();
+    double *a = o1.mutable_data(), *b = o2.mutable_data();
+    const py::ssize_t n = phi.size();
+    {
+        py::gil_scoped_release release;
+        for (py::ssize_t i = 0; i < n; ++i) {
+            auto r = fn(m, p[i], k[i]);
+            a[i] = r.first;
+            b[i] = r.second;
+        }
+    }
+    return py::make_tuple(o1, o2);
+}
+
+// Runs the batch iteration; polls Ctrl-C from this (main) thread while workers run, so a long
+// run can be interrupted and still hand back everything computed so far.
+template <class Map>
+py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
+                 bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
+                 bool stop_on_exit, int n_threads, const std::string& kernel) {
+    if (phi0.ndim() != 1 || K0.ndim() != 1)
+        throw py::value_error("phi0 and K0 must be 1-D arrays");
+    same_shape(phi0, K0, "phi0", "K0");
+    if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
+    IterateOptions opt;
+    opt.n_steps = n_steps;
+    opt.exit_mask = exit_mask;
+    opt.stop_on_exit = stop_on_exit;
+    opt.n_threads = n_threads;
+    if (kernel == "simd")
+        opt.kernel = Kernel::Simd;
+    else if (kernel == "scalar")
+        opt.kernel = Kernel::Scalar;
+    else
+        throw py::value_error("kernel must be 'simd' or 'scalar', got '" + kernel + "'");
+
+    const py::ssize_t n = phi0.shape(0);
+    py::dict res;
+    darray phi_f(n), K_f(n);
+    py::array_t<std::int8_t> status(n);
+    py::array_t<std::int64_t> steps(n);
+    IterateOutput out;
+    out.phi_final = phi_f.mutable_data();
+    out.K_final = K_f.mutable_data();
+    out.status = status.mutable_data();
+    out.steps_done = steps.mutable_data();
+    res["phi_final"] = phi_f;
+    res["K_final"] = K_f;
+    res["status"] = status;
+    res["steps_done"] = steps;
+    if (record_orbit) {
+        darray op({n, py::ssize_t(n_steps + 1)}), ok({n, py::ssize_t(n_steps + 1)});
+        out.orbit_phi = op.mutable_data();
+        out.orbit_K = ok.mutable_data();
+        res["phi"] = op;
+        res["K"] = ok;
+    }
+    if (record_regions) {
+        py::array_t<std::int8_t> reg({n, py::ssize_t(n_steps)});
+        out.regions = reg.mutable_data();
+        res["region"] = reg;
+    }
+    if (record_rotation) {
+        darray rot(n);
+        out.rotation = rot.mutable_data();
+        res["rotation"] = rot;
+    }
+    if (exit_mask) {
+        py::array_t<std::int64_t> ex(n);
+        out.exit_step = ex.mutable_data();
+        res["exit_step"] = ex;
+    }
+
+    std::atomic<bool> cancel{false};
+    opt.cancel = &cancel;
+    bool interrupted = false;
+    const double work = double(n) * double(n_steps);
+    {
+        py::gil_scoped_release release;
+        if (work < 2e6) {
+            // Short runs: no watcher thread, the ~50 us it costs would dominate.
+            m.iterate(phi0.data(), K0.data(), n, opt, out);
+        } else {
+            std::exception_ptr err;
+            std::mutex mu;
+            std::condition_variable cv;
+            bool done = false;
+            std::thread runner([&] {
+                try {
+                    m.iterate(phi0.data(), K0.data(), n, opt, out);
+                } catch (...) {
+                    err = std::current_exception();
+                }
+                std::lock_guard<std::mutex> lock(mu);
+                done = true;
+                cv.notify_one();
+            });
+            std::unique_lock<std::mutex> lock(mu);
+            while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
+                lock.unlock();
+                {
+                    py::gil_scoped_acquire acquire;
+                    if (PyErr_CheckSignals() != 0) {
+                        PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
+                        interrupted = true;
+                        cancel.store(true);
+                    }
+                }
+                lock.lock();
+            }
+            lock.unlock();
+            runner.join();
+            if (err) std::rethrow_exception(err);
+        }
+    }
+    res["interrupted"] = interrupted;
+    return res;
+}
+
+template <class Map, class Cls>
+void bind_common(Cls& cls) {
+    cls.def("_step", [](const Map& m, const darray& phi, const darray& K) {
+           return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step(p, k); });
+       })
+        .def("_step_inverse",
+             [](const Map& m, const darray& phi, const darray& K) {
+                 return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step_inverse(p, k); });
+             })
+        .def("_region_rotation",
+             [](const Map& m, const darray& phi, const darray& K) {
+                 same_shape(phi, K, "phi", "K");
+                 py::array_t<std::int8_t> reg(shape_of(phi));
+                 darray rot(shape_of(phi));
+                 const double *p = phi.data(), *k = K.data();
+                 auto* r = reg.mutable_data();
+                 auto* w = rot.mutable_data();
+                 {
+                     py::gil_scoped_release release;
+                     for (py::ssize_t i = 0; i < phi.size(); ++i) {
+                         r[i] = static_cast<std::int8_t>(m.region(p[i], k[i]));
+                         w[i] = m.rotation(p[i], k[i]);
+                     }
+                 }
+                 return py::make_tuple(reg, rot);
+             })
+        .def("_arcs",
+             [](const Map& m, const darray& K) {
+                 // (n, 6): |J_1|, |J_R|, |J_0|, and the left ends of J_1, J_R, J_0 (NaN for K >= 0).
+                 darray out({K.size(), py::ssize_t(6)});
+                 double* o = out.mutable_data();
+                 const double* k = K.data();
+                 for (py::ssize_t i = 0; i < K.size(); ++i) {
+                     const ArcLengths a = m.arc_lengths(k[i]);
+                     o[6 * i + 0] = a.J1;
+                     o[6 * i + 1] = a.JR;
+                     o[6 * i + 2] = k[i] < 0 ? 2 * M_PI - a.J1 - a.JR : 2 * M_PI;
+                     if (k[i] < 0) {
+                         const auto s = m.arc_starts(k[i]);
+                         for (int j = 0; j < 3; ++j) o[6 * i + 3 + j] = s[std::size_t(j)];
+                     } else {
+                         for (int j = 0; j < 3; ++j) o[6 * i + 3 + j] = std::nan("");
+                     }
+                 }
+                 return out;
+             })
+        .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
+             py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
+             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"))
+        .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
+        .def("valid_band",
+             [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },
+             "Open interval (lo, hi) of K on which the map is defined.");
+}
+
+}  // namespace
+
+void register_truncated_map(py::module_& mod) {
+    py::class_<TruncatedMap> tm(mod, "TruncatedMap", "Compiled F_eps (eq:truncatedmap); use hovering.TruncatedMap.");
+    tm.def(py::init([](double eps, double Omega0, double theta_w, double tau0, double tau1, double lam,
+                       double K_max) { return make_truncated_map(eps, Omega0, theta_w, tau0, tau1, lam, K_max); }),
+           py::arg("eps"), py::arg("Omega0"), py::arg("theta_w"), py::arg("tau0"), py::arg("tau1"),
+           py::arg("lam"), py::arg("K_max"))
+        .def_property_readonly("Omega0", [](const TruncatedMap& m) { return m.arcs().Omega0; })
+        .def_property_readonly("theta_w", [](const TruncatedMap& m) { return m.arcs().theta_w; })
+        .def_property_readonly("tau0", [](const TruncatedMap& m) { return m.arcs().tau0; })
+        .def_property_readonly("tau1", [](const TruncatedMap& m) { return m.arcs().tau1; })
+        .def_property_readonly("lam", [](const TruncatedMap& m) { return m.arcs().lam; });
+    bind_common<TruncatedMap>(tm);
+
+    py::class_<TruncatedFamily> tf(mod, "TruncatedFamily", "Compiled F_{eps1,eps2}; use hovering.TruncatedFamily.");
+    tf.def(py::init([](double eps, std::vector<double> K, std::vector<double> Omega, std::vector<double> JR,
+                       std::vector<double> J1, std::vector<double> forcing, double K_max) {
+               return TruncatedFamily(eps, TabulatedArcs(K, Omega, JR, J1), FourierForcing{std::move(forcing)}, K_max);
+           }),
+           py::arg("eps"), py::arg("K"), py::arg("Omega"), py::arg("JR"), py::arg("J1"), py::arg("forcing"),
+           py::arg("K_max"))
+        .def_property_readonly("forcing", [](const TruncatedFamily& m) { return m.forcing().b; });
+    bind_common<TruncatedFamily>(tf);
+
+    mod.def("simd_is_avx2", &simd_is_avx2, "Whether the SIMD kernel of this build uses 4-wide AVX2 vectors.");
+}

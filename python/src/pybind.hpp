@@ -1,0 +1,14 @@
+#pragma once
+// Shared by every binding file: pybind11 includes and the array conventions of the module.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+namespace py = pybind11;
+
+/// Input arrays: C-contiguous doubles, converted (copied) only when the caller's array is not.
+using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// Register the truncated-map classes (TruncatedMap, TruncatedFamily) on the module.
+void register_truncated_map(py::module_& m);
