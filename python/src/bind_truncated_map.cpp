@@ -50,7 +50,7 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
 template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
                  bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
-                 bool stop_on_exit, int n_threads, const std::string& kernel) {
+                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp) {
     if (phi0.ndim() != 1 || K0.ndim() != 1)
         throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
@@ -66,6 +66,11 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
         opt.kernel = Kernel::Scalar;
     else
         throw py::value_error("kernel must be 'simd' or 'scalar', got '" + kernel + "'");
+    if (sin_ulp == 3.5)
+        opt.fast_sin = true;
+    else if (sin_ulp != 1.0)
+        throw py::value_error("sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got " +
+                              std::to_string(sin_ulp));
 
     const py::ssize_t n = phi0.shape(0);
     py::dict res;
@@ -198,7 +203,7 @@ void bind_common(Cls& cls) {
              })
         .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
              py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
-             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"))
+             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"))
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def("valid_band",
              [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },

@@ -124,8 +124,12 @@ struct IterateOptions {
     bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
     int n_threads = 0;                ///< worker threads; 0 = all hardware threads
     Kernel kernel = Kernel::Simd;     ///< which step implementation to use
+    /// SIMD kernel only: SLEEF's 3.5-ulp sin instead of the 1-ulp one (about 20% faster per step).
+    bool fast_sin = false;
     const std::atomic<bool>* cancel = nullptr;  ///< polled every few steps; set it to stop early
 };
+
+struct OrbitSource;  // work queue of a batch iteration (internal)
 
 /// One member of the truncated family; see the file comment.
 template <class Arcs, class Forcing>
@@ -161,11 +165,11 @@ public:
     ArcLengths arc_lengths(double K) const;
 
 private:
-    struct Chunk;
     void check_point(double phi, double K, const char* who) const;
-    void run_simd(const double* phi0, const double* K0, std::int64_t begin, std::int64_t end,
-                  const IterateOptions& opt, const IterateOutput& out, Chunk& work) const;
-    void run_scalar(const double* phi0, const double* K0, std::int64_t begin, std::int64_t end,
+    template <bool Fast>
+    void run_simd(const double* phi0, const double* K0, OrbitSource& src,
+                  const IterateOptions& opt, const IterateOutput& out) const;
+    void run_scalar(const double* phi0, const double* K0, OrbitSource& src,
                     const IterateOptions& opt, const IterateOutput& out) const;
 
     double eps_;
