@@ -248,6 +248,13 @@ void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
             std::to_string(J1.size()));
     bool has_zero = false;
     std::size_t n_nonpos = 0;
+    // Checked here with the caller's indices: the splines see reordered copies.
+    for (std::size_t i = 0; i < K.size(); ++i) {
+        require_finite(K[i], "K[" + std::to_string(i) + "]");
+        require_finite(Omega[i], "Omega[" + std::to_string(i) + "]");
+        require_finite(JR[i], "JR[" + std::to_string(i) + "]");
+        require_finite(J1[i], "J1[" + std::to_string(i) + "]");
+    }
     for (std::size_t i = 0; i < K.size(); ++i) {
         if (K[i] == 0.0) {
             has_zero = true;
@@ -368,6 +375,13 @@ template <class A, class F>
 double MapCore<A, F>::rotation(double phi, double K) const {
     check_point(phi, K, "rotation");
     return classify(phi, K, arcs_.at(K)).omega;
+}
+
+template <class A, class F>
+std::pair<Region, double> MapCore<A, F>::classify_point(double phi, double K, const char* who) const {
+    check_point(phi, K, who);
+    const Classified c = classify(phi, K, arcs_.at(K));
+    return {c.region, c.omega};
 }
 
 template <class A, class F>

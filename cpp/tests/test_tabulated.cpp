@@ -76,7 +76,7 @@ int main() {
     CHECK_THROWS(TabulatedArcs(K, Omshort, JR, J1), "same length");
     std::vector<double> Omnan = Om;
     Omnan[5] = NAN;
-    CHECK_THROWS(TabulatedArcs(K, Omnan, JR, J1), "Omega value[5] must be finite");
+    CHECK_THROWS(TabulatedArcs(K, Omnan, JR, J1), "Omega[5] must be finite");
     std::vector<double> JRneg = JR;
     for (auto& v : JRneg) v = -1.0;
     CHECK_THROWS(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY), "no valid band");

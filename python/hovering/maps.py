@@ -100,7 +100,8 @@ def _pair(phi, K, who: str):
         p, k = np.broadcast_arrays(p, k)
     except ValueError:
         raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {p.shape} and {k.shape}") from None
-    return np.ascontiguousarray(p), np.ascontiguousarray(k), scalar
+    # np.ascontiguousarray would turn 0-d into 1-d; the binding copies non-contiguous views itself.
+    return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
 
 
 class _MapAPI:
@@ -164,7 +165,7 @@ class _MapAPI:
             A :class:`Region` for scalar input, else an int8 array of region codes.
         """
         p, k, scalar = _pair(phi, K, "region")
-        r, _ = self._region_rotation(p, k)
+        r, _ = self._region_rotation(p, k, "region")
         return Region(int(r)) if scalar else r
 
     def rotation(self, phi, K):
@@ -180,7 +181,7 @@ class _MapAPI:
         ndarray or float
         """
         p, k, scalar = _pair(phi, K, "rotation")
-        _, w = self._region_rotation(p, k)
+        _, w = self._region_rotation(p, k, "rotation")
         return float(w) if scalar else w
 
     def reversal(self, phi, K):

@@ -165,7 +165,7 @@ void bind_common(Cls& cls) {
                  return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step_inverse(p, k); });
              })
         .def("_region_rotation",
-             [](const Map& m, const darray& phi, const darray& K) {
+             [](const Map& m, const darray& phi, const darray& K, const std::string& who) {
                  same_shape(phi, K, "phi", "K");
                  py::array_t<std::int8_t> reg(shape_of(phi));
                  darray rot(shape_of(phi));
@@ -175,8 +175,9 @@ void bind_common(Cls& cls) {
                  {
                      py::gil_scoped_release release;
                      for (py::ssize_t i = 0; i < phi.size(); ++i) {
-                         r[i] = static_cast<std::int8_t>(m.region(p[i], k[i]));
-                         w[i] = m.rotation(p[i], k[i]);
+                         const auto c = m.classify_point(p[i], k[i], who.c_str());
+                         r[i] = static_cast<std::int8_t>(c.first);
+                         w[i] = c.second;
                      }
                  }
                  return py::make_tuple(reg, rot);

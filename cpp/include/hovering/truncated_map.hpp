@@ -142,6 +142,8 @@ public:
     Region region(double phi, double K) const;
     /// Rotation omega_a(K) of the region the point lies in.
     double rotation(double phi, double K) const;
+    /// Region and rotation together; `who` prefixes error messages.
+    std::pair<Region, double> classify_point(double phi, double K, const char* who) const;
     /// One forward step (scalar libm path).
     std::pair<double, double> step(double phi, double K) const;
     /// One backward step: the exact inverse of step().

@@ -1,0 +1,139 @@
+"""Shared set-up and helpers of the hovering test-suite.
+
+* Selects matplotlib's headless Agg backend before anything imports pyplot.
+* Puts this directory on ``sys.path`` so that the independent NumPy oracle imports as
+  ``numpy_reference`` and these helpers as ``conftest`` (``from conftest import ...``).
+
+The helpers never compute a map themselves: they pick test points away from the
+discontinuities (using the independent reference) and turn a reference orbit into a rigorous
+first-order bound on how far two floating-point implementations of the same map may drift apart.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import hovering  # noqa: E402
+import numpy_reference as ref  # noqa: E402
+
+#: Figure parameters of the paper (fig:smalleps) without eps.
+PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+
+#: Parameter sets used throughout: the paper's figure for both signs of eps, the largest eps of
+#: fig:epsbig, and a case with tau1 < 0 and tau0 < 0 (J_R grows below the tangency circle).
+PARAM_SETS = {
+    "paper_eps+0.3": dict(eps=0.3, **PAPER),
+    "paper_eps-0.3": dict(eps=-0.3, **PAPER),
+    "paper_eps+0.92": dict(eps=0.92, **PAPER),
+    "tau1_negative": dict(eps=0.3, Omega0=1.3, theta_w=2.0, tau0=-0.7, tau1=-0.4, lam=0.7),
+}
+
+#: Round-off committed by ONE step of either implementation, in phi and in K.
+#: |phi + omega_a| <= pi + |Omega0| + |tau0 K| + 2 pi < 16 for every parameter set and band used
+#: here, so one ulp of the sum is <= 3.6e-15; the step rounds omega_a (3-4 terms), the sum, the
+#: 2 pi-wrap and sin (1 ulp) - at most ~5 such ulps, hence 1e-14 bounds the local error.
+LOCAL_ROUNDOFF = 1e-14
+
+
+def cdiff(a, b):
+    """Circular distance |a - b| on the circle of length 2 pi (angles may differ by 2 pi k)."""
+    return np.abs(ref.wrap(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)))
+
+
+def band_sample(m, n, rng, K_hi=1.5, margin=0.0):
+    """n random points: phi uniform on [-pi, pi), K uniform in (lo + margin, K_hi)."""
+    lo = m.valid_band()[0]
+    phi = rng.uniform(-np.pi, np.pi, n)
+    K = rng.uniform(lo + margin, K_hi, n)
+    return phi, K
+
+
+def safe_mask(m, phi, K, margin):
+    """Points at least `margin` away from every discontinuity of the truncated map m.
+
+    That is: from the arc ends (reference boundary_distance), from the tangency circle K = 0
+    (where the region changes from J_0u to the three arcs) and from the band floor.
+    """
+    p = m.params
+    lo, hi = m.valid_band()
+    phi = np.asarray(phi, dtype=float)
+    K = np.asarray(K, dtype=float)
+    return (
+        (ref.boundary_distance(phi, K, p) > margin)
+        & (np.abs(K) > margin)
+        & (K > lo + margin)
+        & (K < hi - margin)
+    )
+
+
+def omega_prime(phi, K, p, regions=None):
+    """d omega_a / dK of the truncated map for the region each point lies in (reference regions)."""
+    K = np.asarray(K, dtype=float)
+    reg = ref.region(phi, K, p) if regions is None else regions
+    s = np.sqrt(np.maximum(-K, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dr = np.where(reg == ref.RIGHT, p["lam"] / s, 0.0)
+    return p["tau0"] + np.where(reg == ref.UPPER, p["tau1"], 0.0) + dr
+
+
+def error_bound(phis, Ks, p, local=LOCAL_ROUNDOFF):
+    """First-order bound on the drift between two floating-point evaluations of the same orbit.
+
+    With e_0 = delta_{-1} and e_{j+1} = J_j e_j + delta_j (|delta_j|_inf <= local, J_j the Jacobian
+    of F at the reference point x_j), |e_n|_inf <= local * sum_{k=-1}^{n-1} ||J_{n-1} ... J_{k+1}||_inf.
+    J = [[1, w'], [c, 1 + c w']] with w' = d omega_a/dK and c = eps cos(phibar).
+
+    Parameters
+    ----------
+    phis, Ks : ndarray (n_orbits, n + 1)
+        Reference orbits (points must stay away from the discontinuities).
+
+    Returns
+    -------
+    ndarray (n_orbits, n + 1)
+        Bound on the max-norm error of each orbit point.
+    """
+    n = phis.shape[1] - 1
+    n_orb = phis.shape[0]
+    wp = omega_prime(phis[:, :-1], Ks[:, :-1], p)
+    c = p["eps"] * np.cos(phis[:, 1:])
+    a11, a12, a21, a22 = np.ones_like(wp), wp, c, 1.0 + c * wp
+    acc = np.zeros(phis.shape)
+    for k in range(-1, n):
+        # error injected into x_{k+1} (k = -1: the initial point) and carried by J_{k+1}, J_{k+2}, ...
+        m11, m12, m21, m22 = np.ones(n_orb), np.zeros(n_orb), np.zeros(n_orb), np.ones(n_orb)
+        acc[:, k + 1] += 1.0
+        for j in range(k + 1, n):
+            m11, m12, m21, m22 = (a11[:, j] * m11 + a12[:, j] * m21, a11[:, j] * m12 + a12[:, j] * m22,
+                                  a21[:, j] * m11 + a22[:, j] * m21, a21[:, j] * m12 + a22[:, j] * m22)
+            acc[:, j + 1] += np.maximum(np.abs(m11) + np.abs(m12), np.abs(m21) + np.abs(m22))
+    return local * acc
+
+
+def make_map(params, **kw):
+    """hovering.TruncatedMap from a parameter dict."""
+    return hovering.TruncatedMap(**params, **kw)
+
+
+@pytest.fixture
+def rng():
+    """A fixed-seed generator: the suite is deterministic."""
+    return np.random.default_rng(20240611)
+
+
+@pytest.fixture(params=list(PARAM_SETS), ids=list(PARAM_SETS))
+def any_map(request):
+    """Each parameter set of PARAM_SETS as a TruncatedMap."""
+    return make_map(PARAM_SETS[request.param])
