@@ -485,6 +485,7 @@ void MapCore<A, F>::run_simd(const double* phi0, const double* K0, OrbitSource& 
     const std::int64_t ns = opt.n_steps;
     const double lo = band_.lo, hi = band_.hi;
     const bool watch = opt.exit_mask != 0;
+    const bool need_reg = watch || out.regions;  // region codes are only built when read
     const Packet zero = ei::pset1<Packet>(0.0), one = ei::pset1<Packet>(1.0), two = ei::pset1<Packet>(2.0),
                  three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
                  twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
@@ -580,6 +581,7 @@ void MapCore<A, F>::run_simd(const double* phi0, const double* K0, OrbitSource& 
             const Packet up = ei::pand(neg, ei::pcmp_lt(d, J1));
             const Packet rt = ei::pandnot(ei::pand(neg, ei::pcmp_lt(d, ei::padd(J1, JR))), up);
             omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
+            if (!need_reg) continue;
             reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
             if (watch) {
                 const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
