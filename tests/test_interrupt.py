@@ -47,3 +47,42 @@ def test_interrupt_keeps_every_orbit_state():
         assert again.phi_final[0] == res.phi_final[i] and again.K_final[0] == res.K_final[i]
         if done[i] > 0:
             assert again.rotation[0] == res.rotation[i]
+
+
+def test_interrupt_reports_unstarted_out_of_band_orbits_as_escaped():
+    # Orbits that start outside the band are ESCAPED after 0 steps, interrupted run or not.
+    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, K_max=1.0)
+    n = 20_000
+    phi0 = np.linspace(-3, 3, n)
+    K0 = np.where(np.arange(n) % 2 == 0, 0.1, 5.0)
+    for kernel in ("simd", "scalar"):
+        timer = threading.Timer(0.3, _thread.interrupt_main)
+        timer.start()
+        try:
+            with pytest.raises(KeyboardInterrupt) as info:
+                m.iterate(phi0, K0, 100_000, record=(), n_threads=2, kernel=kernel)
+        finally:
+            timer.cancel()
+        res = info.value.partial
+        outside = K0 > 1.0
+        assert np.all(res.status[outside] == Status.ESCAPED) and np.all(res.steps_done[outside] == 0)
+        assert np.all(res.status[~outside] != Status.ESCAPED)
+
+
+def test_exception_from_a_signal_handler_propagates_unchanged():
+    # Only Ctrl-C becomes KeyboardInterrupt-with-partial; what another handler raises passes through.
+    import signal
+
+    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+
+    def on_alarm(signum, frame):
+        raise TimeoutError("budget exceeded")
+
+    old = signal.signal(signal.SIGALRM, on_alarm)
+    signal.setitimer(signal.ITIMER_REAL, 0.3)
+    try:
+        with pytest.raises(TimeoutError, match="budget exceeded"):
+            m.iterate(np.zeros(20_000), np.full(20_000, 0.1), 100_000, record=(), n_threads=2)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)

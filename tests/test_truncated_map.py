@@ -493,3 +493,16 @@ def test_bad_region_names():
     assert hovering.region_mask([]) == 0
     assert hovering.Region.parse("0") is hovering.Region.ABOVE
     assert hovering.Region.parse(3) is hovering.Region.RIGHT
+
+
+def test_huge_angles_are_rejected_not_mis_wrapped():
+    # Beyond |phi| ~ 1e16 wrapping is off by whole turns; the map refuses angles above 1e6.
+    m = make_map(PARAM_SETS[next(iter(PARAM_SETS))])
+    with pytest.raises(ValueError, match=r"\|step: phi\| <= 1e6"):
+        m.step(-1e18, 0.1)
+    with pytest.raises(ValueError, match=r"phi0\[1\].*<= 1e6"):
+        m.iterate([0.0, 1e7], [0.1, 0.1], 3)
+    # Large but admissible angles wrap like their reduced values (error ~ ulp(1e5) ~ 1e-11).
+    a = m.step(1e5, 0.1)
+    b = m.step(hovering.wrap(1e5), 0.1)
+    assert abs(hovering.wrap(a[0] - b[0])) < 1e-9 and abs(a[1] - b[1]) < 1e-9

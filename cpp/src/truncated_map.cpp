@@ -46,10 +46,22 @@ void require_finite(double v, const std::string& name) {
     if (!std::isfinite(v)) bad(name + " must be finite, got " + fmt(v));
 }
 
+// Beyond this, 2 pi floor(phi / 2 pi) is off by more than one turn in double precision, so an
+// angle cannot be wrapped meaningfully; 1e6 keeps the wrapping error below 1e-9.
+constexpr double kMaxAngle = 1e6;
+constexpr int kMaxThreads = 4096;
+
+void require_angle(double v, const std::string& name) {
+    require_finite(v, name);
+    if (!(std::fabs(v) <= kMaxAngle))
+        bad(name + " must be an angle with |" + name + "| <= 1e6 (larger angles cannot be wrapped to [-pi, pi) "
+            "accurately in double precision), got " + fmt(v));
+}
+
 namespace ei = Eigen::internal;
 // The SIMD register type Eigen picked for this build (AVX-512, AVX, SSE2 or plain double).
 using Packet = ei::packet_traits<double>::type;
-constexpr int kW = ei::unpacket_traits<Packet>::size;
+constexpr int kW = ei::packet_traits<double>::size;  // (unpacket_traits<Packet> trips -Wignored-attributes)
 
 // sin on one packet with SLEEF's vector sin for this instruction set: max error 1.0 ulp, or 3.5 ulp
 // (about 20% faster per step) when Fast is set.
@@ -352,7 +364,7 @@ MapCore<A, F>::MapCore(double eps, A arcs, F forcing, double K_max)
 
 template <class A, class F>
 void MapCore<A, F>::check_point(double phi, double K, const char* who) const {
-    require_finite(phi, std::string(who) + ": phi");
+    require_angle(phi, std::string(who) + ": phi");
     require_finite(K, std::string(who) + ": K");
     if (!(K > band_.lo && K < band_.hi))
         bad(std::string(who) + ": K = " + fmt(K) + " is outside the band (" + fmt(band_.lo) + ", " +
@@ -393,7 +405,7 @@ std::pair<double, double> MapCore<A, F>::step(double phi, double K) const {
 
 template <class A, class F>
 std::pair<double, double> MapCore<A, F>::step_inverse(double phi, double K) const {
-    require_finite(phi, "step_inverse: phi");
+    require_angle(phi, "step_inverse: phi");
     require_finite(K, "step_inverse: K");
     const double K0 = K - eps_ * forcing_.at(phi);
     check_point(phi, K0, "step_inverse (preimage)");
@@ -566,7 +578,8 @@ void MapCore<A, F>::run_simd(const double* phi0, const double* K0, OrbitSource& 
                 if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted);
             for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
                 finish.start(i, phi0[i], K0[i]);
-                finish(i, phi0[i], K0[i], 0.0, 0, Status::Interrupted);
+                const bool inside = K0[i] > lo && K0[i] < hi;
+                finish(i, phi0[i], K0[i], 0.0, 0, inside ? Status::Interrupted : Status::Escaped);
             }
             return;
         }
@@ -715,19 +728,20 @@ void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n
             std::to_string(opt.exit_mask));
     if (opt.stop_on_exit && opt.exit_mask == 0u)
         bad("stop_on_exit needs a non-empty set of regions to stay in");
-    if (opt.n_threads < 0) bad("n_threads must be >= 0 (0 = all cores), got " + std::to_string(opt.n_threads));
+    if (opt.n_threads < 0 || opt.n_threads > kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(opt.n_threads));
     for (std::int64_t i = 0; i < n; ++i) {
-        require_finite(phi0[i], "phi0[" + std::to_string(i) + "]");
+        require_angle(phi0[i], "phi0[" + std::to_string(i) + "]");
         require_finite(K0[i], "K0[" + std::to_string(i) + "]");
     }
     if (n == 0) return;
 
-    int threads = opt.n_threads > 0 ? opt.n_threads : int(std::thread::hardware_concurrency());
-    threads = std::max(1, threads);
-    // Small blocks keep threads balanced when orbits stop at different times; a worker needs at
-    // least a lane-block's worth of orbits to fill its vectors.
+    std::int64_t threads = opt.n_threads > 0 ? opt.n_threads : std::int64_t(std::thread::hardware_concurrency());
+    // A worker needs at least a lane-block's worth of orbits to fill its vectors.
+    threads = std::clamp<std::int64_t>(threads, 1, (n + kLanes - 1) / kLanes);
+    // Small blocks keep threads balanced when orbits stop at different times.
     const std::int64_t block = std::clamp<std::int64_t>((n + 8 * threads - 1) / (8 * threads), 1, 256);
-    threads = int(std::min<std::int64_t>(threads, (n + kLanes - 1) / kLanes));
 
     std::atomic<std::int64_t> next{0};
     std::exception_ptr error;
@@ -752,7 +766,14 @@ void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n
     } else {
         std::vector<std::thread> pool;
         pool.reserve(std::size_t(threads));
-        for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+        try {
+            for (std::int64_t t = 0; t < threads; ++t) pool.emplace_back(worker);
+        } catch (...) {
+            // Could not start a thread: stop the ones running (they drain no more work), then report.
+            next.store(n);
+            for (auto& t : pool) t.join();
+            throw;
+        }
         for (auto& t : pool) t.join();
     }
     if (error) std::rethrow_exception(error);

@@ -134,5 +134,11 @@ int main() {
     std::vector<double> pn = {0.0, NAN};
     o.exit_mask = 0;
     CHECK_THROWS(m.iterate(pn.data(), k0.data(), 2, o, out), "phi0[1] must be finite");
+    o.n_threads = 1 << 29;  // used to overflow 8 * threads (SIGFPE); now a clear error
+    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "n_threads must be in [0, 4096]");
+    o.n_threads = 0;
+    std::vector<double> big = {1e18};
+    CHECK_THROWS(m.iterate(big.data(), k0.data(), 1, o, out), "<= 1e6");
+    CHECK_THROWS(m.step(-1e18, 0.1), "<= 1e6");
     return test_summary("test_iterate");
 }

@@ -310,8 +310,8 @@ class _MapAPI:
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
         if sin_ulp not in (1.0, 3.5):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
-        if n_threads < 0:
-            raise ValueError(f"n_threads must be >= 0 (0 = all cores), got {n_threads}")
+        if not 0 <= n_threads <= 4096:
+            raise ValueError(f"n_threads must be in [0, 4096] (0 = all cores), got {n_threads}")
         mask = region_mask(exit_regions) if exit_regions is not None else 0
         if exit_regions is not None and mask == 0:
             raise ValueError("exit_regions must name at least one region")

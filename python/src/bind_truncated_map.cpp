@@ -9,6 +9,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -112,6 +113,7 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
     std::atomic<bool> cancel{false};
     opt.cancel = &cancel;
     bool interrupted = false;
+    std::unique_ptr<py::error_already_set> handler_error;
     const double work = double(n) * double(n_steps);
     {
         py::gil_scoped_release release;
@@ -136,12 +138,16 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
             std::unique_lock<std::mutex> lock(mu);
             while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
                 lock.unlock();
-                {
+                if (!cancel.load()) {
                     py::gil_scoped_acquire acquire;
                     if (PyErr_CheckSignals() != 0) {
-                        PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
-                        interrupted = true;
                         cancel.store(true);
+                        if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+                            PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
+                            interrupted = true;
+                        } else {
+                            handler_error = std::make_unique<py::error_already_set>();  // e.g. a SIGALRM handler's
+                        }
                     }
                 }
                 lock.lock();
@@ -151,6 +157,7 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
             if (err) std::rethrow_exception(err);
         }
     }
+    if (handler_error) throw std::move(*handler_error);  // what a signal handler raised, unchanged
     res["interrupted"] = interrupted;
     return res;
 }
