@@ -11,7 +11,8 @@ multi-threaded SIMD C++ core.
 
 from __future__ import annotations
 
-from . import _core, geometry
+from . import _core, analysis, geometry
+from .analysis import CriticalCurve, HoveringArea, birkhoff_average, regularity, rotation_number
 from ._types import Region, Status, region_mask
 from .geometry import (
     OMEGA_G,
@@ -41,6 +42,12 @@ __all__ = [
     "Status",
     "region_mask",
     "geometry",
+    "analysis",
+    "rotation_number",
+    "birkhoff_average",
+    "regularity",
+    "HoveringArea",
+    "CriticalCurve",
     "OMEGA_G",
     "L1",
     "L2",

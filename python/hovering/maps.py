@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import operator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Iterable, Optional, Sequence, Union
 
 import numpy as np
@@ -48,6 +48,8 @@ class IterateResult:
         ``exit_regions`` was given.
     n_steps : int
         Steps requested per orbit.
+    map : TruncatedMap or TruncatedFamily
+        The map that produced the result (used by :func:`hovering.rotation_number`).
     """
 
     phi: Optional[np.ndarray]
@@ -60,6 +62,7 @@ class IterateResult:
     steps_done: np.ndarray
     exit_step: Optional[np.ndarray]
     n_steps: int
+    map: object = field(default=None, repr=False, compare=False)
 
     @property
     def n_orbits(self) -> int:
@@ -342,6 +345,7 @@ class _MapAPI:
             steps_done=d["steps_done"],
             exit_step=d.get("exit_step"),
             n_steps=n_steps,
+            map=self,
         )
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
@@ -438,6 +442,46 @@ class TruncatedMap(_MapAPI, _core.TruncatedMap):
     def k_eps2(self, phi, K0=0.0):
         """Leading-order invariant curve through L2 at height K0 (eq:keps2)."""
         return _geo.k_eps2(phi, K0, self.eps, self.Omega0, self.tau0)
+
+    def hovering_area(self, n_steps: int = 10_000, samples: int = 100_000, **kwargs):
+        """Area of the hovering set HOV(eps), with error estimate and theory; see :func:`hovering.analysis.hovering_area`.
+
+        Parameters
+        ----------
+        n_steps : int, optional
+            Iterates that count as "never impacts".
+        samples : int, optional
+            Sample points (stratified over the box below K = 0).
+        **kwargs
+            ``K_low``, ``seed``, ``n_threads``, ``keep_points``.
+
+        Returns
+        -------
+        HoveringArea
+            ``.area``, ``.error``, ``.theory`` and diagnostics.
+        """
+        from .analysis import hovering_area
+
+        return hovering_area(self, n_steps=n_steps, samples=samples, **kwargs)
+
+    def critical_curve(self, n_steps: int = 20_000, **kwargs):
+        """Lowest invariant curve in the no-impact regions, searched along L1; see :func:`hovering.analysis.critical_curve`.
+
+        Parameters
+        ----------
+        n_steps : int, optional
+            Iterates per tested orbit.
+        **kwargs
+            ``K_range``, ``regions``, ``line``, ``grid``, ``digits``, ``tol``, ``n_threads``.
+
+        Returns
+        -------
+        CriticalCurve
+            ``.K_min``, ``.rotation``, ``.K_pred`` (eq:kcrit), ``.rotation_pred`` (eq:rhocrit), ...
+        """
+        from .analysis import critical_curve
+
+        return critical_curve(self, n_steps=n_steps, **kwargs)
 
     def with_eps(self, eps) -> "TruncatedMap":
         """The same map with another eps (e.g. the mirror map F_{-eps}).
