@@ -220,3 +220,19 @@ def test_lowest_curve_above_the_step_for_both_signs():
     assert abs(up.rotation - dn.rotation) < 1e-3
     with pytest.raises(RuntimeError, match="no invariant curve"):
         paper_map(0.3).critical_curve(n_steps=2000, K_range=(-0.6, -0.5), grid=4)
+
+
+def test_critical_curve_is_a_rotational_curve_not_an_island():
+    # At eps = 0.92 on the golden family (c = -0.9) a period-3 island chain lies in J_0 far below
+    # K = 0 (K ~ -2.7): regular and non-impacting, but not a rotational invariant curve. The
+    # search over the whole band must not return it: the critical orbit fills the circle.
+    from hovering.analysis import max_angular_gap
+
+    m = hovering.TruncatedMap(0.92, *hovering.golden_family(0.92, -0.9))
+    lo = m.valid_band()[0]
+    cc = m.critical_curve(n_steps=20_000, K_range=(lo * 0.999, 0.5))
+    assert cc.K_min > -1.5
+    assert max_angular_gap(cc.phi) < 20 * 2 * np.pi / 20_000
+    island = m.iterate([m.L1(-2.73)], [-2.73], 6000, record=("orbit",))
+    assert max_angular_gap(island.phi[0]) > 0.5  # islands leave large gaps: the criterion can fail
+    assert abs(max_angular_gap([0.0, 1.0, 2.0]) - (2 * np.pi - 2.0)) < 1e-15

@@ -28,6 +28,7 @@ __all__ = [
     "hovering_area",
     "CriticalCurve",
     "critical_curve",
+    "max_angular_gap",
 ]
 
 
@@ -301,6 +302,25 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
 # Critical curve
 
 
+def max_angular_gap(phi) -> float:
+    """Largest gap between consecutive angles of a point set on the circle.
+
+    Parameters
+    ----------
+    phi : array_like
+        Angles (NaN entries are ignored).
+
+    Returns
+    -------
+    float
+        The largest gap, in ``[0, 2 pi]`` (``2 pi`` for fewer than two points).
+    """
+    a = np.sort(np.mod(np.asarray(phi, dtype=float)[np.isfinite(phi)], 2 * np.pi))
+    if a.size < 2:
+        return 2 * np.pi
+    return float(max(np.max(np.diff(a)), a[0] + 2 * np.pi - a[-1]))
+
+
 @dataclass(frozen=True)
 class CriticalCurve:
     """The lowest invariant curve inside a set of no-impact regions (see :func:`critical_curve`).
@@ -342,10 +362,12 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
                    tol: float = 1e-6, n_threads: int = 0) -> CriticalCurve:
     """Search the lowest invariant curve that stays in ``regions``, along the line L1 (or L2).
 
-    A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps`` and its
+    A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps``, its
     weighted Birkhoff rotation number agrees over the two halves of the orbit to ``digits``
-    digits (a quasi-periodic orbit, i.e. an invariant curve or an island). The lowest passing start
-    of a grid over ``K_range`` is then refined by bisection against the grid point below it.
+    digits (quasi-periodic), and it fills the circle: its largest gap in phi is below 20 times the
+    mean spacing ``2 pi / n_steps`` (a rotational invariant curve; an island chain of period p
+    leaves gaps ~ 2 pi / p). The lowest passing start of a grid over ``K_range`` is then refined
+    by bisection against the grid point below it.
 
     Parameters
     ----------
@@ -400,7 +422,9 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
                         n_threads=n_threads)
         stayed = res.status == Status.OK
         dig = np.where(stayed, regularity(res), 0.0)
-        return stayed & (dig >= digits), res, dig
+        circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
+                           for i in range(res.n_orbits)])
+        return stayed & (dig >= digits) & circle, res, dig
 
     K_grid = np.linspace(K_a, K_b, grid)
     ok, _, _ = test(K_grid)
