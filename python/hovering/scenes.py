@@ -53,6 +53,7 @@ from typing import Any, Optional
 import numpy as np
 
 from .geometry import OMEGA_G, golden_family
+from .sweeps import Checkpoint
 from .maps import TruncatedMap
 
 __all__ = [
@@ -1007,20 +1008,33 @@ def run_scene(scene: Scene, out: Optional[os.PathLike] = None, quick: bool = Fal
         samples = max(scene.samples // QUICK_FACTOR, 400) if quick else scene.samples
         summary["samples"] = samples
         series_out = []
+        # Each measured point is on disk at once (png.sweep.jsonl); a rerun resumes where an
+        # interrupted one stopped and recomputes nothing already measured.
+        ckpt = Checkpoint(png.with_suffix(".sweep.jsonl"))
+        summary["checkpoint"] = str(ckpt.path)
+        reused = 0
         for s in scene.series:
             rows = []
             for e in scene.eps:
                 ms = s.map_at(e)
                 kw = {} if s.K_low is None else {"K_low": s.K_low}
-                h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-                rows.append(dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
-                                 floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
-                                 theta_w=ms.theta_w))
+                key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+                row = ckpt.get(key)
+                if row is None:
+                    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+                    row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
+                               floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
+                               theta_w=ms.theta_w)
+                    ckpt.put(key, row)
+                else:
+                    reused += 1
+                rows.append(row)
             series_out.append(dict(label=s.label, golden_c=s.golden_c, K_low=s.K_low, points=rows))
             key = f"s{len(series_out) - 1}"
             for col in ("eps", "area", "error", "theory", "K_low", "Omega0", "theta_w"):
                 arrays[f"{key}_{col}"] = np.array([r[col] for r in rows])
         summary["series"] = series_out
+        summary["points_reused"] = reused
         fig = figures.hovering_area_figure(scene, series_out, n_steps=n_steps)
     else:
         results = {}

@@ -1,0 +1,77 @@
+"""Checkpointed sweeps: every finished point is on disk at once, an interrupted sweep resumes.
+
+A :class:`Checkpoint` is an append-only JSON-lines file. Each finished sweep point is one line
+``{"key": ..., "row": ...}``, flushed and fsync'd before the sweep moves on, so an interruption
+(Ctrl-C, a killed job, a full disk) loses at most the point being computed. A rerun with the same
+file skips every point whose key (all parameters that determine the result) is already there.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Optional
+
+__all__ = ["Checkpoint"]
+
+
+def _canonical(key: Any) -> str:
+    return json.dumps(key, sort_keys=True, separators=(",", ":"), allow_nan=True)
+
+
+class Checkpoint:
+    """Append-only store of finished sweep points, keyed by their parameters.
+
+    Parameters
+    ----------
+    path : path-like
+        The JSON-lines file (created on the first :meth:`put`). A last line cut short by an
+        interruption is ignored.
+    """
+
+    def __init__(self, path: os.PathLike):
+        self.path = Path(path)
+        self._rows: dict = {}
+        if self.path.exists():
+            for line in self.path.read_text().splitlines():
+                try:
+                    rec = json.loads(line)
+                    self._rows[_canonical(rec["key"])] = rec["row"]
+                except (ValueError, KeyError, TypeError):
+                    continue  # a line torn by an interruption: recomputed
+
+    def __len__(self) -> int:
+        return len(self._rows)
+
+    def get(self, key: Any) -> Optional[Any]:
+        """The stored row for ``key``, or None.
+
+        Parameters
+        ----------
+        key : JSON-serialisable
+            The point's parameters.
+
+        Returns
+        -------
+        object or None
+        """
+        return self._rows.get(_canonical(key))
+
+    def put(self, key: Any, row: Any) -> None:
+        """Store a finished point durably (flush + fsync) before returning.
+
+        Parameters
+        ----------
+        key : JSON-serialisable
+            The point's parameters.
+        row : JSON-serialisable
+            Its result.
+        """
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        line = json.dumps({"key": key, "row": row}, sort_keys=True, allow_nan=True)
+        with open(self.path, "a", encoding="utf-8") as f:
+            f.write(line + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        self._rows[_canonical(key)] = row
