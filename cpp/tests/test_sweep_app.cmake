@@ -1,0 +1,45 @@
+# Runs hovering_sweep twice on a tiny grid and checks its CSV: rows, values, resume, errors.
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+set(csv "${WORK}/sweep.csv")
+set(common --grid 60,20 --steps 400 --K-range -0.4,0 --threads 2 --out ${csv})
+
+execute_process(COMMAND ${SWEEP} --eps 0.2,-0.2 ${common} RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "sweep failed (${rc}): ${err}")
+endif()
+file(STRINGS "${csv}" lines)
+list(LENGTH lines n)
+if(NOT n EQUAL 3)
+  message(FATAL_ERROR "expected header + 2 rows, got ${n}: ${lines}")
+endif()
+list(GET lines 1 pos)
+list(GET lines 2 neg)
+string(REPLACE "," ";" pos "${pos}")
+string(REPLACE "," ";" neg "${neg}")
+list(GET pos 2 never_pos)
+list(GET neg 2 never_neg)
+list(GET pos 1 norb)
+# thm:hovering: orbits that never impact exist for eps = +0.2 (about 0.5/2.5 of this box), none
+# for eps = -0.2; 1200 orbits per eps.
+if(NOT norb EQUAL 1200 OR never_pos LESS 150 OR NOT never_neg EQUAL 0)
+  message(FATAL_ERROR "unexpected counts: n=${norb} never(+0.2)=${never_pos} never(-0.2)=${never_neg}")
+endif()
+
+# Rerun with one new eps: the two finished ones are skipped, one row is appended.
+execute_process(COMMAND ${SWEEP} --eps 0.2,-0.2,0.1 ${common} RESULT_VARIABLE rc ERROR_VARIABLE err)
+file(STRINGS "${csv}" lines)
+list(LENGTH lines n)
+if(NOT rc EQUAL 0 OR NOT n EQUAL 4 OR NOT err MATCHES "already in")
+  message(FATAL_ERROR "resume failed (${rc}, ${n} lines): ${err}")
+endif()
+
+# Bad input: a clear message naming the value and the allowed range, exit status 2.
+execute_process(COMMAND ${SWEEP} --eps 0.2 --theta_w 4 --out ${WORK}/x.csv RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "theta_w must lie in \\(0, pi\\)")
+  message(FATAL_ERROR "bad theta_w not reported (${rc}): ${err}")
+endif()
+execute_process(COMMAND ${SWEEP} --eps 0.2 --bogus 1 --out ${WORK}/x.csv RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "unknown option '--bogus'")
+  message(FATAL_ERROR "unknown option not reported (${rc}): ${err}")
+endif()
