@@ -39,6 +39,9 @@ def test_readme_examples_run_and_agree_with_the_text():
     assert abs(hv.area - 0.4985) < 1e-3 and abs(hv.error - 0.0066) < 1e-3
     assert abs(cc.K_min - (-0.2764)) < 1e-3 and abs(cc.rotation - 3.7719) < 1e-3
     assert hovering.regularity(ns["orbit"])[0] > 12
+    p = ns["p"]  # the onset-parameter block's printed values
+    for name, v in dict(Omega0=9.8347, tau0=3.0788, tau1=2.9912, lam=2.7694, theta_w=2.4445).items():
+        assert abs(getattr(p, name) - v) < 1e-4, name
     fam = ns["fam"]
     flo, fhi = fam.valid_band()
     assert flo < 0 < fhi == 1.0

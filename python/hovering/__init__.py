@@ -29,6 +29,7 @@ from .geometry import (
     wrap,
 )
 from .maps import IterateResult, TruncatedFamily, TruncatedMap
+from .system import Bilinear, Harmonic, Numerical, OnsetParameters, Potential, StepSystem, Tan, onset_parameters
 
 __version__ = "0.1.0"
 
@@ -61,4 +62,12 @@ __all__ = [
     "golden_family",
     "wrap",
     "simd_is_avx2",
+    "Potential",
+    "Harmonic",
+    "Tan",
+    "Numerical",
+    "Bilinear",
+    "StepSystem",
+    "OnsetParameters",
+    "onset_parameters",
 ]

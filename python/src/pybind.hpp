@@ -12,3 +12,6 @@ using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 /// Register the truncated-map classes (TruncatedMap, TruncatedFamily) on the module.
 void register_truncated_map(py::module_& m);
+
+/// Register the potentials and onset parameters.
+void register_potential(py::module_& m);

@@ -1,0 +1,309 @@
+// Potentials, action-angle variables and onset parameters. Generic quantities use GSL: QAWS
+// quadrature (its Chebyshev moments absorb the (q - a)^(-1/2) (b - q)^(-1/2) endpoint behaviour,
+// so the smooth remainder is integrated to ~1e-13) and Brent root finding.
+
+#include "hovering/potential.hpp"
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_integration.h>
+#include <gsl/gsl_roots.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace hovering {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+
+void gsl_quiet() {
+    static std::once_flag once;
+    std::call_once(once, [] { gsl_set_error_handler_off(); });
+}
+
+double call(double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); }
+
+// int_a^b (x - a)^al (b - x)^be f(x) dx by GSL QAWS.
+double qaws(const std::function<double(double)>& f, double a, double b, double al, double be) {
+    gsl_quiet();
+    gsl_integration_qaws_table* t = gsl_integration_qaws_table_alloc(al, be, 0, 0);
+    gsl_integration_workspace* w = gsl_integration_workspace_alloc(200);
+    gsl_function F{&call, const_cast<std::function<double(double)>*>(&f)};
+    double r = 0, err = 0;
+    const int st = gsl_integration_qaws(&F, a, b, t, 1e-14, 1e-12, 200, w, &r, &err);
+    gsl_integration_workspace_free(w);
+    gsl_integration_qaws_table_free(t);
+    if (st != GSL_SUCCESS && st != GSL_EROUND && !(err <= 1e-10 * std::fabs(r)))
+        throw std::runtime_error(std::string("quadrature did not converge: ") + gsl_strerror(st));
+    return r;
+}
+
+// Root of f on [lo, hi] (f(lo), f(hi) of opposite signs) by Brent's method to ~1 ulp.
+double brent(const std::function<double(double)>& f, double lo, double hi) {
+    gsl_quiet();
+    gsl_function F{&call, const_cast<std::function<double(double)>*>(&f)};
+    gsl_root_fsolver* s = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    gsl_root_fsolver_set(s, &F, lo, hi);
+    double x = 0.5 * (lo + hi);
+    for (int it = 0; it < 200; ++it) {
+        gsl_root_fsolver_iterate(s);
+        x = gsl_root_fsolver_root(s);
+        const double a = gsl_root_fsolver_x_lower(s), b = gsl_root_fsolver_x_upper(s);
+        if (gsl_root_test_interval(a, b, 0.0, 4 * std::numeric_limits<double>::epsilon()) == GSL_SUCCESS) break;
+    }
+    gsl_root_fsolver_free(s);
+    return x;
+}
+
+// The quadrature rules evaluate the smooth factor at the turning points, where its formula is
+// 0/0, and just inside them h - V cancels; there the factor is its limit, from V' at the end.
+template <class F>
+double near_end(double q, double a, double b, double at_a, double at_b, F f) {
+    const double tol = 1e-9 * (std::isfinite(a) ? b - a : std::fabs(b) + 1.0);
+    if (q - a <= tol) return at_a;
+    if (b - q <= tol) return at_b;
+    return f();
+}
+
+void require_positive(double v, const char* name) {
+    if (!std::isfinite(v) || !(v > 0)) bad(std::string(name) + " must be finite and > 0, got " + fmt(v));
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------- generic paths
+
+double Potential::q_limit() const { return kInf; }
+
+void Potential::check_energy(double h, const char* who) const {
+    if (!std::isfinite(h) || !(h > 0))
+        bad(name() + "." + who + ": energy must be finite and > 0 (the minimum is V(0) = 0), got " + fmt(h));
+}
+
+std::pair<double, double> Potential::turning_points(double h) const {
+    check_energy(h, "turning_points");
+    auto side = [&](double sgn) {
+        // Bracket V = h on one side: expand outward (or toward the edge of a bounded well).
+        const double lim = q_limit();
+        double inner = 0, outer = std::isfinite(lim) ? 0.5 * lim : 1.0;
+        for (int k = 0; V(sgn * outer) < h; ++k) {
+            if (k > 200) bad(name() + ": V never reaches the energy " + fmt(h) + " (not a single well?)");
+            inner = outer;
+            outer = std::isfinite(lim) ? lim - 0.5 * (lim - outer) : 2 * outer;
+        }
+        return sgn * brent([&](double x) { return V(sgn * x) - h; }, inner, outer);
+    };
+    return {side(-1.0), side(1.0)};
+}
+
+double Potential::period(double h) const {
+    const auto [a, b] = turning_points(h);
+    // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V)))
+    const double ra = std::sqrt((b - a) / (2 * -dV(a))), rb = std::sqrt((b - a) / (2 * dV(b)));
+    return 2 * qaws([&](double q) { return near_end(q, a, b, ra, rb, [&] { return std::sqrt((q - a) * (b - q) / (2 * (h - V(q)))); }); },
+                    a, b, -0.5, -0.5);
+}
+
+double Potential::action(double h) const {
+    const auto [a, b] = turning_points(h);
+    const double ra = std::sqrt(2 * -dV(a) / (b - a)), rb = std::sqrt(2 * dV(b) / (b - a));
+    return qaws([&](double q) { return near_end(q, a, b, ra, rb, [&] { return std::sqrt(2 * (h - V(q)) / ((q - a) * (b - q))); }); },
+                a, b, 0.5, 0.5) / kPi;
+}
+
+double Potential::energy(double I) const {
+    if (!std::isfinite(I) || !(I > 0)) bad(name() + ".energy: action must be finite and > 0, got " + fmt(I));
+    // Bracket by doubling / halving from h = 1 (action is increasing in h).
+    double lo = 1, hi = 1;
+    for (int k = 0; action(hi) < I; ++k) {
+        if (k > 1000) bad(name() + ".energy: no energy has action " + fmt(I));
+        lo = hi;
+        hi *= 2;
+    }
+    for (int k = 0; lo == hi || action(lo) >= I; ++k) {
+        if (k > 1000) bad(name() + ".energy: no energy has action " + fmt(I));
+        hi = lo;
+        lo *= 0.5;
+    }
+    return brent([&](double h) { return action(h) - I; }, lo, hi);
+}
+
+double Potential::frequency(double h) const { return 2 * kPi / period(h); }
+
+double Potential::angle_of(double q, double h) const {
+    const auto [a, b] = turning_points(h);
+    if (!(q >= a && q <= b))
+        bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h) + ", [" + fmt(a) + ", " + fmt(b) + "]");
+    if (q == b) return 0.0;
+    // omega * time from q to b: int_q^b dq' / sqrt(2(h - V)) = int (b - q')^-1/2 sqrt((b - q') / (2(h - V))) dq'
+    const double rb = std::sqrt(1 / (2 * dV(b)));
+    const double t = qaws([&](double x) { return near_end(x, -kInf, b, 0.0, rb, [&] { return std::sqrt((b - x) / (2 * (h - V(x)))); }); },
+                          q, b, 0.0, -0.5);
+    return frequency(h) * t;
+}
+
+// ------------------------------------------------------------------------------- closed forms
+
+Harmonic::Harmonic(double omega) : omega_(omega) { require_positive(omega, "Harmonic: omega"); }
+double Harmonic::V(double q) const { return 0.5 * omega_ * omega_ * q * q; }
+double Harmonic::dV(double q) const { return omega_ * omega_ * q; }
+std::string Harmonic::name() const { return "Harmonic(omega=" + fmt(omega_) + ")"; }
+std::pair<double, double> Harmonic::turning_points(double h) const {
+    check_energy(h, "turning_points");
+    const double A = std::sqrt(2 * h) / omega_;
+    return {-A, A};
+}
+double Harmonic::period(double h) const {
+    check_energy(h, "period");
+    return 2 * kPi / omega_;
+}
+double Harmonic::action(double h) const {
+    check_energy(h, "action");
+    return h / omega_;
+}
+double Harmonic::energy(double I) const {
+    if (!std::isfinite(I) || !(I > 0)) bad(name() + ".energy: action must be finite and > 0, got " + fmt(I));
+    return omega_ * I;
+}
+double Harmonic::angle_of(double q, double h) const {
+    const double A = turning_points(h).second;
+    if (!(std::fabs(q) <= A)) bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h));
+    return std::acos(q / A);
+}
+
+Tan::Tan(double omega, double alpha) : omega_(omega), alpha_(alpha) {
+    require_positive(omega, "Tan: omega");
+    require_positive(alpha, "Tan: alpha");
+}
+double Tan::V(double q) const {
+    const double t = std::tan(alpha_ * q);
+    return 0.5 * omega_ * omega_ / (alpha_ * alpha_) * t * t;
+}
+double Tan::dV(double q) const {
+    const double c = std::cos(alpha_ * q);
+    return omega_ * omega_ / alpha_ * std::tan(alpha_ * q) / (c * c);
+}
+std::string Tan::name() const { return "Tan(omega=" + fmt(omega_) + ", alpha=" + fmt(alpha_) + ")"; }
+double Tan::q_limit() const { return 0.5 * kPi / alpha_; }
+std::pair<double, double> Tan::turning_points(double h) const {
+    check_energy(h, "turning_points");
+    const double b = std::atan(alpha_ * std::sqrt(2 * h) / omega_) / alpha_;
+    return {-b, b};
+}
+double Tan::period(double h) const {
+    check_energy(h, "period");
+    return 2 * kPi / std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+}
+double Tan::action(double h) const {
+    check_energy(h, "action");
+    // Inverse of H = omega I + alpha^2 I^2 / 2, written without cancellation for small h.
+    return 2 * h / (omega_ + std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h));
+}
+double Tan::energy(double I) const {
+    if (!std::isfinite(I) || !(I > 0)) bad(name() + ".energy: action must be finite and > 0, got " + fmt(I));
+    return omega_ * I + 0.5 * alpha_ * alpha_ * I * I;
+}
+double Tan::angle_of(double q, double h) const {
+    const auto [a, b] = turning_points(h);
+    if (!(q >= a && q <= b)) bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h));
+    const double c = std::sqrt(alpha_ * alpha_ + omega_ * omega_ / (2 * h)) * std::sin(alpha_ * q) / alpha_;
+    return std::acos(std::max(-1.0, std::min(1.0, c)));
+}
+
+Numerical::Numerical(std::shared_ptr<const Potential> base) : base_(std::move(base)) {
+    if (!base_) bad("Numerical: needs a potential");
+}
+
+// ------------------------------------------------------------------------------- onset parameters
+
+namespace {
+
+void check_walls(const Potential& V1, const Potential& V2, double qw1, double qw2, double h) {
+    if (!std::isfinite(qw1) || !(qw1 < 0) || !(std::fabs(qw1) < V1.q_limit()))
+        bad("qw1 must be < 0 and inside the well of V1 (|qw1| < " + fmt(V1.q_limit()) + "), got " + fmt(qw1));
+    if (!std::isfinite(qw2) || !(qw2 < 0) || !(std::fabs(qw2) < V2.q_limit()))
+        bad("qw2 must be < 0 and inside the well of V2 (|qw2| < " + fmt(V2.q_limit()) + "), got " + fmt(qw2));
+    const double hw = V1.V(qw1) + V2.V(qw2);
+    if (!std::isfinite(h) || !(h > hw))
+        bad("h must exceed the step energy h_0^w = V1(qw1) + V2(qw2) = " + fmt(hw) + ", got " + fmt(h));
+}
+
+// Central difference with one Richardson step: O(d^4) truncation, ~1e-12 / d rounding.
+double derivative(const std::function<double(double)>& f, double x, double d) {
+    const double D1 = (f(x + d) - f(x - d)) / (2 * d);
+    const double D2 = (f(x + 0.5 * d) - f(x - 0.5 * d)) / d;
+    return (4 * D2 - D1) / 3;
+}
+
+}  // namespace
+
+OnsetParameters onset_parameters(const Potential& V1, const Potential& V2, double qw1, double qw2, double h) {
+    check_walls(V1, V2, qw1, qw2, h);
+    const double h1w = V1.V(qw1);
+    const double h2 = h - h1w;  // energy of oscillator 2 on the tangent torus
+    const double I_tan = V2.action(h2);
+    auto Omega0 = [&](double I) {
+        const double e2 = V2.energy(I);
+        return V2.frequency(e2) * V1.period(h - e2);  // eq:omega0ofI
+    };
+    auto theta_w = [&](double I) { return V2.angle_of(qw2, V2.energy(I)); };  // eq:thw
+    // Step: 1e-3 of the distance to the nearest singular action (I where H2 = V2(qw2) or H2 = h).
+    const double I_lo = V2.action(V2.V(qw2)), I_hi = V2.action(h);
+    const double d = 1e-3 * std::min(I_tan - I_lo, I_hi - I_tan);
+    OnsetParameters p;
+    p.I_tan = I_tan;
+    p.Omega0 = Omega0(I_tan);
+    p.tau0 = derivative(Omega0, I_tan, d);
+    p.theta_w = theta_w(I_tan);
+    p.tau1 = -2 * derivative(theta_w, I_tan, d);
+    const double w2 = V2.frequency(h2);
+    p.lam = std::sqrt(2 * w2 * w2 * w2) / std::fabs(V1.dV(qw1));
+    return p;
+}
+
+OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2,
+                                             double qw1, double qw2, double h) {
+    require_positive(omega1, "omega1");
+    require_positive(omega2, "omega2");
+    if (!std::isfinite(alpha1) || alpha1 < 0) bad("alpha1 must be finite and >= 0 (0: harmonic), got " + fmt(alpha1));
+    if (!std::isfinite(alpha2) || alpha2 < 0) bad("alpha2 must be finite and >= 0 (0: harmonic), got " + fmt(alpha2));
+    auto pot = [](double w, double a) -> std::unique_ptr<Potential> {
+        if (a > 0) return std::make_unique<Tan>(w, a);
+        return std::make_unique<Harmonic>(w);
+    };
+    check_walls(*pot(omega1, alpha1), *pot(omega2, alpha2), qw1, qw2, h);
+    // sin(alpha q) / alpha and its alpha -> 0 limit q; likewise tan.
+    auto sa = [](double a, double q) { return a > 0 ? std::sin(a * q) / a : q; };
+    auto ta = [](double a, double q) { return a > 0 ? std::tan(a * q) / a : q; };
+    const double h1w = 0.5 * omega1 * omega1 * ta(alpha1, qw1) * ta(alpha1, qw1);
+    const double h2 = h - h1w;
+    const double W1 = std::sqrt(omega1 * omega1 + 2 * alpha1 * alpha1 * h1w);
+    const double W2 = std::sqrt(omega2 * omega2 + 2 * alpha2 * alpha2 * h2);
+    const double c1 = std::cos(alpha1 * qw1), c2 = std::cos(alpha2 * qw2);
+    const double s2 = sa(alpha2, qw2);
+    OnsetParameters p;
+    p.Omega0 = 2 * kPi * W2 / W1;
+    p.tau0 = 2 * kPi * (alpha2 * alpha2 / W1 + alpha1 * alpha1 * W2 * W2 / (W1 * W1 * W1));
+    p.lam = std::sqrt(2.0) * std::pow(W2, 1.5) / (omega1 * omega1 * std::fabs(ta(alpha1, qw1)) / (c1 * c1));
+    p.theta_w = std::acos(std::sqrt(alpha2 * alpha2 + omega2 * omega2 / (2 * h2)) * s2);
+    p.tau1 = -s2 * omega2 * omega2 / (h2 * std::sqrt(2 * h2 * c2 * c2 - omega2 * omega2 * s2 * s2));
+    p.I_tan = alpha2 > 0 ? 2 * h2 / (omega2 + W2) : h2 / omega2;
+    return p;
+}
+
+}  // namespace hovering

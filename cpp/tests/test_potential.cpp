@@ -1,0 +1,91 @@
+// Potentials and onset parameters: closed forms vs GSL quadrature, definitions vs the appendix.
+#include <cmath>
+#include <memory>
+
+#include "check.hpp"
+#include "hovering/potential.hpp"
+
+using namespace hovering;
+
+namespace {
+const double kPi = 3.14159265358979323846;
+double rel(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
+}  // namespace
+
+int main() {
+    // Closed forms against the generic quadrature/root-finding path on the same V: QAWS reaches
+    // ~1e-13 here, so 1e-10 relative leaves margin while catching any formula error.
+    for (auto base : {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
+                      std::shared_ptr<const Potential>(std::make_shared<Tan>(1.4, 0.7)),
+                      std::shared_ptr<const Potential>(std::make_shared<Tan>(0.8, 1.9))}) {
+        Numerical num(base);
+        for (double h : {0.05, 0.7, 2.5}) {
+            auto [a, b] = base->turning_points(h);
+            auto [na, nb] = num.turning_points(h);
+            CHECK(rel(a, na) < 1e-12 && rel(b, nb) < 1e-12, "%s turning points at h=%g", base->name().c_str(), h);
+            CHECK(rel(base->period(h), num.period(h)) < 1e-10, "%s period at h=%g: %.15g vs %.15g",
+                  base->name().c_str(), h, base->period(h), num.period(h));
+            CHECK(rel(base->action(h), num.action(h)) < 1e-10, "%s action at h=%g: %.15g vs %.15g",
+                  base->name().c_str(), h, base->action(h), num.action(h));
+            CHECK(rel(num.energy(num.action(h)), h) < 1e-10, "%s energy(action(h))", base->name().c_str());
+            for (double f : {-0.9, -0.3, 0.0, 0.5}) {
+                const double q = f * b;
+                CHECK(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10, "%s angle_of(%g, %g): %.15g vs %.15g",
+                      base->name().c_str(), q, h, base->angle_of(q, h), num.angle_of(q, h));
+            }
+            // dH/dI = omega(h): the frequency is the derivative of the energy in the action.
+            const double I = base->action(h), dI = 1e-4 * I;
+            const double dHdI = (base->energy(I + dI) - base->energy(I - dI)) / (2 * dI);
+            CHECK(rel(dHdI, base->frequency(h)) < 1e-7, "%s dH/dI vs omega", base->name().c_str());
+        }
+    }
+
+    // Onset parameters: (1) definitions with closed-form potentials, (2) definitions with pure
+    // quadrature, (3) the appendix closed forms (corrected). Derivatives by Richardson central
+    // differences carry ~1e-9 error, so 1e-7 relative.
+    struct Case { double w1, a1, w2, a2, qw1, qw2, h; };
+    for (Case c : {Case{1.0, 0.0, 1.4, 0.7, -1.0, -0.5, 1.0}, Case{1.0, 0.6, 1.4, 0.7, -0.8, -0.4, 1.2},
+                   Case{1.2, 0.9, 1.0, 0.0, -0.7, -0.6, 1.5}, Case{1.0, 0.0, 1.0, 0.0, -1.0, -0.5, 1.0}}) {
+        auto mk = [](double w, double a) -> std::shared_ptr<const Potential> {
+            if (a > 0) return std::make_shared<Tan>(w, a);
+            return std::make_shared<Harmonic>(w);
+        };
+        auto V1 = mk(c.w1, c.a1), V2 = mk(c.w2, c.a2);
+        const OnsetParameters d = onset_parameters(*V1, *V2, c.qw1, c.qw2, c.h);
+        const OnsetParameters q = onset_parameters(Numerical(V1), Numerical(V2), c.qw1, c.qw2, c.h);
+        const OnsetParameters f = onset_parameters_closed_form(c.w1, c.a1, c.w2, c.a2, c.qw1, c.qw2, c.h);
+        const double dv[] = {d.Omega0, d.tau0, d.tau1, d.lam, d.theta_w, d.I_tan};
+        const double qv[] = {q.Omega0, q.tau0, q.tau1, q.lam, q.theta_w, q.I_tan};
+        const double fv[] = {f.Omega0, f.tau0, f.tau1, f.lam, f.theta_w, f.I_tan};
+        const char* names[] = {"Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan"};
+        for (int k = 0; k < 6; ++k) {
+            CHECK(rel(dv[k], qv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs quadrature %.12g", c.a1, c.a2, names[k], dv[k], qv[k]);
+            CHECK(rel(dv[k], fv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs closed form %.12g", c.a1, c.a2, names[k], dv[k], fv[k]);
+        }
+        // Harmonic-harmonic: no twist (tau0 = 0), Omega0 = 2 pi omega2 / omega1 (appendix limits).
+        if (c.a1 == 0 && c.a2 == 0) {
+            CHECK(std::fabs(d.tau0) < 1e-7 && rel(d.Omega0, 2 * kPi * c.w2 / c.w1) < 1e-12, "harmonic limits");
+        }
+        // The appendix as printed: tau0's last term over W1^4 and theta_w = arccos(-...). Where
+        // the two differ from the definitions by a clear margin, the definitions win (README).
+        if (c.a1 > 0) {
+            const double h1w = V1->V(c.qw1), W1 = std::sqrt(c.w1 * c.w1 + 2 * c.a1 * c.a1 * h1w);
+            const double W2 = std::sqrt(c.w2 * c.w2 + 2 * c.a2 * c.a2 * (c.h - h1w));
+            const double tau0_printed = (2 * kPi * c.a2 * c.a2 * std::pow(W1, 3) + 2 * kPi * c.a1 * c.a1 * W2 * W2) / std::pow(W1, 4);
+            CHECK(rel(tau0_printed, d.tau0) > 1e-3, "printed tau0 unexpectedly matches");
+        }
+        CHECK(std::fabs((kPi - d.theta_w) - d.theta_w) > 1e-3, "printed theta_w (= pi - theta_w) distinguishable");
+        CHECK(d.theta_w > kPi / 2 && d.tau1 > 0, "qw2 < 0: theta_w in (pi/2, pi) and tau1 > 0 (sign tau1 = -sign qw2)");
+    }
+
+    // Bad input.
+    Harmonic H(1.0);
+    Tan T(1.4, 0.7);
+    CHECK_THROWS(onset_parameters(H, T, -1.0, -0.5, 0.5), "h must exceed the step energy");
+    CHECK_THROWS(onset_parameters(H, T, 1.0, -0.5, 2.0), "qw1 must be < 0");
+    CHECK_THROWS(onset_parameters(H, T, -1.0, -3.0, 2.0), "qw2 must be < 0 and inside the well of V2");
+    CHECK_THROWS(Harmonic(-1.0), "omega must be finite and > 0");
+    CHECK_THROWS(Tan(1.0, NAN), "alpha must be finite and > 0");
+    CHECK_THROWS(H.period(-1.0), "energy must be finite and > 0");
+    return test_summary("test_potential");
+}
