@@ -72,9 +72,9 @@ double brent(const std::function<double(double)>& f, double lo, double hi) {
 
 // The quadrature rules evaluate the smooth factor at the turning points, where its formula is
 // 0/0, and just inside them h - V cancels; there the factor is its limit, from V' at the end.
+// tol: 1e-9 of the level's width (the caller's turning points).
 template <class F>
-double near_end(double q, double a, double b, double at_a, double at_b, F f) {
-    const double tol = 1e-9 * (std::isfinite(a) ? b - a : std::fabs(b) + 1.0);
+double near_end(double q, double a, double b, double at_a, double at_b, double tol, F f) {
     if (q - a <= tol) return at_a;
     if (b - q <= tol) return at_b;
     return f();
@@ -115,14 +115,14 @@ double Potential::period(double h) const {
     const auto [a, b] = turning_points(h);
     // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V)))
     const double ra = std::sqrt((b - a) / (2 * -dV(a))), rb = std::sqrt((b - a) / (2 * dV(b)));
-    return 2 * qaws([&](double q) { return near_end(q, a, b, ra, rb, [&] { return std::sqrt((q - a) * (b - q) / (2 * (h - V(q)))); }); },
+    return 2 * qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt((q - a) * (b - q) / (2 * (h - V(q)))); }); },
                     a, b, -0.5, -0.5);
 }
 
 double Potential::action(double h) const {
     const auto [a, b] = turning_points(h);
     const double ra = std::sqrt(2 * -dV(a) / (b - a)), rb = std::sqrt(2 * dV(b) / (b - a));
-    return qaws([&](double q) { return near_end(q, a, b, ra, rb, [&] { return std::sqrt(2 * (h - V(q)) / ((q - a) * (b - q))); }); },
+    return qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt(2 * (h - V(q)) / ((q - a) * (b - q))); }); },
                 a, b, 0.5, 0.5) / kPi;
 }
 
@@ -149,12 +149,44 @@ double Potential::angle_of(double q, double h) const {
     const auto [a, b] = turning_points(h);
     if (!(q >= a && q <= b))
         bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h) + ", [" + fmt(a) + ", " + fmt(b) + "]");
-    if (q == b) return 0.0;
-    // omega * time from q to b: int_q^b dq' / sqrt(2(h - V)) = int (b - q')^-1/2 sqrt((b - q') / (2(h - V))) dq'
-    const double rb = std::sqrt(1 / (2 * dV(b)));
-    const double t = qaws([&](double x) { return near_end(x, -kInf, b, 0.0, rb, [&] { return std::sqrt((b - x) / (2 * (h - V(x)))); }); },
-                          q, b, 0.0, -0.5);
-    return frequency(h) * t;
+    const double w = frequency(h);
+    // Integrate from the nearer turning point, where the weight takes the 1/sqrt; within 1e-12 of
+    // it the time is its square-root asymptote sqrt(2 d / |V'|).
+    if (q >= 0.5 * (a + b)) {
+        if (b - q <= 1e-12 * (b - a)) return w * std::sqrt(2 * (b - q) / dV(b));
+        const double rb = std::sqrt(1 / (2 * dV(b)));
+        return w * qaws([&](double x) { return near_end(x, -kInf, b, 0.0, rb, 1e-9 * (b - a), [&] { return std::sqrt((b - x) / (2 * (h - V(x)))); }); },
+                        q, b, 0.0, -0.5);
+    }
+    if (q - a <= 1e-12 * (b - a)) return kPi - w * std::sqrt(2 * (q - a) / -dV(a));
+    const double ra = std::sqrt(1 / (2 * -dV(a)));
+    return kPi - w * qaws([&](double x) { return near_end(x, a, kInf, ra, 0.0, 1e-9 * (b - a), [&] { return std::sqrt((x - a) / (2 * (h - V(x)))); }); },
+                          a, q, -0.5, 0.0);
+}
+
+std::pair<double, double> Potential::point_at(double theta, double h) const {
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    const auto [a, b] = turning_points(h);
+    const double th = std::fabs(theta), w = frequency(h), sg = theta > 0 ? -1.0 : 1.0;
+    // Within 1e-6 of a turning point, q - q_turn ~ theta^2 is below double resolution and
+    // sqrt(2(h - V)) would return rounding noise: use the local expansion (relative error
+    // O(theta^2) = 1e-12): time t to the turning point, p = V'(q_turn) t, q = q_turn - V' t^2 / 2.
+    if (th < 1e-6) {
+        const double t = th / w;
+        return {b - 0.5 * dV(b) * t * t, sg * dV(b) * t};
+    }
+    if (kPi - th < 1e-6) {
+        const double t = (kPi - th) / w;
+        return {a - 0.5 * dV(a) * t * t, -sg * dV(a) * t};
+    }
+    const double q = brent([&](double x) { return angle_of(x, h) - th; }, a, b);
+    return {q, sg * std::sqrt(std::max(0.0, 2 * (h - V(q))))};
+}
+
+double Potential::angle_of_point(double q, double p, double h) const {
+    const auto [a, b] = turning_points(h);
+    const double th = angle_of(std::min(std::max(q, a), b), h);
+    return p > 0 ? -th : th;
 }
 
 // ------------------------------------------------------------------------------- closed forms
@@ -184,6 +216,16 @@ double Harmonic::angle_of(double q, double h) const {
     const double A = turning_points(h).second;
     if (!(std::fabs(q) <= A)) bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h));
     return std::acos(q / A);
+}
+
+std::pair<double, double> Harmonic::point_at(double theta, double h) const {
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    const double A = turning_points(h).second;
+    return {A * std::cos(theta), -A * omega_ * std::sin(theta)};
+}
+
+double Harmonic::angle_of_point(double q, double p, double) const {
+    return std::atan2(-p / omega_, q);  // (q, p) = A (cos theta, -omega sin theta): no arccos near +-1
 }
 
 Tan::Tan(double omega, double alpha) : omega_(omega), alpha_(alpha) {
@@ -223,6 +265,25 @@ double Tan::angle_of(double q, double h) const {
     if (!(q >= a && q <= b)) bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h));
     const double c = std::sqrt(alpha_ * alpha_ + omega_ * omega_ / (2 * h)) * std::sin(alpha_ * q) / alpha_;
     return std::acos(std::max(-1.0, std::min(1.0, c)));
+}
+
+std::pair<double, double> Tan::point_at(double theta, double h) const {
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    check_energy(h, "point_at");
+    // q = asin(k cos theta) / alpha and p = omega(h) dq/dtheta: no sqrt(h - V) near the turning
+    // points, where it would turn a rounding of V into an O(1e-8) momentum.
+    const double k = alpha_ / std::sqrt(alpha_ * alpha_ + omega_ * omega_ / (2 * h));
+    const double kc = k * std::cos(theta);
+    const double q = std::asin(kc) / alpha_;
+    const double w = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+    const double p = -w * k * std::sin(theta) / (alpha_ * std::sqrt(1 - kc * kc));
+    return {q, p};
+}
+
+double Tan::angle_of_point(double q, double p, double h) const {
+    // cos theta = sin(alpha q) / k and sin theta = -p alpha cos(alpha q) / (omega(h) k), k > 0.
+    const double w = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+    return std::atan2(-p * alpha_ * std::cos(alpha_ * q) / w, std::sin(alpha_ * q));
 }
 
 Numerical::Numerical(std::shared_ptr<const Potential> base) : base_(std::move(base)) {

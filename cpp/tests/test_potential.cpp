@@ -33,6 +33,13 @@ int main() {
                 CHECK(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10, "%s angle_of(%g, %g): %.15g vs %.15g",
                       base->name().c_str(), q, h, base->angle_of(q, h), num.angle_of(q, h));
             }
+            // angle_of_point inverts point_at to rounding, including at the turning points.
+            for (double th : {-3.0, -1.0, 0.0, 1e-9, 2.0, 3.14}) {
+                const auto [q, p] = base->point_at(th, h);
+                CHECK(std::fabs(base->angle_of_point(q, p, h) - th) < 1e-12, "%s angle_of_point(point_at(%g))", base->name().c_str(), th);
+                const auto [nq, np] = num.point_at(th, h);
+                CHECK(std::fabs(nq - q) < 1e-9 && std::fabs(np - p) < 1e-9, "%s generic point_at(%g)", base->name().c_str(), th);
+            }
             // dH/dI = omega(h): the frequency is the derivative of the energy in the action.
             const double I = base->action(h), dI = 1e-4 * I;
             const double dHdI = (base->energy(I + dI) - base->energy(I - dI)) / (2 * dI);

@@ -29,7 +29,20 @@ from .geometry import (
     wrap,
 )
 from .maps import IterateResult, TruncatedFamily, TruncatedMap
-from .system import Bilinear, Harmonic, Numerical, OnsetParameters, Potential, StepSystem, Tan, onset_parameters
+from .system import (
+    Bilinear,
+    FlowStatus,
+    Harmonic,
+    Numerical,
+    OnsetParameters,
+    Polynomial,
+    Potential,
+    ReturnMapResult,
+    Section,
+    StepSystem,
+    Tan,
+    onset_parameters,
+)
 
 __version__ = "0.1.0"
 
@@ -70,4 +83,8 @@ __all__ = [
     "StepSystem",
     "OnsetParameters",
     "onset_parameters",
+    "Polynomial",
+    "Section",
+    "ReturnMapResult",
+    "FlowStatus",
 ]

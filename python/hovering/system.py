@@ -1,19 +1,36 @@
-"""The oscillators-step system of sec:setup: potentials, coupling, geometry, onset parameters.
+"""The oscillators-step system of sec:setup: potentials, coupling, geometry, onset parameters,
+the section Sigma_h and the return map of the smooth flow.
 
-This release provides the system description (validated) and its onset parameters
-(sec:parametersdef); the impact flow on GSL and the Poincare return map come next (issue 4).
+The flow with walls (geometry "wall" / "step": impacts, grazing, corner) is the next part of
+issue 4; for now ``Section.return_map`` requires geometry "none".
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import IntEnum
 from typing import Optional
+
+import numpy as np
 
 from . import _core
 from ._core import Harmonic, Numerical, OnsetParameters, Potential, Tan
 
-__all__ = ["Harmonic", "Tan", "Numerical", "Potential", "Bilinear", "StepSystem", "onset_parameters", "OnsetParameters"]
+__all__ = [
+    "Harmonic",
+    "Tan",
+    "Numerical",
+    "Potential",
+    "Bilinear",
+    "Polynomial",
+    "StepSystem",
+    "onset_parameters",
+    "OnsetParameters",
+    "Section",
+    "ReturnMapResult",
+    "FlowStatus",
+]
 
 _GEOMETRIES = ("none", "wall", "step")
 
@@ -35,6 +52,50 @@ class Bilinear:
         float or ndarray
         """
         return q1 * q2
+
+
+@dataclass(frozen=True)
+class Polynomial:
+    """The coupling ``Vc(q1, q2) = sum c_ij q1^i q2^j``.
+
+    Parameters
+    ----------
+    coefficients : dict
+        ``{(i, j): c_ij}`` with integer exponents in [0, 20].
+    """
+
+    coefficients: dict
+
+    def __post_init__(self):
+        for (i, j), c in self.coefficients.items():
+            if not (int(i) == i and int(j) == j and 0 <= i <= 20 and 0 <= j <= 20):
+                raise ValueError(f"exponents must be integers in [0, 20], got ({i}, {j})")
+            if not math.isfinite(c):
+                raise ValueError(f"coefficient of q1^{i} q2^{j} must be finite, got {c}")
+
+    def __call__(self, q1, q2):
+        """Vc(q1, q2).
+
+        Parameters
+        ----------
+        q1, q2 : float or array_like
+            Positions.
+
+        Returns
+        -------
+        float or ndarray
+        """
+        return sum(c * q1**i * q2**j for (i, j), c in self.coefficients.items())
+
+
+def _terms(coupling) -> list:
+    if coupling is None:
+        return []
+    if isinstance(coupling, Bilinear):
+        return [(1.0, 1.0, 1.0)]
+    if isinstance(coupling, Polynomial):
+        return [(float(c), float(i), float(j)) for (i, j), c in coupling.coefficients.items()]
+    raise ValueError(f"coupling must be hovering.Bilinear() or hovering.Polynomial({{(i, j): c}}), got {coupling!r}")
 
 
 @dataclass(frozen=True)
@@ -76,6 +137,7 @@ class StepSystem:
             raise ValueError(f"eps must be finite, got {self.eps}")
         if self.eps != 0 and self.coupling is None:
             raise ValueError("eps != 0 needs a coupling (e.g. hovering.Bilinear())")
+        _terms(self.coupling)
         if self.geometry not in _GEOMETRIES:
             raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {self.geometry!r}")
         for name, pot in (("qw1", self.V1), ("qw2", self.V2)):
@@ -133,3 +195,132 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> 
         (w1, a1), (w2, a2) = wa(sys.V1), wa(sys.V2)
         return _core._onset_parameters_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, float(h))
     raise ValueError(f"method must be 'definitions', 'quadrature' or 'closed_form', got {method!r}")
+
+
+class FlowStatus(IntEnum):
+    """Per-orbit outcome of a return-map computation."""
+
+    OK = 0  #: returned to Sigma_h
+    CORNER = 1  #: hit the corner of the step (the orbit stops)
+    GRAZING = 2  #: touched a wall tangentially
+    STEP_LIMIT = 3  #: max_steps reached before returning
+    NON_FINITE = 4  #: the state became non-finite
+
+
+@dataclass(frozen=True)
+class ReturnMapResult:
+    """Images of points of Sigma_h under the return map, one entry per initial condition.
+
+    Attributes
+    ----------
+    theta, I : ndarray
+        Section coordinates of the image (unperturbed S2 of (q2, p2)).
+    z : ndarray
+        Image states (q1, p1, q2, p2), shape (n, 4).
+    time : ndarray
+        Return times.
+    itinerary : list of str
+        Impacts in order ('R', '1', ...); empty strings for the smooth flow.
+    status : ndarray of int8
+        Per-orbit :class:`FlowStatus`.
+    energy_error : ndarray
+        ``|H(image) - H(start)|``.
+    steps : ndarray of int64
+        Accepted integrator steps.
+    """
+
+    theta: np.ndarray
+    I: np.ndarray
+    z: np.ndarray
+    time: np.ndarray
+    itinerary: list
+    status: np.ndarray
+    energy_error: np.ndarray
+    steps: np.ndarray
+
+
+class Section:
+    """The Poincare section ``Sigma_h = {p1 = 0, dp1/dt < 0, H = h}`` of a system.
+
+    Parameters
+    ----------
+    sys : StepSystem
+        The system.
+    h : float
+        Energy level.
+    """
+
+    def __init__(self, sys: StepSystem, h: float):
+        if not isinstance(sys, StepSystem):
+            raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
+        if not math.isfinite(h):
+            raise ValueError(f"h must be finite, got {h}")
+        self.sys = sys
+        self.h = float(h)
+        self._args = (sys.V1, sys.V2, _terms(sys.coupling), float(sys.eps), float(sys.qw1), float(sys.qw2),
+                      _GEOMETRIES.index(sys.geometry))
+
+    def point(self, theta, I) -> np.ndarray:
+        """States (q1, 0, q2, p2) of Sigma_h at section coordinates (theta, I).
+
+        Parameters
+        ----------
+        theta, I : array_like
+            Angle in [-pi, pi] and action of the unperturbed H2 (broadcast together).
+
+        Returns
+        -------
+        ndarray
+            Shape (n, 4).
+
+        Raises
+        ------
+        ValueError
+            Where no such point exists (e.g. H2(I) >= h), naming the point.
+        """
+        t, i = np.broadcast_arrays(np.asarray(theta, dtype=float), np.asarray(I, dtype=float))
+        return _core._section_points(*self._args, self.h, np.ascontiguousarray(t.ravel()), np.ascontiguousarray(i.ravel()))
+
+    def coordinates(self, z) -> np.ndarray:
+        """Section coordinates (theta, I) of states z (shape (n, 4)).
+
+        Parameters
+        ----------
+        z : array_like
+            States.
+
+        Returns
+        -------
+        ndarray
+            Shape (n, 2): theta in [-pi, pi), I.
+        """
+        return _core._section_coordinates(*self._args, np.ascontiguousarray(np.atleast_2d(np.asarray(z, dtype=float))))
+
+    def return_map(self, theta, I, rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd",
+                   event_tol: float = 1e-13, max_steps: int = 1_000_000, n_threads: int = 0) -> ReturnMapResult:
+        """Return map of many points of Sigma_h (multi-threaded, GIL released).
+
+        Parameters
+        ----------
+        theta, I : array_like
+            Section coordinates of the starting points.
+        rtol, atol : float, optional
+            Tolerances of GSL's step-size control.
+        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2"}, optional
+            GSL explicit Runge-Kutta stepper.
+        event_tol : float, optional
+            |p1| accepted at the located section crossing.
+        max_steps : int, optional
+            Step limit per return (status STEP_LIMIT beyond it).
+        n_threads : int, optional
+            Worker threads (0 = all cores).
+
+        Returns
+        -------
+        ReturnMapResult
+        """
+        z0 = self.point(theta, I)
+        d = _core._return_maps(*self._args, z0, stepper, float(rtol), float(atol), float(event_tol), int(max_steps), int(n_threads))
+        c = self.coordinates(d["z"])
+        return ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
+                               status=d["status"], energy_error=d["energy_error"], steps=d["steps"])

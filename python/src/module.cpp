@@ -5,4 +5,5 @@ PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated near-tangency map and its batch iteration.";
     register_truncated_map(m);
     register_potential(m);
+    register_flow(m);
 }

@@ -15,3 +15,6 @@ void register_truncated_map(py::module_& m);
 
 /// Register the potentials and onset parameters.
 void register_potential(py::module_& m);
+
+/// Register the flow: section coordinates and return maps.
+void register_flow(py::module_& m);

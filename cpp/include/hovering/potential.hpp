@@ -39,6 +39,10 @@ public:
     /// Angle of the point (q, p < 0) on the level h: omega(h) times the time from q to q_max,
     /// in [0, pi] (theta_w of eq:thw for q = q_w).
     virtual double angle_of(double q, double h) const;
+    /// Inverse of the angle: (q, p) on the level h at angle theta in [-pi, pi] (sign(p) = -sign(theta)).
+    virtual std::pair<double, double> point_at(double theta, double h) const;
+    /// Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q).
+    virtual double angle_of_point(double q, double p, double h) const;
 
 protected:
     void check_energy(double h, const char* who) const;
@@ -57,6 +61,8 @@ public:
     double action(double h) const override;
     double energy(double I) const override;
     double angle_of(double q, double h) const override;
+    std::pair<double, double> point_at(double theta, double h) const override;
+    double angle_of_point(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
 
@@ -78,6 +84,8 @@ public:
     double action(double h) const override;
     double energy(double I) const override;
     double angle_of(double q, double h) const override;
+    std::pair<double, double> point_at(double theta, double h) const override;
+    double angle_of_point(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
     /// The nonlinearity alpha.

@@ -1,0 +1,253 @@
+// The smooth oscillators flow on GSL odeiv2 and its return map to Sigma_h.
+//
+// Events: the section crossing (p1 from + to -) is located on the cubic Hermite interpolant of
+// each accepted step (values and derivatives at both ends), then refined by secant iterations on
+// exact single steps of the stepper itself from the step's start, so the event state carries the
+// stepper's accuracy, not the interpolant's.
+
+#include "hovering/flow.hpp"
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace hovering {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+
+const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
+    if (name == "rk2") return gsl_odeiv2_step_rk2;
+    if (name == "rk4") return gsl_odeiv2_step_rk4;
+    if (name == "rkf45") return gsl_odeiv2_step_rkf45;
+    if (name == "rkck") return gsl_odeiv2_step_rkck;
+    if (name == "rk8pd") return gsl_odeiv2_step_rk8pd;
+    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods, which the "
+        "event refinement restarts from a step's start), got '" + name + "'");
+}
+
+int gsl_rhs(double, const double y[], double dydt[], void* params) {
+    static_cast<const FlowSystem*>(params)->rhs(y, dydt);
+    return GSL_SUCCESS;
+}
+
+// Owns the GSL objects of one integration.
+struct Integrator {
+    gsl_odeiv2_system sys;
+    gsl_odeiv2_step* step;
+    gsl_odeiv2_control* control;
+    gsl_odeiv2_evolve* evolve;
+    Integrator(const FlowSystem& s, const FlowOptions& o) {
+        sys = gsl_odeiv2_system{&gsl_rhs, nullptr, 4, const_cast<FlowSystem*>(&s)};
+        step = gsl_odeiv2_step_alloc(stepper_type(o.stepper), 4);
+        control = gsl_odeiv2_control_standard_new(o.atol, o.rtol, 1.0, 0.0);
+        evolve = gsl_odeiv2_evolve_alloc(4);
+    }
+    ~Integrator() {
+        gsl_odeiv2_evolve_free(evolve);
+        gsl_odeiv2_control_free(control);
+        gsl_odeiv2_step_free(step);
+    }
+    Integrator(const Integrator&) = delete;
+    Integrator& operator=(const Integrator&) = delete;
+    // One exact step of length dt from y0 (no error control): the stepper's own accuracy.
+    void exact(const double* y0, double dt, double* y1) {
+        double err[4], dydt_in[4];
+        const FlowSystem& s = *static_cast<const FlowSystem*>(sys.params);
+        s.rhs(y0, dydt_in);
+        double y[4] = {y0[0], y0[1], y0[2], y0[3]};
+        gsl_odeiv2_step_reset(step);
+        gsl_odeiv2_step_apply(step, 0.0, dt, y, err, dydt_in, nullptr, &sys);
+        for (int i = 0; i < 4; ++i) y1[i] = y[i];
+    }
+};
+
+// Cubic Hermite interpolant of a scalar on [0, h] from values and derivatives at both ends.
+double hermite(double g0, double d0, double g1, double d1, double h, double t) {
+    const double s = t / h, s2 = s * s, s3 = s2 * s;
+    return (2 * s3 - 3 * s2 + 1) * g0 + (s3 - 2 * s2 + s) * h * d0 + (-2 * s3 + 3 * s2) * g1 + (s3 - s2) * h * d1;
+}
+
+}  // namespace
+
+double Coupling::value(double q1, double q2) const {
+    double v = 0;
+    for (const auto& t : terms) v += t[0] * std::pow(q1, t[1]) * std::pow(q2, t[2]);
+    return v;
+}
+
+std::array<double, 2> Coupling::gradient(double q1, double q2) const {
+    double g1 = 0, g2 = 0;
+    for (const auto& t : terms) {
+        if (t[1] > 0) g1 += t[0] * t[1] * std::pow(q1, t[1] - 1) * std::pow(q2, t[2]);
+        if (t[2] > 0) g2 += t[0] * t[2] * std::pow(q1, t[1]) * std::pow(q2, t[2] - 1);
+    }
+    return {g1, g2};
+}
+
+void FlowSystem::validate() const {
+    if (!V1 || !V2) bad("the system needs two potentials V1 and V2");
+    if (!std::isfinite(eps)) bad("eps must be finite, got " + fmt(eps));
+    for (const auto& t : coupling.terms) {
+        if (!std::isfinite(t[0])) bad("coupling coefficients must be finite, got " + fmt(t[0]));
+        for (int k = 1; k < 3; ++k)
+            if (!(t[k] >= 0 && t[k] == std::floor(t[k]) && t[k] <= 20))
+                bad("coupling exponents must be integers in [0, 20], got " + fmt(t[k]));
+    }
+    if (!(qw1 < 0 && std::fabs(qw1) < V1->q_limit())) bad("qw1 must be < 0 and inside the well of V1, got " + fmt(qw1));
+    if (!(qw2 < 0 && std::fabs(qw2) < V2->q_limit())) bad("qw2 must be < 0 and inside the well of V2, got " + fmt(qw2));
+}
+
+double FlowSystem::energy(const double* z) const {
+    double H = 0.5 * z[1] * z[1] + V1->V(z[0]) + 0.5 * z[3] * z[3] + V2->V(z[2]);
+    if (eps != 0.0) H += eps * coupling.value(z[0], z[2]);
+    return H;
+}
+
+void FlowSystem::rhs(const double* z, double* dz) const {
+    dz[0] = z[1];
+    dz[1] = -V1->dV(z[0]);
+    dz[2] = z[3];
+    dz[3] = -V2->dV(z[2]);
+    if (eps != 0.0) {  // a scene with eps = 0 evaluates no coupling at all
+        const auto g = coupling.gradient(z[0], z[2]);
+        dz[1] -= eps * g[0];
+        dz[3] -= eps * g[1];
+    }
+}
+
+void FlowOptions::validate() const {
+    stepper_type(stepper);
+    if (!(rtol > 0 && rtol < 1)) bad("rtol must lie in (0, 1), got " + fmt(rtol));
+    if (!(atol > 0 && std::isfinite(atol))) bad("atol must be finite and > 0, got " + fmt(atol));
+    if (!(event_tol > 0 && std::isfinite(event_tol))) bad("event_tol must be finite and > 0, got " + fmt(event_tol));
+    if (max_steps < 1) bad("max_steps must be >= 1, got " + std::to_string(max_steps));
+}
+
+std::array<double, 4> section_point(const FlowSystem& s, double h, double theta, double I) {
+    if (!std::isfinite(h)) bad("h must be finite, got " + fmt(h));
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad("theta must lie in [-pi, pi], got " + fmt(theta));
+    if (!std::isfinite(I) || !(I > 0)) bad("I must be finite and > 0, got " + fmt(I));
+    const double e2 = s.V2->energy(I);
+    const auto [q2, p2] = s.V2->point_at(theta, e2);
+    // p1 = 0: V1(q1) + eps Vc(q1, q2) = h - H2; the root with q1 > 0 (near q1's maximum).
+    const double rest = h - e2;
+    auto F = [&](double q1) { return s.V1->V(q1) + (s.eps != 0 ? s.eps * s.coupling.value(q1, q2) : 0.0) - rest; };
+    if (!(F(0.0) < 0))
+        bad("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): h - H2(I) = " + fmt(rest) +
+            " leaves no energy for oscillator 1 (h must exceed H2(I) = " + fmt(e2) + ")");
+    const double lim = s.V1->q_limit();
+    double lo = 0, hi = std::isfinite(lim) ? 0.5 * lim : 1.0;
+    for (int k = 0; F(hi) < 0; ++k) {
+        if (k > 200) bad("no point of Sigma_h: V1 + eps Vc never reaches h - H2(I) = " + fmt(rest));
+        lo = hi;
+        hi = std::isfinite(lim) ? lim - 0.5 * (lim - hi) : 2 * hi;
+    }
+    for (int it = 0; it < 200 && hi - lo > 1e-16 * hi; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (F(mid) < 0 ? lo : hi) = mid;
+    }
+    std::array<double, 4> z{0.5 * (lo + hi), 0.0, q2, p2};
+    double dz[4];
+    s.rhs(z.data(), dz);
+    if (!(dz[1] < 0))
+        bad("the point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + ") has dp1/dt = " + fmt(dz[1]) +
+            " >= 0 (Sigma_h needs dp1/dt < 0)");
+    return z;
+}
+
+std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) {
+    const double e2 = 0.5 * z[3] * z[3] + s.V2->V(z[2]);
+    double th = s.V2->angle_of_point(z[2], z[3], e2);
+    if (th >= kPi) th -= 2 * kPi;  // [-pi, pi)
+    return {th, s.V2->action(e2)};
+}
+
+ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, const FlowOptions& opt) {
+    if (s.geometry != Geometry::None)
+        bad("return_map: geometry 'wall' and 'step' (impacts) are not implemented yet; use geometry 'none'");
+    static const bool quiet = (gsl_set_error_handler_off(), true);  // once, thread-safe; never abort the host
+    (void)quiet;
+    opt.validate();
+    s.validate();
+    Integrator in(s, opt);
+    ReturnResult r;
+    const double H0 = s.energy(z0.data());
+    double y[4] = {z0[0], z0[1], z0[2], z0[3]}, t = 0;
+    // Step bound: a small fraction of oscillator 1's period, so one step never holds both the
+    // minimum and the maximum of q1 (two sign changes of p1 would cancel).
+    const double T1 = s.V1->period(std::max(1e-12, 0.5 * y[1] * y[1] + s.V1->V(y[0])));
+    const double hmax = T1 / 16;
+    double dt = 1e-3 * T1;
+    bool seen_negative = false, armed = false;
+    for (;;) {
+        if (r.steps >= opt.max_steps) {
+            r.status = FlowStatus::StepLimit;
+            break;
+        }
+        double y0[4] = {y[0], y[1], y[2], y[3]}, d0[4], d1[4];
+        s.rhs(y0, d0);
+        const double t0 = t;
+        dt = std::min(dt, hmax);
+        const int st = gsl_odeiv2_evolve_apply(in.evolve, in.control, in.step, &in.sys, &t, t + hmax, &dt, y);
+        ++r.steps;
+        if (st != GSL_SUCCESS || !std::isfinite(y[0]) || !std::isfinite(y[1]) || !std::isfinite(y[2]) ||
+            !std::isfinite(y[3])) {
+            r.status = FlowStatus::NonFinite;
+            break;
+        }
+        s.rhs(y, d1);
+        // A return passes q1's minimum (p1 from - to +) and then its maximum (p1 from + to -).
+        // Arming the section only after the minimum makes a start with p1 = +-1e-14 (a point
+        // computed on Sigma_h) safe from being taken for its own return.
+        if (!armed) {
+            armed = y[1] > 0 && seen_negative;
+            seen_negative = seen_negative || y[1] < 0;
+            continue;
+        }
+        if (y0[1] > 0 && y[1] <= 0) {
+            const double h = t - t0;
+            double a = 0, b = h;  // bracket on the interpolant
+            for (int it = 0; it < 100; ++it) {
+                const double m = 0.5 * (a + b);
+                (hermite(y0[1], d0[1], y[1], d1[1], h, m) > 0 ? a : b) = m;
+            }
+            // Secant refinement on exact steps of the stepper from y0.
+            double ta = 0.5 * (a + b), tb = ta * (1 - 1e-6) + 1e-12 * h, ya[4], yb[4];
+            in.exact(y0, ta, ya);
+            in.exact(y0, tb, yb);
+            for (int it = 0; it < 50 && std::fabs(ya[1]) > opt.event_tol; ++it) {
+                if (ya[1] == yb[1]) break;
+                const double tn = ta - ya[1] * (ta - tb) / (ya[1] - yb[1]);
+                tb = ta;
+                for (int i = 0; i < 4; ++i) yb[i] = ya[i];
+                ta = tn;
+                in.exact(y0, ta, ya);
+            }
+            for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = ya[i];
+            r.time = t0 + ta;
+            r.status = FlowStatus::Ok;
+            break;
+        }
+    }
+    if (r.status != FlowStatus::Ok)
+        for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
+    r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
+    return r;
+}
+
+}  // namespace hovering

@@ -1,0 +1,129 @@
+// Bindings of the flow: section coordinates and the batch return map (threads, GIL released).
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "hovering/flow.hpp"
+#include "pybind.hpp"
+
+using namespace hovering;
+
+namespace {
+
+FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2,
+                       std::vector<std::array<double, 3>> terms, double eps, double qw1, double qw2, int geometry) {
+    FlowSystem s;
+    s.V1 = std::move(V1);
+    s.V2 = std::move(V2);
+    s.coupling.terms = std::move(terms);
+    s.eps = eps;
+    s.qw1 = qw1;
+    s.qw2 = qw2;
+    s.geometry = static_cast<Geometry>(geometry);
+    s.validate();
+    return s;
+}
+
+}  // namespace
+
+void register_flow(py::module_& m) {
+    m.def("_section_points",
+          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
+             double eps, double qw1, double qw2, int geometry, double h, const darray& theta, const darray& I) {
+              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
+              if (theta.size() != I.size()) throw py::value_error("theta and I must have the same size");
+              darray z({theta.size(), py::ssize_t(4)});
+              double* o = z.mutable_data();
+              for (py::ssize_t i = 0; i < theta.size(); ++i) {
+                  const auto p = section_point(s, h, theta.data()[i], I.data()[i]);
+                  for (int k = 0; k < 4; ++k) o[4 * i + k] = p[std::size_t(k)];
+              }
+              return z;
+          });
+    m.def("_section_coordinates",
+          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
+             double eps, double qw1, double qw2, int geometry, const darray& z) {
+              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
+              if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
+              darray out({z.shape(0), py::ssize_t(2)});
+              for (py::ssize_t i = 0; i < z.shape(0); ++i) {
+                  const auto c = section_coordinates(s, z.data() + 4 * i);
+                  out.mutable_data()[2 * i] = c[0];
+                  out.mutable_data()[2 * i + 1] = c[1];
+              }
+              return out;
+          });
+    m.def("_return_maps",
+          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
+             double eps, double qw1, double qw2, int geometry, const darray& z0, const std::string& stepper, double rtol,
+             double atol, double event_tol, std::int64_t max_steps, int n_threads) {
+              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
+              FlowOptions o;
+              o.stepper = stepper;
+              o.rtol = rtol;
+              o.atol = atol;
+              o.event_tol = event_tol;
+              o.max_steps = max_steps;
+              o.validate();
+              if (s.geometry != Geometry::None)
+                  throw py::value_error("return_map: geometry 'wall' and 'step' (impacts) are not implemented yet; use 'none'");
+              if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
+              if (n_threads < 0 || n_threads > 4096) throw py::value_error("n_threads must be in [0, 4096], got " + std::to_string(n_threads));
+              const py::ssize_t n = z0.shape(0);
+              darray z({n, py::ssize_t(4)}), time(n), err(n);
+              py::array_t<std::int8_t> status(n);
+              py::array_t<std::int64_t> steps(n);
+              std::vector<std::string> itin{static_cast<std::size_t>(n)};
+              const double* in = z0.data();
+              double *zo = z.mutable_data(), *to = time.mutable_data(), *eo = err.mutable_data();
+              auto* so = status.mutable_data();
+              auto* no = steps.mutable_data();
+              {
+                  // Orbits are independent and write disjoint slots of freshly allocated arrays.
+                  py::gil_scoped_release release;
+                  std::atomic<py::ssize_t> next{0};
+                  std::exception_ptr error;
+                  std::mutex mu;
+                  auto work = [&] {
+                      try {
+                          for (py::ssize_t i; (i = next.fetch_add(1)) < n;) {
+                              const std::array<double, 4> a{in[4 * i], in[4 * i + 1], in[4 * i + 2], in[4 * i + 3]};
+                              const ReturnResult r = return_map(s, a, o);
+                              for (int k = 0; k < 4; ++k) zo[4 * i + k] = r.z[std::size_t(k)];
+                              to[i] = r.time;
+                              eo[i] = r.energy_error;
+                              so[i] = static_cast<std::int8_t>(r.status);
+                              no[i] = r.steps;
+                              itin[std::size_t(i)] = r.itinerary;
+                          }
+                      } catch (...) {
+                          std::lock_guard<std::mutex> lock(mu);
+                          if (!error) error = std::current_exception();
+                          next.store(n);
+                      }
+                  };
+                  int t = n_threads > 0 ? n_threads : int(std::thread::hardware_concurrency());
+                  t = int(std::max<py::ssize_t>(1, std::min<py::ssize_t>(t, n)));
+                  std::vector<std::thread> pool;
+                  try {
+                      for (int k = 1; k < t; ++k) pool.emplace_back(work);
+                  } catch (...) {
+                      next.store(n);
+                      for (auto& th : pool) th.join();
+                      throw;
+                  }
+                  work();
+                  for (auto& th : pool) th.join();
+                  if (error) std::rethrow_exception(error);
+              }
+              py::dict d;
+              d["z"] = z;
+              d["time"] = time;
+              d["energy_error"] = err;
+              d["status"] = status;
+              d["steps"] = steps;
+              d["itinerary"] = itin;
+              return d;
+          });
+}

@@ -1,0 +1,91 @@
+"""Section Sigma_h and the smooth-flow return map (issue 4, part) against exact results."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hovering
+from hovering import Bilinear, FlowStatus, Harmonic, Polynomial, Section, StepSystem, Tan
+
+
+def section(eps=0.0, V1=None, V2=None, coupling=None, geometry="none", h=1.0):
+    sys = StepSystem(V1=V1 or Harmonic(1.0), V2=V2 or Tan(1.4, 0.7), coupling=coupling or Bilinear(), eps=eps,
+                     qw1=-1.0, qw2=-0.5, geometry=geometry)
+    return Section(sys, h)
+
+
+@pytest.mark.parametrize("V1,V2", [(Harmonic(1.0), Tan(1.4, 0.7)), (Tan(1.2, 0.5), Harmonic(1.3)), (Tan(1.0, 0.6), Tan(1.4, 0.7))])
+def test_uncoupled_return_is_the_exact_rotation(V1, V2):
+    # eps = 0: I is conserved, the return time is T1(h - H2(I)) and theta advances by
+    # Omega0(I) = omega2 T1 (eq:omega0ofI): exact closed-form oracles. rk8pd at rtol 1e-12: 1e-10.
+    sec = section(V1=V1, V2=V2, h=1.5)
+    th = np.linspace(-3.1, 3.1, 41)
+    for I in (0.1, 0.3):
+        out = sec.return_map(th, np.full_like(th, I), rtol=1e-12, atol=1e-14)
+        e2 = V2.energy(I)
+        T1 = V1.period(1.5 - e2)
+        assert np.all(out.status == FlowStatus.OK)
+        assert np.abs(out.I - I).max() < 1e-10
+        assert np.abs(out.time - T1).max() < 1e-9
+        assert np.abs(hovering.wrap(out.theta - th - V2.frequency(e2) * T1)).max() < 1e-9
+        assert out.itinerary == [""] * th.size
+
+
+def test_energy_error_follows_the_tolerance():
+    # The energy error is bounded by the tolerance: a sharper rtol gives a smaller error, both far
+    # below rtol x (number of steps) (the step control keeps each step's local error below rtol).
+    sec = section(eps=0.05)
+    th = np.linspace(-3, 3, 25)
+    loose = sec.return_map(th, np.full_like(th, 0.3), rtol=1e-6, atol=1e-8)
+    tight = sec.return_map(th, np.full_like(th, 0.3), rtol=1e-12, atol=1e-14)
+    assert loose.energy_error.max() < 1e-6 * loose.steps.max()
+    assert tight.energy_error.max() < 1e-12 * tight.steps.max()
+    assert tight.energy_error.max() < loose.energy_error.max()
+    assert tight.steps.mean() > loose.steps.mean()  # accuracy costs steps
+
+
+def test_time_reversal_of_the_coupled_return_map():
+    # lem:timerevgen: R2 F R2 = F^{-1}, R2(theta, I) = (-theta, I); so F(R2 F(x)) = R2 x. Two
+    # returns at rtol 1e-12: 1e-8. With a polynomial coupling as well as the bilinear one.
+    for coupling in (Bilinear(), Polynomial({(1, 1): 1.0, (2, 1): 0.3, (1, 3): -0.2})):
+        sec = section(eps=0.05, coupling=coupling)
+        th = np.linspace(-2.8, 2.8, 15)
+        I = np.full_like(th, 0.3)
+        y = sec.return_map(th, I, rtol=1e-12, atol=1e-14)
+        back = sec.return_map(-y.theta, y.I, rtol=1e-12, atol=1e-14)
+        assert np.abs(hovering.wrap(back.theta + th)).max() < 1e-8
+        assert np.abs(back.I - I).max() < 1e-8
+
+
+def test_section_points_and_coordinates_roundtrip():
+    sec = section(eps=0.05)
+    th, I = np.linspace(-3.1, 3.1, 9), np.full(9, 0.25)
+    z = sec.point(th, I)
+    assert np.all(z[:, 1] == 0) and np.all(z[:, 0] > 0)
+    c = sec.coordinates(z)
+    assert np.abs(hovering.wrap(c[:, 0] - th)).max() < 1e-12 and np.abs(c[:, 1] - I).max() < 1e-12
+
+
+def test_threads_do_not_change_results():
+    sec = section(eps=0.05)
+    th = np.linspace(-3, 3, 64)
+    a = sec.return_map(th, np.full_like(th, 0.3), n_threads=1)
+    b = sec.return_map(th, np.full_like(th, 0.3), n_threads=2)
+    assert np.array_equal(a.z, b.z) and np.array_equal(a.steps, b.steps)
+
+
+def test_bad_input_is_named():
+    sec = section()
+    with pytest.raises(ValueError, match="no point of Sigma_h"):
+        sec.point(0.3, 5.0)
+    with pytest.raises(ValueError, match="stepper must be one of"):
+        sec.return_map([0.3], [0.3], stepper="euler")
+    with pytest.raises(ValueError, match="rtol must lie in"):
+        sec.return_map([0.3], [0.3], rtol=0.0)
+    with pytest.raises(ValueError, match="not implemented yet"):
+        section(geometry="step").return_map([0.3], [0.3])
+    with pytest.raises(ValueError, match="exponents must be integers"):
+        Polynomial({(1.5, 1): 1.0})
+    with pytest.raises(ValueError, match="coupling must be"):
+        StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), coupling=lambda a, b: a * b, eps=0.1)
