@@ -9,7 +9,9 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_roots.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -76,12 +78,6 @@ struct Integrator {
     }
 };
 
-// Cubic Hermite interpolant of a scalar on [0, h] from values and derivatives at both ends.
-double hermite(double g0, double d0, double g1, double d1, double h, double t) {
-    const double s = t / h, s2 = s * s, s3 = s2 * s;
-    return (2 * s3 - 3 * s2 + 1) * g0 + (s3 - 2 * s2 + s) * h * d0 + (-2 * s3 + 3 * s2) * g1 + (s3 - s2) * h * d1;
-}
-
 }  // namespace
 
 double Coupling::value(double q1, double q2) const {
@@ -136,6 +132,9 @@ void FlowOptions::validate() const {
     if (!(atol > 0 && std::isfinite(atol))) bad("atol must be finite and > 0, got " + fmt(atol));
     if (!(event_tol > 0 && std::isfinite(event_tol))) bad("event_tol must be finite and > 0, got " + fmt(event_tol));
     if (max_steps < 1) bad("max_steps must be >= 1, got " + std::to_string(max_steps));
+    if (max_impacts < 1 || max_impacts > 1000000) bad("max_impacts must be in [1, 1000000], got " + std::to_string(max_impacts));
+    if (!(grazing_tol >= 0 && std::isfinite(grazing_tol))) bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
+    if (!(corner_tol >= 0 && std::isfinite(corner_tol))) bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
 }
 
 std::array<double, 4> section_point(const FlowSystem& s, double h, double theta, double I) {
@@ -177,9 +176,64 @@ std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) 
     return {th, s.V2->action(e2)};
 }
 
+namespace {
+
+// Root of y[idx](tau) - off on [lo, hi] (values of opposite signs), where y(tau) is one step of
+// the stepper of length tau from y0: a continuous extension of the accepted step with the
+// stepper's own accuracy. GSL's Brent solver, stopped at |f| <= tol or a ~1e-15 relative bracket.
+struct LocateCtx {
+    Integrator* in;
+    const double* y0;
+    int idx;
+    double off;
+    double y[4];
+};
+
+double locate_fn(double tau, void* p) {
+    auto* c = static_cast<LocateCtx*>(p);
+    c->in->exact(c->y0, tau, c->y);
+    return c->y[c->idx] - c->off;
+}
+
+double locate(Integrator& in, const double* y0, int idx, double off, double lo, double hi, double tol, double* yout) {
+    LocateCtx ctx{&in, y0, idx, off, {}};
+    const double flo = locate_fn(lo, &ctx);
+    if (flo == 0) {
+        for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
+        return lo;
+    }
+    const double fhi = locate_fn(hi, &ctx);
+    if (fhi == 0 || (flo > 0) == (fhi > 0)) {  // no sign change (rounding at a bracket end): take hi
+        for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
+        return hi;
+    }
+    gsl_function F{&locate_fn, &ctx};
+    gsl_root_fsolver* sol = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    gsl_root_fsolver_set(sol, &F, lo, hi);
+    double tau = 0.5 * (lo + hi);
+    for (int it = 0; it < 200; ++it) {
+        gsl_root_fsolver_iterate(sol);
+        tau = gsl_root_fsolver_root(sol);
+        const double a = gsl_root_fsolver_x_lower(sol), b = gsl_root_fsolver_x_upper(sol);
+        if (std::fabs(locate_fn(tau, &ctx)) <= tol || gsl_root_test_interval(a, b, 0.0, 1e-15) == GSL_SUCCESS) break;
+    }
+    gsl_root_fsolver_free(sol);
+    locate_fn(tau, &ctx);
+    for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
+    return tau;
+}
+
+enum class Ev { Section, Right, Upper, GrazeRight, GrazeUpper };
+
+struct Candidate {
+    double tau;
+    Ev kind;
+    double y[4];
+};
+
+}  // namespace
+
 ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, const FlowOptions& opt) {
-    if (s.geometry != Geometry::None)
-        bad("return_map: geometry 'wall' and 'step' (impacts) are not implemented yet; use geometry 'none'");
     static const bool quiet = (gsl_set_error_handler_off(), true);  // once, thread-safe; never abort the host
     (void)quiet;
     opt.validate();
@@ -194,7 +248,10 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
     const double hmax = T1 / 16;
     double dt = 1e-3 * T1;
     bool seen_negative = false, armed = false;
-    for (;;) {
+    const bool right = s.geometry != Geometry::None, upper = s.geometry == Geometry::Step;
+    const bool is_step = s.geometry == Geometry::Step;
+    bool done = false;
+    while (!done) {
         if (r.steps >= opt.max_steps) {
             r.status = FlowStatus::StepLimit;
             break;
@@ -211,40 +268,103 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
             break;
         }
         s.rhs(y, d1);
-        // A return passes q1's minimum (p1 from - to +) and then its maximum (p1 from + to -).
-        // Arming the section only after the minimum makes a start with p1 = +-1e-14 (a point
-        // computed on Sigma_h) safe from being taken for its own return.
-        if (!armed) {
-            armed = y[1] > 0 && seen_negative;
-            seen_negative = seen_negative || y[1] < 0;
-            continue;
+        const double h = t - t0;
+
+        // Candidate events of this step, each located on exact steps from y0.
+        std::vector<Candidate> cands;
+        auto wall = [&](int gi, double off, Ev cross, Ev graze) {
+            const int pi = gi + 1;
+            const double g0 = y0[gi] - off, g1 = y[gi] - off;
+            Candidate c{};
+            if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
+                c.kind = cross;
+                c.tau = locate(in, y0, gi, off, 0.0, h, opt.event_tol, c.y);
+                cands.push_back(c);
+            } else if (g0 > 0 && g1 > 0 && y0[pi] < 0 && y[pi] > 0) {
+                // Turning inside the step: the minimum of g (p = 0) may dip through the wall even
+                // though g > 0 at both ends (a near-grazing impact a sign test would miss).
+                double ym[4];
+                const double tm = locate(in, y0, pi, 0.0, 0.0, h, 1e-3 * opt.event_tol, ym);
+                const double gm = ym[gi] - off;
+                if (gm < -opt.grazing_tol) {
+                    c.kind = cross;
+                    c.tau = locate(in, y0, gi, off, 0.0, tm, opt.event_tol, c.y);
+                    cands.push_back(c);
+                } else if (gm <= opt.grazing_tol) {
+                    c.kind = graze;
+                    c.tau = tm;
+                    for (int i = 0; i < 4; ++i) c.y[i] = ym[i];
+                    cands.push_back(c);
+                }
+            }
+        };
+        if (right) wall(0, s.qw1, Ev::Right, Ev::GrazeRight);
+        if (upper) wall(2, s.qw2, Ev::Upper, Ev::GrazeUpper);
+        if (armed && y0[1] > 0 && y[1] <= 0) {
+            Candidate c{};
+            c.kind = Ev::Section;
+            c.tau = locate(in, y0, 1, 0.0, 0.0, h, opt.event_tol, c.y);
+            cands.push_back(c);
         }
-        if (y0[1] > 0 && y[1] <= 0) {
-            const double h = t - t0;
-            double a = 0, b = h;  // bracket on the interpolant
-            for (int it = 0; it < 100; ++it) {
-                const double m = 0.5 * (a + b);
-                (hermite(y0[1], d0[1], y[1], d1[1], h, m) > 0 ? a : b) = m;
+        std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.tau < b.tau; });
+
+        bool restarted = false;
+        for (const Candidate& c : cands) {
+            auto stop = [&](FlowStatus status) {
+                for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = c.y[i];
+                r.time = t0 + c.tau;
+                r.status = status;
+                done = true;
+            };
+            if (c.kind == Ev::Section) {
+                stop(FlowStatus::Ok);
+                break;
             }
-            // Secant refinement on exact steps of the stepper from y0.
-            double ta = 0.5 * (a + b), tb = ta * (1 - 1e-6) + 1e-12 * h, ya[4], yb[4];
-            in.exact(y0, ta, ya);
-            in.exact(y0, tb, yb);
-            for (int it = 0; it < 50 && std::fabs(ya[1]) > opt.event_tol; ++it) {
-                if (ya[1] == yb[1]) break;
-                const double tn = ta - ya[1] * (ta - tb) / (ya[1] - yb[1]);
-                tb = ta;
-                for (int i = 0; i < 4; ++i) yb[i] = ya[i];
-                ta = tn;
-                in.exact(y0, ta, ya);
+            const bool is_right = c.kind == Ev::Right || c.kind == Ev::GrazeRight;
+            // The other coordinate decides whether the wall is there: the right wall spans
+            // q2 < qw2 (all q2 for the infinite wall), the upper wall q1 < qw1.
+            const double other = is_right ? c.y[2] - s.qw2 : c.y[0] - s.qw1;
+            const bool has_wall = is_right ? (!is_step || other < 0) : other < 0;
+            if (is_step && std::fabs(other) <= opt.corner_tol && (c.kind == Ev::Right || c.kind == Ev::Upper)) {
+                stop(FlowStatus::Corner);
+                break;
             }
-            for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = ya[i];
-            r.time = t0 + ta;
-            r.status = FlowStatus::Ok;
+            if (!has_wall) continue;  // crossed the wall's line beside / above the step
+            if (c.kind == Ev::GrazeRight || c.kind == Ev::GrazeUpper) {
+                stop(FlowStatus::Grazing);
+                break;
+            }
+            if (r.itinerary.size() >= std::size_t(opt.max_impacts)) {
+                stop(FlowStatus::ImpactLimit);
+                break;
+            }
+            // Elastic reflection (eq:R1, eq:R2), placed exactly on the wall so that the restart
+            // (g = 0, moving away) cannot find the same impact again.
+            for (int i = 0; i < 4; ++i) y[i] = c.y[i];
+            if (is_right) {
+                y[0] = s.qw1;
+                y[1] = -y[1];
+                r.itinerary += 'R';
+            } else {
+                y[2] = s.qw2;
+                y[3] = -y[3];
+                r.itinerary += '1';
+            }
+            t = t0 + c.tau;
+            gsl_odeiv2_evolve_reset(in.evolve);
+            gsl_odeiv2_step_reset(in.step);
+            restarted = true;
             break;
         }
+        if (done) break;
+        // A return passes q1's minimum (p1 from - to +, or a right-wall reflection) and then its
+        // maximum (p1 from + to -). Arming the section only after the minimum makes a start with
+        // p1 = +-1e-14 (a point computed on Sigma_h) safe from being taken for its own return.
+        seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
+        armed = armed || (seen_negative && y[1] > 0);
+        (void)restarted;
     }
-    if (r.status != FlowStatus::Ok)
+    if (!done)
         for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
     r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
     return r;

@@ -65,8 +65,73 @@ int main() {
     bad = o;
     bad.rtol = 0;
     CHECK_THROWS(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
-    FlowSystem w = s;
-    w.geometry = Geometry::Step;
-    CHECK_THROWS(return_map(w, section_point(s, h, 0.3, 0.3), o), "not implemented yet");
+    bad = o;
+    bad.max_impacts = 0;
+    CHECK_THROWS(return_map(s, section_point(s, h, 0.3, 0.3), bad), "max_impacts must be in");
+
+    // ---- walls, eps = 0: each itinerary has an exact oracle (partial energies are conserved).
+    s.eps = 0.0;
+    const double h1w = s.V1->V(s.qw1), I_tan = s.V2->action(h - h1w);
+    auto oracle_wall_time = [&](double I) {  // harmonic V1: q1 = A cos(t), reflected at qw1
+        const double h1 = h - s.V2->energy(I), A = std::sqrt(2 * h1);
+        return 2 * std::acos(s.qw1 / A);
+    };
+    // Infinite wall: every orbit with I < I_tan reflects once ('R'), the others never.
+    FlowSystem wl = s;
+    wl.geometry = Geometry::Wall;
+    for (double I : {0.2 * I_tan, 0.7 * I_tan, 1.2 * I_tan}) {
+        const double e2 = s.V2->energy(I);
+        for (double th : {-2.0, 0.5, 2.9}) {
+            const ReturnResult r = return_map(wl, section_point(wl, h, th, I), o);
+            const auto c = section_coordinates(wl, r.z.data());
+            const bool hits = I < I_tan;
+            const double T = hits ? oracle_wall_time(I) : s.V1->period(h - e2);
+            CHECK(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : ""), "wall I=%g: itinerary '%s'", I, r.itinerary.c_str());
+            CHECK(std::fabs(r.time - T) < 1e-9, "wall I=%g th=%g: time %.15g vs %.15g", I, th, r.time, T);
+            CHECK(std::fabs(c[1] - I) < 1e-10 && std::fabs(wrap(c[0] - th - s.V2->frequency(e2) * T)) < 1e-9,
+                  "wall I=%g th=%g: (theta, I) off", I, th);
+            CHECK(r.energy_error < 1e-10, "wall energy error %.3g", r.energy_error);
+        }
+    }
+    // Step: the three regions J_R, J_1, J_0 of thm:regionsJdyn on one circle I < I_tan.
+    FlowSystem sp = s;
+    sp.geometry = Geometry::Step;
+    const double I = 0.7 * I_tan, e2 = s.V2->energy(I), T1 = s.V1->period(h - e2), w2 = s.V2->frequency(e2);
+    const double thw = s.V2->angle_of(s.qw2, e2);
+    int seen_R = 0, seen_1 = 0, seen_0 = 0;
+    for (int k = 0; k < 120; ++k) {
+        const double th = -kPi + (k + 0.5) * 2 * kPi / 120;
+        const ReturnResult r = return_map(sp, section_point(sp, h, th, I), o);
+        if (r.status != FlowStatus::Ok) continue;
+        const auto c = section_coordinates(sp, r.z.data());
+        CHECK(std::fabs(c[1] - I) < 1e-10, "step: I changed at th=%g ('%s')", th, r.itinerary.c_str());
+        double T = T1, dth = w2 * T1;
+        if (r.itinerary == "R") {
+            T = oracle_wall_time(I);
+            dth = w2 * T;
+            ++seen_R;
+        } else if (r.itinerary == "1") {
+            dth = w2 * T1 + 2 * (kPi - thw);  // eq:Thetaj1
+            ++seen_1;
+        } else {
+            CHECK(r.itinerary.empty(), "unexpected itinerary '%s'", r.itinerary.c_str());
+            ++seen_0;
+        }
+        CHECK(std::fabs(r.time - T) < 1e-9 && std::fabs(wrap(c[0] - th - dth)) < 1e-9,
+              "step th=%g '%s': time %.12g vs %.12g, dtheta %.12g vs %.12g", th, r.itinerary.c_str(), r.time, T, wrap(c[0] - th), wrap(dth));
+    }
+    CHECK(seen_R > 5 && seen_1 > 1 && seen_0 > 5, "regions seen: R %d, 1 %d, 0 %d", seen_R, seen_1, seen_0);
+
+    // Grazing: on the tangent circle I = I_tan the orbit touches q1 = qw1; 1e-9 below it every orbit
+    // dips ~1e-9 through the wall inside a step (a sign test at step ends misses such dips) and must
+    // reflect; 1e-9 above it none may.
+    int graze = 0, below = 0, above = 0;
+    for (int k = 0; k < 100; ++k) {
+        const double th = -kPi + (k + 0.5) * 2 * kPi / 100;
+        graze += return_map(wl, section_point(wl, h, th, I_tan), o).status == FlowStatus::Grazing;
+        below += return_map(wl, section_point(wl, h, th, I_tan - 1e-9), o).itinerary == "R";
+        above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), o).itinerary.empty();
+    }
+    CHECK(graze == 100 && below == 100 && above == 100, "grazing %d, 1e-9 below reflected %d, above free %d (of 100)", graze, below, above);
     return test_summary("test_flow");
 }

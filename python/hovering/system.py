@@ -1,8 +1,5 @@
 """The oscillators-step system of sec:setup: potentials, coupling, geometry, onset parameters,
-the section Sigma_h and the return map of the smooth flow.
-
-The flow with walls (geometry "wall" / "step": impacts, grazing, corner) is the next part of
-issue 4; for now ``Section.return_map`` requires geometry "none".
+the section Sigma_h and the return map of the impact flow (geometry "none", "wall", "step").
 """
 
 from __future__ import annotations
@@ -205,6 +202,7 @@ class FlowStatus(IntEnum):
     GRAZING = 2  #: touched a wall tangentially
     STEP_LIMIT = 3  #: max_steps reached before returning
     NON_FINITE = 4  #: the state became non-finite
+    IMPACT_LIMIT = 5  #: more impacts than max_impacts in one return (chattering)
 
 
 @dataclass(frozen=True)
@@ -297,7 +295,8 @@ class Section:
         return _core._section_coordinates(*self._args, np.ascontiguousarray(np.atleast_2d(np.asarray(z, dtype=float))))
 
     def return_map(self, theta, I, rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd",
-                   event_tol: float = 1e-13, max_steps: int = 1_000_000, n_threads: int = 0) -> ReturnMapResult:
+                   event_tol: float = 1e-13, max_steps: int = 1_000_000, max_impacts: int = 100,
+                   grazing_tol: float = 1e-12, corner_tol: float = 1e-10, n_threads: int = 0) -> ReturnMapResult:
         """Return map of many points of Sigma_h (multi-threaded, GIL released).
 
         Parameters
@@ -312,6 +311,14 @@ class Section:
             |p1| accepted at the located section crossing.
         max_steps : int, optional
             Step limit per return (status STEP_LIMIT beyond it).
+        max_impacts : int, optional
+            Impact limit per return (status IMPACT_LIMIT beyond it: chattering).
+        grazing_tol : float, optional
+            An orbit whose distance to a wall has a minimum within this of zero touches it
+            tangentially (status GRAZING). Minima of the distance inside a step are searched, so
+            dips deeper than this are impacts however short.
+        corner_tol : float, optional
+            An impact this close to the corner is a corner hit (status CORNER).
         n_threads : int, optional
             Worker threads (0 = all cores).
 
@@ -320,7 +327,8 @@ class Section:
         ReturnMapResult
         """
         z0 = self.point(theta, I)
-        d = _core._return_maps(*self._args, z0, stepper, float(rtol), float(atol), float(event_tol), int(max_steps), int(n_threads))
+        d = _core._return_maps(*self._args, z0, stepper, float(rtol), float(atol), float(event_tol), int(max_steps),
+                               int(max_impacts), float(grazing_tol), float(corner_tol), int(n_threads))
         c = self.coordinates(d["z"])
         return ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
                                status=d["status"], energy_error=d["energy_error"], steps=d["steps"])

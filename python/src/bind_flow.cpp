@@ -57,7 +57,8 @@ void register_flow(py::module_& m) {
     m.def("_return_maps",
           [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
              double eps, double qw1, double qw2, int geometry, const darray& z0, const std::string& stepper, double rtol,
-             double atol, double event_tol, std::int64_t max_steps, int n_threads) {
+             double atol, double event_tol, std::int64_t max_steps, int max_impacts, double grazing_tol, double corner_tol,
+             int n_threads) {
               const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
               FlowOptions o;
               o.stepper = stepper;
@@ -65,9 +66,10 @@ void register_flow(py::module_& m) {
               o.atol = atol;
               o.event_tol = event_tol;
               o.max_steps = max_steps;
+              o.max_impacts = max_impacts;
+              o.grazing_tol = grazing_tol;
+              o.corner_tol = corner_tol;
               o.validate();
-              if (s.geometry != Geometry::None)
-                  throw py::value_error("return_map: geometry 'wall' and 'step' (impacts) are not implemented yet; use 'none'");
               if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
               if (n_threads < 0 || n_threads > 4096) throw py::value_error("n_threads must be in [0, 4096], got " + std::to_string(n_threads));
               const py::ssize_t n = z0.shape(0);

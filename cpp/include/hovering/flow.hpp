@@ -1,8 +1,9 @@
 #pragma once
 // The oscillators-step flow (sec:setup) on GSL odeiv2 and its Poincare return map to
-// Sigma_h = {p1 = 0, dp1/dt < 0}. This part covers the smooth flow (geometry None): section
-// coordinates, the return map with event location, energy error and per-orbit status. The walls
-// (geometry Wall / Step: impacts, grazing, corner) are the next part of issue 4.
+// Sigma_h = {p1 = 0, dp1/dt < 0}: section coordinates, impacts with the right wall (geometry
+// Wall: the infinite wall q1 = qw1; Step: q2 < qw2 only) and the upper wall (Step, q1 < qw1),
+// corner hits, grazing, and per-orbit status. Events are searched on every accepted step,
+// including minima of a wall distance inside a step (near-grazing dips).
 
 #include <array>
 #include <cstdint>
@@ -28,6 +29,7 @@ enum class FlowStatus : std::int8_t {
     Grazing = 2,    ///< touched a wall tangentially
     StepLimit = 3,  ///< max_steps reached before returning
     NonFinite = 4,  ///< the state became non-finite
+    ImpactLimit = 5,  ///< more impacts than max_impacts in one return (chattering)
 };
 
 /// Vc = sum_k c_k q1^i_k q2^j_k.
@@ -63,6 +65,9 @@ struct FlowOptions {
     double atol = 1e-12;            ///< absolute tolerance of the step control
     double event_tol = 1e-13;       ///< |event function| accepted at a located event
     std::int64_t max_steps = 1000000;  ///< per return
+    int max_impacts = 100;          ///< per return; more ends the orbit with ImpactLimit
+    double grazing_tol = 1e-12;     ///< |min distance to a wall| below which an orbit touches it tangentially
+    double corner_tol = 1e-10;      ///< distance to the corner below which an impact is a corner hit
     /// Validate (throws std::invalid_argument naming the bad value and the allowed range).
     void validate() const;
 };
