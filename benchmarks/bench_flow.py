@@ -7,7 +7,8 @@ Omega0(I) without), so "achieved accuracy" is the max angle error against it, no
 integrator. Near-grazing: 200 orbits whose action lies 1e-4 .. 1e-9 below the tangent circle, so
 q1 dips that far (times |V1'|) through the wall: each must reflect exactly once.
 
-Needs scipy (pip install scipy); not run in CI. Run: python benchmarks/bench_flow.py
+Also heyoka.py (Taylor integrator with events) when installed. Needs scipy (pip install scipy, and
+optionally heyoka); not run in CI. Run: python benchmarks/bench_flow.py
 """
 
 from __future__ import annotations
@@ -71,6 +72,39 @@ def scipy_return(z0, rtol):
     raise RuntimeError("no return")
 
 
+def heyoka_integrator(rtol):
+    """One compiled Taylor integrator per tolerance: wall (terminal), section, q1's minimum."""
+    import heyoka as hy
+
+    q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
+    w2, a2 = V2.omega, V2.alpha
+    sys = [(q1, p1), (p1, -q1), (q2, p2), (p2, -(w2**2 / a2) * hy.tan(a2 * q2) / hy.cos(a2 * q2) ** 2)]
+    ev = [hy.t_event(q1 - QW1, direction=hy.event_direction.negative),
+          hy.t_event(p1, direction=hy.event_direction.negative),
+          hy.t_event(p1, direction=hy.event_direction.positive)]
+    return hy.taylor_adaptive(sys, [1.0, 0.0, 0.0, 0.1], t_events=ev, tol=rtol)
+
+
+def heyoka_return(ta, z0):
+    """Return map with heyoka.py: terminal outcome -(i+1) names the event i that stopped it."""
+    ta.time = 0.0
+    ta.state[:] = z0
+    ta.reset_cooldowns()
+    armed, impacts = False, 0
+    for _ in range(50):
+        oc = int(ta.propagate_until(ta.time + 20.0)[0])
+        if oc == -1:
+            ta.state[0], ta.state[1] = QW1, -ta.state[1]
+            impacts, armed = impacts + 1, True
+        elif oc == -3:
+            armed = True
+        elif oc == -2 and armed:
+            return ta.state.copy(), impacts
+        elif oc != -2:
+            raise RuntimeError(f"heyoka stopped with outcome {oc}")
+    raise RuntimeError("no return")
+
+
 def angle_error(theta0, I, theta1):
     d, _ = exact_angle(I)
     return abs(hovering.wrap(theta1 - theta0 - d))
@@ -104,13 +138,32 @@ def main():
         err = max(angle_error(a, b, c) for a, b, c in zip(th, I, thetas))
         sc[rtol] = (err, dt)
         print(f"{'scipy solve_ivp DOP853':28s} {rtol:7.0e} {err:16.2e} {1e6 * dt:10.1f}")
+    hk = {}
+    try:
+        import heyoka  # noqa: F401
+
+        for rtol in (1e-6, 1e-9, 1e-12):
+            t0 = time.perf_counter()
+            ta = heyoka_integrator(rtol)
+            compile_s = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            thetas = [SEC.coordinates(heyoka_return(ta, z)[0])[0, 0] for z in z0]
+            dt = (time.perf_counter() - t0) / n
+            err = max(angle_error(a, b, c) for a, b, c in zip(th, I, thetas))
+            hk[rtol] = (err, dt, ta)
+            print(f"{'heyoka.py Taylor':28s} {rtol:7.0e} {err:16.2e} {1e6 * dt:10.1f}   (+{compile_s:.2f} s to compile)")
+    except ImportError:
+        print("heyoka.py not installed: skipped (pip install heyoka)")
     print("speed-up at the same rtol (scipy time / ours):",
           ", ".join(f"{r:.0e}: {sc[r][1] / ours[r][1]:.0f}x" for r in ours))
 
     # Near-grazing impacts: every one of these orbits must reflect once.
     depths = np.logspace(-4, -9, 6)
     print(f"\nmissed impacts out of 40 per depth (action below I_tan by depth; q1 dips ~ depth x omega2):")
-    print(f"{'depth':>8s} {'hovering 1e-6':>14s} {'hovering 1e-12':>15s} {'scipy 1e-6':>11s} {'scipy 1e-12':>12s}")
+    if hk:
+        print("speed-up at the same rtol (heyoka time / ours):", ", ".join(f"{r:.0e}: {hk[r][1] / ours[r][1]:.1f}x" for r in ours))
+    print(f"{'depth':>8s} {'hovering 1e-6':>14s} {'hovering 1e-12':>15s} {'scipy 1e-6':>11s} {'scipy 1e-12':>12s}"
+          f"{' heyoka 1e-6 heyoka 1e-12' if hk else ''}")
     for d in depths:
         tt = np.linspace(-3.1, 3.1, 40)
         row = []
@@ -120,7 +173,10 @@ def main():
         zz = SEC.point(tt, np.full(40, I_tan - d))
         for rtol in (1e-6, 1e-12):
             row.append(sum(scipy_return(z, rtol)[1] != 1 for z in zz))
-        print(f"{d:8.0e} {row[0]:14d} {row[1]:15d} {row[2]:11d} {row[3]:12d}")
+        extra = ""
+        if hk:
+            extra = "".join(f" {sum(heyoka_return(hk[r][2], z)[1] != 1 for z in zz):11d}" for r in (1e-6, 1e-12))
+        print(f"{d:8.0e} {row[0]:14d} {row[1]:15d} {row[2]:11d} {row[3]:12d}{extra}")
 
 
 if __name__ == "__main__":
