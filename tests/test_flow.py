@@ -111,3 +111,29 @@ def test_step_time_reversal_and_itineraries():
         kinds.add(y.itinerary[i])
     assert {"R", "1", ""} <= kinds
     assert y.energy_error.max() < 1e-10
+
+
+def test_corner_singularity_curve_and_either_side():
+    # On a circle below the tangent one the boundary between 'R' (right wall) and '' (above the
+    # step) is the corner-singularity curve sigma_R0: orbits from it hit the corner. Found by
+    # bisection in theta to ~1e-15; from there the orbit must stop with CORNER, and 1e-9 to either
+    # side (5x the corner band) it must take the neighbouring itineraries without a corner hit.
+    sec = section(eps=0.05, geometry="step")
+    I = 0.8 * sec.sys.V2.action(1.0 - sec.sys.V1.V(-1.0))
+    th = np.linspace(-np.pi, np.pi, 241)[:-1]
+    it = sec.return_map(th, np.full_like(th, I), rtol=1e-12, atol=1e-14).itinerary
+    k = next(i for i in range(len(th) - 1) if it[i] == "R" and it[i + 1] == "")
+    a, b = th[k], th[k + 1]
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        if sec.return_map([m], [I], rtol=1e-12, atol=1e-14).itinerary[0] == "R":
+            a = m
+        else:
+            b = m
+    c = b  # first theta past the last 'R' orbit: the corner band is ~corner_tol / |dq2/dtheta| ~ 2e-10 wide
+    on = sec.return_map([c], [I], rtol=1e-12, atol=1e-14)
+    assert on.status[0] == FlowStatus.CORNER
+    left = sec.return_map([c - 1e-9], [I], rtol=1e-12, atol=1e-14)
+    right = sec.return_map([c + 1e-9], [I], rtol=1e-12, atol=1e-14)
+    assert left.status[0] == FlowStatus.OK and left.itinerary[0] == "R"
+    assert right.status[0] == FlowStatus.OK and right.itinerary[0] == ""
