@@ -41,7 +41,11 @@ from .system import (
     Section,
     StepSystem,
     Tan,
+    forcing_function,
+    from_normal,
     onset_parameters,
+    tangential_curve,
+    to_normal,
 )
 
 __version__ = "0.1.0"
@@ -87,4 +91,8 @@ __all__ = [
     "Section",
     "ReturnMapResult",
     "FlowStatus",
+    "tangential_curve",
+    "forcing_function",
+    "to_normal",
+    "from_normal",
 ]

@@ -27,6 +27,10 @@ __all__ = [
     "Section",
     "ReturnMapResult",
     "FlowStatus",
+    "tangential_curve",
+    "forcing_function",
+    "to_normal",
+    "from_normal",
 ]
 
 _GEOMETRIES = ("none", "wall", "step")
@@ -332,3 +336,122 @@ class Section:
         c = self.coordinates(d["z"])
         return ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
                                status=d["status"], energy_error=d["energy_error"], steps=d["steps"])
+
+
+def _wall_section(sec: "Section") -> "Section":
+    """The same system with the infinite wall q1 = qw1 (the tangential curve is about that line)."""
+    s = sec.sys
+    return Section(StepSystem(V1=s.V1, V2=s.V2, coupling=s.coupling, eps=s.eps, qw1=s.qw1, qw2=s.qw2, geometry="wall"), sec.h)
+
+
+def tangential_curve(sec: "Section", theta, rtol: float = 1e-12, bracket: float = 0.2, iterations: int = 55) -> np.ndarray:
+    """The tangential curve ``I_tan^eps(theta)`` (Def:sing_curve), by bisection in I.
+
+    For each theta, the action at which the orbit from (theta, I) touches the line q1 = qw1
+    tangentially before its return: below it the orbit crosses the line (impacts the infinite
+    wall), above it the orbit turns back before the line. Found by a vectorised bisection between
+    ``I_tan (1 -+ bracket)`` (eq:Itan) on the wall system's itineraries.
+
+    Parameters
+    ----------
+    sec : Section
+        The section (its system's eps, potentials and qw1 are used).
+    theta : array_like
+        Angles.
+    rtol : float, optional
+        Integration tolerance of each return.
+    bracket : float, optional
+        Relative half-width of the initial bracket around I_tan(h).
+    iterations : int, optional
+        Bisection steps (55 reach ~1e-16 relative).
+
+    Returns
+    -------
+    ndarray
+        ``I_tan^eps(theta)``.
+
+    Raises
+    ------
+    ValueError
+        If the bracket does not contain the tangency for some theta (eps too large for it).
+    """
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    ws = _wall_section(sec)
+    I0 = sec.sys.V2.action(sec.h - sec.sys.V1.V(sec.sys.qw1))
+    lo, hi = np.full(th.shape, I0 * (1 - bracket)), np.full(th.shape, I0 * (1 + bracket))
+
+    def crosses(I):
+        out = ws.return_map(th, I, rtol=rtol, atol=rtol * 1e-2)
+        return np.array([len(s) > 0 for s in out.itinerary]) | (out.status == FlowStatus.GRAZING)
+
+    if not (crosses(lo).all() and not crosses(hi).any()):
+        raise ValueError(f"the tangency is not inside I_tan (1 +- {bracket}) for every theta; raise bracket")
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        c = crosses(mid)
+        lo = np.where(c, mid, lo)
+        hi = np.where(c, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def forcing_function(sec: "Section", phi, **kwargs) -> np.ndarray:
+    """``f(phi) = (I_tan^eps(-phi) - I_tan^eps(phi)) / eps`` (eq:defoff), odd in phi.
+
+    Parameters
+    ----------
+    sec : Section
+        The section of a system with eps != 0.
+    phi : array_like
+        Angles.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    ndarray
+    """
+    if sec.sys.eps == 0:
+        raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
+    p = np.atleast_1d(np.asarray(phi, dtype=float))
+    both = tangential_curve(sec, np.concatenate([-p, p]), **kwargs)
+    return (both[: p.size] - both[p.size :]) / sec.sys.eps
+
+
+def to_normal(sec: "Section", theta, I, **kwargs):
+    """Normal coordinates ``(phi, K) = (theta, I - I_tan^eps(theta))`` (eq:kphidef).
+
+    Parameters
+    ----------
+    sec : Section
+        The section.
+    theta, I : array_like
+        Section coordinates.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    phi, K : ndarray
+    """
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    return th, np.asarray(I, dtype=float) - tangential_curve(sec, th, **kwargs)
+
+
+def from_normal(sec: "Section", phi, K, **kwargs):
+    """Inverse of :func:`to_normal`: ``(theta, I) = (phi, K + I_tan^eps(phi))`` (eq:kphiinvdef).
+
+    Parameters
+    ----------
+    sec : Section
+        The section.
+    phi, K : array_like
+        Normal coordinates.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    theta, I : ndarray
+    """
+    p = np.atleast_1d(np.asarray(phi, dtype=float))
+    return p, np.asarray(K, dtype=float) + tangential_curve(sec, p, **kwargs)
