@@ -7,6 +7,8 @@
 
 #include "hovering/flow.hpp"
 
+#include "detail.hpp"
+
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gsl/gsl_roots.h>
@@ -21,16 +23,9 @@ namespace hovering {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
-
-[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+using detail::bad;
+using detail::fmt;
+using detail::kPi;
 
 const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "rk2") return gsl_odeiv2_step_rk2;
@@ -234,8 +229,7 @@ struct Candidate {
 }  // namespace
 
 ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, const FlowOptions& opt) {
-    static const bool quiet = (gsl_set_error_handler_off(), true);  // once, thread-safe; never abort the host
-    (void)quiet;
+    detail::gsl_quiet();
     opt.validate();
     s.validate();
     Integrator in(s, opt);

@@ -4,6 +4,8 @@
 
 #include "hovering/potential.hpp"
 
+#include "detail.hpp"
+
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include <gsl/gsl_roots.h>
@@ -19,22 +21,11 @@ namespace hovering {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
-
-[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
-
-void gsl_quiet() {
-    static std::once_flag once;
-    std::call_once(once, [] { gsl_set_error_handler_off(); });
-}
+using detail::bad;
+using detail::fmt;
+using detail::gsl_quiet;
+using detail::kInf;
+using detail::kPi;
 
 double call(double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); }
 

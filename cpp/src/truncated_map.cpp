@@ -4,6 +4,8 @@
 
 #include "hovering/truncated_map.hpp"
 
+#include "detail.hpp"
+
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_spline.h>
 #include <sleef.h>
@@ -27,20 +29,14 @@ namespace hovering {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using detail::bad;
+using detail::fmt;
+using detail::gsl_quiet;
+using detail::kInf;
+using detail::kPi;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kInvTwoPi = 1.0 / kTwoPi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
-
-[[noreturn]] void bad(const std::string& msg) { throw std::invalid_argument(msg); }
 
 void require_finite(double v, const std::string& name) {
     if (!std::isfinite(v)) bad(name + " must be finite, got " + fmt(v));
@@ -80,13 +76,6 @@ inline Packet psin(const Packet& x) {
 #else
     return Fast ? Sleef_sin_u35(x) : Sleef_sin_u10(x);
 #endif
-}
-
-// Turn GSL's abort-on-error handler off once: every GSL call here has its inputs validated first,
-// and a library must never abort its host process.
-void gsl_quiet() {
-    static std::once_flag once;
-    std::call_once(once, [] { gsl_set_error_handler_off(); });
 }
 
 struct Classified {
