@@ -11,7 +11,6 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
-#include <gsl/gsl_roots.h>
 
 #include <algorithm>
 #include <cmath>
@@ -175,46 +174,21 @@ namespace {
 
 // Root of y[idx](tau) - off on [lo, hi] (values of opposite signs), where y(tau) is one step of
 // the stepper of length tau from y0: a continuous extension of the accepted step with the
-// stepper's own accuracy. GSL's Brent solver, stopped at |f| <= tol or a ~1e-15 relative bracket.
-struct LocateCtx {
-    Integrator* in;
-    const double* y0;
-    int idx;
-    double off;
-    double y[4];
-};
-
-double locate_fn(double tau, void* p) {
-    auto* c = static_cast<LocateCtx*>(p);
-    c->in->exact(c->y0, tau, c->y);
-    return c->y[c->idx] - c->off;
-}
-
+// stepper's own accuracy. Brent (GSL), stopped at |f| <= tol or a ~1e-15 relative bracket.
 double locate(Integrator& in, const double* y0, int idx, double off, double lo, double hi, double tol, double* yout) {
-    LocateCtx ctx{&in, y0, idx, off, {}};
-    const double flo = locate_fn(lo, &ctx);
-    if (flo == 0) {
-        for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
-        return lo;
+    double y[4];
+    auto f = [&](double tau) {
+        in.exact(y0, tau, y);
+        return y[idx] - off;
+    };
+    double tau = lo;
+    const double flo = f(lo);
+    if (flo != 0) {
+        const double fhi = f(hi);
+        tau = hi;  // no sign change (rounding at a bracket end, or an exact zero at hi): take hi
+        if (fhi != 0 && (flo > 0) != (fhi > 0)) tau = detail::brent(f, lo, hi, 1e-15, tol);
     }
-    const double fhi = locate_fn(hi, &ctx);
-    if (fhi == 0 || (flo > 0) == (fhi > 0)) {  // no sign change (rounding at a bracket end): take hi
-        for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
-        return hi;
-    }
-    gsl_function F{&locate_fn, &ctx};
-    gsl_root_fsolver* sol = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    gsl_root_fsolver_set(sol, &F, lo, hi);
-    double tau = 0.5 * (lo + hi);
-    for (int it = 0; it < 200; ++it) {
-        gsl_root_fsolver_iterate(sol);
-        tau = gsl_root_fsolver_root(sol);
-        const double a = gsl_root_fsolver_x_lower(sol), b = gsl_root_fsolver_x_upper(sol);
-        if (std::fabs(locate_fn(tau, &ctx)) <= tol || gsl_root_test_interval(a, b, 0.0, 1e-15) == GSL_SUCCESS) break;
-    }
-    gsl_root_fsolver_free(sol);
-    locate_fn(tau, &ctx);
-    for (int i = 0; i < 4; ++i) yout[i] = ctx.y[i];
+    in.exact(y0, tau, yout);
     return tau;
 }
 

@@ -8,7 +8,6 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
-#include <gsl/gsl_roots.h>
 
 #include <cmath>
 #include <functional>
@@ -44,21 +43,9 @@ double qaws(const std::function<double(double)>& f, double a, double b, double a
     return r;
 }
 
-// Root of f on [lo, hi] (f(lo), f(hi) of opposite signs) by Brent's method to ~1 ulp.
+// Root of f on [lo, hi] (f(lo), f(hi) of opposite signs) to ~1 ulp.
 double brent(const std::function<double(double)>& f, double lo, double hi) {
-    gsl_quiet();
-    gsl_function F{&call, const_cast<std::function<double(double)>*>(&f)};
-    gsl_root_fsolver* s = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    gsl_root_fsolver_set(s, &F, lo, hi);
-    double x = 0.5 * (lo + hi);
-    for (int it = 0; it < 200; ++it) {
-        gsl_root_fsolver_iterate(s);
-        x = gsl_root_fsolver_root(s);
-        const double a = gsl_root_fsolver_x_lower(s), b = gsl_root_fsolver_x_upper(s);
-        if (gsl_root_test_interval(a, b, 0.0, 4 * std::numeric_limits<double>::epsilon()) == GSL_SUCCESS) break;
-    }
-    gsl_root_fsolver_free(s);
-    return x;
+    return detail::brent(f, lo, hi, 4 * std::numeric_limits<double>::epsilon());
 }
 
 // The quadrature rules evaluate the smooth factor at the turning points, where its formula is
