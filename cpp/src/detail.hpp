@@ -65,4 +65,116 @@ inline double brent(const std::function<double(double)>& f, double lo, double hi
     return x;
 }
 
+/// Root of a function on [lo, hi] (values of opposite signs at the ends) by Newton's method
+/// (GSL's fdfsolver) from the guess x0, safeguarded: every evaluation shrinks the bracket, and an
+/// iterate outside it, a zero derivative or 10 iterations without convergence hand over to Brent
+/// on the current bracket (f(lo) has the sign f_lo_positive, f(hi) the other). fdf(x, &f, &df)
+/// evaluates both at once (one integrator step each), so from a good guess this costs 2-3
+/// evaluations where bisection-type methods need ~8. Stops at
+/// |f| <= ftol or a Newton correction below x_tol; the last evaluation is at the returned x.
+inline double newton_bracketed(const std::function<void(double, double*, double*)>& fdf, double lo, bool f_lo_positive,
+                               double hi, double x0, double x_tol, double ftol) {
+    gsl_quiet();
+    struct Ctx {
+        const std::function<void(double, double*, double*)>* fdf;
+        double x, fx, dfx;
+        double lo, hi;
+        int sign_lo;  // sign of f at lo
+        void (*eval)(double, void*, double*, double*);
+    } ctx{&fdf, std::nan(""), std::nan(""), std::nan(""), lo, hi, f_lo_positive ? 1 : -1, nullptr};
+    // GSL's Newton init asks for f and f' separately: all three callbacks share one cached
+    // evaluation, so each point costs one integrator step.
+    auto eval = [](double x, void* p, double* f, double* df) {
+        auto* c = static_cast<Ctx*>(p);
+        if (!(x == c->x)) {
+            (*c->fdf)(x, &c->fx, &c->dfx);
+            c->x = x;
+            if (x >= c->lo && x <= c->hi && c->fx != 0) ((c->fx > 0 ? 1 : -1) == c->sign_lo ? c->lo : c->hi) = x;
+        }
+        *f = c->fx;
+        *df = c->dfx;
+    };
+    gsl_function_fdf F{[](double x, void* p) {
+                           double f, df;
+                           auto* c = static_cast<Ctx*>(p);
+                           c->eval(x, p, &f, &df);
+                           return f;
+                       },
+                       [](double x, void* p) {
+                           double f, df;
+                           auto* c = static_cast<Ctx*>(p);
+                           c->eval(x, p, &f, &df);
+                           return df;
+                       },
+                       eval, &ctx};
+    ctx.eval = eval;
+    x0 = std::min(std::max(x0, lo), hi);
+    gsl_root_fdfsolver* s = gsl_root_fdfsolver_alloc(gsl_root_fdfsolver_newton);
+    bool ok = gsl_root_fdfsolver_set(s, &F, x0) == GSL_SUCCESS;
+    double x = x0;
+    for (int it = 0; ok; ++it) {
+        if (std::fabs(ctx.fx) <= ftol) break;
+        if (it == 10 || ctx.dfx == 0 || !std::isfinite(ctx.dfx)) {
+            ok = false;
+            break;
+        }
+        const double xn = ctx.x - ctx.fx / ctx.dfx;
+        if (!(xn >= ctx.lo && xn <= ctx.hi)) {  // Newton would leave the bracket
+            ok = false;
+            break;
+        }
+        const double dx = std::fabs(xn - ctx.x);
+        if (gsl_root_fdfsolver_iterate(s) != GSL_SUCCESS) {
+            ok = false;
+            break;
+        }
+        x = gsl_root_fdfsolver_root(s);
+        if (dx <= x_tol) break;
+    }
+    gsl_root_fdfsolver_free(s);
+    if (ok) return x;
+    // Brent on the shrunken bracket; its last evaluation is re-done at the returned root.
+    double f, df, flo, fhi;
+    fdf(ctx.lo, &flo, &df);
+    fdf(ctx.hi, &fhi, &df);
+    if (flo == 0 || fhi == 0 || (flo > 0) == (fhi > 0)) {  // rounding at an end: take the better end
+        const double r = std::fabs(flo) <= std::fabs(fhi) ? ctx.lo : ctx.hi;
+        fdf(r, &f, &df);
+        return r;
+    }
+    const double r = brent([&](double t) {
+        fdf(t, &f, &df);
+        return f;
+    }, ctx.lo, ctx.hi, 1e-15, ftol);
+    fdf(r, &f, &df);
+    return r;
+}
+
+/// Root in [0, h] of the cubic Hermite interpolant of values f0, f1 and derivatives d0, d1 at
+/// 0 and h (f0, f1 of opposite signs): the first guess of an event time inside a step.
+inline double hermite_root(double f0, double d0, double f1, double d1, double h) {
+    auto H = [&](double s, double* dh) {  // s in [0, 1]
+        const double s2 = s * s, s3 = s2 * s;
+        const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+        *dh = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * h * d0 + (-6 * s2 + 6 * s) * f1 + (3 * s2 - 2 * s) * h * d1;
+        return h00 * f0 + h10 * h * d0 + h01 * f1 + h11 * h * d1;
+    };
+    double lo = 0, hi = 1, s = f0 / (f0 - f1);  // secant start
+    const bool neg_lo = f0 < 0;
+    for (int it = 0; it < 30; ++it) {
+        double dh;
+        const double v = H(s, &dh);
+        if (v == 0) break;
+        ((v < 0) == neg_lo ? lo : hi) = s;
+        double sn = dh != 0 ? s - v / dh : 0.5 * (lo + hi);
+        if (!(sn > lo && sn < hi)) sn = 0.5 * (lo + hi);
+        if (std::fabs(sn - s) < 1e-12) {
+            s = sn;
+            break;
+        }
+        s = sn;
+    }
+    return s * h;
+}
+
 }  // namespace hovering::detail

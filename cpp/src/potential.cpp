@@ -215,8 +215,10 @@ double Tan::V(double q) const {
     return 0.5 * omega_ * omega_ / (alpha_ * alpha_) * t * t;
 }
 double Tan::dV(double q) const {
-    const double c = std::cos(alpha_ * q);
-    return omega_ * omega_ / alpha_ * std::tan(alpha_ * q) / (c * c);
+    // tan / cos^2 = tan (1 + tan^2): one transcendental call per force evaluation, the flow's
+    // dominant cost.
+    const double t = std::tan(alpha_ * q);
+    return omega_ * omega_ / alpha_ * t * (1 + t * t);
 }
 std::string Tan::name() const { return "Tan(omega=" + fmt(omega_) + ", alpha=" + fmt(alpha_) + ")"; }
 double Tan::q_limit() const { return 0.5 * kPi / alpha_; }
