@@ -70,10 +70,11 @@ inline double brent(const std::function<double(double)>& f, double lo, double hi
 /// iterate outside it, a zero derivative or 10 iterations without convergence hand over to Brent
 /// on the current bracket (f(lo) has the sign f_lo_positive, f(hi) the other). fdf(x, &f, &df)
 /// evaluates both at once (one integrator step each), so from a good guess this costs 2-3
-/// evaluations where bisection-type methods need ~8. Stops at
-/// |f| <= ftol or a Newton correction below x_tol; the last evaluation is at the returned x.
+/// evaluations where bisection-type methods need ~8. Returns the last evaluated point x once the
+/// next Newton correction -f/f' (stored in *delta) is below x_tol: the caller applies it to its
+/// state linearly (error ~ delta^2) instead of paying for another evaluation.
 inline double newton_bracketed(const std::function<void(double, double*, double*)>& fdf, double lo, bool f_lo_positive,
-                               double hi, double x0, double x_tol, double ftol) {
+                               double hi, double x0, double x_tol, double* delta) {
     gsl_quiet();
     struct Ctx {
         const std::function<void(double, double*, double*)>* fdf;
@@ -111,10 +112,12 @@ inline double newton_bracketed(const std::function<void(double, double*, double*
     x0 = std::min(std::max(x0, lo), hi);
     gsl_root_fdfsolver* s = gsl_root_fdfsolver_alloc(gsl_root_fdfsolver_newton);
     bool ok = gsl_root_fdfsolver_set(s, &F, x0) == GSL_SUCCESS;
-    double x = x0;
     for (int it = 0; ok; ++it) {
-        if (std::fabs(ctx.fx) <= ftol) break;
-        if (it == 10 || ctx.dfx == 0 || !std::isfinite(ctx.dfx)) {
+        if (ctx.fx == 0) {
+            *delta = 0;
+            break;
+        }
+        if (it == 10 || ctx.dfx == 0 || !std::isfinite(ctx.dfx) || !std::isfinite(ctx.fx)) {
             ok = false;
             break;
         }
@@ -123,18 +126,15 @@ inline double newton_bracketed(const std::function<void(double, double*, double*
             ok = false;
             break;
         }
-        const double dx = std::fabs(xn - ctx.x);
-        if (gsl_root_fdfsolver_iterate(s) != GSL_SUCCESS) {
-            ok = false;
-            break;
-        }
-        x = gsl_root_fdfsolver_root(s);
-        if (dx <= x_tol) break;
+        *delta = xn - ctx.x;
+        if (std::fabs(*delta) <= x_tol) break;
+        if (gsl_root_fdfsolver_iterate(s) != GSL_SUCCESS) ok = false;
     }
     gsl_root_fdfsolver_free(s);
-    if (ok) return x;
-    // Brent on the shrunken bracket; its last evaluation is re-done at the returned root.
+    if (ok) return ctx.x;
+    // Brent on the shrunken bracket, then one evaluation at its root.
     double f, df, flo, fhi;
+    *delta = 0;
     fdf(ctx.lo, &flo, &df);
     fdf(ctx.hi, &fhi, &df);
     if (flo == 0 || fhi == 0 || (flo > 0) == (fhi > 0)) {  // rounding at an end: take the better end
@@ -145,7 +145,7 @@ inline double newton_bracketed(const std::function<void(double, double*, double*
     const double r = brent([&](double t) {
         fdf(t, &f, &df);
         return f;
-    }, ctx.lo, ctx.hi, 1e-15, ftol);
+    }, ctx.lo, ctx.hi, 1e-15);
     fdf(r, &f, &df);
     return r;
 }

@@ -48,96 +48,148 @@ double ipow(double x, int n) {
     return r;
 }
 
-// The vector field with the common potentials and the bilinear coupling inlined. The flow's
+// The vector field with the common potentials and the bilinear coupling inlined, one
+// instantiation per (V1 kind, V2 kind, coupling kind), chosen once per integration. The flow's
 // inner loop evaluates it 13 times per rk8pd step; through virtual calls it spent ~8 of its ~21 ns
 // outside the one tan() it needs. Same arithmetic, in the same order, as Potential::dV and
 // FlowSystem::rhs, so both give bit-identical results.
-struct Field {
-    enum class Kind { Harmonic, Tan, Other };
-    struct Force {
-        Kind kind = Kind::Other;
-        double a = 0, b = 0;  // Harmonic: a = omega^2; Tan: a = omega^2 / alpha, b = alpha
-        const Potential* p = nullptr;
-        explicit Force(const Potential* pot) : p(pot) {
-            if (const auto* h = dynamic_cast<const Harmonic*>(pot)) {
-                kind = Kind::Harmonic;
-                a = h->omega() * h->omega();
-            } else if (const auto* t = dynamic_cast<const Tan*>(pot)) {
-                kind = Kind::Tan;
-                a = t->omega() * t->omega() / t->alpha();
-                b = t->alpha();
-            }
-        }
-        double operator()(double q) const {
-            switch (kind) {
-                case Kind::Harmonic: return a * q;
-                case Kind::Tan: {
-                    const double t = std::tan(b * q);
-                    return a * t * (1 + t * t);
-                }
-                default: return p->dV(q);
-            }
-        }
-    };
-    Force f1, f2;
-    double eps;
-    const Coupling* coupling;
-    double bilinear_c = 0;
-    bool bilinear = false;
-    explicit Field(const FlowSystem& s) : f1(s.V1.get()), f2(s.V2.get()), eps(s.eps), coupling(&s.coupling) {
-        const auto& t = s.coupling.terms;
-        if (t.size() == 1 && t[0][1] == 1 && t[0][2] == 1) {
-            bilinear = true;
-            bilinear_c = t[0][0];
+enum class Kind { Harmonic, Tan, Other };
+enum class CKind { None, Bilinear, General };
+
+struct Force {
+    Kind kind = Kind::Other;
+    double a = 0, b = 0;  // Harmonic: a = omega^2; Tan: a = omega^2 / alpha, b = alpha
+    const Potential* p = nullptr;
+    explicit Force(const Potential* pot) : p(pot) {
+        if (const auto* h = dynamic_cast<const Harmonic*>(pot)) {
+            kind = Kind::Harmonic;
+            a = h->omega() * h->omega();
+        } else if (const auto* t = dynamic_cast<const Tan*>(pot)) {
+            kind = Kind::Tan;
+            a = t->omega() * t->omega() / t->alpha();
+            b = t->alpha();
         }
     }
-    void operator()(const double* z, double* dz) const {
-        dz[0] = z[1];
-        dz[1] = -f1(z[0]);
-        dz[2] = z[3];
-        dz[3] = -f2(z[2]);
-        if (eps != 0.0) {  // a scene with eps = 0 evaluates no coupling at all
-            if (bilinear) {
-                dz[1] -= eps * (bilinear_c * z[2]);
-                dz[3] -= eps * (bilinear_c * z[0]);
-            } else {
-                const auto g = coupling->gradient(z[0], z[2]);
-                dz[1] -= eps * g[0];
-                dz[3] -= eps * g[1];
-            }
+    template <Kind K>
+    double eval(double q) const {
+        if constexpr (K == Kind::Harmonic) {
+            return a * q;
+        } else if constexpr (K == Kind::Tan) {
+            const double t = std::tan(b * q);
+            return a * t * (1 + t * t);
+        } else {
+            return p->dV(q);
         }
     }
 };
 
+struct Field {
+    Force f1, f2;
+    double eps;
+    const Coupling* coupling;
+    double bilinear_c = 0;
+    CKind ckind = CKind::None;
+    void (*fn)(const Field&, const double*, double*) = nullptr;
+
+    template <Kind K1, Kind K2, CKind C>
+    static void eval(const Field& F, const double* z, double* dz) {
+        dz[0] = z[1];
+        dz[1] = -F.f1.eval<K1>(z[0]);
+        dz[2] = z[3];
+        dz[3] = -F.f2.eval<K2>(z[2]);
+        if constexpr (C == CKind::Bilinear) {
+            dz[1] -= F.eps * (F.bilinear_c * z[2]);
+            dz[3] -= F.eps * (F.bilinear_c * z[0]);
+        } else if constexpr (C == CKind::General) {
+            const auto g = F.coupling->gradient(z[0], z[2]);
+            dz[1] -= F.eps * g[0];
+            dz[3] -= F.eps * g[1];
+        }
+    }
+    template <Kind K1, Kind K2>
+    void pick_c() {
+        fn = ckind == CKind::None ? &eval<K1, K2, CKind::None>
+           : ckind == CKind::Bilinear ? &eval<K1, K2, CKind::Bilinear> : &eval<K1, K2, CKind::General>;
+    }
+    template <Kind K1>
+    void pick_2() {
+        if (f2.kind == Kind::Harmonic) pick_c<K1, Kind::Harmonic>();
+        else if (f2.kind == Kind::Tan) pick_c<K1, Kind::Tan>();
+        else pick_c<K1, Kind::Other>();
+    }
+    explicit Field(const FlowSystem& s) : f1(s.V1.get()), f2(s.V2.get()), eps(s.eps), coupling(&s.coupling) {
+        const auto& t = s.coupling.terms;
+        if (eps == 0.0) {
+            ckind = CKind::None;  // a scene with eps = 0 evaluates no coupling at all
+        } else if (t.size() == 1 && t[0][1] == 1 && t[0][2] == 1) {
+            ckind = CKind::Bilinear;
+            bilinear_c = t[0][0];
+        } else {
+            ckind = CKind::General;
+        }
+        if (f1.kind == Kind::Harmonic) pick_2<Kind::Harmonic>();
+        else if (f1.kind == Kind::Tan) pick_2<Kind::Tan>();
+        else pick_2<Kind::Other>();
+    }
+    void operator()(const double* z, double* dz) const { fn(*this, z, dz); }
+};
+
 int gsl_rhs(double, const double y[], double dydt[], void* params) {
-    (*static_cast<const Field*>(params))(y, dydt);
+    const auto* F = static_cast<const Field*>(params);
+    F->fn(*F, y, dydt);
     return GSL_SUCCESS;
 }
 
-// Owns the GSL objects of one integration.
+// Owns the GSL objects of one integration. The adaptive loop drives GSL's stepper and step-size
+// control directly instead of gsl_odeiv2_evolve_apply: the evolve object evaluates the field at
+// both ends of every step, while the end derivative of one step is the start derivative of the next
+// (13 instead of 14 evaluations per rk8pd step), and the event search needs exactly those two.
 struct Integrator {
     Field field;
     gsl_odeiv2_system sys;
     gsl_odeiv2_step* step;
     gsl_odeiv2_control* control;
-    gsl_odeiv2_evolve* evolve;
     Integrator(const FlowSystem& s, const FlowOptions& o) : field(s) {
         sys = gsl_odeiv2_system{&gsl_rhs, nullptr, 4, &field};
         step = gsl_odeiv2_step_alloc(stepper_type(o.stepper), 4);
         control = gsl_odeiv2_control_standard_new(o.atol, o.rtol, 1.0, 0.0);
-        evolve = gsl_odeiv2_evolve_alloc(4);
+        gsl_odeiv2_control_init(control, o.atol, o.rtol, 1.0, 0.0);
     }
     ~Integrator() {
-        gsl_odeiv2_evolve_free(evolve);
         gsl_odeiv2_control_free(control);
         gsl_odeiv2_step_free(step);
     }
     Integrator(const Integrator&) = delete;
     Integrator& operator=(const Integrator&) = delete;
-    // One exact step of length dt from y0 (no error control): the stepper's own accuracy.
-    void exact(const double* y0, double dt, double* y1) {
-        double err[4], dydt_in[4];
-        field(y0, dydt_in);
+    // One error-controlled step from (y, d = field(y)) with trial length *h (<= hmax): on return y,
+    // d hold the new state and its derivative, *h_done the length taken, *h the proposal for the
+    // next step. Rejected trials shrink *h and retry from the same state. false: the step size
+    // underflowed or the stepper failed (non-finite state).
+    bool advance(double* y, double* d, double* h, double hmax, double* h_done, std::int64_t* trials) {
+        double y0[4] = {y[0], y[1], y[2], y[3]}, err[4], dout[4];
+        for (;;) {
+            ++*trials;
+            const double h0 = std::min(*h, hmax);
+            const int st = gsl_odeiv2_step_apply(step, 0.0, h0, y, err, d, dout, &sys);
+            bool finite = st == GSL_SUCCESS;
+            for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(y[i]) && std::isfinite(err[i]);
+            double hn = h0;
+            const int adj = finite ? gsl_odeiv2_control_hadjust(control, step, y, err, dout, &hn) : GSL_ODEIV_HADJ_DEC;
+            if (adj != GSL_ODEIV_HADJ_DEC) {
+                for (int i = 0; i < 4; ++i) d[i] = dout[i];
+                *h_done = h0;
+                *h = hn;
+                return true;
+            }
+            for (int i = 0; i < 4; ++i) y[i] = y0[i];
+            *h = finite ? hn : 0.5 * h0;
+            if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) return false;  // the tolerance cannot be met
+        }
+    }
+    // One exact step of length dt from y0 with derivative d0 (no error control): the stepper's own
+    // accuracy.
+    void exact(const double* y0, const double* d0, double dt, double* y1) {
+        double err[4], dydt_in[4] = {d0[0], d0[1], d0[2], d0[3]};
         double y[4] = {y0[0], y0[1], y0[2], y0[3]};
         gsl_odeiv2_step_reset(step);
         gsl_odeiv2_step_apply(step, 0.0, dt, y, err, dydt_in, nullptr, &sys);
@@ -249,9 +301,11 @@ namespace {
 // the stepper of length tau from y0: a continuous extension of the accepted step with the
 // stepper's own accuracy. The first guess is the root of the cubic Hermite interpolant through
 // y0, y1 = y(hi) and their derivatives d0, d1; Newton's method on exact steps (d/dtau y[idx] is
-// rhs[idx] of the stepped state, to the stepper's accuracy) then converges in 2-3 steps.
-double locate(Integrator& in, const double* y0, const double* d0, const double* y1, const double* d1,
-              int idx, double off, double hi, double tol, double* yout) {
+// rhs[idx] of the stepped state, to the stepper's accuracy) then converges in ~2 steps. The last
+// correction delta (|delta| <= sqrt(time_tol)) moves the state along its derivative, leaving an
+// error ~ delta^2 |z''| / 2 ~ time_tol |z''| / 2.
+double locate(Integrator& in, const double* y0, const double* d0, const double* y1, const double* d1, int idx,
+              double off, double hi, double time_tol, double* yout) {
     const double f0 = y0[idx] - off, f1 = y1[idx] - off;
     if (f0 == 0) {
         for (int i = 0; i < 4; ++i) yout[i] = y0[i];
@@ -262,14 +316,20 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
         return hi;
     }
     const double guess = detail::hermite_root(f0, d0[idx], f1, d1[idx], hi);
+    double dy[4];
     auto fdf = [&](double tau, double* f, double* df) {
-        double dy[4];
-        in.exact(y0, tau, yout);
+        in.exact(y0, d0, tau, yout);
         in.field(yout, dy);
         *f = yout[idx] - off;
         *df = dy[idx];
     };
-    return detail::newton_bracketed(fdf, 0.0, f0 > 0, hi, guess, 1e-15 * std::max(hi, 1.0), tol);
+    double delta = 0;
+    double tau = detail::newton_bracketed(fdf, 0.0, f0 > 0, hi, guess, std::sqrt(time_tol), &delta);
+    if (delta != 0 && tau + delta >= 0 && tau + delta <= hi && std::fabs(delta) <= std::sqrt(time_tol)) {
+        tau += delta;
+        for (int i = 0; i < 4; ++i) yout[i] += delta * dy[i];
+    }
+    return tau;
 }
 
 enum class Ev { Section, Right, Upper, GrazeRight, GrazeUpper };
@@ -297,6 +357,8 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
     const double T2 = s.V2->period(std::max(1e-12, 0.5 * y[3] * y[3] + s.V2->V(y[2])));
     const double hmax = 0.125 * std::min(T1, T2);
     double dt = 1e-3 * hmax;
+    double dy[4];
+    in.field(y, dy);
     bool seen_negative = false, armed = false;
     const bool right = s.geometry != Geometry::None, upper = s.geometry == Geometry::Step;
     const bool is_step = s.geometry == Geometry::Step;
@@ -306,27 +368,21 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
             r.status = FlowStatus::StepLimit;
             break;
         }
-        double y0[4] = {y[0], y[1], y[2], y[3]}, d0[4], d1[4];
+        double y0[4] = {y[0], y[1], y[2], y[3]}, d0[4] = {dy[0], dy[1], dy[2], dy[3]};
         const double t0 = t;
-        dt = std::min(dt, hmax);
-        const int st = gsl_odeiv2_evolve_apply(in.evolve, in.control, in.step, &in.sys, &t, t + hmax, &dt, y);
+        double h = 0;
+        std::int64_t trials = 0;
+        const bool ok = in.advance(y, dy, &dt, hmax, &h, &trials);
         ++r.steps;
-        if (st != GSL_SUCCESS || !std::isfinite(y[0]) || !std::isfinite(y[1]) || !std::isfinite(y[2]) ||
-            !std::isfinite(y[3])) {
+        if (!ok) {
+            for (int i = 0; i < 4; ++i) y[i] = y0[i];
             r.status = FlowStatus::NonFinite;
             break;
         }
-        const double h = t - t0;
-        // Derivatives at the step's ends, for the interpolants of the event search: only
-        // evaluated when some event function changes sign or turns inside the step.
-        bool have_d = false;
-        auto derivs = [&] {
-            if (!have_d) {
-                in.field(y0, d0);
-                in.field(y, d1);
-                have_d = true;
-            }
-        };
+        t = t0 + h;
+        const double* d1 = dy;
+        // Both end derivatives are known (d0 from the last step, d1 from this one): the event
+        // interpolants cost no extra evaluation.
 
         // Candidate events of this step, each located on exact steps from y0.
         std::vector<Candidate> cands;
@@ -336,15 +392,13 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
             Candidate c{};
             if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
                 c.kind = cross;
-                derivs();
                 c.tau = locate(in, y0, d0, y, d1, gi, off, h, opt.event_tol, c.y);
                 cands.push_back(c);
             } else if (g0 > 0 && g1 > 0 && y0[pi] < 0 && y[pi] > 0) {
                 // Turning inside the step: the minimum of g (p = 0) may dip through the wall even
                 // though g > 0 at both ends (a near-grazing impact a sign test would miss).
                 double ym[4], dm[4];
-                derivs();
-                const double tm = locate(in, y0, d0, y, d1, pi, 0.0, h, 1e-3 * opt.event_tol, ym);
+                const double tm = locate(in, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
                 const double gm = ym[gi] - off;
                 if (gm < -opt.grazing_tol) {
                     c.kind = cross;
@@ -364,7 +418,6 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
         if (armed && y0[1] > 0 && y[1] <= 0) {
             Candidate c{};
             c.kind = Ev::Section;
-            derivs();
             c.tau = locate(in, y0, d0, y, d1, 1, 0.0, h, opt.event_tol, c.y);
             cands.push_back(c);
         }
@@ -413,7 +466,7 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
                 r.itinerary += '1';
             }
             t = t0 + c.tau;
-            gsl_odeiv2_evolve_reset(in.evolve);
+            in.field(y, dy);
             gsl_odeiv2_step_reset(in.step);
             restarted = true;
             break;

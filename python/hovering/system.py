@@ -299,7 +299,7 @@ class Section:
         return _core._section_coordinates(*self._args, np.ascontiguousarray(np.atleast_2d(np.asarray(z, dtype=float))))
 
     def return_map(self, theta, I, rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd",
-                   event_tol: float = 1e-13, max_steps: int = 1_000_000, max_impacts: int = 100,
+                   event_tol: float = 1e-15, max_steps: int = 1_000_000, max_impacts: int = 100,
                    grazing_tol: float = 1e-12, corner_tol: float = 1e-10, n_threads: int = 0) -> ReturnMapResult:
         """Return map of many points of Sigma_h (multi-threaded, GIL released).
 
@@ -312,7 +312,9 @@ class Section:
         stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2"}, optional
             GSL explicit Runge-Kutta stepper.
         event_tol : float, optional
-            |p1| accepted at the located section crossing.
+            Time accuracy of located events (impacts, section crossing, a wall distance's
+            minimum): Newton's method on exact stepper steps runs until its correction is below
+            sqrt(event_tol), and that last correction is applied linearly (error ~ event_tol).
         max_steps : int, optional
             Step limit per return (status STEP_LIMIT beyond it).
         max_impacts : int, optional

@@ -63,7 +63,7 @@ struct FlowOptions {
     std::string stepper = "rk8pd";  ///< GSL explicit RK: rk2, rk4, rkf45, rkck, rk8pd
     double rtol = 1e-10;            ///< relative tolerance of the step control
     double atol = 1e-12;            ///< absolute tolerance of the step control
-    double event_tol = 1e-13;       ///< |event function| accepted at a located event
+    double event_tol = 1e-15;       ///< time accuracy of located events (Newton on exact steps)
     std::int64_t max_steps = 1000000;  ///< per return
     int max_impacts = 100;          ///< per return; more ends the orbit with ImpactLimit
     double grazing_tol = 1e-12;     ///< |min distance to a wall| below which an orbit touches it tangentially
