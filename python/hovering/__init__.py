@@ -11,7 +11,7 @@ multi-threaded SIMD C++ core.
 
 from __future__ import annotations
 
-from . import _core, analysis, geometry
+from . import _core, analysis, fullmap, geometry
 from .analysis import CriticalCurve, HoveringArea, birkhoff_average, regularity, rotation_number
 from ._types import Region, Status, region_mask
 from .geometry import (
@@ -28,6 +28,7 @@ from .geometry import (
     rho_crit,
     wrap,
 )
+from .fullmap import CornerCurves, MapComparison, TangentialCurve, compare_maps, corner_curves, truncated_from_flow
 from .maps import IterateResult, TruncatedFamily, TruncatedMap
 from .system import (
     Bilinear,
@@ -92,6 +93,12 @@ __all__ = [
     "ReturnMapResult",
     "FlowStatus",
     "tangential_curve",
+    "TangentialCurve",
+    "CornerCurves",
+    "MapComparison",
+    "corner_curves",
+    "truncated_from_flow",
+    "compare_maps",
     "forcing_function",
     "to_normal",
     "from_normal",
