@@ -45,3 +45,17 @@ def test_readme_examples_run_and_agree_with_the_text():
     fam = ns["fam"]
     flo, fhi = fam.valid_band()
     assert flo < 0 < fhi == 1.0
+
+
+def test_readme_fullmap_block():
+    # The hovering.fullmap block: measured-arc truncation at eps = 0.05 on the circle K = -0.015.
+    # All three regions are hit and agree with the flow; G_K = O(eps K) with the constant 0.4-0.7
+    # measured in tests/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
+    ns: dict = {}
+    for code in _python_blocks():
+        exec(compile(code, str(README), "exec"), ns)
+    c = ns["cmp"]
+    assert c.agree.mean() > 0.95 and {"", "R", "1"} <= set(c.region_full)
+    assert np.nanmax(np.abs(c.GK)) < 2 * 0.05 * 0.015
+    assert np.nanmax(np.abs(c.dphi)) < 2 * 0.05
+    np.testing.assert_allclose(ns["curves"].JR + ns["curves"].J0 + ns["curves"].J1, 2 * np.pi, atol=1e-9)
