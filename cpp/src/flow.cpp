@@ -32,8 +32,10 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "rkf45") return gsl_odeiv2_step_rkf45;
     if (name == "rkck") return gsl_odeiv2_step_rkck;
     if (name == "rk8pd") return gsl_odeiv2_step_rk8pd;
-    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods, which the "
-        "event refinement restarts from a step's start), got '" + name + "'");
+    if (name == "msadams") return gsl_odeiv2_step_msadams;
+    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods) or msadams "
+        "(variable-order Adams multistep); the implicit steppers need a Jacobian the flow does not "
+        "provide; got '" + name + "'");
 }
 
 // x^n for a small integer n >= 0 by repeated squaring: exact for n <= 2 and, unlike std::pow,
@@ -140,32 +142,69 @@ int gsl_rhs(double, const double y[], double dydt[], void* params) {
     return GSL_SUCCESS;
 }
 
-// Owns the GSL objects of one integration. The adaptive loop drives GSL's stepper and step-size
-// control directly instead of gsl_odeiv2_evolve_apply: the evolve object evaluates the field at
-// both ends of every step, while the end derivative of one step is the start derivative of the next
-// (13 instead of 14 evaluations per rk8pd step), and the event search needs exactly those two.
+// Owns the GSL objects of one integration. For one-step methods the adaptive loop drives GSL's
+// stepper and step-size control directly instead of gsl_odeiv2_evolve_apply: the evolve object
+// evaluates the field at both ends of every step, while the end derivative of one step is the
+// start derivative of the next (13 instead of 14 evaluations per rk8pd step), and the event search
+// needs exactly those two. The multistep msadams needs GSL's driver (it reads the control through
+// it) and its history cannot restart inside a step, so its events are located on an rk8pd
+// extension of the step, subdivided until rk8pd's own error estimate meets the tolerances.
 struct Integrator {
     Field field;
     gsl_odeiv2_system sys;
-    gsl_odeiv2_step* step;
-    gsl_odeiv2_control* control;
-    Integrator(const FlowSystem& s, const FlowOptions& o) : field(s) {
+    gsl_odeiv2_step* step = nullptr;
+    gsl_odeiv2_control* control = nullptr;
+    gsl_odeiv2_driver* driver = nullptr;  // msadams only: owns step, control and evolve
+    gsl_odeiv2_step* ext = nullptr;       // msadams only: rk8pd for event extensions
+    int ext_sub = 1;                      // substeps of the extension
+    double t_ms = 0;                      // msadams: running time (its history is in time)
+    double atol, rtol;
+    Integrator(const FlowSystem& s, const FlowOptions& o) : field(s), atol(o.atol), rtol(o.rtol) {
         sys = gsl_odeiv2_system{&gsl_rhs, nullptr, 4, &field};
-        step = gsl_odeiv2_step_alloc(stepper_type(o.stepper), 4);
-        control = gsl_odeiv2_control_standard_new(o.atol, o.rtol, 1.0, 0.0);
-        gsl_odeiv2_control_init(control, o.atol, o.rtol, 1.0, 0.0);
+        const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
+        if (T == gsl_odeiv2_step_msadams) {
+            driver = gsl_odeiv2_driver_alloc_standard_new(&sys, T, 1e-3, o.atol, o.rtol, 1.0, 0.0);
+            step = driver->s;
+            control = driver->c;
+            ext = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, 4);
+        } else {
+            step = gsl_odeiv2_step_alloc(T, 4);
+            control = gsl_odeiv2_control_standard_new(o.atol, o.rtol, 1.0, 0.0);
+        }
     }
     ~Integrator() {
-        gsl_odeiv2_control_free(control);
-        gsl_odeiv2_step_free(step);
+        if (driver) {
+            gsl_odeiv2_driver_free(driver);
+            gsl_odeiv2_step_free(ext);
+        } else {
+            gsl_odeiv2_control_free(control);
+            gsl_odeiv2_step_free(step);
+        }
     }
     Integrator(const Integrator&) = delete;
     Integrator& operator=(const Integrator&) = delete;
+    // Forget the step history (after an impact the flow restarts from a new state).
+    void restart() {
+        if (driver) gsl_odeiv2_driver_reset(driver);
+        else gsl_odeiv2_step_reset(step);
+    }
     // One error-controlled step from (y, d = field(y)) with trial length *h (<= hmax): on return y,
     // d hold the new state and its derivative, *h_done the length taken, *h the proposal for the
     // next step. Rejected trials shrink *h and retry from the same state. false: the step size
     // underflowed or the stepper failed (non-finite state).
     bool advance(double* y, double* d, double* h, double hmax, double* h_done, std::int64_t* trials) {
+        if (driver) {
+            ++*trials;
+            const double t0 = t_ms;
+            *h = std::min(*h, hmax);
+            const int st = gsl_odeiv2_evolve_apply(driver->e, driver->c, driver->s, &sys, &t_ms, t0 + hmax, h, y);
+            bool finite = st == GSL_SUCCESS;
+            for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(y[i]);
+            *h_done = t_ms - t0;
+            if (!finite || !(*h_done > 0)) return false;
+            field(y, d);
+            return true;
+        }
         double y0[4] = {y[0], y[1], y[2], y[3]}, err[4], dout[4];
         for (;;) {
             ++*trials;
@@ -186,13 +225,32 @@ struct Integrator {
             if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) return false;  // the tolerance cannot be met
         }
     }
-    // One exact step of length dt from y0 with derivative d0 (no error control): the stepper's own
-    // accuracy.
+    // Before an event search on [0, h] from y0: for msadams, pick the number of rk8pd substeps
+    // whose error estimate meets the tolerances (rk8pd's error ~ h^8: m = ratio^(1/8), rounded up).
+    void prepare_extension(const double* y0, const double* d0, double h) {
+        if (!driver) return;
+        double y[4] = {y0[0], y0[1], y0[2], y0[3]}, err[4], din[4] = {d0[0], d0[1], d0[2], d0[3]};
+        gsl_odeiv2_step_reset(ext);
+        gsl_odeiv2_step_apply(ext, 0.0, h, y, err, din, nullptr, &sys);
+        double ratio = 0;
+        for (int i = 0; i < 4; ++i) ratio = std::max(ratio, std::fabs(err[i]) / (atol + rtol * std::fabs(y[i])));
+        ext_sub = std::isfinite(ratio) ? std::min(64, std::max(1, int(std::ceil(1.2 * std::pow(ratio, 0.125))))) : 64;
+    }
+    // The continuous extension of the current step at length dt from y0 (derivative d0): one step
+    // of the stepper itself (its own accuracy, no error control), or for msadams ext_sub rk8pd steps.
     void exact(const double* y0, const double* d0, double dt, double* y1) {
         double err[4], dydt_in[4] = {d0[0], d0[1], d0[2], d0[3]};
         double y[4] = {y0[0], y0[1], y0[2], y0[3]};
-        gsl_odeiv2_step_reset(step);
-        gsl_odeiv2_step_apply(step, 0.0, dt, y, err, dydt_in, nullptr, &sys);
+        if (driver) {
+            gsl_odeiv2_step_reset(ext);
+            for (int k = 0; k < ext_sub; ++k) {
+                if (k > 0) field(y, dydt_in);
+                gsl_odeiv2_step_apply(ext, 0.0, dt / ext_sub, y, err, dydt_in, nullptr, &sys);
+            }
+        } else {
+            gsl_odeiv2_step_reset(step);
+            gsl_odeiv2_step_apply(step, 0.0, dt, y, err, dydt_in, nullptr, &sys);
+        }
         for (int i = 0; i < 4; ++i) y1[i] = y[i];
     }
 };
@@ -316,6 +374,7 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
         return hi;
     }
     const double guess = detail::hermite_root(f0, d0[idx], f1, d1[idx], hi);
+    in.prepare_extension(y0, d0, hi);
     double dy[4];
     auto fdf = [&](double tau, double* f, double* df) {
         in.exact(y0, d0, tau, yout);
@@ -467,7 +526,7 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
             }
             t = t0 + c.tau;
             in.field(y, dy);
-            gsl_odeiv2_step_reset(in.step);
+            in.restart();
             restarted = true;
             break;
         }
