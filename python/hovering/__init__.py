@@ -30,6 +30,7 @@ from .geometry import (
 )
 from .fullmap import CornerCurves, MapComparison, TangentialCurve, compare_maps, corner_curves, truncated_from_flow
 from .maps import IterateResult, TruncatedFamily, TruncatedMap
+from .potentials import CustomPotential, check_potential
 from .system import (
     Bilinear,
     FlowStatus,
@@ -84,6 +85,8 @@ __all__ = [
     "Harmonic",
     "Tan",
     "Numerical",
+    "CustomPotential",
+    "check_potential",
     "Bilinear",
     "StepSystem",
     "OnsetParameters",

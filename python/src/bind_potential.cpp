@@ -1,14 +1,228 @@
-// Bindings of the potentials and the onset parameters (pure C++ numerics; no GIL-sensitive loops).
+// Bindings of the potentials and the onset parameters.
+//
+// Besides the compiled potentials, V and V' may come from Python: a subclass of hovering.Potential
+// (through the trampoline PyPotential) or two callables (CallablePotential, behind
+// hovering.CustomPotential). The base class Potential answers every energy question from V and dV
+// alone, so nothing else is needed from Python. The core may call them from the return map's worker
+// threads with the GIL released: every call into Python takes the GIL itself, and a Python
+// exception travels up through the core (and GSL's frames) as pybind11::error_already_set, which
+// the flow's thread pool hands to the calling thread.
+#include <cmath>
+#include <limits>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include "hovering/potential.hpp"
 #include "pybind.hpp"
 
 using namespace hovering;
 
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// All 17 significant digits, so that a message names the value the core really saw.
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+/// Holds the GIL for one call into Python from any thread. On a thread Python does not know (the
+/// return map's workers), the first call creates a Python thread state; it is kept, with one extra
+/// reference, until the thread ends, instead of being created and destroyed on every call (which
+/// made a two-thread return map with Python potentials 16x slower: 21 ms instead of 1.3 ms per
+/// return). Threads Python created are left alone: Python deletes their states itself.
+class CallbackGil {
+public:
+    CallbackGil() : fresh_(PyGILState_GetThisThreadState() == nullptr), gil_() {
+        if (fresh_) {
+            gil_.inc_ref();
+            keeper().kept = true;
+        }
+    }
+
+private:
+    struct Keeper {
+        bool kept = false;
+        ~Keeper() {
+            if (!kept || !Py_IsInitialized()) return;
+            py::gil_scoped_acquire gil;
+            gil.dec_ref();  // the extra reference: the state is deleted when `gil` ends
+        }
+    };
+    static Keeper& keeper() {
+        thread_local Keeper k;
+        return k;
+    }
+    bool fresh_;
+    py::gil_scoped_acquire gil_;
+};
+
+/// The float value of what a Python V or V' returned (GIL held). Anything float() accepts (float,
+/// int, NumPy scalars) is a value; anything else is a TypeError naming the potential and the call.
+/// A non-finite value at |q| < q_limit is a ValueError: inside the well it is a defect of the
+/// callable, and the generic quadrature and root finding would turn it into garbage. Outside the
+/// well (where only a rejected trial step of the integrator can look) it is passed on, so that the
+/// step-size control shrinks the step, or the orbit ends with status NON_FINITE.
+double checked_value(const py::object& r, const Potential& pot, const char* fn, double q) {
+    double v;
+    if (PyFloat_CheckExact(r.ptr())) {
+        v = PyFloat_AS_DOUBLE(r.ptr());
+    } else {
+        v = PyFloat_AsDouble(r.ptr());
+        if (v == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            std::string shown = py::repr(r).cast<std::string>();
+            if (shown.size() > 80) shown = shown.substr(0, 77) + "...";
+            throw py::type_error(pot.name() + "." + fn + "(" + fmt(q) + ") returned " + shown + " of type " +
+                                 std::string(Py_TYPE(r.ptr())->tp_name) + ": V and V' must return a float");
+        }
+    }
+    if (!std::isfinite(v)) {
+        const double lim = pot.q_limit();
+        if (std::fabs(q) < lim)
+            throw py::value_error(pot.name() + "." + fn + "(" + fmt(q) + ") = " + fmt(v) +
+                                  ": V and V' must be finite inside the well, |q| < q_limit = " + fmt(lim));
+    }
+    return v;
+}
+
+/// The Python object of a trampoline instance, or an empty handle if it no longer exists (GIL held).
+py::handle python_self(const Potential* p) {
+    return py::detail::get_object_handle(p, py::detail::get_type_info(typeid(Potential)));
+}
+
+/// A subclass's own definition of `attr` (a class constant, a property or a method, which is
+/// called), or an empty object when only the base class's property would answer: that property
+/// calls back into the trampoline, so reading it here would recurse.
+py::object subclass_attr(py::handle self, const char* attr) {
+    const py::object mine = py::getattr(py::type::handle_of(self), attr, py::none());
+    if (mine.is(py::type::of<Potential>().attr(attr))) return py::object();
+    py::object v = py::getattr(self, attr);
+    if (PyCallable_Check(v.ptr())) v = v();
+    return v;
+}
+
+/// Trampoline of hovering.Potential: a Python subclass defines V(self, q) and dV(self, q), and may
+/// define name and q_limit (class constants, properties or methods).
+class PyPotential : public Potential {
+public:
+    double V(double q) const override { return call("V", q); }
+    double dV(double q) const override { return call("dV", q); }
+
+    std::string name() const override {
+        CallbackGil gil;
+        const py::handle self = python_self(this);
+        if (!self) return "Potential(<Python object released>)";
+        // The name goes into the core's error messages: a failing name must not replace them.
+        try {
+            const py::object v = subclass_attr(self, "name");
+            if (v) return py::str(v).cast<std::string>();
+        } catch (py::error_already_set&) {
+        }
+        return py::type::handle_of(self).attr("__name__").cast<std::string>() + "()";
+    }
+
+    double q_limit() const override {  // asked once per orbit, on the worker threads too
+        CallbackGil gil;
+        const py::handle self = python_self(this);
+        if (!self) return kInf;
+        const py::object v = subclass_attr(self, "q_limit");
+        if (!v) return kInf;
+        const double lim = v.cast<double>();
+        if (!(lim > 0)) throw py::value_error(name() + ": q_limit must be > 0 (or inf), got " + fmt(lim));
+        return lim;
+    }
+
+private:
+    double call(const char* fn, double q) const {
+        CallbackGil gil;
+        const py::function f = py::get_override(static_cast<const Potential*>(this), fn);
+        if (!f) {
+            if (!python_self(this))
+                throw std::runtime_error(std::string("Potential.") + fn + ": the Python object of this potential was released");
+            throw py::type_error(name() + " does not define " + fn +
+                                 "(self, q): subclass hovering.Potential and define V(self, q) and dV(self, q), "
+                                 "or use hovering.CustomPotential(V, dV)");
+        }
+        return checked_value(f(q), *this, fn, q);
+    }
+};
+
+/// V and V' as two Python callables (hovering.CustomPotential validates them first).
+class CallablePotential final : public Potential {
+public:
+    /// Stores the callables; q_limit > 0 (inf for an unbounded well).
+    CallablePotential(py::object V, py::object dV, double q_limit, std::string name)
+        : V_(std::move(V)), dV_(std::move(dV)), q_limit_(q_limit), name_(std::move(name)) {
+        if (!PyCallable_Check(V_.ptr()) || !PyCallable_Check(dV_.ptr())) throw py::value_error("V and dV must be callable");
+        if (!(q_limit_ > 0)) throw py::value_error("q_limit must be > 0 (or inf), got " + fmt(q_limit_));
+    }
+    /// The last reference may go from a thread without the GIL (a core object holding the
+    /// potential): dropping the callables needs it.
+    ~CallablePotential() override {
+        if (!Py_IsInitialized()) {  // interpreter gone: leak rather than touch freed state
+            V_.release();
+            dV_.release();
+            return;
+        }
+        py::gil_scoped_acquire gil;
+        V_ = py::object();
+        dV_ = py::object();
+    }
+    double V(double q) const override { return call(V_, "V", q); }
+    double dV(double q) const override { return call(dV_, "dV", q); }
+    std::string name() const override { return name_; }
+    double q_limit() const override { return q_limit_; }
+    /// The callable V.
+    py::object V_callable() const { return V_; }
+    /// The callable V'.
+    py::object dV_callable() const { return dV_; }
+
+private:
+    double call(const py::object& f, const char* fn, double q) const {
+        CallbackGil gil;
+        return checked_value(f(q), *this, fn, q);
+    }
+    py::object V_, dV_;
+    double q_limit_;
+    std::string name_;
+};
+
+/// A shared_ptr to the C++ part of a Python potential whose control block also owns a reference to
+/// the Python object. pybind11's shared_ptr holder keeps only the C++ part alive: a core object that
+/// stores the potential (Numerical) would otherwise outlive a Python subclass's methods, which live
+/// on the Python side (the holder has no py::trampoline_self_life_support; that is a smart_holder
+/// feature of pybind11 >= 3 only).
+std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
+    if (!py::isinstance<Potential>(obj))
+        throw py::type_error("expected a hovering potential (Harmonic, Tan, CustomPotential, a Potential subclass), got " +
+                             py::repr(obj).cast<std::string>());
+    const Potential* cpp = obj.cast<const Potential*>();
+    std::shared_ptr<py::object> owner(new py::object(obj), [](py::object* o) {
+        if (!Py_IsInitialized()) {
+            o->release();
+            delete o;
+            return;
+        }
+        py::gil_scoped_acquire gil;
+        delete o;
+    });
+    return std::shared_ptr<const Potential>(owner, cpp);
+}
+
+}  // namespace
+
 void register_potential(py::module_& m) {
-    py::class_<Potential, std::shared_ptr<Potential>> pot(m, "Potential", "A single-well potential V(q) (compiled).");
-    pot.def("V", &Potential::V, py::arg("q"), "V(q).")
+    py::class_<Potential, PyPotential, std::shared_ptr<Potential>> pot(
+        m, "Potential",
+        "A single-well potential V(q), V(0) = 0, q V'(q) > 0. Subclass it in Python by defining V(self, q) and "
+        "dV(self, q) (and optionally name, q_limit); every energy question is then answered by quadrature.");
+    pot.def(py::init<>())
+        .def("V", &Potential::V, py::arg("q"), "V(q).")
         .def("dV", &Potential::dV, py::arg("q"), "V'(q).")
         .def("turning_points", &Potential::turning_points, py::arg("h"), "Turning points (q_min, q_max) of the level V = h.")
         .def("period", &Potential::period, py::arg("h"), "Period T(h).")
@@ -17,6 +231,10 @@ void register_potential(py::module_& m) {
         .def("energy", &Potential::energy, py::arg("I"), "Energy H(I), inverse of action().")
         .def("angle_of", &Potential::angle_of, py::arg("q"), py::arg("h"),
              "Angle of (q, p < 0) on the level h: omega(h) x time from q to q_max (paper's convention).")
+        .def("point_at", &Potential::point_at, py::arg("theta"), py::arg("h"),
+             "(q, p) at angle theta in [-pi, pi] on the level h (sign(p) = -sign(theta)).")
+        .def("angle_of_point", &Potential::angle_of_point, py::arg("q"), py::arg("p"), py::arg("h"),
+             "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q).")
         .def_property_readonly("name", &Potential::name)
         .def_property_readonly("q_limit", &Potential::q_limit, "Largest |q| inside the well (inf if unbounded).")
         .def("__repr__", &Potential::name);
@@ -30,7 +248,14 @@ void register_potential(py::module_& m) {
         .def_property_readonly("alpha", &Tan::alpha);
     py::class_<Numerical, Potential, std::shared_ptr<Numerical>>(
         m, "Numerical", "Answers every energy question of another potential by GSL quadrature and root finding.")
-        .def(py::init<std::shared_ptr<const Potential>>(), py::arg("base"));
+        .def(py::init([](const py::object& base) { return std::make_shared<Numerical>(keep_python_alive(base)); }),
+             py::arg("base"));
+    py::class_<CallablePotential, Potential, std::shared_ptr<CallablePotential>>(
+        m, "_CallablePotential", "V and V' as Python callables (unvalidated; use hovering.CustomPotential).")
+        .def(py::init<py::object, py::object, double, std::string>(), py::arg("V"), py::arg("dV"), py::arg("q_limit"),
+             py::arg("name"))
+        .def_property_readonly("V_callable", &CallablePotential::V_callable, "The callable V(q).")
+        .def_property_readonly("dV_callable", &CallablePotential::dV_callable, "The callable V'(q).");
 
     py::class_<OnsetParameters>(m, "OnsetParameters", "Onset parameters of sec:parametersdef.")
         .def_readonly("Omega0", &OnsetParameters::Omega0)
