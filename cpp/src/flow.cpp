@@ -333,11 +333,27 @@ std::array<double, 4> section_point(const FlowSystem& s, double h, double theta,
         lo = hi;
         hi = std::isfinite(lim) ? lim - 0.5 * (lim - hi) : 2 * hi;
     }
+    // Newton on F (F' = V1' + eps dVc/dq1 > 0 on the bracket's right part), kept inside the
+    // bracket by bisection: ~5 iterations instead of ~55 bisections (1.6 us per point before).
+    auto dF = [&](double q1) { return s.V1->dV(q1) + (s.eps != 0 ? s.eps * s.coupling.gradient(q1, q2)[0] : 0.0); };
+    double q = 0.5 * (lo + hi);
     for (int it = 0; it < 200 && hi - lo > 1e-16 * hi; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (F(mid) < 0 ? lo : hi) = mid;
+        const double f = F(q);
+        if (f == 0) {
+            lo = hi = q;
+            break;
+        }
+        (f < 0 ? lo : hi) = q;
+        const double d = dF(q);
+        double qn = d > 0 ? q - f / d : 0.5 * (lo + hi);
+        if (!(qn > lo && qn < hi)) qn = 0.5 * (lo + hi);
+        if (std::fabs(qn - q) <= 1e-16 * std::fabs(q)) {
+            q = qn;
+            break;
+        }
+        q = qn;
     }
-    std::array<double, 4> z{0.5 * (lo + hi), 0.0, q2, p2};
+    std::array<double, 4> z{q, 0.0, q2, p2};
     double dz[4];
     s.rhs(z.data(), dz);
     if (!(dz[1] < 0))
