@@ -441,3 +441,18 @@ def test_default_threads_fall_back_to_one_for_python_potentials():
     th, I = np.linspace(-3, 3, 6), np.full(6, 0.3)
     a, b = sec.return_map(th, I), sec.return_map(th, I, n_threads=2)
     np.testing.assert_array_equal(a.theta, b.theta)  # threads never change results
+
+
+def test_overriding_a_compiled_potential_is_refused():
+    # The flow evaluates Harmonic/Tan forces from their parameters (no virtual call), so a Python
+    # subclass overriding V or dV would be ignored silently: StepSystem must refuse it by name.
+    class Stiffer(hovering.Harmonic):
+        def dV(self, q):
+            return 2.0 * q
+
+    class Plain(hovering.Tan):  # no override: still fine
+        pass
+
+    with pytest.raises(ValueError, match="overrides V/dV of the compiled Harmonic"):
+        hovering.StepSystem(V1=Stiffer(1.0), V2=hovering.Tan(1.4, 0.7))
+    hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=Plain(1.4, 0.7))

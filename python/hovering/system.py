@@ -132,8 +132,15 @@ class StepSystem:
 
     def __post_init__(self):
         for name in ("V1", "V2"):
-            if not isinstance(getattr(self, name), Potential):
-                raise ValueError(f"{name} must be a hovering potential (Harmonic, Tan, ...), got {getattr(self, name)!r}")
+            pot = getattr(self, name)
+            if not isinstance(pot, Potential):
+                raise ValueError(f"{name} must be a hovering potential (Harmonic, Tan, CustomPotential, ...), got {pot!r}")
+            # The core computes Harmonic and Tan forces from their parameters: a Python override of
+            # V or dV in a subclass of them would be silently ignored by the flow.
+            for base in (Harmonic, Tan):
+                if isinstance(pot, base) and any(getattr(type(pot), f) is not getattr(base, f) for f in ("V", "dV")):
+                    raise ValueError(f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "
+                                     "core would ignore; subclass hovering.Potential (or use CustomPotential) instead")
         if not math.isfinite(self.eps):
             raise ValueError(f"eps must be finite, got {self.eps}")
         if self.eps != 0 and self.coupling is None:
