@@ -10,9 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <sstream>
 #include <string>
 
+#include "detail.hpp"
 #include "hovering/potential.hpp"
 #include "pybind.hpp"
 
@@ -22,13 +22,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// All 17 significant digits, so that a message names the value the core really saw.
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
+using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
 /// Holds the GIL for one call into Python from any thread. On a thread Python does not know (the
 /// return map's workers), the first call creates a Python thread state; it is kept, with one extra
