@@ -20,7 +20,7 @@ using namespace hovering;
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using hovering::detail::kInf;
 
 using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
