@@ -19,7 +19,7 @@ import hovering
 from hovering import Bilinear, Harmonic, Section, StepSystem, Tan, TruncatedFamily, TruncatedMap
 
 V1, V2, H, QW1, QW2 = Harmonic(1.0), Tan(1.4, 0.7), 1.0, -1.0, -0.5
-CODE = {"1": int(hovering.Region.UPPER), "R": int(hovering.Region.RIGHT)}
+CODE = {"1": int(hovering.Region.UPPER), "R": int(hovering.Region.RIGHT), "0": int(hovering.Region.ABOVE), "u": int(hovering.Region.BESIDE)}
 
 
 def compare(eps, K, n_phi=24, n_modes=6):
@@ -39,8 +39,7 @@ def compare(eps, K, n_phi=24, n_modes=6):
     pb, Kb = hovering.to_normal(sec, out.theta, out.I)
     pt, Kt = fam.step(ph, np.full_like(ph, K))
     reg = fam.region(ph, np.full_like(ph, K))
-    free = int(hovering.Region.BESIDE if K >= 0 else hovering.Region.ABOVE)
-    same = np.array([CODE.get(s, free) == r for s, r in zip(out.itinerary, reg)]) & (out.status == 0)
+    same = np.array([CODE.get(s, -2) == r for s, r in zip(out.itinerary, reg)]) & (out.status == 0)
     return dict(same=int(same.sum()), n=n_phi, dphi=float(np.abs(hovering.wrap(pb - pt))[same].max()),
                 dK=float(np.abs(Kb - Kt)[same].max()), b=b)
 

@@ -28,7 +28,7 @@ def _measure_arcs(sec, I, n=720):
         if a != b:
             bds[(a, b)] = boundary(th[k], th[(k + 1) % n] + (2 * np.pi if k + 1 == n else 0.0))
     gap = lambda x, y: (y - x) % (2 * np.pi)  # noqa: E731
-    return gap(bds[("1", "R")], bds[("R", "")]), gap(bds[("", "1")], bds[("1", "R")])
+    return gap(bds[("1", "R")], bds[("R", "0")]), gap(bds[("0", "1")], bds[("1", "R")])
 
 
 def test_arc_lengths_from_the_flow_fix_the_sign_of_tau1():

@@ -81,7 +81,7 @@ def test_measured_arc_truncation_reproduces_the_eps0_flow(sec0, curve0):
     Kp = rng.choice(K[1:-1], 240)
     c = fm.compare_maps(sec0, curve0, fam, ph, Kp)
     assert c.agree.mean() > 0.99  # points within ~1e-12 of a corner curve may land either side
-    assert {"", "R", "1"} <= set(c.region_full[c.agree])
+    assert {"0", "R", "1"} <= set(c.region_full[c.agree])
     assert np.nanmax(np.abs(c.dphi)) < 1e-7
     assert np.nanmax(np.abs(c.dK)) < 1e-10
     p = hovering.onset_parameters(sec0.sys, 1.0)
@@ -109,7 +109,7 @@ def test_remainder_GK_scales_like_eps_K_in_J0():
             np.concatenate([-np.linspace(0.3, 0.0, 31) ** 2, np.linspace(0.01, 0.3, 10)]), forcing=tuple(b))
         for K in (-0.01, -0.005):
             c = fm.compare_maps(sec, curve, m, ph, np.full(ph.shape, K))
-            sel = (c.region_full == "") & np.isfinite(c.GK)
+            sel = (c.region_full == "0") & np.isfinite(c.GK)
             assert sel.sum() > 10
             out[eps, K] = np.max(np.abs(c.GK[sel]))
     for K in (-0.01, -0.005):

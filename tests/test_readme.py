@@ -55,7 +55,7 @@ def test_readme_fullmap_block():
     for code in _python_blocks():
         exec(compile(code, str(README), "exec"), ns)
     c = ns["cmp"]
-    assert c.agree.mean() > 0.95 and {"", "R", "1"} <= set(c.region_full)
+    assert c.agree.mean() > 0.95 and {"0", "R", "1"} <= set(c.region_full)
     assert np.nanmax(np.abs(c.GK)) < 2 * 0.05 * 0.015
     assert np.nanmax(np.abs(c.dphi)) < 2 * 0.05
     np.testing.assert_allclose(ns["curves"].JR + ns["curves"].J0 + ns["curves"].J1, 2 * np.pi, atol=1e-9)

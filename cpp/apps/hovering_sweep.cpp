@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "hovering/truncated_map.hpp"
+#include "hovering/truncated/map.hpp"
 
 namespace {
 

@@ -2,8 +2,8 @@
 #include <cmath>
 #include <memory>
 
-#include "check.hpp"
-#include "hovering/flow.hpp"
+#include "testing.hpp"
+#include "hovering/flow/return_map.hpp"
 
 using namespace hovering;
 
@@ -12,7 +12,7 @@ const double kPi = 3.14159265358979323846;
 double wrap(double x) { return x - 2 * kPi * std::floor((x + kPi) / (2 * kPi)); }
 }  // namespace
 
-int main() {
+TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, msadams", "[flow]") {
     FlowSystem s;
     s.V1 = std::make_shared<Harmonic>(1.0);
     s.V2 = std::make_shared<Tan>(1.4, 0.7);
@@ -35,12 +35,12 @@ int main() {
             const auto z0 = section_point(s, h, th, I);
             const ReturnResult r = return_map(s, z0, o);
             const auto c = section_coordinates(s, r.z.data());
-            CHECK(r.status == FlowStatus::Ok, "status");
-            CHECK(std::fabs(c[1] - I) < 1e-10, "I=%g th=%g: action %.15g changed", I, th, c[1]);
-            CHECK(std::fabs(wrap(c[0] - th - Om)) < 1e-9, "I=%g th=%g: angle %.15g vs %.15g", I, th, c[0], wrap(th + Om));
-            CHECK(std::fabs(r.time - T1) < 1e-9, "return time %.15g vs T1 %.15g", r.time, T1);
-            CHECK(r.energy_error < 1e-10, "energy error %.3g", r.energy_error);
-            CHECK(std::fabs(r.z[1]) < 1e-12 && r.z[0] > 0, "returned onto Sigma_h");
+            CHECKF(r.status == FlowStatus::Ok, "status");
+            CHECKF(std::fabs(c[1] - I) < 1e-10, "I=%g th=%g: action %.15g changed", I, th, c[1]);
+            CHECKF(std::fabs(wrap(c[0] - th - Om)) < 1e-9, "I=%g th=%g: angle %.15g vs %.15g", I, th, c[0], wrap(th + Om));
+            CHECKF(std::fabs(r.time - T1) < 1e-9, "return time %.15g vs T1 %.15g", r.time, T1);
+            CHECKF(r.energy_error < 1e-10, "energy error %.3g", r.energy_error);
+            CHECKF(std::fabs(r.z[1]) < 1e-12 && r.z[0] > 0, "returned onto Sigma_h");
         }
     }
 
@@ -52,22 +52,22 @@ int main() {
         auto y = return_map(s, x, o).z;
         y[3] = -y[3];
         const auto back = return_map(s, y, o).z;
-        CHECK(std::fabs(back[2] - x[2]) < 1e-8 && std::fabs(back[3] + x[3]) < 1e-8 && std::fabs(back[0] - x[0]) < 1e-8,
+        CHECKF(std::fabs(back[2] - x[2]) < 1e-8 && std::fabs(back[3] + x[3]) < 1e-8 && std::fabs(back[0] - x[0]) < 1e-8,
               "time reversal at th=%g: (%.12g, %.12g) vs (%.12g, %.12g)", th, back[2], back[3], x[2], -x[3]);
     }
 
     // Bad input.
-    CHECK_THROWS(section_point(s, h, 0.3, 5.0), "no point of Sigma_h");
-    CHECK_THROWS(section_point(s, h, 4.0, 0.3), "theta must lie in [-pi, pi]");
+    CHECK_INVALID(section_point(s, h, 0.3, 5.0), "no point of Sigma_h");
+    CHECK_INVALID(section_point(s, h, 4.0, 0.3), "theta must lie in [-pi, pi]");
     FlowOptions bad = o;
     bad.stepper = "euler";
-    CHECK_THROWS(return_map(s, section_point(s, h, 0.3, 0.3), bad), "stepper must be one of");
+    CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "stepper must be one of");
     bad = o;
     bad.rtol = 0;
-    CHECK_THROWS(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
+    CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
     bad = o;
     bad.max_impacts = 0;
-    CHECK_THROWS(return_map(s, section_point(s, h, 0.3, 0.3), bad), "max_impacts must be in");
+    CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "max_impacts must be in");
 
     // ---- walls, eps = 0: each itinerary has an exact oracle (partial energies are conserved).
     s.eps = 0.0;
@@ -86,11 +86,12 @@ int main() {
             const auto c = section_coordinates(wl, r.z.data());
             const bool hits = I < I_tan;
             const double T = hits ? oracle_wall_time(I) : s.V1->period(h - e2);
-            CHECK(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : ""), "wall I=%g: itinerary '%s'", I, r.itinerary.c_str());
-            CHECK(std::fabs(r.time - T) < 1e-9, "wall I=%g th=%g: time %.15g vs %.15g", I, th, r.time, T);
-            CHECK(std::fabs(c[1] - I) < 1e-10 && std::fabs(wrap(c[0] - th - s.V2->frequency(e2) * T)) < 1e-9,
+            // The infinite wall: an orbit that reaches q1 = qw1 reflects ('R'); the others never cross it ('u').
+            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "wall I=%g: itinerary '%s'", I, r.itinerary.c_str());
+            CHECKF(std::fabs(r.time - T) < 1e-9, "wall I=%g th=%g: time %.15g vs %.15g", I, th, r.time, T);
+            CHECKF(std::fabs(c[1] - I) < 1e-10 && std::fabs(wrap(c[0] - th - s.V2->frequency(e2) * T)) < 1e-9,
                   "wall I=%g th=%g: (theta, I) off", I, th);
-            CHECK(r.energy_error < 1e-10, "wall energy error %.3g", r.energy_error);
+            CHECKF(r.energy_error < 1e-10, "wall energy error %.3g", r.energy_error);
         }
     }
     // Step: the three regions J_R, J_1, J_0 of thm:regionsJdyn on one circle I < I_tan.
@@ -104,7 +105,7 @@ int main() {
         const ReturnResult r = return_map(sp, section_point(sp, h, th, I), o);
         if (r.status != FlowStatus::Ok) continue;
         const auto c = section_coordinates(sp, r.z.data());
-        CHECK(std::fabs(c[1] - I) < 1e-10, "step: I changed at th=%g ('%s')", th, r.itinerary.c_str());
+        CHECKF(std::fabs(c[1] - I) < 1e-10, "step: I changed at th=%g ('%s')", th, r.itinerary.c_str());
         double T = T1, dth = w2 * T1;
         if (r.itinerary == "R") {
             T = oracle_wall_time(I);
@@ -114,13 +115,15 @@ int main() {
             dth = w2 * T1 + 2 * (kPi - thw);  // eq:Thetaj1
             ++seen_1;
         } else {
-            CHECK(r.itinerary.empty(), "unexpected itinerary '%s'", r.itinerary.c_str());
+            // I < I_tan: every orbit reaches q1 = qw1, so a return without impact crossed it above the step.
+            CHECKF(r.itinerary == "0", "unexpected itinerary '%s'", r.itinerary.c_str());
+            CHECKF(region_of(r.itinerary) == Region::Above, "region of '0'");
             ++seen_0;
         }
-        CHECK(std::fabs(r.time - T) < 1e-9 && std::fabs(wrap(c[0] - th - dth)) < 1e-9,
+        CHECKF(std::fabs(r.time - T) < 1e-9 && std::fabs(wrap(c[0] - th - dth)) < 1e-9,
               "step th=%g '%s': time %.12g vs %.12g, dtheta %.12g vs %.12g", th, r.itinerary.c_str(), r.time, T, wrap(c[0] - th), wrap(dth));
     }
-    CHECK(seen_R > 5 && seen_1 > 1 && seen_0 > 5, "regions seen: R %d, 1 %d, 0 %d", seen_R, seen_1, seen_0);
+    CHECKF(seen_R > 5 && seen_1 > 1 && seen_0 > 5, "regions seen: R %d, 1 %d, 0 %d", seen_R, seen_1, seen_0);
 
     // Grazing: on the tangent circle I = I_tan the orbit touches q1 = qw1; 1e-9 below it every orbit
     // dips ~1e-9 through the wall inside a step (a sign test at step ends misses such dips) and must
@@ -130,9 +133,9 @@ int main() {
         const double th = -kPi + (k + 0.5) * 2 * kPi / 100;
         graze += return_map(wl, section_point(wl, h, th, I_tan), o).status == FlowStatus::Grazing;
         below += return_map(wl, section_point(wl, h, th, I_tan - 1e-9), o).itinerary == "R";
-        above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), o).itinerary.empty();
+        above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), o).itinerary == "u";
     }
-    CHECK(graze == 100 && below == 100 && above == 100, "grazing %d, 1e-9 below reflected %d, above free %d (of 100)", graze, below, above);
+    CHECKF(graze == 100 && below == 100 && above == 100, "grazing %d, 1e-9 below reflected %d, above free %d (of 100)", graze, below, above);
 
     // msadams (GSL's variable-order Adams): the same exact wall answers and near-grazing dips, its
     // events located on an rk8pd extension of each step. Adams' global error runs ~400x its local
@@ -149,12 +152,11 @@ int main() {
             const double dth = s.V2->frequency(e2) * (hits ? 2 * std::acos(wl.qw1 / A1) : s.V1->period(h - e2));
             const ReturnResult r = return_map(wl, section_point(wl, h, th, I), ms);
             const auto c = section_coordinates(wl, r.z.data());
-            CHECK(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : ""), "msadams th=%g I=%g: '%s'", th, I, r.itinerary.c_str());
-            CHECK(std::fabs(wrap(c[0] - th - dth)) < 5e-9, "msadams th=%g I=%g: dtheta error %.3g", th, I, wrap(c[0] - th - dth));
+            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "msadams th=%g I=%g: '%s'", th, I, r.itinerary.c_str());
+            CHECKF(std::fabs(wrap(c[0] - th - dth)) < 5e-9, "msadams th=%g I=%g: dtheta error %.3g", th, I, wrap(c[0] - th - dth));
         }
         ms_below += return_map(wl, section_point(wl, h, th, I_tan - 1e-9), ms).itinerary == "R";
-        ms_above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), ms).itinerary.empty();
+        ms_above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), ms).itinerary == "u";
     }
-    CHECK(ms_below == 40 && ms_above == 40, "msadams: 1e-9 below reflected %d, above free %d (of 40)", ms_below, ms_above);
-    return test_summary("test_flow");
+    CHECKF(ms_below == 40 && ms_above == 40, "msadams: 1e-9 below reflected %d, above free %d (of 40)", ms_below, ms_above);
 }

@@ -4,8 +4,8 @@
 #include <random>
 #include <vector>
 
-#include "check.hpp"
-#include "hovering/truncated_map.hpp"
+#include "testing.hpp"
+#include "hovering/truncated/map.hpp"
 
 using namespace hovering;
 namespace {
@@ -34,7 +34,7 @@ Run run(const TruncatedMap& m, const std::vector<double>& p0, const std::vector<
 }
 }  // namespace
 
-int main() {
+TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, cancellation", "[truncated][iterate]") {
     const double OmegaG = kPi * (std::sqrt(5.0) - 1.0);
     TruncatedMap m = make_truncated_map(0.3, OmegaG, 3 * kPi / 4, 1.0, 0.5, 0.5);
     std::mt19937_64 rng(3);
@@ -45,7 +45,7 @@ int main() {
 
     // Same kernel, 1 vs 2 threads: bit-identical (orbits are independent).
     Run a = run(m, p0, k0, 200, Kernel::Simd, 1), b = run(m, p0, k0, 200, Kernel::Simd, 2);
-    CHECK(a.pf == b.pf && a.kf == b.kf && a.reg == b.reg && a.st == b.st, "thread count changed SIMD results");
+    CHECKF(a.pf == b.pf && a.kf == b.kf && a.reg == b.reg && a.st == b.st, "thread count changed SIMD results");
 
     // SIMD vs scalar over 5 steps: SLEEF sin and libm sin differ by ~1 ulp, so states agree to
     // ~1e-15 per step; 1e-12 allows the ~5 steps of growth. (Longer orbits diverge: the map is chaotic.)
@@ -56,8 +56,8 @@ int main() {
         worst = std::max({worst, std::fabs(wrap_angle(s.pf[i] - v.pf[i])), std::fabs(s.kf[i] - v.kf[i])});
         for (int j = 0; j < 5; ++j) reg_diff += s.reg[i * 5 + j] != v.reg[i * 5 + j];
     }
-    CHECK(worst < 1e-12, "SIMD vs scalar after 5 steps: %.3g", worst);
-    CHECK(reg_diff == 0, "SIMD and scalar regions differ at %d steps", reg_diff);
+    CHECKF(worst < 1e-12, "SIMD vs scalar after 5 steps: %.3g", worst);
+    CHECKF(reg_diff == 0, "SIMD and scalar regions differ at %d steps", reg_diff);
 
     // Recorded orbit = repeated single steps; rotation = mean omega of the recorded steps.
     Run r = run(m, p0, k0, 50, Kernel::Scalar, 2);
@@ -67,15 +67,15 @@ int main() {
         std::int64_t nd = r.done[i];
         for (std::int64_t j = 0; j < nd; ++j) {
             sum += m.rotation(p, k);
-            CHECK(r.reg[i * 50 + j] == static_cast<std::int8_t>(m.region(p, k)), "recorded region");
+            CHECKF(r.reg[i * 50 + j] == static_cast<std::int8_t>(m.region(p, k)), "recorded region");
             auto nx = m.step(p, k);
             p = nx.first; k = nx.second;
             worst_orbit = std::max(worst_orbit, std::fabs(r.op[i * 51 + j + 1] - p) + std::fabs(r.ok[i * 51 + j + 1] - k));
         }
         if (nd > 0) worst_rot = std::max(worst_rot, std::fabs(r.rot[i] - sum / double(nd)));
     }
-    CHECK(worst_orbit == 0.0, "scalar orbit differs from repeated step(): %.3g", worst_orbit);
-    CHECK(worst_rot < 1e-12, "rotation mean off by %.3g", worst_rot);
+    CHECKF(worst_orbit == 0.0, "scalar orbit differs from repeated step(): %.3g", worst_orbit);
+    CHECKF(worst_rot < 1e-12, "rotation mean off by %.3g", worst_rot);
 
     // Escape: an orbit started just above the band floor with a downward kick leaves the band;
     // it stops with Escaped, keeps the escaped image, and the tail of its orbit is NaN.
@@ -90,13 +90,13 @@ int main() {
             if (e.st[i] != static_cast<std::int8_t>(Status::Escaped)) continue;
             ++esc;
             std::int64_t d = e.done[i];
-            CHECK(!(e.kf[i] > lo), "escaped orbit %zu has K=%g inside the band", i, e.kf[i]);
-            if (d < 1000) CHECK(std::isnan(e.op[i * 1001 + d + 1]), "tail must be NaN");
-            if (d < 1000) CHECK(e.reg[i * 1000 + d] == -1, "region tail must be None");
-            CHECK(e.op[i * 1001 + d] == e.pf[i], "last recorded point is the final state");
+            CHECKF(!(e.kf[i] > lo), "escaped orbit %zu has K=%g inside the band", i, e.kf[i]);
+            if (d < 1000) CHECKF(std::isnan(e.op[i * 1001 + d + 1]), "tail must be NaN");
+            if (d < 1000) CHECKF(e.reg[i * 1000 + d] == -1, "region tail must be None");
+            CHECKF(e.op[i * 1001 + d] == e.pf[i], "last recorded point is the final state");
         }
-        CHECK(esc >= 2, "expected escapes near the band floor, got %d", esc);
-        CHECK(e.st.back() == static_cast<std::int8_t>(Status::Escaped) && e.done.back() == 0, "outside start");
+        CHECKF(esc >= 2, "expected escapes near the band floor, got %d", esc);
+        CHECKF(e.st.back() == static_cast<std::int8_t>(Status::Escaped) && e.done.back() == 0, "outside start");
     }
 
     // Exit watch: stay in {Beside, Above}; the first exit step matches a direct scan, in both kernels.
@@ -109,13 +109,13 @@ int main() {
             std::int64_t first = -1;
             for (std::int64_t j = 0; j < w.done[i]; ++j)
                 if (w.reg[i * 300 + j] >= 2) { first = j; break; }
-            CHECK(w.ex[i] == first, "orbit %zu: exit_step %lld vs scan %lld", i, (long long)w.ex[i], (long long)first);
+            CHECKF(w.ex[i] == first, "orbit %zu: exit_step %lld vs scan %lld", i, (long long)w.ex[i], (long long)first);
             if (first >= 0) {
                 ++checked;
-                CHECK(st.st[i] == static_cast<std::int8_t>(Status::Exited) && st.done[i] == first, "stop_on_exit");
+                CHECKF(st.st[i] == static_cast<std::int8_t>(Status::Exited) && st.done[i] == first, "stop_on_exit");
             }
         }
-        CHECK(checked > 20, "too few exits to test: %d", checked);
+        CHECKF(checked > 20, "too few exits to test: %d", checked);
     }
 
     // Cancellation before the start: every orbit Interrupted at step 0, nothing lost or garbage.
@@ -123,22 +123,21 @@ int main() {
     Run c = run(m, p0, k0, 100, Kernel::Simd, 2, 0, false, &cancel);
     bool all_int = true;
     for (std::size_t i = 0; i < n; ++i) all_int &= c.st[i] == static_cast<std::int8_t>(Status::Interrupted) && c.done[i] == 0 && c.pf[i] == p0[i];
-    CHECK(all_int, "cancelled run must report Interrupted with the initial state");
+    CHECKF(all_int, "cancelled run must report Interrupted with the initial state");
 
     // Bad options.
     IterateOptions o; o.n_steps = -1;
     IterateOutput out;
-    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "n_steps must be >= 0");
-    o.n_steps = 1; o.exit_mask = 16;
-    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "exit_mask");
+    CHECK_INVALID(m.iterate(p0.data(), k0.data(), 1, o, out), "n_steps must be >= 0");
+    o.n_steps = 1; o.exit_mask = 1u << kRegionCount;  // region codes are 0 .. kRegionCount - 1
+    CHECK_INVALID(m.iterate(p0.data(), k0.data(), 1, o, out), "exit_mask");
     std::vector<double> pn = {0.0, NAN};
     o.exit_mask = 0;
-    CHECK_THROWS(m.iterate(pn.data(), k0.data(), 2, o, out), "phi0[1] must be finite");
+    CHECK_INVALID(m.iterate(pn.data(), k0.data(), 2, o, out), "phi0[1] must be finite");
     o.n_threads = 1 << 29;  // used to overflow 8 * threads (SIGFPE); now a clear error
-    CHECK_THROWS(m.iterate(p0.data(), k0.data(), 1, o, out), "n_threads must be in [0, 4096]");
+    CHECK_INVALID(m.iterate(p0.data(), k0.data(), 1, o, out), "n_threads must be in [0, 4096]");
     o.n_threads = 0;
     std::vector<double> big = {1e18};
-    CHECK_THROWS(m.iterate(big.data(), k0.data(), 1, o, out), "<= 1e6");
-    CHECK_THROWS(m.step(-1e18, 0.1), "<= 1e6");
-    return test_summary("test_iterate");
+    CHECK_INVALID(m.iterate(big.data(), k0.data(), 1, o, out), "<= 1e6");
+    CHECK_INVALID(m.step(-1e18, 0.1), "<= 1e6");
 }

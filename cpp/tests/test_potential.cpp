@@ -2,8 +2,8 @@
 #include <cmath>
 #include <memory>
 
-#include "check.hpp"
-#include "hovering/potential.hpp"
+#include "testing.hpp"
+#include "hovering/flow/system.hpp"
 
 using namespace hovering;
 
@@ -12,7 +12,7 @@ const double kPi = 3.14159265358979323846;
 double rel(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
 }  // namespace
 
-int main() {
+TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways", "[flow][potential]") {
     // Closed forms against the generic quadrature/root-finding path on the same V: QAWS reaches
     // ~1e-13 here, so 1e-10 relative leaves margin while catching any formula error.
     for (auto base : {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
@@ -22,28 +22,28 @@ int main() {
         for (double h : {0.05, 0.7, 2.5}) {
             auto [a, b] = base->turning_points(h);
             auto [na, nb] = num.turning_points(h);
-            CHECK(rel(a, na) < 1e-12 && rel(b, nb) < 1e-12, "%s turning points at h=%g", base->name().c_str(), h);
-            CHECK(rel(base->period(h), num.period(h)) < 1e-10, "%s period at h=%g: %.15g vs %.15g",
+            CHECKF(rel(a, na) < 1e-12 && rel(b, nb) < 1e-12, "%s turning points at h=%g", base->name().c_str(), h);
+            CHECKF(rel(base->period(h), num.period(h)) < 1e-10, "%s period at h=%g: %.15g vs %.15g",
                   base->name().c_str(), h, base->period(h), num.period(h));
-            CHECK(rel(base->action(h), num.action(h)) < 1e-10, "%s action at h=%g: %.15g vs %.15g",
+            CHECKF(rel(base->action(h), num.action(h)) < 1e-10, "%s action at h=%g: %.15g vs %.15g",
                   base->name().c_str(), h, base->action(h), num.action(h));
-            CHECK(rel(num.energy(num.action(h)), h) < 1e-10, "%s energy(action(h))", base->name().c_str());
+            CHECKF(rel(num.energy(num.action(h)), h) < 1e-10, "%s energy(action(h))", base->name().c_str());
             for (double f : {-0.9, -0.3, 0.0, 0.5}) {
                 const double q = f * b;
-                CHECK(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10, "%s angle_of(%g, %g): %.15g vs %.15g",
+                CHECKF(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10, "%s angle_of(%g, %g): %.15g vs %.15g",
                       base->name().c_str(), q, h, base->angle_of(q, h), num.angle_of(q, h));
             }
             // angle_of_point inverts point_at to rounding, including at the turning points.
             for (double th : {-3.0, -1.0, 0.0, 1e-9, 2.0, 3.14}) {
                 const auto [q, p] = base->point_at(th, h);
-                CHECK(std::fabs(base->angle_of_point(q, p, h) - th) < 1e-12, "%s angle_of_point(point_at(%g))", base->name().c_str(), th);
+                CHECKF(std::fabs(base->angle_of_point(q, p, h) - th) < 1e-12, "%s angle_of_point(point_at(%g))", base->name().c_str(), th);
                 const auto [nq, np] = num.point_at(th, h);
-                CHECK(std::fabs(nq - q) < 1e-9 && std::fabs(np - p) < 1e-9, "%s generic point_at(%g)", base->name().c_str(), th);
+                CHECKF(std::fabs(nq - q) < 1e-9 && std::fabs(np - p) < 1e-9, "%s generic point_at(%g)", base->name().c_str(), th);
             }
             // dH/dI = omega(h): the frequency is the derivative of the energy in the action.
             const double I = base->action(h), dI = 1e-4 * I;
             const double dHdI = (base->energy(I + dI) - base->energy(I - dI)) / (2 * dI);
-            CHECK(rel(dHdI, base->frequency(h)) < 1e-7, "%s dH/dI vs omega", base->name().c_str());
+            CHECKF(rel(dHdI, base->frequency(h)) < 1e-7, "%s dH/dI vs omega", base->name().c_str());
         }
     }
 
@@ -66,12 +66,12 @@ int main() {
         const double fv[] = {f.Omega0, f.tau0, f.tau1, f.lam, f.theta_w, f.I_tan};
         const char* names[] = {"Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan"};
         for (int k = 0; k < 6; ++k) {
-            CHECK(rel(dv[k], qv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs quadrature %.12g", c.a1, c.a2, names[k], dv[k], qv[k]);
-            CHECK(rel(dv[k], fv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs closed form %.12g", c.a1, c.a2, names[k], dv[k], fv[k]);
+            CHECKF(rel(dv[k], qv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs quadrature %.12g", c.a1, c.a2, names[k], dv[k], qv[k]);
+            CHECKF(rel(dv[k], fv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs closed form %.12g", c.a1, c.a2, names[k], dv[k], fv[k]);
         }
         // Harmonic-harmonic: no twist (tau0 = 0), Omega0 = 2 pi omega2 / omega1 (appendix limits).
         if (c.a1 == 0 && c.a2 == 0) {
-            CHECK(std::fabs(d.tau0) < 1e-7 && rel(d.Omega0, 2 * kPi * c.w2 / c.w1) < 1e-12, "harmonic limits");
+            CHECKF(std::fabs(d.tau0) < 1e-7 && rel(d.Omega0, 2 * kPi * c.w2 / c.w1) < 1e-12, "harmonic limits");
         }
         // The appendix as printed: tau0's last term over W1^4 and theta_w = arccos(-...). Where
         // the two differ from the definitions by a clear margin, the definitions win (README).
@@ -79,20 +79,19 @@ int main() {
             const double h1w = V1->V(c.qw1), W1 = std::sqrt(c.w1 * c.w1 + 2 * c.a1 * c.a1 * h1w);
             const double W2 = std::sqrt(c.w2 * c.w2 + 2 * c.a2 * c.a2 * (c.h - h1w));
             const double tau0_printed = (2 * kPi * c.a2 * c.a2 * std::pow(W1, 3) + 2 * kPi * c.a1 * c.a1 * W2 * W2) / std::pow(W1, 4);
-            CHECK(rel(tau0_printed, d.tau0) > 1e-3, "printed tau0 unexpectedly matches");
+            CHECKF(rel(tau0_printed, d.tau0) > 1e-3, "printed tau0 unexpectedly matches");
         }
-        CHECK(std::fabs((kPi - d.theta_w) - d.theta_w) > 1e-3, "printed theta_w (= pi - theta_w) distinguishable");
-        CHECK(d.theta_w > kPi / 2 && d.tau1 > 0, "qw2 < 0: theta_w in (pi/2, pi) and tau1 > 0 (sign tau1 = -sign qw2)");
+        CHECKF(std::fabs((kPi - d.theta_w) - d.theta_w) > 1e-3, "printed theta_w (= pi - theta_w) distinguishable");
+        CHECKF(d.theta_w > kPi / 2 && d.tau1 > 0, "qw2 < 0: theta_w in (pi/2, pi) and tau1 > 0 (sign tau1 = -sign qw2)");
     }
 
     // Bad input.
     Harmonic H(1.0);
     Tan T(1.4, 0.7);
-    CHECK_THROWS(onset_parameters(H, T, -1.0, -0.5, 0.5), "h must exceed the step energy");
-    CHECK_THROWS(onset_parameters(H, T, 1.0, -0.5, 2.0), "qw1 must be < 0");
-    CHECK_THROWS(onset_parameters(H, T, -1.0, -3.0, 2.0), "qw2 must be < 0 and inside the well of V2");
-    CHECK_THROWS(Harmonic(-1.0), "omega must be finite and > 0");
-    CHECK_THROWS(Tan(1.0, NAN), "alpha must be finite and > 0");
-    CHECK_THROWS(H.period(-1.0), "energy must be finite and > 0");
-    return test_summary("test_potential");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, 0.5), "h must exceed the step energy");
+    CHECK_INVALID(onset_parameters(H, T, 1.0, -0.5, 2.0), "qw1 must be < 0");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -3.0, 2.0), "qw2 must be < 0 and inside the well of V2");
+    CHECK_INVALID(Harmonic(-1.0), "omega must be finite and > 0");
+    CHECK_INVALID(Tan(1.0, NAN), "alpha must be finite and > 0");
+    CHECK_INVALID(H.period(-1.0), "energy must be finite and > 0");
 }

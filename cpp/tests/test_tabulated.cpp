@@ -4,15 +4,15 @@
 #include <random>
 #include <vector>
 
-#include "check.hpp"
-#include "hovering/truncated_map.hpp"
+#include "testing.hpp"
+#include "hovering/truncated/map.hpp"
 
 using namespace hovering;
 namespace {
 const double kPi = 3.14159265358979323846;
 }
 
-int main() {
+TEST_CASE("tabulated family equals F_eps on linear tables; any table + odd forcing is reversible", "[truncated]") {
     const double OmegaG = kPi * (std::sqrt(5.0) - 1.0), tw = 3 * kPi / 4, tau0 = 1, tau1 = 0.5, lam = 0.5;
     // Omega and |J_R| are linear in K and |J_1| is linear in sqrt(-K): a natural cubic spline
     // reproduces linear data exactly, so the tabulated family must equal F_eps to rounding.
@@ -26,8 +26,8 @@ int main() {
     }
     TruncatedFamily fam(0.3, TabulatedArcs(K, Om, JR, J1), FourierForcing{{1.0}}, INFINITY);
     TruncatedMap ref = make_truncated_map(0.3, OmegaG, tw, tau0, tau1, lam);
-    CHECK(std::fabs(fam.band().lo - ref.band().lo) < 1e-9, "band lo %.15g vs %.15g", fam.band().lo, ref.band().lo);
-    CHECK(fam.band().hi == 1.0, "band hi is the top of the table, got %g", fam.band().hi);
+    CHECKF(std::fabs(fam.band().lo - ref.band().lo) < 1e-9, "band lo %.15g vs %.15g", fam.band().lo, ref.band().lo);
+    CHECKF(fam.band().hi == 1.0, "band hi is the top of the table, got %g", fam.band().hi);
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> uphi(-kPi, kPi), uK(-3.1, 0.99);
     double worst = 0;
@@ -40,8 +40,8 @@ int main() {
         worst = std::max({worst, std::fabs(wrap_angle(a - c)), std::fabs(b - d)});
     }
     // Regions can differ only within rounding of an arc end: a handful in 20000 at most.
-    CHECK(disagree <= 2, "regions disagree at %d points", disagree);
-    CHECK(worst < 1e-12, "tabulated vs analytic step differ by %.3g", worst);
+    CHECKF(disagree <= 2, "regions disagree at %d points", disagree);
+    CHECKF(worst < 1e-12, "tabulated vs analytic step differ by %.3g", worst);
 
     // A nonlinear table and three Fourier modes: the lemma says any such family is reversible.
     std::vector<double> Om2, JR2, J12;
@@ -62,24 +62,23 @@ int main() {
         auto [rp, rk] = g.step(-p1, k1 - 0.4 * f1);
         worst_rev = std::max({worst_rev, std::fabs(wrap_angle(-rp - phi)), std::fabs(rk - 0.4 * g.forcing().at(rp) - k)});
     }
-    CHECK(worst_inv < 1e-12, "nonlinear family: F^-1 F error %.3g", worst_inv);
-    CHECK(worst_rev < 1e-12, "nonlinear family: R F R error %.3g", worst_rev);
+    CHECKF(worst_inv < 1e-12, "nonlinear family: F^-1 F error %.3g", worst_inv);
+    CHECKF(worst_rev < 1e-12, "nonlinear family: R F R error %.3g", worst_rev);
 
     // Malformed tables.
     std::vector<double> Kbad = K;
     std::swap(Kbad[3], Kbad[4]);
-    CHECK_THROWS(TabulatedArcs(Kbad, Om, JR, J1), "strictly increasing");
+    CHECK_INVALID(TabulatedArcs(Kbad, Om, JR, J1), "strictly increasing");
     std::vector<double> J1bad = J1;
     J1bad[40] = 0.1;  // K = 0 entry
-    CHECK_THROWS(TabulatedArcs(K, Om, JR, J1bad), "J1 must vanish at K = 0");
+    CHECK_INVALID(TabulatedArcs(K, Om, JR, J1bad), "J1 must vanish at K = 0");
     std::vector<double> Kshort(K.begin(), K.end() - 1), Omshort(Om.begin(), Om.end() - 2);
-    CHECK_THROWS(TabulatedArcs(K, Omshort, JR, J1), "same length");
+    CHECK_INVALID(TabulatedArcs(K, Omshort, JR, J1), "same length");
     std::vector<double> Omnan = Om;
     Omnan[5] = NAN;
-    CHECK_THROWS(TabulatedArcs(K, Omnan, JR, J1), "Omega[5] must be finite");
+    CHECK_INVALID(TabulatedArcs(K, Omnan, JR, J1), "Omega[5] must be finite");
     std::vector<double> JRneg = JR;
     for (auto& v : JRneg) v = -1.0;
-    CHECK_THROWS(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY), "no valid band");
-    CHECK_THROWS(TruncatedFamily(0.1, TabulatedArcs(K, Om, JR, J1), FourierForcing{{}}, INFINITY), "at least one sine coefficient");
-    return test_summary("test_tabulated");
+    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY), "no valid band");
+    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JR, J1), FourierForcing{{}}, INFINITY), "at least one sine coefficient");
 }

@@ -3,8 +3,8 @@
 #include <random>
 #include <vector>
 
-#include "check.hpp"
-#include "hovering/truncated_map.hpp"
+#include "testing.hpp"
+#include "hovering/truncated/map.hpp"
 
 using namespace hovering;
 namespace {
@@ -36,36 +36,36 @@ double band_by_scan(double tw, double tau1, double lam) {
 }
 }  // namespace
 
-int main() {
+TEST_CASE("F_eps: band, bad input, exact inverse, reversibility, eps = 0 interval exchange", "[truncated]") {
     // Band: closed form against a scan (step 1e-5 in K, so agreement to 1e-5 is all a scan can give).
     struct P { double tw, tau1, lam; };
     for (P p : {P{3 * kPi / 4, 0.5, 0.5}, P{0.1, 0.5, 0.5}, P{2.0, -0.8, 1.3}, P{1.0, 0.0, 0.7}, P{2.5, 3.0, 0.2}}) {
         TruncatedMap m = make_truncated_map(0.1, 1.0, p.tw, 1.0, p.tau1, p.lam);
         double scan = band_by_scan(p.tw, p.tau1, p.lam);
-        CHECK(std::fabs(m.band().lo - scan) <= 1.01e-5, "tw=%g tau1=%g lam=%g: band lo %.12g vs scan %.12g", p.tw, p.tau1, p.lam, m.band().lo, scan);
-        CHECK(std::isinf(m.band().hi), "hi should be +inf");
+        CHECKF(std::fabs(m.band().lo - scan) <= 1.01e-5, "tw=%g tau1=%g lam=%g: band lo %.12g vs scan %.12g", p.tw, p.tau1, p.lam, m.band().lo, scan);
+        CHECKF(std::isinf(m.band().hi), "hi should be +inf");
     }
     // eq:kmindef would give -min((pi/lam)^2, 2(pi - tw)/tau1) = -11.9 here; |J_0| closes first (typo 3).
-    CHECK(make_truncated_map(0.1, 1.0, 0.1, 1.0, 0.5, 0.5).band().lo > -0.06, "typo-3 case");
+    CHECKF(make_truncated_map(0.1, 1.0, 0.1, 1.0, 0.5, 0.5).band().lo > -0.06, "typo-3 case");
 
     // Bad input names the parameter and the allowed range.
-    CHECK_THROWS(make_truncated_map(0.3, OmegaG, 0.0, 1, 0.5, 0.5), "theta_w must lie in (0, pi)");
-    CHECK_THROWS(make_truncated_map(0.3, OmegaG, kPi, 1, 0.5, 0.5), "theta_w must lie in (0, pi)");
-    CHECK_THROWS(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, 0.0), "lam must be > 0");
-    CHECK_THROWS(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, -1.0), "lam must be > 0");
-    CHECK_THROWS(make_truncated_map(std::nan(""), OmegaG, 1.0, 1, 0.5, 0.5), "eps must be finite");
-    CHECK_THROWS(make_truncated_map(0.3, INFINITY, 1.0, 1, 0.5, 0.5), "Omega0 must be finite");
-    CHECK_THROWS(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, 0.5, -1.0), "K_max must be > 0");
+    CHECK_INVALID(make_truncated_map(0.3, OmegaG, 0.0, 1, 0.5, 0.5), "theta_w must lie in (0, pi)");
+    CHECK_INVALID(make_truncated_map(0.3, OmegaG, kPi, 1, 0.5, 0.5), "theta_w must lie in (0, pi)");
+    CHECK_INVALID(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, 0.0), "lam must be > 0");
+    CHECK_INVALID(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, -1.0), "lam must be > 0");
+    CHECK_INVALID(make_truncated_map(std::nan(""), OmegaG, 1.0, 1, 0.5, 0.5), "eps must be finite");
+    CHECK_INVALID(make_truncated_map(0.3, INFINITY, 1.0, 1, 0.5, 0.5), "Omega0 must be finite");
+    CHECK_INVALID(make_truncated_map(0.3, OmegaG, 1.0, 1, 0.5, 0.5, -1.0), "K_max must be > 0");
     TruncatedMap m = make_truncated_map(0.3, OmegaG, 3 * kPi / 4, 1.0, 0.5, 0.5);
-    CHECK_THROWS(m.step(0.0, -4.0), "outside the band");
-    CHECK_THROWS(m.step(std::nan(""), -1.0), "phi must be finite");
-    CHECK_THROWS(m.region(0.0, INFINITY), "K must be finite");
+    CHECK_INVALID(m.step(0.0, -4.0), "outside the band");
+    CHECK_INVALID(m.step(std::nan(""), -1.0), "phi must be finite");
+    CHECK_INVALID(m.region(0.0, INFINITY), "K must be finite");
 
     // wrap_angle lands in [-pi, pi) even at the edges.
     for (double x : {kPi, -kPi, 3 * kPi, -3 * kPi, std::nextafter(kPi, 0.0), 1e6, -1e6}) {
         double y = wrap_angle(x);
-        CHECK(y >= -kPi && y < kPi, "wrap(%.17g) = %.17g", x, y);
-        CHECK(std::fabs(std::remainder(y - x, 2 * kPi)) < 1e-9, "wrap changed the angle");
+        CHECKF(y >= -kPi && y < kPi, "wrap(%.17g) = %.17g", x, y);
+        CHECKF(std::fabs(std::remainder(y - x, 2 * kPi)) < 1e-9, "wrap changed the angle");
     }
 
     // Exact inverse and reversibility R F R = F^{-1}, R(phi, K) = (-phi, K - eps sin phi), on random
@@ -90,9 +90,9 @@ int main() {
             worst_rev = std::max({worst_rev, std::fabs(wrap_angle(back_phi - phi)), std::fabs(back_K - K)});
             ++tested;
         }
-        CHECK(tested > 99000, "too few points tested: %d", tested);
-        CHECK(worst_inv < 1e-12, "eps=%g: F^-1 F error %.3g", eps, worst_inv);
-        CHECK(worst_rev < 1e-12, "eps=%g: R F R error %.3g", eps, worst_rev);
+        CHECKF(tested > 99000, "too few points tested: %d", tested);
+        CHECKF(worst_inv < 1e-12, "eps=%g: F^-1 F error %.3g", eps, worst_inv);
+        CHECKF(worst_rev < 1e-12, "eps=%g: R F R error %.3g", eps, worst_rev);
     }
 
     // eps = 0: K is invariant and each circle K < 0 is a 3-interval exchange that reverses the
@@ -105,14 +105,13 @@ int main() {
         Region want[3] = {Region::Upper, Region::Right, Region::Above};
         for (int r = 0; r < 3; ++r) {
             double mid = wrap_angle(st[r] + 0.5 * len[r]);
-            CHECK(f0.region(mid, K) == want[r], "K=%g arc %d midpoint region", K, r);
+            CHECKF(f0.region(mid, K) == want[r], "K=%g arc %d midpoint region", K, r);
             auto [pm, km] = f0.step(mid, K);
-            CHECK(km == K, "eps=0 must keep K exactly");
-            CHECK(std::fabs(wrap_angle(pm + mid)) < 1e-12, "K=%g arc %d: image midpoint %.15g != -%.15g", K, r, pm, mid);
+            CHECKF(km == K, "eps=0 must keep K exactly");
+            CHECKF(std::fabs(wrap_angle(pm + mid)) < 1e-12, "K=%g arc %d: image midpoint %.15g != -%.15g", K, r, pm, mid);
             // Endpoints (just inside) map to the reflected endpoints, in reversed order.
             auto [pl, kl] = f0.step(wrap_angle(st[r] + 1e-9), K);
-            CHECK(std::fabs(wrap_angle(pl + st[r] + len[r])) < 1e-8, "left end of arc %d maps to -right end", r);
+            CHECKF(std::fabs(wrap_angle(pl + st[r] + len[r])) < 1e-8, "left end of arc %d maps to -right end", r);
         }
     }
-    return test_summary("test_truncated_map");
 }

@@ -85,7 +85,7 @@ class TangentialCurve:
 
 
 def _labels(sec, curve, phi, K, rtol):
-    """Itinerary of each (phi, K): '' (J_0), 'R', '1', ...; '?' for non-OK statuses."""
+    """Itinerary of each (phi, K): '0' (J_0), 'u' (J_0u), 'R', '1', ...; '?' for non-OK statuses."""
     th, I = curve.from_normal(wrap(phi), K)
     out = sec.return_map(th, I, rtol=rtol, atol=rtol)
     lab = np.array([s if st == FlowStatus.OK else "?" for s, st in zip(out.itinerary, out.status)], dtype=object)
@@ -201,7 +201,7 @@ def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_ph
         hi = np.where(left, hi, mid)
     bnd = wrap(0.5 * (lo + hi))
 
-    names = {("R", ""): "phi_R0", ("", "1"): "phi_01", ("1", "R"): "phi_1R"}
+    names = {("R", "0"): "phi_R0", ("0", "1"): "phi_01", ("1", "R"): "phi_1R"}
     res = {v: np.full(nK, np.nan) for v in names.values()}
     for i, x, y, b in zip(bk, la, lb, bnd):
         key = names.get((x, y))
@@ -210,7 +210,7 @@ def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_ph
     p = onset_parameters(sec.sys, sec.h)
     Omega, spread = np.full(nK, np.nan), np.full(nK, np.nan)
     for i in range(nK):
-        zero = lab[i] == ""
+        zero = (lab[i] == "0") | (lab[i] == "u")  # no impact: J_0, or J_0u on circles K >= 0
         if zero.any():
             ref = p.Omega0 + p.tau0 * Ks[i]
             lifted = ref + wrap(rot[i][zero] - wrap(ref))
@@ -219,7 +219,7 @@ def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_ph
     JR = np.where(Ks < 0, gap(res["phi_1R"], res["phi_R0"]), 0.0)
     J0 = np.where(Ks < 0, gap(res["phi_R0"], res["phi_01"]), _TWO_PI)
     J1 = np.where(Ks < 0, gap(res["phi_01"], res["phi_1R"]), 0.0)
-    other = np.array([np.sum(~np.isin(lab[i], ["", "R", "1"])) for i in range(nK)])
+    other = np.array([np.sum(~np.isin(lab[i], ["0", "u", "R", "1"])) for i in range(nK)])
     return CornerCurves(K=Ks, JR=JR, J0=J0, J1=J1, Omega=Omega, Omega_spread=spread, other=other,
                         resolution=_TWO_PI / n_phi / 2.0 ** bisections, **res)
 
@@ -282,8 +282,8 @@ class MapComparison:
         The remainder ``G_K = K_bar - K - eps f(phi_bar)`` of eq:returnmapfull at the flow's image
         (dK also contains eps (f(phi_bar_trunc) - f(phi_bar)) = O(eps dphi)); NaN like dK.
     region_full, region_trunc : ndarray
-        Itinerary of the flow ('' J_0 / J_0u, 'R', '1', '?' = not OK) and region letter of the
-        truncated map ('' for J_0 / J_0u, 'R', '1').
+        Itinerary of the flow ('0' J_0, 'u' J_0u, 'R', '1', '?' = not OK) and the same letter for
+        the truncated map's region.
     """
 
     phi: np.ndarray
@@ -328,8 +328,8 @@ def compare_maps(sec: Section, curve: TangentialCurve, trunc, phi, K, rtol: floa
     pb, Kb = curve.to_normal(out.theta, out.I)
     pt, Kt = trunc.step(ph, Kk)
     reg = np.asarray(trunc.region(ph, Kk))
-    letter = {int(Region.RIGHT): "R", int(Region.UPPER): "1"}
-    rt = np.array([letter.get(int(r), "") for r in reg], dtype=object)
+    letter = {int(Region.RIGHT): "R", int(Region.UPPER): "1", int(Region.ABOVE): "0", int(Region.BESIDE): "u"}
+    rt = np.array([letter[int(r)] for r in reg], dtype=object)
     ok = (lab == rt)
     dphi = np.where(ok, wrap(np.asarray(pt) - pb), np.nan)
     dK = np.where(ok, np.asarray(Kt) - Kb, np.nan)

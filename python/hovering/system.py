@@ -229,7 +229,9 @@ class ReturnMapResult:
     time : ndarray
         Return times.
     itinerary : list of str
-        Impacts in order ('R', '1', ...); empty strings for the smooth flow.
+        Impacts in order ('R', '1', 'R1', ...); without impact '0' if the segment crossed
+        q1 = qw1 above the step (J_0), 'u' if it never crossed it (J_0u); '' for the smooth flow
+        (geometry "none") and for returns that did not end OK without impact.
     status : ndarray of int8
         Per-orbit :class:`FlowStatus`.
     energy_error : ndarray
@@ -401,7 +403,7 @@ def tangential_curve(sec: "Section", theta, rtol: float = 1e-12, bracket: float 
 
     def crosses(I):
         out = ws.return_map(th, I, rtol=rtol, atol=rtol * 1e-2)
-        return np.array([len(s) > 0 for s in out.itinerary]) | (out.status == FlowStatus.GRAZING)
+        return np.array(["R" in s for s in out.itinerary]) | (out.status == FlowStatus.GRAZING)
 
     if not (crosses(lo).all() and not crosses(hi).any()):
         raise ValueError(f"the tangency is not inside I_tan (1 +- {bracket}) for every theta; raise bracket")

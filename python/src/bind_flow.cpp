@@ -1,10 +1,5 @@
 // Bindings of the flow: section coordinates and the batch return map (threads, GIL released).
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
-
-#include "hovering/flow.hpp"
+#include "hovering/flow/return_map.hpp"
 #include "pybind.hpp"
 
 using namespace hovering;
@@ -77,47 +72,17 @@ void register_flow(py::module_& m) {
               py::array_t<std::int8_t> status(n);
               py::array_t<std::int64_t> steps(n);
               std::vector<std::string> itin{static_cast<std::size_t>(n)};
-              const double* in = z0.data();
-              double *zo = z.mutable_data(), *to = time.mutable_data(), *eo = err.mutable_data();
-              auto* so = status.mutable_data();
-              auto* no = steps.mutable_data();
+              ReturnMapsOutput out;
+              out.z = z.mutable_data();
+              out.time = time.mutable_data();
+              out.energy_error = err.mutable_data();
+              out.status = status.mutable_data();
+              out.steps = steps.mutable_data();
+              out.itinerary = itin.data();
               {
                   // Orbits are independent and write disjoint slots of freshly allocated arrays.
                   py::gil_scoped_release release;
-                  std::atomic<py::ssize_t> next{0};
-                  std::exception_ptr error;
-                  std::mutex mu;
-                  auto work = [&] {
-                      try {
-                          for (py::ssize_t i; (i = next.fetch_add(1)) < n;) {
-                              const std::array<double, 4> a{in[4 * i], in[4 * i + 1], in[4 * i + 2], in[4 * i + 3]};
-                              const ReturnResult r = return_map(s, a, o);
-                              for (int k = 0; k < 4; ++k) zo[4 * i + k] = r.z[std::size_t(k)];
-                              to[i] = r.time;
-                              eo[i] = r.energy_error;
-                              so[i] = static_cast<std::int8_t>(r.status);
-                              no[i] = r.steps;
-                              itin[std::size_t(i)] = r.itinerary;
-                          }
-                      } catch (...) {
-                          std::lock_guard<std::mutex> lock(mu);
-                          if (!error) error = std::current_exception();
-                          next.store(n);
-                      }
-                  };
-                  int t = n_threads > 0 ? n_threads : int(std::thread::hardware_concurrency());
-                  t = int(std::max<py::ssize_t>(1, std::min<py::ssize_t>(t, n)));
-                  std::vector<std::thread> pool;
-                  try {
-                      for (int k = 1; k < t; ++k) pool.emplace_back(work);
-                  } catch (...) {
-                      next.store(n);
-                      for (auto& th : pool) th.join();
-                      throw;
-                  }
-                  work();
-                  for (auto& th : pool) th.join();
-                  if (error) std::rethrow_exception(error);
+                  return_maps(s, z0.data(), n, o, n_threads, nullptr, out);
               }
               py::dict d;
               d["z"] = z;

@@ -12,8 +12,8 @@
 #include <memory>
 #include <string>
 
-#include "detail.hpp"
-#include "hovering/potential.hpp"
+#include "hovering/detail/common.hpp"
+#include "hovering/flow/system.hpp"
 #include "pybind.hpp"
 
 using namespace hovering;

@@ -13,7 +13,7 @@
 #include <mutex>
 #include <thread>
 
-#include "hovering/truncated_map.hpp"
+#include "hovering/truncated/map.hpp"
 #include "pybind.hpp"
 
 using namespace hovering;

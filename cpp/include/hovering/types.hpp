@@ -1,25 +1,36 @@
 #pragma once
-// Vocabulary shared by every model of the return map: region labels and per-orbit outcomes.
+// Vocabulary shared by both models of the return map (the truncated map and the flow): region
+// labels and per-orbit outcomes.
 
 #include <cstdint>
 
 namespace hovering {
 
-/// Region of the tangential band an orbit point lies in (paper labels 0u, 0, 1, R).
+/// Region of Sigma_h a point lies in: which way its segment passes the step before it returns.
 enum class Region : std::int8_t {
-    None = -1,   ///< no step was taken from this point (orbit already stopped)
-    Beside = 0,  ///< J_0u: K >= 0, passes beside the step without crossing q1 = qw1
-    Above = 1,   ///< J_0: hovers above the step without impact
+    None = -1,   ///< no return was taken from this point (the orbit had stopped)
+    Beside = 0,  ///< J_0u: passes beside the step without crossing q1 = qw1
+    Above = 1,   ///< J_0: crosses q1 = qw1 above the step, no impact ("hovers")
     Upper = 2,   ///< J_1: one impact on the upper wall of the step
     Right = 3,   ///< J_R: one impact on the right wall of the step
+    Multi = 4,   ///< more than one impact (the flow only: outside the tangential band)
 };
 
-/// Per-orbit outcome of a batch iteration; numerical outcomes, never exceptions.
+/// Number of region codes >= 0 (bits of a region mask).
+inline constexpr int kRegionCount = 5;
+
+/// Per-orbit outcome of a batch iteration (either model); numerical outcomes, never exceptions.
 enum class Status : std::int8_t {
-    Ok = 0,           ///< all requested steps were taken
-    Escaped = 1,      ///< the orbit left the band where the map is defined
-    Exited = 2,       ///< the orbit left the requested set of regions and stop_on_exit was set
-    Interrupted = 3,  ///< the caller cancelled the run; the state reached so far is kept
+    Ok = 0,            ///< all requested steps were taken
+    Escaped = 1,       ///< the orbit left the band where the map is defined
+    Exited = 2,        ///< the orbit left the requested set of regions and stop_on_exit was set
+    Interrupted = 3,   ///< the caller cancelled the run; the state reached so far is kept
+    Corner = 4,        ///< flow: the orbit hit the corner of the step (the flow stops there)
+    Grazing = 5,       ///< flow: the orbit touched a wall tangentially (a singular return)
+    StepLimit = 6,     ///< flow: one return needed more integrator steps than allowed
+    NonFinite = 7,     ///< flow: the state became non-finite (a runaway orbit)
+    ImpactLimit = 8,   ///< flow: more impacts in one return than allowed (chattering)
+    OffSection = 9,    ///< flow: the point is not on Sigma_h at this energy
 };
 
 /// Which implementation of one map step a batch iteration uses.

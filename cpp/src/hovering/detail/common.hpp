@@ -1,5 +1,6 @@
 #pragma once
-// Helpers shared by the core's translation units (not installed, not public API).
+// Helpers shared by the core's translation units (not installed, not public API): messages that
+// name the bad value, GSL error handling, and the root finders of event location and potentials.
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
@@ -17,6 +18,9 @@ namespace hovering::detail {
 
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr double kTwoPi = 2.0 * kPi;
+inline constexpr double kInvTwoPi = 1.0 / kTwoPi;
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A double with all 17 significant digits, for error messages that name the offending value.
 inline std::string fmt(double v) {
@@ -28,6 +32,23 @@ inline std::string fmt(double v) {
 
 /// Throw the bad-input exception (pybind11 turns it into ValueError).
 [[noreturn]] inline void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+
+/// Throw unless v is finite, naming it.
+inline void require_finite(double v, const std::string& name) {
+    if (!std::isfinite(v)) bad(name + " must be finite, got " + fmt(v));
+}
+
+/// Beyond this, 2 pi floor(phi / 2 pi) is off by more than one turn in double precision, so an
+/// angle cannot be wrapped meaningfully; 1e6 keeps the wrapping error below 1e-9.
+inline constexpr double kMaxAngle = 1e6;
+
+/// Throw unless v is a finite angle that can be wrapped accurately (|v| <= kMaxAngle), naming it.
+inline void require_angle(double v, const std::string& name) {
+    require_finite(v, name);
+    if (!(std::fabs(v) <= kMaxAngle))
+        bad(name + " must be an angle with |" + name + "| <= 1e6 (larger angles cannot be wrapped to [-pi, pi) "
+            "accurately in double precision), got " + fmt(v));
+}
 
 /// Turn GSL's abort-on-error handler off once: every GSL call here validates its inputs first,
 /// and a library must never abort its host process.

@@ -14,92 +14,11 @@
 #include <utility>
 #include <vector>
 
+#include "hovering/truncated/arcs.hpp"
+#include "hovering/truncated/forcing.hpp"
 #include "hovering/types.hpp"
 
 namespace hovering {
-
-/// Omega(K), |J_R|(K), |J_1|(K) at one K (the arcs vanish for K >= 0).
-struct ArcLengths {
-    double Omega;  ///< rotation of J_0 / J_0u
-    double JR;     ///< length of J_R (0 for K >= 0)
-    double J1;     ///< length of J_1 (0 for K >= 0)
-};
-
-/// Open interval of K on which a map is defined.
-struct Band {
-    double lo;  ///< lower end (< 0)
-    double hi;  ///< upper end (> 0, may be +inf)
-};
-
-/// Arcs of the paper's F_eps: Omega = Omega0 + tau0 K, |J_R| = 2(pi - theta_w) + tau1 K, |J_1| = 2 lam sqrt(-K).
-struct AnalyticArcs {
-    double Omega0, theta_w, tau0, tau1, lam;
-
-    /// Validate the parameters; throws std::invalid_argument naming the bad one and its range.
-    void validate() const;
-    /// Arc lengths at one K.
-    ArcLengths at(double K) const;
-    /// Lowest K of the band: all three arc lengths stay in (0, 2 pi) on (lo, 0).
-    double band_lo() const;
-};
-
-/// A smooth function sampled on an increasing grid, interpolated by a GSL natural cubic spline.
-class Spline {
-public:
-    /// Build from x (strictly increasing, >= 3 points) and y (same size, finite).
-    Spline(std::vector<double> x, std::vector<double> y, const char* name);
-    ~Spline();
-    Spline(const Spline&);
-    Spline& operator=(const Spline&) = delete;
-    /// Value at x (x inside [x.front(), x.back()]); thread-safe (no shared accelerator).
-    double operator()(double x) const;
-    /// Smallest grid abscissa.
-    double xmin() const { return x_.front(); }
-    /// Largest grid abscissa.
-    double xmax() const { return x_.back(); }
-    /// The grid abscissae.
-    const std::vector<double>& x() const { return x_; }
-    /// The grid values.
-    const std::vector<double>& y() const { return y_; }
-
-private:
-    std::vector<double> x_, y_;
-    const char* name_;
-    void* spline_;  // gsl_spline*, opaque so that GSL headers stay out of the public interface
-};
-
-/// Arcs given as tables: Omega on a K grid, |J_R| on its K <= 0 part, |J_1| interpolated in sqrt(-K).
-///
-/// |J_1| is smooth in sqrt(-K), not in K (thm:cornersing), so it is splined in s = sqrt(-K);
-/// |J_R| and Omega are smooth in K.
-struct TabulatedArcs {
-    /// Build from a K grid (strictly increasing, containing 0 and >= 3 points with K <= 0).
-    TabulatedArcs(const std::vector<double>& K, const std::vector<double>& Omega,
-                  const std::vector<double>& JR, const std::vector<double>& J1);
-    /// Arc lengths at one K (K inside the grid).
-    ArcLengths at(double K) const;
-    /// Lowest K of the grid range on which all arc lengths stay in (0, 2 pi) up to K = 0.
-    double band_lo() const;
-    /// Largest K of the grid.
-    double kmax() const { return Omega.xmax(); }
-
-    Spline Omega;  ///< Omega(K) on the whole grid
-    Spline JR;     ///< |J_R|(K) for K <= 0
-    Spline J1s;    ///< |J_1| as a function of s = sqrt(-K)
-};
-
-/// f(phi) = sin(phi): the first Fourier mode, the paper's choice for F_eps.
-struct SineForcing {
-    /// f at one angle.
-    double at(double phi) const;
-};
-
-/// f(phi) = sum_k b_k sin(k phi), k = 1..n: any odd forcing, which keeps the map reversible.
-struct FourierForcing {
-    std::vector<double> b;  ///< b[0] multiplies sin(phi), b[1] sin(2 phi), ...
-    /// f at one angle.
-    double at(double phi) const;
-};
 
 /// Where a batch iteration writes; a null pointer means "not recorded".
 ///
@@ -128,8 +47,6 @@ struct IterateOptions {
     bool fast_sin = false;
     const std::atomic<bool>* cancel = nullptr;  ///< polled every few steps; set it to stop early
 };
-
-struct OrbitSource;  // work queue of a batch iteration (internal)
 
 /// One member of the truncated family; see the file comment.
 template <class Arcs, class Forcing>
@@ -168,11 +85,6 @@ public:
 
 private:
     void check_point(double phi, double K, const char* who) const;
-    template <bool Fast>
-    void run_simd(const double* phi0, const double* K0, OrbitSource& src,
-                  const IterateOptions& opt, const IterateOutput& out) const;
-    void run_scalar(const double* phi0, const double* K0, OrbitSource& src,
-                    const IterateOptions& opt, const IterateOutput& out) const;
 
     double eps_;
     Arcs arcs_;

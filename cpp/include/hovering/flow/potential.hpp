@@ -110,26 +110,4 @@ private:
     std::shared_ptr<const Potential> base_;
 };
 
-/// The onset parameters of sec:parametersdef at energy h (eq:omega0ofI .. eq:deftau1).
-struct OnsetParameters {
-    double Omega0;   ///< rotation of non-impacting orbits at I_tan (eq:omega0ofI)
-    double tau0;     ///< dOmega0/dI at I_tan (eq:deftau0)
-    double tau1;     ///< -2 dtheta_w/dI at I_tan (eq:deftau1)
-    double lam;      ///< sqrt(2 omega_2^3) / |V_1'(qw1)| (eq:deflambdah)
-    double theta_w;  ///< angle of the corner height qw2 on the tangent circle (eq:thw)
-    double I_tan;    ///< action of the tangent circle, H_2(I_tan) = h - V_1(qw1) (eq:Itan)
-};
-
-/// Onset parameters from the definitions: derivatives of Omega0(I) and theta_w(I) by central
-/// differences (step chosen for the ~1e-12 accuracy of the underlying quantities).
-/// Throws std::invalid_argument if h is not above the step energy V1(qw1) + V2(qw2) or a wall lies
-/// outside its potential's well.
-OnsetParameters onset_parameters(const Potential& V1, const Potential& V2, double qw1, double qw2, double h);
-
-/// The closed forms of the appendix (sec:calculationofparam) for Tan/harmonic pairs, with the two
-/// corrections the definitions require (see the README): tau0's last term over W1^3 (printed W1^4),
-/// and theta_w = arccos(+sqrt(alpha^2 + omega^2 / (2 h2)) sin(alpha qw2) / alpha) (printed with a minus).
-OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2,
-                                             double qw1, double qw2, double h);
-
 }  // namespace hovering

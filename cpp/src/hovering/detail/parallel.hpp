@@ -1,0 +1,95 @@
+#pragma once
+// The core's one thread pool: batch iterations of the truncated map, batch return maps and the
+// flow map's iterations all hand out independent orbits to workers through a WorkQueue.
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+namespace hovering::detail {
+
+/// Largest thread count a caller may ask for (0 means one per hardware thread).
+inline constexpr int kMaxThreads = 4096;
+
+/// Indices [0, n) handed out in blocks from one shared counter (lock-free).
+struct WorkQueue {
+    std::atomic<std::int64_t> next{0};
+    std::int64_t n = 0;      ///< number of items
+    std::int64_t block = 1;  ///< items taken per visit to the shared counter
+    WorkQueue(std::int64_t n_items, std::int64_t block_size) : n(n_items), block(std::max<std::int64_t>(1, block_size)) {}
+    /// Hand out nothing more (cancellation, or a worker failed).
+    void stop() { next.store(n); }
+};
+
+/// One worker's view of a WorkQueue: pops its block item by item.
+struct WorkCursor {
+    WorkQueue& q;
+    std::int64_t cur = 0, end = 0;
+    explicit WorkCursor(WorkQueue& queue) : q(queue) {}
+    /// Next item index; false when the queue is exhausted.
+    bool pop(std::int64_t& i) {
+        if (cur == end) {
+            cur = q.next.fetch_add(q.block);
+            if (cur >= q.n) {
+                cur = end = q.n;
+                return false;
+            }
+            end = std::min(q.n, cur + q.block);
+        }
+        i = cur++;
+        return true;
+    }
+};
+
+/// Worker threads for a batch: `requested` (0 = all hardware threads), at least 1, at most `useful`.
+inline int worker_count(int requested, std::int64_t useful) {
+    std::int64_t t = requested > 0 ? requested : std::int64_t(std::thread::hardware_concurrency());
+    return int(std::clamp<std::int64_t>(t, 1, std::max<std::int64_t>(1, useful)));
+}
+
+/// Block size that keeps workers balanced when items take very different times (early exit):
+/// about 8 blocks per worker, at most `cap` items each.
+inline std::int64_t balanced_block(std::int64_t n, int threads, std::int64_t cap) {
+    return std::clamp<std::int64_t>((n + 8 * std::int64_t(threads) - 1) / (8 * std::int64_t(threads)), 1, cap);
+}
+
+/// Run body(cursor) on `threads` workers, the calling thread being one of them. The first
+/// exception a worker throws stops the queue (the others drain no more work) and is rethrown once
+/// all have returned; a thread the system refuses to start is reported the same way, with a hint.
+template <class Body>
+void run_workers(int threads, WorkQueue& q, Body&& body) {
+    std::exception_ptr error;
+    std::mutex mu;
+    auto work = [&] {
+        try {
+            WorkCursor c(q);
+            body(c);
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(mu);
+            if (!error) error = std::current_exception();
+            q.stop();
+        }
+    };
+    std::vector<std::thread> pool;
+    pool.reserve(std::size_t(std::max(0, threads - 1)));
+    try {
+        for (int k = 1; k < threads; ++k) pool.emplace_back(work);
+    } catch (const std::system_error& e) {
+        q.stop();
+        for (auto& t : pool) t.join();
+        throw std::runtime_error("could not start worker thread " + std::to_string(pool.size() + 2) + " of " +
+                                 std::to_string(threads) + " (" + e.what() + "): ask for fewer threads (n_threads)");
+    }
+    work();
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+}
+
+}  // namespace hovering::detail

@@ -1,0 +1,61 @@
+#pragma once
+// GSL odeiv2 stepping of one orbit (internal): an error-controlled step, and the continuous
+// extension "one stepper step of length tau from the step's start" on which events are located.
+
+#include <gsl/gsl_odeiv2.h>
+
+#include <string>
+
+#include "hovering/flow/field.hpp"
+#include "hovering/flow/return_map.hpp"
+
+namespace hovering::detail {
+
+/// The GSL stepper type of a name; throws std::invalid_argument naming the allowed ones.
+const gsl_odeiv2_step_type* stepper_type(const std::string& name);
+
+/// Owns the GSL objects of one integration, reused from return to return by one worker.
+///
+/// For one-step methods the adaptive loop drives GSL's stepper and step-size control directly
+/// instead of gsl_odeiv2_evolve_apply: the evolve object evaluates the field at both ends of every
+/// step, while the end derivative of one step is the start derivative of the next (13 instead of
+/// 14 evaluations per rk8pd step), and the event search needs exactly those two. The multistep
+/// msadams needs GSL's driver (it reads the control through it) and its history cannot restart
+/// inside a step, so its events are located on an rk8pd extension of the step, subdivided until
+/// rk8pd's own error estimate meets the tolerances.
+class Integrator {
+public:
+    Integrator(const FlowSystem& s, const FlowOptions& o);
+    ~Integrator();
+    Integrator(const Integrator&) = delete;
+    Integrator& operator=(const Integrator&) = delete;
+
+    /// The field (with its auxiliary variables) this integrator steps.
+    const Field& field() const { return field_; }
+    /// State dimension (4 plus one per Tan potential).
+    int dim() const { return field_.dim; }
+    /// Forget the step history (a new orbit, or a restart after an impact).
+    void restart();
+    /// One error-controlled step from (y, d = field(y)) with trial length *h (<= hmax): on return
+    /// y, d hold the new state and its derivative, *h_done the length taken, *h the proposal for
+    /// the next step. Rejected trials shrink *h and retry from the same state. false: the step
+    /// size underflowed or the stepper failed (non-finite state); y is then unspecified.
+    bool advance(double* y, double* d, double* h, double hmax, double* h_done);
+    /// Before an event search on [0, h] from y0 (msadams only: sizes the rk8pd extension).
+    void prepare_extension(const double* y0, const double* d0, double h);
+    /// The continuous extension of the current step at length dt from y0 (derivative d0).
+    void exact(const double* y0, const double* d0, double dt, double* y1);
+
+private:
+    Field field_;
+    gsl_odeiv2_system sys_;
+    gsl_odeiv2_step* step_ = nullptr;
+    gsl_odeiv2_control* control_ = nullptr;
+    gsl_odeiv2_driver* driver_ = nullptr;  // msadams only: owns step, control and evolve
+    gsl_odeiv2_step* ext_ = nullptr;       // msadams only: rk8pd for event extensions
+    int ext_sub_ = 1;                      // substeps of the extension
+    double t_ms_ = 0;                      // msadams: running time (its history is in time)
+    double atol_, rtol_;
+};
+
+}  // namespace hovering::detail

@@ -1,0 +1,89 @@
+// The return map to Sigma_h: one return, and batches of returns on the core's thread pool.
+
+#include "hovering/flow/return_map.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "hovering/detail/common.hpp"
+#include "hovering/detail/parallel.hpp"
+#include "hovering/flow/tracer.hpp"
+
+namespace hovering {
+
+using detail::bad;
+using detail::kNaN;
+
+Status orbit_status(FlowStatus s) {
+    switch (s) {
+        case FlowStatus::Ok: return Status::Ok;
+        case FlowStatus::Corner: return Status::Corner;
+        case FlowStatus::Grazing: return Status::Grazing;
+        case FlowStatus::StepLimit: return Status::StepLimit;
+        case FlowStatus::NonFinite: return Status::NonFinite;
+        case FlowStatus::ImpactLimit: return Status::ImpactLimit;
+        case FlowStatus::OffSection: return Status::OffSection;
+        case FlowStatus::Interrupted: return Status::Interrupted;
+    }
+    return Status::NonFinite;
+}
+
+Region region_of(const std::string& itinerary) {
+    if (itinerary.size() > 1) return Region::Multi;
+    if (itinerary == "u") return Region::Beside;
+    if (itinerary == "0") return Region::Above;
+    if (itinerary == "1") return Region::Upper;
+    if (itinerary == "R") return Region::Right;
+    return Region::None;
+}
+
+ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, const FlowOptions& opt) {
+    detail::gsl_quiet();
+    opt.validate();
+    s.validate();
+    detail::Tracer tracer(s, opt);
+    return tracer.trace(z0);
+}
+
+void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
+                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out) {
+    detail::gsl_quiet();
+    opt.validate();
+    s.validate();
+    if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
+    if (n_threads < 0 || n_threads > detail::kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(n_threads));
+    if (n == 0) return;
+    auto write = [&](std::int64_t i, const ReturnResult& r) {
+        for (int k = 0; k < 4; ++k)
+            if (out.z) out.z[4 * i + k] = r.status == FlowStatus::OffSection ? kNaN : r.z[std::size_t(k)];
+        if (out.time) out.time[i] = r.time;
+        if (out.status) out.status[i] = static_cast<std::int8_t>(r.status);
+        if (out.region) out.region[i] = static_cast<std::int8_t>(r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None);
+        if (out.energy_error) out.energy_error[i] = r.energy_error;
+        if (out.steps) out.steps[i] = r.steps;
+        if (out.itinerary) out.itinerary[i] = r.itinerary;
+    };
+    const int threads = detail::worker_count(n_threads, n);
+    detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
+    detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
+        detail::Tracer tracer(s, opt);
+        for (std::int64_t i; cur.pop(i);) {
+            const std::array<double, 4> a{z0[4 * i], z0[4 * i + 1], z0[4 * i + 2], z0[4 * i + 3]};
+            ReturnResult r;
+            if (cancel && cancel->load(std::memory_order_relaxed)) {
+                r.z = a;
+                r.status = FlowStatus::Interrupted;
+            } else if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]) && std::isfinite(a[3]))) {
+                r.z = a;
+                r.status = FlowStatus::OffSection;
+            } else {
+                r = tracer.trace(a, false, cancel);
+            }
+            write(i, r);
+        }
+    });
+}
+
+}  // namespace hovering

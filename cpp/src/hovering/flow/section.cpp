@@ -1,0 +1,96 @@
+// Points of Sigma_h from section coordinates and back, and the options of the return map.
+
+#include <cmath>
+#include <string>
+
+#include "hovering/detail/common.hpp"
+#include "hovering/flow/integrator.hpp"
+#include "hovering/flow/return_map.hpp"
+
+namespace hovering {
+
+using detail::bad;
+using detail::fmt;
+using detail::kPi;
+
+void FlowOptions::validate() const {
+    detail::stepper_type(stepper);
+    if (!(rtol > 0 && rtol < 1)) bad("rtol must lie in (0, 1), got " + fmt(rtol));
+    if (!(atol > 0 && std::isfinite(atol))) bad("atol must be finite and > 0, got " + fmt(atol));
+    if (!(event_tol > 0 && std::isfinite(event_tol))) bad("event_tol must be finite and > 0, got " + fmt(event_tol));
+    if (max_steps < 1) bad("max_steps must be >= 1, got " + std::to_string(max_steps));
+    if (max_impacts < 1 || max_impacts > 1000000) bad("max_impacts must be in [1, 1000000], got " + std::to_string(max_impacts));
+    if (!(grazing_tol >= 0 && std::isfinite(grazing_tol))) bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
+    if (!(corner_tol >= 0 && std::isfinite(corner_tol))) bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
+}
+
+bool try_section_point(const FlowSystem& s, double h, double theta, double I, std::array<double, 4>& z,
+                       std::string* why) {
+    if (!std::isfinite(h)) bad("h must be finite, got " + fmt(h));
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad("theta must lie in [-pi, pi], got " + fmt(theta));
+    if (!std::isfinite(I)) bad("I must be finite, got " + fmt(I));
+    auto fail = [&](const std::string& msg) {
+        if (why) *why = msg;
+        return false;
+    };
+    if (!(I > 0)) return fail("no point of Sigma_h at I = " + fmt(I) + ": actions are > 0");
+    const double e2 = s.V2->energy(I);
+    const auto [q2, p2] = s.V2->point_at(theta, e2);
+    // p1 = 0: V1(q1) + eps Vc(q1, q2) = h - H2; the root with q1 > 0 (near q1's maximum).
+    const double rest = h - e2;
+    auto F = [&](double q1) { return s.V1->V(q1) + (s.eps != 0 ? s.eps * s.coupling.value(q1, q2) : 0.0) - rest; };
+    if (!(F(0.0) < 0))
+        return fail("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): h - H2(I) = " +
+                    fmt(rest) + " leaves no energy for oscillator 1 (h must exceed H2(I) = " + fmt(e2) + ")");
+    const double lim = s.V1->q_limit();
+    double lo = 0, hi = std::isfinite(lim) ? 0.5 * lim : 1.0;
+    for (int k = 0; F(hi) < 0; ++k) {
+        if (k > 200) return fail("no point of Sigma_h: V1 + eps Vc never reaches h - H2(I) = " + fmt(rest));
+        lo = hi;
+        hi = std::isfinite(lim) ? lim - 0.5 * (lim - hi) : 2 * hi;
+    }
+    // Newton on F (F' = V1' + eps dVc/dq1 > 0 on the bracket's right part), kept inside the
+    // bracket by bisection: ~5 iterations instead of ~55 bisections (1.6 us per point before).
+    auto dF = [&](double q1) { return s.V1->dV(q1) + (s.eps != 0 ? s.eps * s.coupling.gradient(q1, q2)[0] : 0.0); };
+    double q = 0.5 * (lo + hi);
+    for (int it = 0; it < 200 && hi - lo > 1e-16 * hi; ++it) {
+        const double f = F(q);
+        if (f == 0) {
+            lo = hi = q;
+            break;
+        }
+        (f < 0 ? lo : hi) = q;
+        const double d = dF(q);
+        double qn = d > 0 ? q - f / d : 0.5 * (lo + hi);
+        if (!(qn > lo && qn < hi)) qn = 0.5 * (lo + hi);
+        if (std::fabs(qn - q) <= 1e-16 * std::fabs(q)) {
+            q = qn;
+            break;
+        }
+        q = qn;
+    }
+    const std::array<double, 4> p{q, 0.0, q2, p2};
+    double dz[4];
+    s.rhs(p.data(), dz);
+    if (!(dz[1] < 0))
+        return fail("the point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + ") has dp1/dt = " +
+                    fmt(dz[1]) + " >= 0 (Sigma_h needs dp1/dt < 0)");
+    z = p;
+    return true;
+}
+
+std::array<double, 4> section_point(const FlowSystem& s, double h, double theta, double I) {
+    std::array<double, 4> z{};
+    std::string why;
+    if (!try_section_point(s, h, theta, I, z, &why)) bad(why);
+    return z;
+}
+
+std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) {
+    const double e2 = 0.5 * z[3] * z[3] + s.V2->V(z[2]);
+    double th = s.V2->angle_of_point(z[2], z[3], e2);
+    if (th >= kPi) th -= 2 * kPi;  // [-pi, pi)
+    return {th, s.V2->action(e2)};
+}
+
+}  // namespace hovering

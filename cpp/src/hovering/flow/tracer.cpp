@@ -1,0 +1,255 @@
+// The return loop: adaptive GSL steps, events located on exact stepper steps, reflections.
+//
+// Events (section crossing, wall crossings, a wall distance's minimum inside a step): first guess
+// on the cubic Hermite interpolant of the accepted step (values and derivatives at both ends),
+// then Newton iterations on exact single steps of the stepper itself from the step's start, so the
+// event state carries the stepper's accuracy, not the interpolant's. A candidate that provably
+// cannot matter is not located at all: a quintic Hermite interpolant (positions, velocities and
+// accelerations at both ends, all known) bounds a coordinate over the step, with the distance to
+// the cubic one as its error estimate; a minimum that stays clear of a wall, a crossing of the
+// line q2 = qw2 beside the step, or a crossing of q1 = qw1 well above it costs nothing.
+
+#include "hovering/flow/tracer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hovering/detail/common.hpp"
+
+namespace hovering::detail {
+
+namespace {
+
+// Lower bound of a coordinate q over a step of length h, from q, q' and q'' at both ends.
+double lower_bound(double q0, double v0, double a0, double q1, double v1, double a1, double h) {
+    const double d0 = h * v0, d1 = h * v1, c0 = h * h * a0, c1 = h * h * a1;
+    double lo = std::min(q0, q1), dev = 0;
+    for (int k = 1; k < 16; ++k) {
+        const double s = k / 16.0, s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
+        const double quintic = q0 * (1 - 10 * s3 + 15 * s4 - 6 * s5) + d0 * (s - 6 * s3 + 8 * s4 - 3 * s5) +
+                               c0 * (0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5) + c1 * (0.5 * s3 - s4 + 0.5 * s5) +
+                               d1 * (-4 * s3 + 7 * s4 - 3 * s5) + q1 * (10 * s3 - 15 * s4 + 6 * s5);
+        const double cubic = q0 * (2 * s3 - 3 * s2 + 1) + d0 * (s3 - 2 * s2 + s) + q1 * (-2 * s3 + 3 * s2) +
+                             d1 * (s3 - s2);
+        lo = std::min(lo, quintic);
+        dev = std::max(dev, std::fabs(quintic - cubic));
+    }
+    // 4x the cubic's estimated error covers the quintic's own (O(h^2) smaller); the last term
+    // bounds how far the quintic dips between the 1/16 samples (|q''| h^2 / 8 per 1/16^2).
+    const double between = h * h * std::max(std::fabs(a0), std::fabs(a1)) / 1024.0;
+    return lo - 4 * dev - between - 1e-12 * (1 + std::fabs(q0));
+}
+
+// Root of y[idx](tau) - off on [0, hi] (values of opposite signs), where y(tau) is one step of
+// the stepper of length tau from y0: a continuous extension of the accepted step with the
+// stepper's own accuracy. The first guess is the root of the cubic Hermite interpolant through
+// y0, y1 = y(hi) and their derivatives d0, d1; Newton's method on exact steps (d/dtau y[idx] is
+// rhs[idx] of the stepped state, to the stepper's accuracy) then converges in ~2 steps. The last
+// correction delta (|delta| <= sqrt(time_tol)) moves the state along its derivative, leaving an
+// error ~ delta^2 |z''| / 2 ~ time_tol |z''| / 2.
+double locate(Integrator& in, const double* y0, const double* d0, const double* y1, const double* d1, int idx,
+              double off, double hi, double time_tol, double* yout) {
+    const int n = in.dim();
+    const double f0 = y0[idx] - off, f1 = y1[idx] - off;
+    if (f0 == 0) {
+        for (int i = 0; i < n; ++i) yout[i] = y0[i];
+        return 0.0;
+    }
+    if (f1 == 0) {
+        for (int i = 0; i < n; ++i) yout[i] = y1[i];
+        return hi;
+    }
+    const double guess = hermite_root(f0, d0[idx], f1, d1[idx], hi);
+    in.prepare_extension(y0, d0, hi);
+    double dy[kMaxDim];
+    auto fdf = [&](double tau, double* f, double* df) {
+        in.exact(y0, d0, tau, yout);
+        in.field()(yout, dy);
+        *f = yout[idx] - off;
+        *df = dy[idx];
+    };
+    double delta = 0;
+    double tau = newton_bracketed(fdf, 0.0, f0 > 0, hi, guess, std::sqrt(time_tol), &delta);
+    if (delta != 0 && tau + delta >= 0 && tau + delta <= hi && std::fabs(delta) <= std::sqrt(time_tol)) {
+        tau += delta;
+        for (int i = 0; i < n; ++i) yout[i] += delta * dy[i];
+    }
+    return tau;
+}
+
+}  // namespace
+
+Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) { cands_.reserve(8); }
+
+ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
+    const FlowSystem& s = s_;
+    const FlowOptions& opt = o_;
+    const int n = in_.dim();
+    const Field& field = in_.field();
+    ReturnResult r;
+    const double H0 = s.energy(z0.data());
+    double y[kMaxDim] = {z0[0], z0[1], z0[2], z0[3]}, t = 0;
+    field.sync_aux(y);
+    in_.restart();
+    // Step bound: a fraction of the shorter oscillator period, so one step never holds both a
+    // minimum and a maximum of q1 or q2 (two sign changes of p would cancel); 1/8 leaves a factor 4
+    // for the O(eps) period shifts of the coupled flow.
+    const double T1 = s.V1->period(std::max(1e-12, 0.5 * y[1] * y[1] + s.V1->V(y[0])));
+    const double T2 = s.V2->period(std::max(1e-12, 0.5 * y[3] * y[3] + s.V2->V(y[2])));
+    const double hmax = 0.125 * std::min(T1, T2);
+    double dt = 1e-3 * hmax;
+    double dy[kMaxDim];
+    field(y, dy);
+    bool seen_negative = false, armed = first_crossing, crossed = false;
+    const bool right = s.geometry != Geometry::None, upper = s.geometry == Geometry::Step;
+    const bool is_step = s.geometry == Geometry::Step;
+    bool done = false;
+    while (!done) {
+        if (r.steps >= opt.max_steps) {
+            r.status = FlowStatus::StepLimit;
+            break;
+        }
+        if (cancel && (r.steps & 255) == 255 && cancel->load(std::memory_order_relaxed)) {
+            r.status = FlowStatus::Interrupted;
+            break;
+        }
+        double y0[kMaxDim], d0[kMaxDim];
+        for (int i = 0; i < n; ++i) {
+            y0[i] = y[i];
+            d0[i] = dy[i];
+        }
+        const double t0 = t;
+        double h = 0;
+        const bool ok = in_.advance(y, dy, &dt, hmax, &h);
+        ++r.steps;
+        if (!ok) {
+            for (int i = 0; i < n; ++i) y[i] = y0[i];
+            r.status = FlowStatus::NonFinite;
+            break;
+        }
+        t = t0 + h;
+        const double* d1 = dy;
+        // Lower bounds of q1 and q2 over the step, computed when an event candidate needs them.
+        double lb[2] = {kNaN, kNaN};
+        auto bound = [&](int qi) {
+            double& b = lb[qi / 2];
+            if (std::isnan(b)) b = lower_bound(y0[qi], y0[qi + 1], d0[qi + 1], y[qi], y[qi + 1], d1[qi + 1], h);
+            return b;
+        };
+        // Whether the wall of coordinate gi cannot be present anywhere on this step: the upper
+        // wall needs q1 < qw1, the step's right wall q2 < qw2.
+        auto wall_absent = [&](int gi) {
+            if (!is_step) return false;
+            return gi == 2 ? bound(0) > s.qw1 + opt.corner_tol : bound(2) > s.qw2 + opt.corner_tol;
+        };
+
+        // Candidate events of this step, each located on exact steps from y0.
+        cands_.clear();
+        auto wall = [&](int gi, double off, Ev cross, Ev graze) {
+            const int pi = gi + 1;
+            const double g0 = y0[gi] - off, g1 = y[gi] - off;
+            Candidate c{};
+            if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
+                if (wall_absent(gi)) {
+                    crossed = crossed || gi == 0;  // q1 = qw1 crossed above the step
+                    return;
+                }
+                c.kind = cross;
+                c.tau = locate(in_, y0, d0, y, d1, gi, off, h, opt.event_tol, c.y);
+                cands_.push_back(c);
+            } else if (g0 > 0 && g1 > 0 && y0[pi] < 0 && y[pi] > 0) {
+                // Turning inside the step: the minimum of g (p = 0) may dip through the wall even
+                // though g > 0 at both ends (a near-grazing impact a sign test would miss).
+                if (bound(gi) - off > opt.grazing_tol || (gi == 2 && wall_absent(2))) return;
+                double ym[kMaxDim], dm[kMaxDim];
+                const double tm = locate(in_, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
+                const double gm = ym[gi] - off;
+                if (gm < -opt.grazing_tol) {
+                    c.kind = cross;
+                    field(ym, dm);
+                    c.tau = locate(in_, y0, d0, ym, dm, gi, off, tm, opt.event_tol, c.y);
+                    cands_.push_back(c);
+                } else if (gm <= opt.grazing_tol) {
+                    c.kind = graze;
+                    c.tau = tm;
+                    for (int i = 0; i < n; ++i) c.y[i] = ym[i];
+                    cands_.push_back(c);
+                }
+            }
+        };
+        if (right) wall(0, s.qw1, Ev::Right, Ev::GrazeRight);
+        if (upper) wall(2, s.qw2, Ev::Upper, Ev::GrazeUpper);
+        if (armed && y0[1] > 0 && y[1] <= 0) {
+            Candidate c{};
+            c.kind = Ev::Section;
+            c.tau = locate(in_, y0, d0, y, d1, 1, 0.0, h, opt.event_tol, c.y);
+            cands_.push_back(c);
+        }
+        std::sort(cands_.begin(), cands_.end(), [](const Candidate& a, const Candidate& b) { return a.tau < b.tau; });
+
+        for (const Candidate& c : cands_) {
+            auto stop = [&](FlowStatus status) {
+                for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = c.y[i];
+                r.time = t0 + c.tau;
+                r.status = status;
+                done = true;
+            };
+            if (c.kind == Ev::Section) {
+                stop(FlowStatus::Ok);
+                break;
+            }
+            const bool is_right = c.kind == Ev::Right || c.kind == Ev::GrazeRight;
+            // The other coordinate decides whether the wall is there: the right wall spans
+            // q2 < qw2 (all q2 for the infinite wall), the upper wall q1 < qw1.
+            const double other = is_right ? c.y[2] - s.qw2 : c.y[0] - s.qw1;
+            const bool has_wall = is_right ? (!is_step || other < 0) : other < 0;
+            if (is_step && std::fabs(other) <= opt.corner_tol && (c.kind == Ev::Right || c.kind == Ev::Upper)) {
+                stop(FlowStatus::Corner);
+                break;
+            }
+            if (!has_wall) {  // crossed the wall's line beside / above the step
+                crossed = crossed || (is_right && c.kind == Ev::Right);
+                continue;
+            }
+            if (c.kind == Ev::GrazeRight || c.kind == Ev::GrazeUpper) {
+                stop(FlowStatus::Grazing);
+                break;
+            }
+            if (r.itinerary.size() >= std::size_t(opt.max_impacts)) {
+                stop(FlowStatus::ImpactLimit);
+                break;
+            }
+            // Elastic reflection (eq:R1, eq:R2), placed exactly on the wall so that the restart
+            // (g = 0, moving away) cannot find the same impact again.
+            for (int i = 0; i < n; ++i) y[i] = c.y[i];
+            if (is_right) {
+                y[0] = s.qw1;
+                y[1] = -y[1];
+                r.itinerary += 'R';
+            } else {
+                y[2] = s.qw2;
+                y[3] = -y[3];
+                r.itinerary += '1';
+            }
+            field.sync_aux(y);
+            t = t0 + c.tau;
+            field(y, dy);
+            in_.restart();
+            break;
+        }
+        if (done) break;
+        // A return passes q1's minimum (p1 from - to +, or a right-wall reflection) and then its
+        // maximum (p1 from + to -). Arming the section only after the minimum makes a start with
+        // p1 = +-1e-14 (a point computed on Sigma_h) safe from being taken for its own return.
+        seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
+        armed = armed || (seen_negative && y[1] > 0);
+    }
+    if (!done)
+        for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
+    if (r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None)
+        r.itinerary = crossed ? "0" : "u";
+    r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
+    return r;
+}
+
+}  // namespace hovering::detail

@@ -1,0 +1,389 @@
+// Batch iteration of the truncated family: the SIMD lane kernel (Eigen packets + SLEEF sin), the
+// scalar reference kernel, and MapCore::iterate on the core's thread pool. Compiled with
+// -fno-trapping-math -fno-math-errno (see CMakeLists.txt): without them GCC will not if-convert
+// Eigen's select() chains or inline sqrt, and the lane kernel falls back to scalar code. Neither
+// flag changes IEEE results.
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "hovering/detail/common.hpp"
+#include "hovering/detail/parallel.hpp"
+#include "hovering/detail/simd.hpp"
+#include "hovering/truncated/classify.hpp"
+#include "hovering/truncated/map.hpp"
+
+namespace hovering {
+
+namespace {
+
+using detail::bad;
+using detail::classify;
+using detail::Classified;
+using detail::kInvTwoPi;
+using detail::kNaN;
+using detail::kPi;
+using detail::kTwoPi;
+using detail::Packet;
+using detail::psin;
+using detail::WorkCursor;
+using detail::kW;
+namespace ei = Eigen::internal;
+
+// Arc lengths of a packet of heights: packet arithmetic for the analytic model, in the same
+// operation order as AnalyticArcs::at so that both kernels round alike ...
+inline void arcs_packet(const AnalyticArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
+    const Packet zero = ei::pset1<Packet>(0.0);
+    Om = ei::padd(ei::pset1<Packet>(a.Omega0), ei::pmul(ei::pset1<Packet>(a.tau0), k));
+    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), ei::psqrt(ei::pmax(ei::pnegate(k), zero)));
+    JR = ei::pand(ei::pcmp_lt(k, zero),
+                  ei::padd(ei::pset1<Packet>(2.0 * (kPi - a.theta_w)), ei::pmul(ei::pset1<Packet>(a.tau1), k)));
+}
+
+// ... and lane by lane for tables (spline lookups are gathers; this model is not the hot path).
+inline void arcs_packet(const TabulatedArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
+    alignas(64) double kk[kW], o[kW], r[kW], l[kW];
+    ei::pstore(kk, k);
+    for (int w = 0; w < kW; ++w) {
+        const ArcLengths x = a.at(kk[w]);
+        o[w] = x.Omega;
+        r[w] = x.JR;
+        l[w] = x.J1;
+    }
+    Om = ei::pload<Packet>(o);
+    JR = ei::pload<Packet>(r);
+    J1 = ei::pload<Packet>(l);
+}
+
+template <bool Fast>
+inline Packet force_packet(const SineForcing&, const Packet& p) { return psin<Fast>(p); }
+
+template <bool Fast>
+inline Packet force_packet(const FourierForcing& f, const Packet& p) {
+    Packet acc = ei::pset1<Packet>(0.0);
+    for (std::size_t k = 0; k < f.b.size(); ++k)
+        if (f.b[k] != 0.0)
+            acc = ei::padd(acc, ei::pmul(ei::pset1<Packet>(f.b[k]), psin<Fast>(ei::pmul(ei::pset1<Packet>(double(k + 1)), p))));
+    return acc;
+}
+
+// ------------------------------------------------------------------ batch iteration
+
+// Writes an orbit's outputs once it stops, and the NaN / None tail of its recorded arrays.
+struct Finisher {
+    const IterateOptions& opt;
+    const IterateOutput& out;
+    void start(std::int64_t i, double phi, double K) const {
+        if (out.orbit_phi) out.orbit_phi[i * (opt.n_steps + 1)] = phi;
+        if (out.orbit_K) out.orbit_K[i * (opt.n_steps + 1)] = K;
+        if (out.exit_step) out.exit_step[i] = -1;
+    }
+    void operator()(std::int64_t i, double phi, double K, double rotsum, std::int64_t steps,
+                    Status st) const {
+        const std::int64_t ns = opt.n_steps;
+        if (out.phi_final) out.phi_final[i] = phi;
+        if (out.K_final) out.K_final[i] = K;
+        if (out.rotation) out.rotation[i] = steps > 0 ? rotsum / double(steps) : kNaN;
+        if (out.status) out.status[i] = static_cast<std::int8_t>(st);
+        if (out.steps_done) out.steps_done[i] = steps;
+        if (out.orbit_phi)
+            std::fill(out.orbit_phi + i * (ns + 1) + steps + 1, out.orbit_phi + (i + 1) * (ns + 1), kNaN);
+        if (out.orbit_K)
+            std::fill(out.orbit_K + i * (ns + 1) + steps + 1, out.orbit_K + (i + 1) * (ns + 1), kNaN);
+        if (out.regions)
+            std::fill(out.regions + i * ns + steps, out.regions + (i + 1) * ns,
+                      static_cast<std::int8_t>(Region::None));
+    }
+};
+
+bool cancelled(const IterateOptions& opt) {
+    return opt.cancel && opt.cancel->load(std::memory_order_relaxed);
+}
+
+// Packets in flight per worker: several independent dependency chains hide the latency of one
+// step (sqrt, floor, sin) while the whole state stays in registers / L1.
+constexpr int kP = 8;
+constexpr int kLanes = kP * kW;
+
+template <bool Fast, class A, class F>
+void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
+              const IterateOptions& opt, const IterateOutput& out) {
+    // Lane kernel on Eigen packets: kLanes orbits are stepped together; an orbit that stops frees
+    // its lane, which is refilled from the source at once, so the vectors stay full even when
+    // orbits stop at very different times (early exit). Per-lane bookkeeping happens on a rare
+    // path that unpacks the packets into lane arrays and packs them back.
+    const Finisher finish{opt, out};
+    const std::int64_t ns = opt.n_steps;
+    const double lo = m.band().lo, hi = m.band().hi;
+    const bool watch = opt.exit_mask != 0;
+    const bool need_reg = watch || out.regions;  // region codes are only built when read
+    const Packet zero = ei::pset1<Packet>(0.0), one = ei::pset1<Packet>(1.0), two = ei::pset1<Packet>(2.0),
+                 three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
+                 twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
+                 half = ei::pset1<Packet>(0.5), eps = ei::pset1<Packet>(m.eps()), plo = ei::pset1<Packet>(lo),
+                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero);
+    Packet allow[4];
+    for (int r = 0; r < 4; ++r) allow[r] = (opt.exit_mask >> r) & 1u ? all : zero;
+
+    Packet phi[kP], K[kP], rot[kP], live[kP], fresh[kP], reg[kP], omega[kP];
+    alignas(64) double lphi[kLanes], lK[kLanes], lrot[kLanes], llive[kLanes], lfresh[kLanes], lreg[kLanes];
+    std::int64_t idx[kLanes], start[kLanes];
+    std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
+
+    auto unpack = [&] {
+        for (int q = 0; q < kP; ++q) {
+            ei::pstore(lphi + q * kW, phi[q]);
+            ei::pstore(lK + q * kW, K[q]);
+            ei::pstore(lrot + q * kW, rot[q]);
+            ei::pstore(llive + q * kW, live[q]);
+            ei::pstore(lfresh + q * kW, fresh[q]);
+        }
+    };
+    auto pack = [&] {
+        for (int q = 0; q < kP; ++q) {
+            phi[q] = ei::pload<Packet>(lphi + q * kW);
+            K[q] = ei::pload<Packet>(lK + q * kW);
+            rot[q] = ei::pload<Packet>(lrot + q * kW);
+            live[q] = ei::pload<Packet>(llive + q * kW);
+            fresh[q] = ei::pload<Packet>(lfresh + q * kW);
+        }
+    };
+    const double on = [] { double x; const std::uint64_t b = ~std::uint64_t(0); std::memcpy(&x, &b, 8); return x; }();
+    auto is_live = [&](int j) { return std::memcmp(&llive[j], &on, 8) == 0; };
+    // Put the next orbit that starts inside the band into lane j (orbits starting outside finish
+    // at once); with no work left the lane computes a harmless point that is ignored everywhere.
+    auto fill = [&](int j) {
+        for (std::int64_t i; src.pop(i);) {
+            finish.start(i, phi0[i], K0[i]);
+            if (!(K0[i] > lo && K0[i] < hi)) {
+                finish(i, phi0[i], K0[i], 0.0, 0, Status::Escaped);
+                continue;
+            }
+            if (ns == 0) {
+                finish(i, phi0[i], K0[i], 0.0, 0, Status::Ok);
+                continue;
+            }
+            lphi[j] = phi0[i];
+            lK[j] = K0[i];
+            lrot[j] = 0.0;
+            llive[j] = on;
+            lfresh[j] = on;  // not yet reported as leaving the watched regions
+            idx[j] = i;
+            start[j] = it;
+            return true;
+        }
+        lphi[j] = 0.0;
+        lK[j] = 0.0;
+        lrot[j] = 0.0;
+        llive[j] = 0.0;
+        lfresh[j] = 0.0;
+        return false;
+    };
+    int nlive = 0;
+    for (int j = 0; j < kLanes; ++j) nlive += fill(j);
+    pack();
+    auto next_completion = [&] {
+        std::int64_t c = ns;
+        for (int j = 0; j < kLanes; ++j)
+            if (is_live(j)) c = std::min(c, ns - (it - start[j]));
+        return c;
+    };
+    std::int64_t countdown = next_completion();
+
+    while (nlive > 0) {
+        if ((it & 63) == 0 && cancelled(opt)) {
+            unpack();
+            for (int j = 0; j < kLanes; ++j)
+                if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted);
+            for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
+                finish.start(i, phi0[i], K0[i]);
+                const bool inside = K0[i] > lo && K0[i] < hi;
+                finish(i, phi0[i], K0[i], 0.0, 0, inside ? Status::Interrupted : Status::Escaped);
+            }
+            return;
+        }
+        // Classify every lane: region code and rotation omega_a (same arithmetic as classify()).
+        Packet leaving = zero;
+        for (int q = 0; q < kP; ++q) {
+            Packet Om, JR, J1;
+            arcs_packet(m.arcs(), K[q], Om, JR, J1);
+            Packet d = ei::psub(phi[q], ei::psub(pi, ei::pmul(half, ei::padd(ei::padd(Om, JR), J1))));
+            d = ei::psub(d, ei::pmul(twopi, ei::pfloor(ei::pmul(d, inv2pi))));
+            const Packet neg = ei::pcmp_lt(K[q], zero);
+            const Packet up = ei::pand(neg, ei::pcmp_lt(d, J1));
+            const Packet rt = ei::pandnot(ei::pand(neg, ei::pcmp_lt(d, ei::padd(J1, JR))), up);
+            omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
+            if (!need_reg) continue;
+            reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
+            if (watch) {
+                const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
+                                  ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
+                                  ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
+                leaving = ei::por(leaving, ei::pandnot(ei::pand(live[q], fresh[q]), ok));
+            }
+        }
+        if (watch && ei::predux_any(leaving)) {
+            unpack();
+            for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
+            bool refilled = false;
+            for (int j = 0; j < kLanes; ++j) {
+                if (!is_live(j) || std::memcmp(&lfresh[j], &on, 8) != 0) continue;
+                if ((opt.exit_mask >> int(lreg[j])) & 1u) continue;
+                if (out.exit_step) out.exit_step[idx[j]] = it - start[j];
+                lfresh[j] = 0.0;
+                if (opt.stop_on_exit) {
+                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Exited);
+                    nlive -= !fill(j);
+                    refilled = true;
+                }
+            }
+            pack();
+            if (refilled) {  // refilled lanes need their own classification
+                countdown = next_completion();
+                continue;
+            }
+        }
+        if (out.regions) {
+            for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
+            ei::pstore(llive, live[0]);  // lane liveness is only read here and on the rare path
+            for (int q = 1; q < kP; ++q) ei::pstore(llive + q * kW, live[q]);
+            for (int j = 0; j < kLanes; ++j)
+                if (is_live(j)) out.regions[idx[j] * ns + (it - start[j])] = static_cast<std::int8_t>(lreg[j]);
+        }
+        // Step: rotate, wrap to [-pi, pi), kick.
+        Packet outside = zero;
+        for (int q = 0; q < kP; ++q) {
+            rot[q] = ei::padd(rot[q], omega[q]);
+            Packet p = ei::padd(phi[q], omega[q]);
+            p = ei::psub(p, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(p, pi), inv2pi))));
+            p = ei::pselect(ei::pcmp_le(pi, p), ei::psub(p, twopi), p);
+            p = ei::pselect(ei::pcmp_lt(p, mpi), ei::padd(p, twopi), p);
+            phi[q] = p;
+            K[q] = ei::padd(K[q], ei::pmul(eps, force_packet<Fast>(m.forcing(), p)));
+            const Packet inside = ei::pand(ei::pcmp_lt(plo, K[q]), ei::pcmp_lt(K[q], phi_));
+            outside = ei::por(outside, ei::pandnot(live[q], inside));
+        }
+        ++it;
+        --countdown;
+        if (out.orbit_phi || out.orbit_K) {
+            unpack();
+            for (int j = 0; j < kLanes; ++j) {
+                if (!is_live(j)) continue;
+                const std::int64_t at = idx[j] * (ns + 1) + (it - start[j]);
+                if (out.orbit_phi) out.orbit_phi[at] = lphi[j];
+                if (out.orbit_K) out.orbit_K[at] = lK[j];
+            }
+        }
+        if (countdown == 0 || ei::predux_any(outside)) {
+            unpack();
+            for (int j = 0; j < kLanes; ++j) {
+                if (!is_live(j)) continue;
+                if (!(lK[j] > lo && lK[j] < hi))
+                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Escaped);
+                else if (it - start[j] == ns)
+                    finish(idx[j], lphi[j], lK[j], lrot[j], ns, Status::Ok);
+                else
+                    continue;
+                nlive -= !fill(j);
+            }
+            pack();
+            countdown = next_completion();
+        }
+    }
+}
+
+template <class A, class F>
+void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
+                const IterateOptions& opt, const IterateOutput& out) {
+    const Finisher finish{opt, out};
+    const std::int64_t ns = opt.n_steps;
+    for (std::int64_t i; src.pop(i);) {
+        double phi = phi0[i], K = K0[i], rot = 0.0;
+        finish.start(i, phi, K);
+        bool reported = false;
+        std::int64_t n = 0;
+        Status st = Status::Ok;
+        if (!(K > m.band().lo && K < m.band().hi)) {
+            finish(i, phi, K, 0.0, 0, Status::Escaped);
+            continue;
+        }
+        for (; n < ns; ++n) {
+            if ((n & 63) == 0 && cancelled(opt)) {
+                st = Status::Interrupted;
+                break;
+            }
+            const Classified c = classify(phi, K, m.arcs().at(K));
+            if (opt.exit_mask && !reported && !((opt.exit_mask >> int(c.region)) & 1u)) {
+                if (out.exit_step) out.exit_step[i] = n;
+                reported = true;
+                if (opt.stop_on_exit) {
+                    st = Status::Exited;
+                    break;
+                }
+            }
+            if (out.regions) out.regions[i * ns + n] = static_cast<std::int8_t>(c.region);
+            rot += c.omega;
+            phi = wrap_angle(phi + c.omega);
+            K += m.eps() * m.forcing().at(phi);
+            if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
+            if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
+            if (!(K > m.band().lo && K < m.band().hi)) {
+                st = Status::Escaped;
+                ++n;
+                break;
+            }
+        }
+        finish(i, phi, K, rot, n, st);
+    }
+}
+
+}  // namespace
+
+bool simd_is_avx2() {
+#if defined(__AVX2__)
+    return true;
+#else
+    return false;
+#endif
+}
+
+template <class A, class F>
+void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n,
+                            const IterateOptions& opt, const IterateOutput& out) const {
+    if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
+    if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
+    if (opt.exit_mask >= (1u << kRegionCount))
+        bad("exit_mask must be a set of region codes 0.." + std::to_string(kRegionCount - 1) + " (a bit mask < " +
+            std::to_string(1u << kRegionCount) + "), got " + std::to_string(opt.exit_mask));
+    if (opt.stop_on_exit && opt.exit_mask == 0u)
+        bad("stop_on_exit needs a non-empty set of regions to stay in");
+    if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(opt.n_threads));
+    for (std::int64_t i = 0; i < n; ++i) {
+        detail::require_angle(phi0[i], "phi0[" + std::to_string(i) + "]");
+        detail::require_finite(K0[i], "K0[" + std::to_string(i) + "]");
+    }
+    if (n == 0) return;
+    // A worker needs at least a lane-block's worth of orbits to fill its vectors; small blocks
+    // keep workers balanced when orbits stop at different times.
+    const int threads = detail::worker_count(opt.n_threads, (n + kLanes - 1) / kLanes);
+    detail::WorkQueue queue(n, detail::balanced_block(n, threads, 256));
+    detail::run_workers(threads, queue, [&](WorkCursor& src) {
+        if (opt.kernel == Kernel::Simd && opt.fast_sin)
+            run_simd<true>(*this, phi0, K0, src, opt, out);
+        else if (opt.kernel == Kernel::Simd)
+            run_simd<false>(*this, phi0, K0, src, opt, out);
+        else
+            run_scalar(*this, phi0, K0, src, opt, out);
+    });
+}
+
+template void MapCore<AnalyticArcs, SineForcing>::iterate(const double*, const double*, std::int64_t,
+                                                          const IterateOptions&, const IterateOutput&) const;
+template void MapCore<TabulatedArcs, FourierForcing>::iterate(const double*, const double*, std::int64_t,
+                                                              const IterateOptions&, const IterateOutput&) const;
+
+}  // namespace hovering

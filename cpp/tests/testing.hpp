@@ -1,0 +1,48 @@
+#pragma once
+// Shared by the C++ tests (Catch2 v2 from Debian): printf-style context for checks that run in
+// loops, and "throws std::invalid_argument whose message names ..." for the bad-input tests.
+
+#include <catch2/catch.hpp>
+
+#include <cstdarg>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace hovering_test {
+
+/// printf into a std::string (the context a failing check prints).
+inline std::string msg(const char* fmt, ...) {
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    return buf;
+}
+
+/// Matches an exception whose what() contains a substring.
+class MessageContains : public Catch::MatcherBase<std::invalid_argument> {
+public:
+    explicit MessageContains(std::string needle) : needle_(std::move(needle)) {}
+    bool match(const std::invalid_argument& e) const override {
+        return std::string(e.what()).find(needle_) != std::string::npos;
+    }
+    std::string describe() const override { return "message contains \"" + needle_ + "\""; }
+
+private:
+    std::string needle_;
+};
+
+}  // namespace hovering_test
+
+/// CHECK(cond) with printf-style context printed when it fails.
+#define CHECKF(cond, ...)                              \
+    do {                                               \
+        INFO(hovering_test::msg(__VA_ARGS__));         \
+        CHECK((cond));                                 \
+    } while (0)
+
+/// expr throws std::invalid_argument whose message contains needle (bad input names itself).
+#define CHECK_INVALID(expr, needle) \
+    CHECK_THROWS_MATCHES(expr, std::invalid_argument, hovering_test::MessageContains(needle))
