@@ -83,7 +83,7 @@ def test_bad_input_is_named():
         sec.return_map([0.3], [0.3], stepper="euler")
     with pytest.raises(ValueError, match="rtol must lie in"):
         sec.return_map([0.3], [0.3], rtol=0.0)
-    with pytest.raises(ValueError, match="max_impacts must be in"):
+    with pytest.raises(ValueError, match="max_impacts must be an integer in"):
         sec.return_map([0.3], [0.3], max_impacts=0)
     with pytest.raises(ValueError, match="exponents must be integers"):
         Polynomial({(1.5, 1): 1.0})

@@ -1,8 +1,14 @@
 """hovering: a simulator for Hamiltonian impact systems near the onset of impacts.
 
-The truncated near-tangency map of Pazi, Zobova and Rom-Kedar, "Hovering Sets in Near
-Pseudo-Integrable Hamiltonian Impact Systems" (eq:truncatedmap), and its general family, with a
-multi-threaded SIMD C++ core.
+Two models of the return map of the perturbed oscillators-step system of Pazi, Zobova and
+Rom-Kedar, "Hovering Sets in Near Pseudo-Integrable Hamiltonian Impact Systems", with one interface:
+
+* :mod:`hovering.truncated`: the truncated near-tangency map F_eps (eq:truncatedmap) and the
+  general family F_{eps1,eps2}, on a multi-threaded SIMD C++ core, and their theory;
+* :mod:`hovering.flow`: the physical system (potentials, step, Sigma_h) and its impact flow;
+* :mod:`hovering.normal`: the bridge: normal coordinates (phi, K) and :class:`FlowMap`, the flow's
+  return map as a map you iterate;
+* :mod:`hovering.analysis`: rotation numbers, hovering sets and critical curves of any of them.
 
 >>> import hovering
 >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * 3.141592653589793 / 4)
@@ -11,29 +17,21 @@ multi-threaded SIMD C++ core.
 
 from __future__ import annotations
 
-from . import _core, analysis, fullmap, geometry
-from .analysis import CriticalCurve, HoveringArea, birkhoff_average, regularity, rotation_number
-from ._types import Region, Status, region_mask
-from .geometry import (
-    OMEGA_G,
-    K_crit,
-    L1,
-    L2,
-    golden_family,
-    hovering_area_theory,
-    k_eps1,
-    k_eps2,
-    rho1,
-    rho2,
-    rho_crit,
-    wrap,
+from . import _core, analysis, flow, normal, truncated
+from ._common import FlowStatus, Geometry, Region, Status, region_mask, wrap
+from ._protocols import ReturnMap
+from .analysis import (
+    CriticalCurve,
+    HoveringArea,
+    birkhoff_average,
+    critical_curve,
+    hovering_area,
+    regularity,
+    rotation_number,
 )
-from .fullmap import CornerCurves, MapComparison, TangentialCurve, compare_maps, corner_curves, truncated_from_flow
-from .maps import IterateResult, TruncatedFamily, TruncatedMap
-from .potentials import CustomPotential, check_potential
-from .system import (
+from .flow import (
     Bilinear,
-    FlowStatus,
+    CustomPotential,
     Harmonic,
     Numerical,
     OnsetParameters,
@@ -43,31 +41,74 @@ from .system import (
     Section,
     StepSystem,
     Tan,
+    check_potential,
+    onset_parameters,
+)
+from .normal import (
+    CornerCurves,
+    FlowMap,
+    FlowSteps,
+    MapComparison,
+    TangentialCurve,
+    compare_maps,
+    corner_curves,
+    forcing_coefficients,
     forcing_function,
     from_normal,
-    onset_parameters,
     tangential_curve,
     to_normal,
+    truncated_from_flow,
 )
+from .truncated import (
+    OMEGA_G,
+    K_crit,
+    L1,
+    L2,
+    IterateResult,
+    Theory,
+    TruncatedFamily,
+    TruncatedMap,
+    golden_family,
+    hovering_area_theory,
+    k_eps1,
+    k_eps2,
+    rho1,
+    rho2,
+    rho_crit,
+)
+from .truncated.theory import theory
+from . import geometry, fullmap  # noqa: E402  (old module paths, one release)
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
-simd_is_avx2 = _core.simd_is_avx2
+simd_is_avx2 = _core.truncated.simd_is_avx2
 
 __all__ = [
     "TruncatedMap",
     "TruncatedFamily",
     "IterateResult",
+    "FlowMap",
+    "FlowSteps",
+    "ReturnMap",
     "Region",
     "Status",
+    "FlowStatus",
+    "Geometry",
     "region_mask",
-    "geometry",
+    "truncated",
+    "flow",
+    "normal",
     "analysis",
+    "geometry",
     "rotation_number",
     "birkhoff_average",
     "regularity",
+    "hovering_area",
+    "critical_curve",
     "HoveringArea",
     "CriticalCurve",
+    "Theory",
+    "theory",
     "OMEGA_G",
     "L1",
     "L2",
@@ -94,7 +135,6 @@ __all__ = [
     "Polynomial",
     "Section",
     "ReturnMapResult",
-    "FlowStatus",
     "tangential_curve",
     "TangentialCurve",
     "CornerCurves",
@@ -103,6 +143,7 @@ __all__ = [
     "truncated_from_flow",
     "compare_maps",
     "forcing_function",
+    "forcing_coefficients",
     "to_normal",
     "from_normal",
 ]

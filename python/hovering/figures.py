@@ -30,8 +30,9 @@ from typing import Optional
 
 import numpy as np
 
-from ._types import Region, Status
-from .geometry import golden_family, hovering_area_theory, wrap
+from ._common import Region, Status
+from ._common import wrap
+from .truncated.theory import golden_family, hovering_area_theory
 from .plotting import draw_geometry, plot_orbits
 
 __all__ = [

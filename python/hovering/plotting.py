@@ -6,7 +6,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._types import Region
+from ._common import Region
 
 __all__ = ["REGION_COLORS", "draw_geometry", "plot_orbits", "phase_portrait"]
 

@@ -52,9 +52,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .geometry import OMEGA_G, golden_family
+from .truncated.theory import OMEGA_G, golden_family
 from .sweeps import Checkpoint
-from .maps import TruncatedMap
+from .truncated.maps import TruncatedMap
 
 __all__ = [
     "KINDS",
@@ -951,7 +951,7 @@ def _run_orbit_panel(scene: Scene, p: PanelSpec, n_steps: int, quick: bool) -> P
 
 
 def _orbit_summary(pr: PanelResult) -> list:
-    from ._types import Region, Status
+    from ._common import Region, Status
 
     res = pr.res
     out = []

@@ -1,13 +1,21 @@
-// Bindings of the flow: section coordinates and the batch return map (threads, GIL released).
+// Bindings of the flow: FlowSystem and FlowOptions as classes, points of Sigma_h and their
+// coordinates, and the batch return map (core thread pool, GIL released, Ctrl-C honoured).
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
 #include "hovering/flow/return_map.hpp"
 #include "pybind.hpp"
+#include "signals.hpp"
 
 using namespace hovering;
 
 namespace {
 
 FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2,
-                       std::vector<std::array<double, 3>> terms, double eps, double qw1, double qw2, int geometry) {
+                       std::vector<std::array<double, 3>> terms, double eps, double qw1, double qw2, Geometry geometry) {
     FlowSystem s;
     s.V1 = std::move(V1);
     s.V2 = std::move(V2);
@@ -15,7 +23,7 @@ FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<cons
     s.eps = eps;
     s.qw1 = qw1;
     s.qw2 = qw2;
-    s.geometry = static_cast<Geometry>(geometry);
+    s.geometry = geometry;
     s.validate();
     return s;
 }
@@ -23,53 +31,94 @@ FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<cons
 }  // namespace
 
 void register_flow(py::module_& m) {
-    m.def("_section_points",
-          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
-             double eps, double qw1, double qw2, int geometry, double h, const darray& theta, const darray& I) {
-              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
-              if (theta.size() != I.size()) throw py::value_error("theta and I must have the same size");
-              darray z({theta.size(), py::ssize_t(4)});
-              double* o = z.mutable_data();
-              for (py::ssize_t i = 0; i < theta.size(); ++i) {
-                  const auto p = section_point(s, h, theta.data()[i], I.data()[i]);
-                  for (int k = 0; k < 4; ++k) o[4 * i + k] = p[std::size_t(k)];
+    py::class_<FlowSystem>(m, "FlowSystem",
+                           "H = p1^2/2 + V1(q1) + p2^2/2 + V2(q2) + eps Vc(q1, q2) with walls at qw1, qw2 "
+                           "(validated; use hovering.StepSystem).")
+        .def(py::init(&make_system), py::arg("V1"), py::arg("V2"), py::arg("terms"), py::arg("eps"), py::arg("qw1"),
+             py::arg("qw2"), py::arg("geometry"))
+        .def_readonly("eps", &FlowSystem::eps)
+        .def_readonly("qw1", &FlowSystem::qw1)
+        .def_readonly("qw2", &FlowSystem::qw2)
+        .def_readonly("geometry", &FlowSystem::geometry)
+        .def_property_readonly("terms", [](const FlowSystem& s) { return s.coupling.terms; },
+                               "Coupling terms (c, i, j): Vc = sum c q1^i q2^j.")
+        .def("energy",
+             [](const FlowSystem& s, const darray& z) {
+                 if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
+                 darray out(z.shape(0));
+                 for (py::ssize_t i = 0; i < z.shape(0); ++i) out.mutable_data()[i] = s.energy(z.data() + 4 * i);
+                 return out;
+             },
+             py::arg("z"), "H of states z (shape (n, 4)).");
+
+    py::class_<FlowOptions>(m, "FlowOptions", "Integrator settings of the return map (validated on use).")
+        .def(py::init([](std::string stepper, double rtol, double atol, double event_tol, std::int64_t max_steps,
+                         int max_impacts, double grazing_tol, double corner_tol) {
+                 FlowOptions o;
+                 o.stepper = std::move(stepper);
+                 o.rtol = rtol;
+                 o.atol = atol;
+                 o.event_tol = event_tol;
+                 o.max_steps = max_steps;
+                 o.max_impacts = max_impacts;
+                 o.grazing_tol = grazing_tol;
+                 o.corner_tol = corner_tol;
+                 o.validate();
+                 return o;
+             }),
+             py::arg("stepper") = "rk8pd", py::arg("rtol") = 1e-10, py::arg("atol") = 1e-12, py::arg("event_tol") = 1e-15,
+             py::arg("max_steps") = 1000000, py::arg("max_impacts") = 100, py::arg("grazing_tol") = 1e-12,
+             py::arg("corner_tol") = 1e-10)
+        .def_readonly("stepper", &FlowOptions::stepper)
+        .def_readonly("rtol", &FlowOptions::rtol)
+        .def_readonly("atol", &FlowOptions::atol)
+        .def_readonly("event_tol", &FlowOptions::event_tol)
+        .def_readonly("max_steps", &FlowOptions::max_steps)
+        .def_readonly("max_impacts", &FlowOptions::max_impacts)
+        .def_readonly("grazing_tol", &FlowOptions::grazing_tol)
+        .def_readonly("corner_tol", &FlowOptions::corner_tol);
+
+    m.def("section_points",
+          [](const FlowSystem& s, double h, const darray& theta, const darray& I) {
+              if (theta.ndim() != 1 || I.ndim() != 1 || theta.size() != I.size())
+                  throw py::value_error("theta and I must be 1-D arrays of the same size");
+              const py::ssize_t n = theta.size();
+              darray z({n, py::ssize_t(4)});
+              py::array_t<bool> ok(n);
+              std::vector<std::string> why(static_cast<std::size_t>(n));
+              for (py::ssize_t i = 0; i < n; ++i) {
+                  std::array<double, 4> p{};
+                  const bool good = try_section_point(s, h, theta.data()[i], I.data()[i], p, &why[std::size_t(i)]);
+                  if (!good) p.fill(std::numeric_limits<double>::quiet_NaN());
+                  ok.mutable_data()[i] = good;
+                  for (int k = 0; k < 4; ++k) z.mutable_data()[4 * i + k] = p[std::size_t(k)];
               }
-              return z;
-          });
-    m.def("_section_coordinates",
-          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
-             double eps, double qw1, double qw2, int geometry, const darray& z) {
-              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
+              return py::make_tuple(z, ok, why);
+          },
+          py::arg("system"), py::arg("h"), py::arg("theta"), py::arg("I"),
+          "Points of Sigma_h at (theta, I): (z (n, 4), ok, reasons); NaN rows where no point exists.");
+    m.def("section_coordinates",
+          [](const FlowSystem& s, const darray& z) {
               if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
               darray out({z.shape(0), py::ssize_t(2)});
               for (py::ssize_t i = 0; i < z.shape(0); ++i) {
-                  const auto c = section_coordinates(s, z.data() + 4 * i);
+                  const double* zi = z.data() + 4 * i;
+                  std::array<double, 2> c{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+                  if (std::isfinite(zi[0]) && std::isfinite(zi[1]) && std::isfinite(zi[2]) && std::isfinite(zi[3]))
+                      c = section_coordinates(s, zi);
                   out.mutable_data()[2 * i] = c[0];
                   out.mutable_data()[2 * i + 1] = c[1];
               }
               return out;
-          });
-    m.def("_return_maps",
-          [](std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, std::vector<std::array<double, 3>> terms,
-             double eps, double qw1, double qw2, int geometry, const darray& z0, const std::string& stepper, double rtol,
-             double atol, double event_tol, std::int64_t max_steps, int max_impacts, double grazing_tol, double corner_tol,
-             int n_threads) {
-              const FlowSystem s = make_system(V1, V2, terms, eps, qw1, qw2, geometry);
-              FlowOptions o;
-              o.stepper = stepper;
-              o.rtol = rtol;
-              o.atol = atol;
-              o.event_tol = event_tol;
-              o.max_steps = max_steps;
-              o.max_impacts = max_impacts;
-              o.grazing_tol = grazing_tol;
-              o.corner_tol = corner_tol;
+          },
+          py::arg("system"), py::arg("z"), "Section coordinates (theta, I) of states z (NaN rows stay NaN).");
+    m.def("return_maps",
+          [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads) {
               o.validate();
               if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
-              if (n_threads < 0 || n_threads > 4096) throw py::value_error("n_threads must be in [0, 4096], got " + std::to_string(n_threads));
               const py::ssize_t n = z0.shape(0);
               darray z({n, py::ssize_t(4)}), time(n), err(n);
-              py::array_t<std::int8_t> status(n);
+              py::array_t<std::int8_t> status(n), region(n);
               py::array_t<std::int64_t> steps(n);
               std::vector<std::string> itin{static_cast<std::size_t>(n)};
               ReturnMapsOutput out;
@@ -77,20 +126,24 @@ void register_flow(py::module_& m) {
               out.time = time.mutable_data();
               out.energy_error = err.mutable_data();
               out.status = status.mutable_data();
+              out.region = region.mutable_data();
               out.steps = steps.mutable_data();
               out.itinerary = itin.data();
-              {
-                  // Orbits are independent and write disjoint slots of freshly allocated arrays.
-                  py::gil_scoped_release release;
-                  return_maps(s, z0.data(), n, o, n_threads, nullptr, out);
-              }
+              std::atomic<bool> cancel{false};
+              // Orbits are independent and write disjoint slots of freshly allocated arrays.
+              const bool interrupted =
+                  hovering_py::run_watched([&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out); }, cancel, n >= 64);
               py::dict d;
               d["z"] = z;
               d["time"] = time;
               d["energy_error"] = err;
               d["status"] = status;
+              d["region"] = region;
               d["steps"] = steps;
               d["itinerary"] = itin;
+              d["interrupted"] = interrupted;
               return d;
-          });
+          },
+          py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"),
+          "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit.");
 }

@@ -1,9 +1,19 @@
-// Entry point of hovering._core: a thin module, each topic registers itself.
+// Entry point of hovering._core: a thin module with one submodule per topic of the core
+// (truncated, flow, normal), each registering itself; the shared enums live at the top.
 #include "pybind.hpp"
 
 PYBIND11_MODULE(_core, m) {
-    m.doc() = "Compiled core of hovering: the truncated near-tangency map and its batch iteration.";
-    register_truncated_map(m);
-    register_potential(m);
-    register_flow(m);
+    m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";
+    register_enums(m);
+    auto truncated = m.def_submodule("truncated", "The truncated near-tangency family F_{eps1,eps2}.");
+    register_truncated(truncated);
+    auto flow = m.def_submodule("flow", "Potentials, the oscillators-step system, Sigma_h and the return map.");
+    register_potential(flow);
+    register_flow(flow);
+    auto normal = m.def_submodule("normal", "The tangential curve (normal coordinates) and the flow map.");
+    register_normal(normal);
+    // `from hovering._core.flow import X` needs the submodules in sys.modules (def_submodule only
+    // sets them as attributes).
+    auto modules = py::module_::import("sys").attr("modules");
+    for (auto sub : {truncated, flow, normal}) modules[sub.attr("__name__")] = sub;
 }

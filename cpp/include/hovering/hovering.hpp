@@ -14,3 +14,6 @@
 #include "hovering/flow/potential.hpp"
 #include "hovering/flow/return_map.hpp"
 #include "hovering/flow/system.hpp"
+
+#include "hovering/normal/flow_map.hpp"
+#include "hovering/normal/tangential_curve.hpp"

@@ -44,16 +44,16 @@ struct Force {
     const Potential* p = nullptr;
     int aux = -1;         // Tan: index of u = tan(alpha q) in the state
     explicit Force(const Potential* pot);
-    /// V'(q) (q is state[qi]); the Tan force reads u from the state.
-    template <Kind K>
-    double eval(const double* z, int qi) const {
+    /// V'(q) (q is state[QI]); the Tan force reads u from state[AUX].
+    template <Kind K, int QI, int AUX>
+    double eval(const double* z) const {
         if constexpr (K == Kind::Harmonic) {
-            return a * z[qi];
+            return a * z[QI];
         } else if constexpr (K == Kind::Tan) {
-            const double u = z[aux];
+            const double u = z[AUX];
             return a * u * (1 + u * u);
         } else {
-            return p->dV(z[qi]);
+            return p->dV(z[QI]);
         }
     }
 };
@@ -66,10 +66,11 @@ struct Field {
     double bilinear_c = 0;
     CKind ckind = CKind::None;
     int dim = 4;
-    void (*fn)(const Field&, const double*, double*) = nullptr;
+    /// dz/dt in GSL's calling convention (params = this Field), handed to GSL directly.
+    int (*fn)(double, const double*, double*, void*) = nullptr;
 
     explicit Field(const FlowSystem& s);
-    void operator()(const double* z, double* dz) const { fn(*this, z, dz); }
+    void operator()(const double* z, double* dz) const { fn(0.0, z, dz, const_cast<Field*>(this)); }
     /// Set the auxiliary variables from the positions (at a start, or after a reflection).
     void sync_aux(double* z) const {
         if (f1.aux >= 0) z[f1.aux] = std::tan(f1.b * z[0]);
@@ -77,11 +78,14 @@ struct Field {
     }
 
     template <Kind K1, Kind K2, CKind C>
-    static void eval(const Field& F, const double* z, double* dz) {
+    static int eval(double, const double* z, double* dz, void* params) {
+        // The auxiliary variables follow (q1, p1, q2, p2) in the order V1, V2: compile-time indices.
+        constexpr int A1 = 4, A2 = K1 == Kind::Tan ? 5 : 4;
+        const Field& F = *static_cast<const Field*>(params);
         dz[0] = z[1];
-        dz[1] = -F.f1.eval<K1>(z, 0);
+        dz[1] = -F.f1.eval<K1, 0, A1>(z);
         dz[2] = z[3];
-        dz[3] = -F.f2.eval<K2>(z, 2);
+        dz[3] = -F.f2.eval<K2, 2, A2>(z);
         if constexpr (C == CKind::Bilinear) {
             dz[1] -= F.eps * (F.bilinear_c * z[2]);
             dz[3] -= F.eps * (F.bilinear_c * z[0]);
@@ -91,13 +95,14 @@ struct Field {
             dz[3] -= F.eps * g[1];
         }
         if constexpr (K1 == Kind::Tan) {
-            const double u = z[F.f1.aux];
-            dz[F.f1.aux] = F.f1.b * (1 + u * u) * z[1];
+            const double u = z[A1];
+            dz[A1] = F.f1.b * (1 + u * u) * z[1];
         }
         if constexpr (K2 == Kind::Tan) {
-            const double u = z[F.f2.aux];
-            dz[F.f2.aux] = F.f2.b * (1 + u * u) * z[3];
+            const double u = z[A2];
+            dz[A2] = F.f2.b * (1 + u * u) * z[3];
         }
+        return 0;  // GSL_SUCCESS
     }
 
 private:

@@ -6,20 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "hovering/detail/common.hpp"
 
 namespace hovering::detail {
-
-namespace {
-
-int gsl_rhs(double, const double y[], double dydt[], void* params) {
-    const auto* F = static_cast<const Field*>(params);
-    F->fn(*F, y, dydt);
-    return GSL_SUCCESS;
-}
-
-}  // namespace
 
 const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "rk2") return gsl_odeiv2_step_rk2;
@@ -35,7 +26,7 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
 
 Integrator::Integrator(const FlowSystem& s, const FlowOptions& o) : field_(s), atol_(o.atol), rtol_(o.rtol) {
     gsl_quiet();
-    sys_ = gsl_odeiv2_system{&gsl_rhs, nullptr, std::size_t(field_.dim), &field_};
+    sys_ = gsl_odeiv2_system{field_.fn, nullptr, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
     if (T == gsl_odeiv2_step_msadams) {
         driver_ = gsl_odeiv2_driver_alloc_standard_new(&sys_, T, 1e-3, o.atol, o.rtol, 1.0, 0.0);
@@ -49,12 +40,8 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& o) : field_(s), a
         }
     } else {
         step_ = gsl_odeiv2_step_alloc(T, std::size_t(field_.dim));
-        control_ = gsl_odeiv2_control_standard_new(o.atol, o.rtol, 1.0, 0.0);
-        if (!step_ || !control_) {
-            if (step_) gsl_odeiv2_step_free(step_);
-            if (control_) gsl_odeiv2_control_free(control_);
-            throw std::bad_alloc();
-        }
+        if (!step_) throw std::bad_alloc();
+        order_ = int(gsl_odeiv2_step_order(step_));
     }
 }
 
@@ -63,7 +50,6 @@ Integrator::~Integrator() {
         gsl_odeiv2_driver_free(driver_);
         gsl_odeiv2_step_free(ext_);
     } else {
-        gsl_odeiv2_control_free(control_);
         gsl_odeiv2_step_free(step_);
     }
 }
@@ -94,7 +80,7 @@ bool Integrator::advance(double* y, double* d, double* h, double hmax, double* h
         bool finite = st == GSL_SUCCESS;
         for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y[i]) && std::isfinite(err[i]);
         double hn = h0;
-        const int adj = finite ? gsl_odeiv2_control_hadjust(control_, step_, y, err, dout, &hn) : GSL_ODEIV_HADJ_DEC;
+        const int adj = finite ? hadjust(y, err, &hn) : GSL_ODEIV_HADJ_DEC;
         if (adj != GSL_ODEIV_HADJ_DEC) {
             for (int i = 0; i < n; ++i) d[i] = dout[i];
             *h_done = h0;
@@ -105,6 +91,27 @@ bool Integrator::advance(double* y, double* d, double* h, double hmax, double* h
         *h = finite ? hn : 0.5 * h0;
         if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) return false;  // the tolerance cannot be met
     }
+}
+
+int Integrator::hadjust(const double* y, const double* err, double* h) const {
+    // GSL's standard rule (gsl_odeiv2_control_standard_new(atol, rtol, 1, 0), control.c): scaled
+    // error rmax = max_i |err_i| / (atol + rtol |y_i|); above 1.1 the step shrinks by
+    // 0.9 rmax^(-1/order) (at most 5x), below 0.5 it grows (at most 5x, never shrinks). GSL grows
+    // by rmax^(-1/(order+1)); here the same root rmax^(-1/order) serves both, which for rk8pd is
+    // three square roots: GSL's pow took 5% of a return's time, and cbrt for the 9th root more.
+    double rmax = std::numeric_limits<double>::min();
+    for (int i = 0; i < field_.dim; ++i) rmax = std::max(rmax, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
+    // The root: rmax^(1/order) (three square roots for rk8pd).
+    const double root = order_ == 8 ? std::sqrt(std::sqrt(std::sqrt(rmax))) : std::pow(rmax, 1.0 / order_);
+    if (rmax > 1.1) {
+        *h *= std::max(0.2, 0.9 / root);
+        return GSL_ODEIV_HADJ_DEC;
+    }
+    if (rmax < 0.5) {
+        *h *= std::min(5.0, std::max(1.0, 0.9 / root));
+        return GSL_ODEIV_HADJ_INC;
+    }
+    return GSL_ODEIV_HADJ_NIL;
 }
 
 void Integrator::prepare_extension(const double* y0, const double* d0, double h) {

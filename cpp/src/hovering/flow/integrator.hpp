@@ -34,9 +34,14 @@ public:
     const Field& field() const { return field_; }
     /// State dimension (4 plus one per Tan potential).
     int dim() const { return field_.dim; }
+    /// Order of the stepper (8 for rk8pd).
+    int order() const { return int(gsl_odeiv2_step_order(step_)); }
+    /// The step-size rule of GSL's standard control for the step just taken (y its end, err its
+    /// error estimate): scales *h and returns GSL_ODEIV_HADJ_DEC (reject), _INC or _NIL.
+    int hadjust(const double* y, const double* err, double* h) const;
     /// Forget the step history (a new orbit, or a restart after an impact).
     void restart();
-    /// One error-controlled step from (y, d = field(y)) with trial length *h (<= hmax): on return
+    /// One error-controlled step (GSL step, GSL's standard step-size rule) from (y, d = field(y)) with trial length *h (<= hmax): on return
     /// y, d hold the new state and its derivative, *h_done the length taken, *h the proposal for
     /// the next step. Rejected trials shrink *h and retry from the same state. false: the step
     /// size underflowed or the stepper failed (non-finite state); y is then unspecified.
@@ -50,12 +55,13 @@ private:
     Field field_;
     gsl_odeiv2_system sys_;
     gsl_odeiv2_step* step_ = nullptr;
-    gsl_odeiv2_control* control_ = nullptr;
-    gsl_odeiv2_driver* driver_ = nullptr;  // msadams only: owns step, control and evolve
+    gsl_odeiv2_control* control_ = nullptr;  // msadams only (the driver's)
+    gsl_odeiv2_driver* driver_ = nullptr;    // msadams only: owns step, control and evolve
     gsl_odeiv2_step* ext_ = nullptr;       // msadams only: rk8pd for event extensions
     int ext_sub_ = 1;                      // substeps of the extension
     double t_ms_ = 0;                      // msadams: running time (its history is in time)
     double atol_, rtol_;
+    int order_ = 8;  // one-step methods: the stepper's order, for the step-size rule
 };
 
 }  // namespace hovering::detail

@@ -1,20 +1,14 @@
-// Bindings of MapCore<...>: vectorised single steps and the batch iteration.
+// Bindings of the truncated family (MapCore<...>): vectorised single steps and the batch iteration.
 //
 // Every loop over user arrays runs with the GIL released: the core only reads the input buffers
 // (owned by the caller's arrays, kept alive by this frame) and writes freshly allocated outputs.
 
-#include <Python.h>
-
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
-#include <cstring>
-#include <memory>
-#include <mutex>
-#include <thread>
+#include <cmath>
 
 #include "hovering/truncated/map.hpp"
 #include "pybind.hpp"
+#include "signals.hpp"
 
 using namespace hovering;
 
@@ -46,8 +40,8 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
     return py::make_tuple(o1, o2);
 }
 
-// Runs the batch iteration; polls Ctrl-C from this (main) thread while workers run, so a long
-// run can be interrupted and still hand back everything computed so far.
+// Runs the batch iteration with Ctrl-C watched (signals.hpp), so a long run can be interrupted and
+// still hand back everything computed so far.
 template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
                  bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
@@ -112,52 +106,9 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
 
     std::atomic<bool> cancel{false};
     opt.cancel = &cancel;
-    bool interrupted = false;
-    std::unique_ptr<py::error_already_set> handler_error;
-    const double work = double(n) * double(n_steps);
-    {
-        py::gil_scoped_release release;
-        if (work < 2e6) {
-            // Short runs: no watcher thread, the ~50 us it costs would dominate.
-            m.iterate(phi0.data(), K0.data(), n, opt, out);
-        } else {
-            std::exception_ptr err;
-            std::mutex mu;
-            std::condition_variable cv;
-            bool done = false;
-            std::thread runner([&] {
-                try {
-                    m.iterate(phi0.data(), K0.data(), n, opt, out);
-                } catch (...) {
-                    err = std::current_exception();
-                }
-                std::lock_guard<std::mutex> lock(mu);
-                done = true;
-                cv.notify_one();
-            });
-            std::unique_lock<std::mutex> lock(mu);
-            while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
-                lock.unlock();
-                if (!cancel.load()) {
-                    py::gil_scoped_acquire acquire;
-                    if (PyErr_CheckSignals() != 0) {
-                        cancel.store(true);
-                        if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
-                            PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
-                            interrupted = true;
-                        } else {
-                            handler_error = std::make_unique<py::error_already_set>();  // e.g. a SIGALRM handler's
-                        }
-                    }
-                }
-                lock.lock();
-            }
-            lock.unlock();
-            runner.join();
-            if (err) std::rethrow_exception(err);
-        }
-    }
-    if (handler_error) throw std::move(*handler_error);  // what a signal handler raised, unchanged
+    // Short runs (< 2e6 orbit-steps, ~5 ms) get no watcher thread: its ~50 us would dominate.
+    const bool interrupted = hovering_py::run_watched([&] { m.iterate(phi0.data(), K0.data(), n, opt, out); }, cancel,
+                                                      double(n) * double(n_steps) >= 2e6);
     res["interrupted"] = interrupted;
     return res;
 }
@@ -220,7 +171,7 @@ void bind_common(Cls& cls) {
 
 }  // namespace
 
-void register_truncated_map(py::module_& mod) {
+void register_truncated(py::module_& mod) {
     py::class_<TruncatedMap> tm(mod, "TruncatedMap", "Compiled F_eps (eq:truncatedmap); use hovering.TruncatedMap.");
     tm.def(py::init([](double eps, double Omega0, double theta_w, double tau0, double tau1, double lam,
                        double K_max) { return make_truncated_map(eps, Omega0, theta_w, tau0, tau1, lam, K_max); }),

@@ -1,0 +1,115 @@
+#pragma once
+// The flow's return map as a map you iterate: the same map interface as the truncated family
+// (step, step_inverse, region, batch iteration with the same options, statuses and regions), on
+// normal coordinates (phi, K) (eq:kphidef, from a TangentialCurve) or on section coordinates
+// (theta, I). Each return starts on Sigma_h at energy h exactly: the image's coordinates are
+// computed and the next point of Sigma_h is solved from them, so iterating n steps is the same,
+// bit for bit, as n calls of step().
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "hovering/flow/return_map.hpp"
+#include "hovering/normal/tangential_curve.hpp"
+#include "hovering/truncated/arcs.hpp"
+#include "hovering/types.hpp"
+
+namespace hovering {
+
+namespace detail {
+class Tracer;
+}
+
+/// What a flow-map iteration does besides stepping (the flow's counterpart of IterateOptions).
+struct FlowIterateOptions {
+    std::int64_t n_steps = 0;         ///< returns per orbit (>= 0)
+    unsigned exit_mask = 0;           ///< bit r: Region r is in the watched set; 0 disables the watch
+    bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
+    int n_threads = 0;                ///< worker threads; 0 = all hardware threads
+    const std::atomic<bool>* cancel = nullptr;  ///< polled between and inside returns
+};
+
+/// Where a flow-map iteration writes; a null pointer means "not recorded". Per-point arrays are
+/// (n_orbits, n_steps + 1) (states: 4 per point), per-return arrays (n_orbits, n_steps); entries
+/// after an orbit stopped are NaN (Region::None, 0 steps, "" itinerary).
+struct FlowIterateOutput {
+    double* x_final = nullptr;        ///< (n) last point reached: phi or theta
+    double* y_final = nullptr;        ///< (n) K or I
+    double* orbit_x = nullptr;        ///< points: phi (normal) or theta (section)
+    double* orbit_y = nullptr;        ///< K or I
+    double* orbit_theta = nullptr;    ///< section coordinates of the points
+    double* orbit_I = nullptr;
+    double* states = nullptr;         ///< (n, n_steps + 1, 4) points of Sigma_h (q1, p1, q2, p2)
+    std::int8_t* regions = nullptr;   ///< Region of each return
+    double* times = nullptr;          ///< return times
+    double* energy_error = nullptr;   ///< |H(image) - h| before the image is put back on Sigma_h
+    std::int64_t* integrator_steps = nullptr;  ///< accepted integrator steps per return
+    std::string* itinerary = nullptr;          ///< itinerary of each return
+    double* rotation = nullptr;       ///< (n) mean lifted rotation per return (see FlowMap::rotation_of)
+    std::int8_t* status = nullptr;    ///< (n) Status, always written when non-null
+    std::int64_t* steps_done = nullptr;  ///< (n) returns taken
+    std::int64_t* exit_step = nullptr;   ///< (n) first return outside the watched set, else -1
+};
+
+/// One return of the map: the image, its region and what the flow reported.
+struct FlowStep {
+    double x = 0, y = 0;  ///< image in map coordinates (NaN unless status is Ok)
+    Region region = Region::None;
+    ReturnResult ret;     ///< the flow's return (state, time, itinerary, energy error, steps)
+};
+
+/// The flow's return map on one section; see the file comment.
+class FlowMap {
+public:
+    /// Map on normal coordinates (phi, K) when curve is set (it must be a graph), else on
+    /// section coordinates (theta, I). lift (optional, e.g. the onset parameters' arcs) is the
+    /// model whose rotation omega_a(K) picks the branch of each measured angle advance.
+    FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const TangentialCurve> curve = nullptr,
+            std::shared_ptr<const AnalyticArcs> lift = nullptr);
+
+    /// One return from (x, y); a point with no point of Sigma_h gives status OffSection.
+    FlowStep step(double x, double y) const;
+    /// The preimage, by time reversal (lem:timerevgen): F^{-1} = R2 F R2 in (theta, I).
+    FlowStep step_inverse(double x, double y) const;
+    /// step (or step_inverse) of n points on the core's thread pool, into out[0 .. n). Points not
+    /// reached before *cancel is set get FlowStatus::Interrupted.
+    void steps(const double* x, const double* y, std::int64_t n, bool inverse, int n_threads,
+               const std::atomic<bool>* cancel, FlowStep* out) const;
+    /// Iterate n orbits from (x0[i], y0[i]); see FlowIterateOutput for what is written. One
+    /// orbit's outcome (corner, grazing, runaway, off the section) never stops the others.
+    void iterate(const double* x0, const double* y0, std::int64_t n, const FlowIterateOptions& opt,
+                 const FlowIterateOutput& out) const;
+
+    /// Section coordinates (theta, I) of a map point (phi wrapped to [-pi, pi)).
+    std::pair<double, double> to_section(double x, double y) const;
+    /// Map coordinates of section coordinates.
+    std::pair<double, double> from_section(double theta, double I) const;
+    /// Point of Sigma_h at map coordinates (x, y); false where there is none.
+    bool state(double x, double y, std::array<double, 4>& z, std::string* why = nullptr) const;
+    /// The lifted rotation of a return from (x, y) in region r to the image angle x1: the advance
+    /// x1 - x on the branch nearest to the lift model's omega_r(K) ([0, 2 pi) without a model).
+    double rotation_of(double x, double y, Region r, double x1) const;
+
+    /// The system.
+    const FlowSystem& system() const { return s_; }
+    /// Energy of the section.
+    double h() const { return h_; }
+    /// Integrator options.
+    const FlowOptions& options() const { return opt_; }
+    /// The tangential curve (null: section coordinates).
+    const std::shared_ptr<const TangentialCurve>& curve() const { return curve_; }
+
+private:
+    FlowStep advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const;
+    FlowSystem s_;
+    double h_;
+    FlowOptions opt_;
+    std::shared_ptr<const TangentialCurve> curve_;
+    std::shared_ptr<const AnalyticArcs> lift_;
+    double lift_I0_ = 0;
+};
+
+}  // namespace hovering

@@ -1,0 +1,256 @@
+// The flow's return map as an iterable map: see flow_map.hpp.
+
+#include "hovering/normal/flow_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "hovering/detail/common.hpp"
+#include "hovering/detail/parallel.hpp"
+#include "hovering/flow/tracer.hpp"
+
+namespace hovering {
+
+using detail::bad;
+using detail::fmt;
+using detail::kNaN;
+using detail::kPi;
+using detail::kTwoPi;
+
+namespace {
+
+double wrap(double x) {
+    double y = x - kTwoPi * std::floor((x + kPi) / kTwoPi);
+    if (y >= kPi) y -= kTwoPi;
+    return y;
+}
+
+}  // namespace
+
+FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const TangentialCurve> curve,
+                 std::shared_ptr<const AnalyticArcs> lift)
+    : s_(std::move(s)), h_(h), opt_(std::move(opt)), curve_(std::move(curve)), lift_(std::move(lift)) {
+    detail::gsl_quiet();
+    s_.validate();
+    opt_.validate();
+    if (!std::isfinite(h_)) bad("h must be finite, got " + fmt(h_));
+    if (curve_) {
+        if (!curve_->is_graph()) bad(curve_->not_graph_reason());
+        if (curve_->h() != h_) bad("the tangential curve was measured at h = " + fmt(curve_->h()) + ", not at h = " + fmt(h_));
+    }
+    if (lift_) lift_->validate();
+    const double E1 = h_ - s_.V1->V(s_.qw1);
+    lift_I0_ = E1 > 0 ? s_.V2->action(E1) : 0.0;
+}
+
+std::pair<double, double> FlowMap::to_section(double x, double y) const {
+    const double th = wrap(x);
+    return {th, curve_ ? y + curve_->I_tan(th) : y};
+}
+
+std::pair<double, double> FlowMap::from_section(double theta, double I) const {
+    const double th = wrap(theta);
+    return {th, curve_ ? I - curve_->I_tan(th) : I};
+}
+
+bool FlowMap::state(double x, double y, std::array<double, 4>& z, std::string* why) const {
+    const auto [th, I] = to_section(x, y);
+    return try_section_point(s_, h_, th, I, z, why);
+}
+
+double FlowMap::rotation_of(double x, double y, Region r, double x1) const {
+    const double adv = wrap(x1 - x);
+    if (!lift_) return adv < 0 ? adv + kTwoPi : adv;
+    const double K = curve_ ? y : y - lift_I0_;
+    const ArcLengths a = lift_->at(K);
+    double ref = a.Omega;
+    if (r == Region::Upper) ref += a.JR;
+    if (r == Region::Right) ref -= a.J1;
+    return ref + wrap(adv - ref);
+}
+
+FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const {
+    FlowStep st;
+    st.x = st.y = kNaN;
+    auto [th, I] = to_section(x, y);
+    if (inverse) th = -th;  // R2: theta -> -theta (section_point accepts [-pi, pi])
+    std::array<double, 4> z{};
+    if (!try_section_point(s_, h_, th, I, z)) {
+        st.ret.status = FlowStatus::OffSection;
+        st.ret.z = {kNaN, kNaN, kNaN, kNaN};
+        return st;
+    }
+    st.ret = tr.trace(z, false, cancel);
+    if (st.ret.status != FlowStatus::Ok) return st;
+    st.ret.energy_error = std::fabs(s_.energy(st.ret.z.data()) - h_);
+    auto c = section_coordinates(s_, st.ret.z.data());
+    if (inverse) {
+        c[0] = wrap(-c[0]);
+        std::reverse(st.ret.itinerary.begin(), st.ret.itinerary.end());
+    }
+    const auto [x1, y1] = from_section(c[0], c[1]);
+    st.x = x1;
+    st.y = y1;
+    st.region = region_of(st.ret.itinerary);
+    return st;
+}
+
+FlowStep FlowMap::step(double x, double y) const {
+    detail::require_angle(x, "step: x");
+    detail::require_finite(y, "step: y");
+    detail::Tracer tr(s_, opt_);
+    return advance(tr, x, y, false, nullptr);
+}
+
+FlowStep FlowMap::step_inverse(double x, double y) const {
+    detail::require_angle(x, "step_inverse: x");
+    detail::require_finite(y, "step_inverse: y");
+    detail::Tracer tr(s_, opt_);
+    return advance(tr, x, y, true, nullptr);
+}
+
+void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inverse, int n_threads,
+                    const std::atomic<bool>* cancel, FlowStep* out) const {
+    if (n < 0) bad("number of points must be >= 0, got " + std::to_string(n));
+    if (n_threads < 0 || n_threads > detail::kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(n_threads));
+    for (std::int64_t i = 0; i < n; ++i) {
+        detail::require_angle(x[i], "x[" + std::to_string(i) + "]");
+        detail::require_finite(y[i], "y[" + std::to_string(i) + "]");
+    }
+    if (n == 0) return;
+    const int threads = detail::worker_count(n_threads, n);
+    detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
+    detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
+        detail::Tracer tr(s_, opt_);
+        for (std::int64_t i; cur.pop(i);) {
+            if (cancel && cancel->load(std::memory_order_relaxed)) {
+                out[i] = FlowStep{};
+                out[i].x = out[i].y = kNaN;
+                out[i].ret.status = FlowStatus::Interrupted;
+                continue;
+            }
+            out[i] = advance(tr, x[i], y[i], inverse, cancel);
+        }
+    });
+}
+
+void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const FlowIterateOptions& opt,
+                      const FlowIterateOutput& out) const {
+    if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
+    if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
+    if (opt.exit_mask >= (1u << kRegionCount))
+        bad("exit_mask must be a set of region codes 0.." + std::to_string(kRegionCount - 1) + ", got " +
+            std::to_string(opt.exit_mask));
+    if (opt.stop_on_exit && opt.exit_mask == 0u) bad("stop_on_exit needs a non-empty set of regions to stay in");
+    if (opt.exit_mask && s_.geometry == Geometry::None)
+        bad("regions need walls: the smooth flow (geometry none) labels no return, so exit regions cannot be watched");
+    if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(opt.n_threads));
+    for (std::int64_t i = 0; i < n; ++i) {
+        detail::require_angle(x0[i], "x0[" + std::to_string(i) + "]");
+        detail::require_finite(y0[i], "y0[" + std::to_string(i) + "]");
+    }
+    if (n == 0) return;
+    const std::int64_t ns = opt.n_steps;
+    const std::int64_t np = ns + 1;  // points per orbit
+
+    auto record_point = [&](std::int64_t i, std::int64_t k, double x, double y, const std::array<double, 4>* z) {
+        const std::int64_t at = i * np + k;
+        if (out.orbit_x) out.orbit_x[at] = x;
+        if (out.orbit_y) out.orbit_y[at] = y;
+        if (out.orbit_theta || out.orbit_I) {
+            const auto [th, I] = to_section(x, y);
+            if (out.orbit_theta) out.orbit_theta[at] = th;
+            if (out.orbit_I) out.orbit_I[at] = I;
+        }
+        if (out.states) {
+            std::array<double, 4> zz{kNaN, kNaN, kNaN, kNaN};
+            if (z) zz = *z;
+            else state(x, y, zz);
+            for (int c = 0; c < 4; ++c) out.states[4 * at + c] = zz[std::size_t(c)];
+        }
+    };
+    // An orbit's outputs once it stops, and the NaN / None tails of its recorded arrays.
+    auto finish = [&](std::int64_t i, double x, double y, double rot, std::int64_t steps, Status st) {
+        if (out.x_final) out.x_final[i] = x;
+        if (out.y_final) out.y_final[i] = y;
+        if (out.rotation) out.rotation[i] = steps > 0 ? rot / double(steps) : kNaN;
+        if (out.status) out.status[i] = static_cast<std::int8_t>(st);
+        if (out.steps_done) out.steps_done[i] = steps;
+        for (std::int64_t k = steps + 1; k < np; ++k) {
+            const std::int64_t at = i * np + k;
+            if (out.orbit_x) out.orbit_x[at] = kNaN;
+            if (out.orbit_y) out.orbit_y[at] = kNaN;
+            if (out.orbit_theta) out.orbit_theta[at] = kNaN;
+            if (out.orbit_I) out.orbit_I[at] = kNaN;
+            if (out.states)
+                for (int c = 0; c < 4; ++c) out.states[4 * at + c] = kNaN;
+        }
+        for (std::int64_t k = steps; k < ns; ++k) {
+            const std::int64_t at = i * ns + k;
+            if (out.regions) out.regions[at] = static_cast<std::int8_t>(Region::None);
+            if (out.times) out.times[at] = kNaN;
+            if (out.energy_error) out.energy_error[at] = kNaN;
+            if (out.integrator_steps) out.integrator_steps[at] = 0;
+            if (out.itinerary) out.itinerary[at].clear();
+        }
+    };
+    auto cancelled = [&] { return opt.cancel && opt.cancel->load(std::memory_order_relaxed); };
+
+    const int threads = detail::worker_count(opt.n_threads, n);
+    detail::WorkQueue queue(n, detail::balanced_block(n, threads, 4));
+    detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
+        detail::Tracer tr(s_, opt_);
+        for (std::int64_t i; cur.pop(i);) {
+            double x = x0[i], y = y0[i], rot = 0;
+            if (out.exit_step) out.exit_step[i] = -1;
+            std::array<double, 4> z{};
+            if (!state(x, y, z)) {
+                record_point(i, 0, x, y, nullptr);
+                finish(i, x, y, 0.0, 0, Status::OffSection);
+                continue;
+            }
+            record_point(i, 0, x, y, &z);
+            Status status = Status::Ok;
+            std::int64_t k = 0;
+            bool reported = false;
+            for (; k < ns; ++k) {
+                if (cancelled()) {
+                    status = Status::Interrupted;
+                    break;
+                }
+                const FlowStep st = advance(tr, x, y, false, opt.cancel);
+                if (st.ret.status != FlowStatus::Ok) {
+                    status = orbit_status(st.ret.status);
+                    break;
+                }
+                const int r = int(st.region);
+                if (opt.exit_mask && !reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
+                    if (out.exit_step) out.exit_step[i] = k;
+                    reported = true;
+                    if (opt.stop_on_exit) {
+                        status = Status::Exited;
+                        break;
+                    }
+                }
+                const std::int64_t at = i * ns + k;
+                if (out.regions) out.regions[at] = static_cast<std::int8_t>(st.region);
+                if (out.times) out.times[at] = st.ret.time;
+                if (out.energy_error) out.energy_error[at] = st.ret.energy_error;
+                if (out.integrator_steps) out.integrator_steps[at] = st.ret.steps;
+                if (out.itinerary) out.itinerary[at] = st.ret.itinerary;
+                if (out.rotation) rot += rotation_of(x, y, st.region, st.x);
+                x = st.x;
+                y = st.y;
+                record_point(i, k + 1, x, y, nullptr);
+            }
+            finish(i, x, y, rot, k, status);
+        }
+    });
+}
+
+}  // namespace hovering

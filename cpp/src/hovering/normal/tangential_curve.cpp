@@ -1,0 +1,244 @@
+// The tangential curve measured on the flow: see tangential_curve.hpp.
+
+#include "hovering/normal/tangential_curve.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "hovering/detail/common.hpp"
+#include "hovering/flow/tracer.hpp"
+
+namespace hovering {
+
+using detail::bad;
+using detail::fmt;
+using detail::kPi;
+using detail::kTwoPi;
+
+namespace {
+
+double wrap(double x) { return x - kTwoPi * std::floor((x + kPi) / kTwoPi); }
+
+}  // namespace
+
+// ------------------------------------------------------------------ trigonometric interpolation
+
+TrigInterpolant::TrigInterpolant(const std::vector<double>& v) {
+    const std::size_t n = v.size();
+    if (n < 4 || n % 2) bad("a trigonometric interpolant needs an even number >= 4 of samples, got " + std::to_string(n));
+    const std::size_t m = n / 2;
+    a_.assign(m + 1, 0.0);
+    b_.assign(m + 1, 0.0);
+    for (std::size_t j = 0; j <= m; ++j) {
+        double a = 0, b = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+            const double x = kTwoPi * double(j * k % n) / double(n);  // exact argument reduction
+            a += v[k] * std::cos(x);
+            b += v[k] * std::sin(x);
+        }
+        const double w = (j == 0 || j == m) ? 1.0 / double(n) : 2.0 / double(n);  // mean and Nyquist count once
+        a_[j] = w * a;
+        b_[j] = (j == 0 || j == m) ? 0.0 : w * b;
+    }
+    // Modes below 1e-17 of the largest value contribute nothing in double precision: dropping the
+    // tail makes every evaluation (several per return of the flow map) proportionally cheaper.
+    double scale = 0;
+    for (double x : v) scale = std::max(scale, std::fabs(x));
+    std::size_t keep = a_.size();
+    while (keep > 1 && std::fabs(a_[keep - 1]) + std::fabs(b_[keep - 1]) < 1e-17 * scale) --keep;
+    a_.resize(keep);
+    b_.resize(keep);
+}
+
+std::pair<double, double> TrigInterpolant::with_derivative(double s) const {
+    // cos(j x), sin(j x) by the rotation recurrence: one sincos per evaluation.
+    const double x = s + kPi;
+    const double c1 = std::cos(x), s1 = std::sin(x);
+    double c = 1, sn = 0, f = a_.empty() ? 0.0 : a_[0], df = 0;
+    for (std::size_t j = 1; j < a_.size(); ++j) {
+        const double cn = c * c1 - sn * s1;
+        sn = sn * c1 + c * s1;
+        c = cn;
+        f += a_[j] * c + b_[j] * sn;
+        df += double(j) * (b_[j] * c - a_[j] * sn);
+    }
+    return {f, df};
+}
+
+double TrigInterpolant::operator()(double s) const { return with_derivative(s).first; }
+
+// ------------------------------------------------------------------ the curve
+
+namespace {
+
+// The wall tangency point at wall angle s: the action I_w(s) with H2(I) + eps Vc(qw1, q2(s, I))
+// = h - V1(qw1) (eq:XiwallepsI), required to be unique on (0, 4 I0], and its state (qw1, 0, q2, p2).
+std::array<double, 4> wall_point(const FlowSystem& sys, double h, double s, double I0) {
+    const double E1 = h - sys.V1->V(sys.qw1);
+    auto G = [&](double I) {
+        const double e2 = sys.V2->energy(I);
+        const double q2 = sys.V2->point_at(s, e2).first;
+        return e2 + (sys.eps != 0 ? sys.eps * sys.coupling.value(sys.qw1, q2) : 0.0) - E1;
+    };
+    const int m = 48;
+    double lo = 0, hi = 0, g_prev = 0, I_prev = 0;
+    int changes = 0;
+    for (int k = 1; k <= m; ++k) {
+        const double I = 4.0 * I0 * k / m;
+        double g;
+        try {
+            g = G(I);
+        } catch (const std::invalid_argument&) {
+            break;  // beyond the well of V2 (e.g. a Tan potential's energy range): stop the scan
+        }
+        if (k > 1 && (g > 0) != (g_prev > 0)) {
+            ++changes;
+            lo = I_prev;
+            hi = I;
+        }
+        g_prev = g;
+        I_prev = I;
+    }
+    if (changes == 0)
+        bad("the wall tangency curve has no point at wall angle " + fmt(s) + ": no action in (0, 4 I_tan] puts "
+            "oscillator 2 on H2 + eps Vc(qw1, q2) = h - V1(qw1) (eps = " + fmt(sys.eps) + " too large?)");
+    if (changes > 1)
+        bad("the wall tangency curve is not a graph over the wall angle: at angle " + fmt(s) + " the level "
+            "H2 + eps Vc(qw1, q2) = h - V1(qw1) is met at " + std::to_string(changes) + " actions (eps = " +
+            fmt(sys.eps) + "); normal coordinates do not exist");
+    const double I = detail::brent(G, lo, hi, 1e-15);
+    const auto [q2, p2] = sys.V2->point_at(s, sys.V2->energy(I));
+    std::array<double, 4> z{sys.qw1, 0.0, q2, p2};
+    double dz[4];
+    sys.rhs(z.data(), dz);
+    if (!(dz[1] > 0))
+        bad("at wall angle " + fmt(s) + " the point of q1 = qw1 with p1 = 0 is not a minimum of q1 (dp1/dt = " +
+            fmt(dz[1]) + " <= 0): the coupling (eps = " + fmt(sys.eps) + ") overpowers the force of V1 there");
+    return z;
+}
+
+// The Sigma_h point whose segment touches q1 = qw1 at the wall point of angle s: the time-reversed
+// wall point traced forward to its first crossing of Sigma_h, reversed back.
+std::pair<double, double> trace_back(detail::Tracer& tr, double h, double s, double I0) {
+    const FlowSystem& sys = tr.system();
+    const auto zw = wall_point(sys, h, s, I0);
+    const ReturnResult r = tr.trace({zw[0], 0.0, zw[2], -zw[3]}, true);
+    if (r.status != FlowStatus::Ok)
+        bad("the tangential curve could not be traced back from wall angle " + fmt(s) + " (integration status " +
+            std::to_string(int(r.status)) + ")");
+    const double q2 = r.z[2], p2 = -r.z[3];
+    const double e2 = 0.5 * p2 * p2 + sys.V2->V(q2);
+    return {wrap(sys.V2->angle_of_point(q2, p2, e2)), sys.V2->action(e2)};
+}
+
+}  // namespace
+
+TangentialCurve TangentialCurve::measure(const FlowSystem& s, double h, int n, const FlowOptions& opt, int n_check) {
+    detail::gsl_quiet();
+    s.validate();
+    opt.validate();
+    if (n < 8 || n % 2 || n > 4096) bad("n must be an even number in [8, 4096], got " + std::to_string(n));
+    if (n_check < 0 || n_check > n) bad("n_check must be in [0, n], got " + std::to_string(n_check));
+    if (!std::isfinite(h)) bad("h must be finite, got " + fmt(h));
+    const double E1 = h - s.V1->V(s.qw1);
+    if (!(E1 > 0)) bad("h = " + fmt(h) + " does not reach the line q1 = qw1 (h must exceed V1(qw1) = " + fmt(s.V1->V(s.qw1)) + ")");
+    FlowSystem smooth = s;  // the segment from Sigma_h to its touching point meets no wall
+    smooth.geometry = Geometry::None;
+    detail::Tracer tr(smooth, opt);
+    TangentialCurve c;
+    c.h_ = h;
+    c.eps_ = s.eps;
+    c.I0_ = s.V2->action(E1);
+    c.s_.resize(std::size_t(n));
+    c.theta_.resize(std::size_t(n));
+    c.I_.resize(std::size_t(n));
+    std::vector<double> u(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+        const double sk = -kPi + kTwoPi * k / n;
+        const auto [th, I] = trace_back(tr, h, sk, c.I0_);
+        c.s_[std::size_t(k)] = sk;
+        c.theta_[std::size_t(k)] = th;
+        c.I_[std::size_t(k)] = I;
+        u[std::size_t(k)] = wrap(th - sk);
+    }
+    // theta(s) - s must be continuous and periodic: unwrap it; a winding left over means theta(s)
+    // is not a degree-one circle map, so no interpolant (and no graph) exists.
+    double wind = 0;
+    for (int k = 1; k <= n; ++k) {
+        const double d = wrap(u[std::size_t(k % n)] - u[std::size_t(k - 1)]);
+        if (k < n) u[std::size_t(k)] = u[std::size_t(k - 1)] + d;
+        else wind = u[std::size_t(n - 1)] + d - u[0];
+    }
+    if (std::fabs(wind) > 1e-6)
+        bad("the tangential curve winds " + fmt(wind / kTwoPi) + " extra times around the cylinder (eps = " + fmt(s.eps) +
+            "): it is not a graph over theta and normal coordinates do not exist");
+    c.u_ = TrigInterpolant(u);
+    c.Ifun_ = TrigInterpolant(c.I_);
+    c.min_slope_ = 1e300;
+    for (int k = 0; k < 8 * n; ++k) {
+        const double sk = -kPi + kTwoPi * k / (8 * n);
+        const double slope = 1 + c.u_.with_derivative(sk).second;
+        if (slope < c.min_slope_) {
+            c.min_slope_ = slope;
+            c.min_slope_s_ = sk;
+        }
+    }
+    if (c.is_graph()) {
+        // I_tan(theta) is smooth and periodic in theta too: interpolate it directly, so normal
+        // coordinates cost one interpolant evaluation instead of a Newton inversion of theta(s).
+        std::vector<double> Ith(static_cast<std::size_t>(2 * n));
+        for (int k = 0; k < 2 * n; ++k) Ith[std::size_t(k)] = c.Ifun_(c.parameter_of(-kPi + kTwoPi * k / (2 * n)));
+        c.Itheta_ = TrigInterpolant(Ith);
+    }
+    for (int k = 0; k < n_check; ++k) {
+        const double sk = -kPi + kTwoPi * (double(k) * n / n_check + 0.5) / n;  // midway between samples
+        const auto [th, I] = trace_back(tr, h, sk, c.I0_);
+        const auto [thi, Ii] = c.at(sk);
+        c.err_theta_ = std::max(c.err_theta_, std::fabs(wrap(th - thi)));
+        c.err_I_ = std::max(c.err_I_, std::fabs(I - Ii));
+        if (c.is_graph()) c.err_I_ = std::max(c.err_I_, std::fabs(I - c.I_tan(th)));  // the theta-interpolant too
+    }
+    return c;
+}
+
+std::pair<double, double> TangentialCurve::at(double s) const {
+    return {wrap(s + u_(s)), Ifun_(s)};
+}
+
+std::string TangentialCurve::not_graph_reason() const {
+    if (is_graph()) return "";
+    return "the tangential curve is not a graph over theta at eps = " + fmt(eps_) + ": theta(s) turns back (dtheta/ds = " +
+           fmt(min_slope_) + " at wall angle " + fmt(min_slope_s_) + "), so one theta has several tangency actions and "
+           "normal coordinates (phi, K) do not exist; use section coordinates (theta, I)";
+}
+
+double TangentialCurve::parameter_of(double theta) const {
+    if (!is_graph()) bad(not_graph_reason());
+    // F(s) = s + u(s) - lift(theta) is increasing with F(s + 2 pi) = F(s) + 2 pi: from s0 with
+    // |F(s0)| <= pi the root lies in [s0 - 2 pi, s0 + 2 pi]; Newton, kept in the bracket.
+    double s = theta - u_.mean();
+    const double target = s + u_(s) - wrap(s + u_(s) - theta);
+    double lo = s - kTwoPi, hi = s + kTwoPi;
+    for (int it = 0; it < 100; ++it) {
+        const auto [uv, du] = u_.with_derivative(s);
+        const double F = s + uv - target;
+        if (F == 0) break;
+        (F < 0 ? lo : hi) = s;
+        double sn = s - F / (1 + du);
+        if (!(sn > lo && sn < hi)) sn = 0.5 * (lo + hi);
+        if (std::fabs(sn - s) <= 4e-16 * (1 + std::fabs(s))) {
+            s = sn;
+            break;
+        }
+        s = sn;
+    }
+    return s;
+}
+
+double TangentialCurve::I_tan(double theta) const {
+    if (!is_graph()) bad(not_graph_reason());
+    return Itheta_(theta);
+}
+
+}  // namespace hovering

@@ -1,0 +1,93 @@
+"""Vocabulary shared by both models: region labels, outcomes, angle wrapping.
+
+The enums are the core's own (bound from C++ as :class:`enum.IntEnum`, so their values cannot
+drift from the kernels'); this module only adds the paper's labels and a parser.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._core import FlowStatus, Geometry, Kernel, Region, Status
+
+__all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS"]
+
+#: The paper's label of each region code (``'m'``: more than one impact, the flow only).
+REGION_LABELS = {-1: "-", 0: "0u", 1: "0", 2: "1", 3: "R", 4: "m"}
+
+
+def _label(self) -> str:
+    """The paper's label of the region: ``'0u'``, ``'0'``, ``'1'``, ``'R'`` (``'m'``: several impacts)."""
+    return REGION_LABELS[int(self)]
+
+
+def _parse(cls, value) -> "Region":
+    """Convert a Region, its name (``'ABOVE'``), paper label (``'0'``) or code (1) to a Region.
+
+    Parameters
+    ----------
+    value : Region, str or int
+        What to convert.
+
+    Returns
+    -------
+    Region
+
+    Raises
+    ------
+    ValueError
+        If the value names no region.
+    """
+    if isinstance(value, cls):
+        return value
+    if isinstance(value, str):
+        key = value.strip()
+        for r in cls:
+            if r is not cls.NONE and key in (r.name, r.name.lower(), REGION_LABELS[int(r)]):
+                return r
+    elif isinstance(value, (int, np.integer)) and not isinstance(value, bool) and 0 <= value < len(REGION_LABELS) - 1:
+        return cls(int(value))
+    allowed = ", ".join(f"{r.name} ('{REGION_LABELS[int(r)]}')" for r in cls if r is not cls.NONE)
+    raise ValueError(f"unknown region {value!r}; allowed: {allowed}")
+
+
+Region.label = property(_label)
+Region.parse = classmethod(_parse)
+
+
+def region_mask(regions) -> int:
+    """Bit mask (bit r = Region r) of a collection of regions.
+
+    Parameters
+    ----------
+    regions : iterable of Region, str or int
+        Regions in any form accepted by ``Region.parse``.
+
+    Returns
+    -------
+    int
+        The mask, 0 for an empty collection.
+    """
+    mask = 0
+    for r in regions:
+        mask |= 1 << int(Region.parse(r))
+    return mask
+
+
+def wrap(x):
+    """Wrap angles to ``[-pi, pi)``.
+
+    Parameters
+    ----------
+    x : array_like
+        Angles in radians.
+
+    Returns
+    -------
+    ndarray or float
+        ``x`` shifted by a multiple of ``2 pi`` into ``[-pi, pi)``.
+    """
+    y = np.asarray(x, dtype=float) - 2 * np.pi * np.floor((np.asarray(x, dtype=float) + np.pi) / (2 * np.pi))
+    y = np.where(y >= np.pi, y - 2 * np.pi, y)
+    y = np.where(y < -np.pi, y + 2 * np.pi, y)
+    return y if np.ndim(y) else float(y)

@@ -1,0 +1,18 @@
+"""Analyses written once for every map (TruncatedMap, TruncatedFamily, FlowMap): rotation numbers
+and regularity, the hovering set HOV(eps), and the critical invariant curve."""
+
+from .critical import CriticalCurve, critical_curve, max_angular_gap
+from .hovering import HoveringArea, hovering_area
+from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
+
+__all__ = [
+    "birkhoff_weights",
+    "birkhoff_average",
+    "rotation_number",
+    "regularity",
+    "HoveringArea",
+    "hovering_area",
+    "CriticalCurve",
+    "critical_curve",
+    "max_angular_gap",
+]

@@ -1,0 +1,218 @@
+"""The critical invariant curve: the lowest invariant curve inside a set of no-impact regions,
+searched along L1 (or L2), next to the leading-order predictions (eq:kcrit, eq:rhocrit, and
+:func:`hovering.theory` for every Omega0 and forcing). Works on any map: truncated or the flow.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional, Sequence
+
+import numpy as np
+
+from .._common import Region, Status
+from .rotation import regularity, rotation_number
+
+__all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
+
+
+def max_angular_gap(phi) -> float:
+    """Largest gap between consecutive angles of a point set on the circle.
+
+    Parameters
+    ----------
+    phi : array_like
+        Angles (NaN entries are ignored).
+
+    Returns
+    -------
+    float
+        The largest gap, in ``[0, 2 pi]`` (``2 pi`` for fewer than two points).
+    """
+    a = np.sort(np.mod(np.asarray(phi, dtype=float)[np.isfinite(phi)], 2 * np.pi))
+    if a.size < 2:
+        return 2 * np.pi
+    return float(max(np.max(np.diff(a)), a[0] + 2 * np.pi - a[-1]))
+
+
+@dataclass(frozen=True)
+class CriticalCurve:
+    """The lowest invariant curve inside a set of no-impact regions (see :func:`critical_curve`).
+
+    Attributes
+    ----------
+    K0 : float
+        Height where the critical orbit starts on the search line (L1 or L2).
+    K_min : float
+        Lowest K along the critical orbit (the curve's minimum).
+    rotation : float
+        Weighted Birkhoff rotation number of the critical orbit.
+    rotation_mean : float
+        The paper's rho = <omega_a> of the same orbit.
+    digits : float
+        Regularity of the orbit (see :func:`regularity`).
+    K_pred, rotation_pred : float
+        Leading-order predictions of the curve's height on its search line and its rotation
+        (eq:kcrit and eq:rhocrit in the hovering case; for the other sign the curve k^{u0}, whose
+        rotation the first-order theory gives only through its mean height).
+    K_fail : float
+        Highest tested start below K0 whose orbit impacts or is not regular (bracket of K0).
+    line : str
+        The search line ("L1" or "L2").
+    hovers : bool
+        Whether these parameters hover (:class:`hovering.Theory`); if not, the curve found is the
+        lowest invariant curve avoiding impacts, k^{u0}, not a hovering critical curve.
+    note : str
+        The theory's explanation (sign of eps sin(Omega0/2), resonance).
+    phi, K : ndarray
+        The critical orbit.
+    """
+
+    K0: float
+    K_min: float
+    rotation: float
+    rotation_mean: float
+    digits: float
+    K_pred: float
+    rotation_pred: float
+    K_fail: float
+    phi: np.ndarray = field(repr=False)
+    K: np.ndarray = field(repr=False)
+    line: str = "L1"
+    hovers: bool = True
+    note: str = ""
+
+
+def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] = None,
+                   regions=("0u", "0"), line: Optional[str] = None, grid: int = 64, digits: float = 8.0,
+                   tol: float = 1e-6, n_threads: int = 0) -> CriticalCurve:
+    """Search the lowest invariant curve that stays in ``regions``, along the line L1 (or L2).
+
+    A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps``, its
+    weighted Birkhoff rotation number agrees over the two halves of the orbit to ``digits``
+    digits (quasi-periodic), and it fills the circle: its largest gap in phi is below 20 times the
+    mean spacing ``2 pi / n_steps`` (a rotational invariant curve; an island chain of period p
+    leaves gaps ~ 2 pi / p). The lowest passing start of a grid over ``K_range`` is then refined
+    by bisection against the grid point below it.
+
+    Where the parameters do not hover (``eps sin(Omega0/2) < 0``, thm:hovering) the lowest curve
+    avoiding impacts is k^{u0}, with its minimum near L2 at K >= 0: the default search moves to L2
+    and the result says ``hovers=False`` with the reason in ``note``.
+
+    Parameters
+    ----------
+    m : TruncatedMap, TruncatedFamily or FlowMap
+        The map.
+    n_steps : int, optional
+        Iterates per tested orbit (>= 16).
+    K_range : (float, float), optional
+        Heights searched. Default: from 3 times the predicted critical height (or ``-2 |eps| /
+        |sin(Omega0/2)|`` when none is predicted) up to ``|eps| / |sin(Omega0/2)|``, in the band.
+    regions : iterable, optional
+        The no-impact set: ``("0u", "0")`` for the hovering critical curve, ``("0u",)`` for the
+        curve k^{u0} (lowest curve in K >= 0).
+    line : {"L1", "L2"}, optional
+        Search line. Default: L1 in the hovering case, L2 otherwise (minima of the curves lie near
+        L1 when ``eps sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves).
+    grid : int, optional
+        Grid points of the first scan (>= 2).
+    digits : float, optional
+        Regularity threshold, in (0, 16].
+    tol : float, optional
+        Bisection tolerance on K0, > 0 (at least 1e-14 times the scale of K0).
+    n_threads : int, optional
+        Worker threads for the scan.
+
+    Returns
+    -------
+    CriticalCurve
+
+    Raises
+    ------
+    ValueError
+        For bad arguments (named, with the allowed range).
+    RuntimeError
+        If no start in ``K_range`` passes (no invariant curve found: widen the range); the message
+        says when the sign of eps does not hover.
+    """
+    th = m.theory()
+    hover_search = any(Region.parse(r) == Region.ABOVE for r in regions)
+    if line is None:
+        line = "L2" if hover_search and not th.hovers and m.eps != 0 else "L1"
+    if line not in ("L1", "L2"):
+        raise ValueError(f"line must be 'L1' or 'L2', got {line!r}")
+    for name, v, least in (("n_steps", n_steps, 16), ("grid", grid, 2)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+            raise ValueError(f"{name} must be an integer >= {least}, got {v!r}")
+    if not (isinstance(digits, (int, float, np.floating)) and 0 < digits <= 16):
+        raise ValueError(f"digits must be a number in (0, 16], got {digits!r}")
+    line_fn = m.L1 if line == "L1" else m.L2
+    lo, hi = m.valid_band()
+    s = abs(math.sin(0.5 * th.Omega0))
+    scale = abs(m.eps) * max(abs(b) for b in th.forcing) / max(s, 1e-3)
+    if K_range is None:
+        K_a = 3 * th.K_crit if th.hovers else -2 * scale
+        K_range = (max(K_a, lo * (1 - 1e-9)), min(max(scale, 1e-6), hi))
+    K_range = tuple(K_range)
+    if len(K_range) != 2:
+        raise ValueError(f"K_range must be a pair (K_lo, K_hi), got {K_range!r}")
+    K_a, K_b = map(float, K_range)
+    if not (lo < K_a < K_b < hi):
+        raise ValueError(f"K_range must be increasing inside the band ({lo}, {hi}), got {K_range}")
+    if not (isinstance(tol, (int, float, np.floating)) and math.isfinite(tol) and tol >= 1e-14 * max(abs(K_a), abs(K_b))):
+        raise ValueError(f"tol must be finite and >= 1e-14 x the scale of K_range ({1e-14 * max(abs(K_a), abs(K_b)):.3g}), "
+                         f"got {tol!r}")
+    flow = hasattr(m, "step_rotations")
+    record = ("orbit", "regions") if flow else ("orbit",)
+
+    def test(K0s):
+        K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
+        res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
+                        n_threads=n_threads)
+        stayed = res.status == Status.OK
+        dig = np.where(stayed, regularity(res), 0.0)
+        circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
+                           for i in range(res.n_orbits)])
+        return stayed & (dig >= digits) & circle, res, dig
+
+    K_grid = np.linspace(K_a, K_b, grid)
+    ok, _, _ = test(K_grid)
+    if not ok.any():
+        why = f"; {th.note}" if hover_search and not th.hovers else "; widen K_range"
+        raise RuntimeError(
+            f"no invariant curve in regions {tuple(regions)} found on {line} for K0 in [{K_a}, {K_b}] "
+            f"with {n_steps} steps and {digits} digits{why}")
+    j = int(np.argmax(ok))
+    K_pass = K_grid[j]
+    K_fail = K_grid[j - 1] if j > 0 else K_a
+    if j > 0:
+        while K_pass - K_fail > tol:
+            mid = 0.5 * (K_pass + K_fail)
+            if test([mid])[0][0]:
+                K_pass = mid
+            else:
+                K_fail = mid
+    _, res, dig = test([K_pass])
+    rho_w = rotation_number(res, "birkhoff")[0]
+    rho_m = rotation_number(res, "mean")[0]
+    if th.hovers or not hover_search:
+        K_pred, rho_pred = th.K_crit, th.rho_crit
+    else:  # k^{u0}: crosses L2 at its minimum ~0, and L1 at K_lowest
+        K_pred = 0.0 if line == "L2" else th.K_lowest
+        rho_pred = th.Omega0 + th.tau0 * (th.K_lowest + m.eps * float(np.mean(th.G(np.linspace(-np.pi, np.pi, 4096, endpoint=False)))))
+    return CriticalCurve(
+        K0=float(K_pass),
+        K_min=float(np.min(res.K[0])),
+        rotation=float(rho_w),
+        rotation_mean=float(rho_m),
+        digits=float(dig[0]),
+        K_pred=float(K_pred),
+        rotation_pred=float(rho_pred),
+        K_fail=float(K_fail),
+        phi=res.phi[0],
+        K=res.K[0],
+        line=line,
+        hovers=bool(th.hovers),
+        note=th.note,
+    )

@@ -1,0 +1,201 @@
+"""The hovering set HOV(eps) by its definition, on any map: truncated (F_eps, F_{eps1,eps2}) or the flow.
+
+HOV(eps) is the set of points that impact under the eps = 0 map and never impact under the eps
+map (sec:truncinvcurves). Both models share (phi, K): the flow's normal coordinates are those of
+its own tangential curve, and a point is carried to eps = 0 by its normal coordinates, i.e. the
+eps = 0 flow starts at (theta, I) = (phi, K + I_tan(h)). That is the identification under which
+F_0 and F_eps act on one (phi, K) plane, as in the paper's definition and eq:hovsetsize.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from .._common import Status
+
+__all__ = ["HoveringArea", "hovering_area"]
+
+
+@dataclass(frozen=True)
+class HoveringArea:
+    """Measured area of the hovering set HOV(eps) (see :func:`hovering_area`).
+
+    Attributes
+    ----------
+    area : float
+        Estimate at the largest iteration count.
+    error : float
+        ``2 * sampling_error + iteration_error``.
+    sampling_error : float
+        One standard deviation of the sampling (binomial; an upper bound for the stratified scheme).
+    iteration_error : float
+        Change of the estimate over the last doubling of the iteration count (estimates only fall
+        as orbits are followed longer).
+    theory : float
+        Leading-order prediction (eq:hovsetsize, generalised by :func:`hovering.theory` to every
+        Omega0 and the map's own forcing): 0 for the sign of eps that does not hover.
+    areas : dict
+        Estimate at each iteration count (N/4, N/2, N).
+    n_samples : int
+        Initial conditions sampled.
+    box : tuple
+        ``(phi_lo, phi_hi, K_lo, K_hi)`` of the sampled box.
+    impact_fraction_F0 : float
+        Fraction of the box that impacts under F_0 within N steps (part of the definition).
+    floor_touched : bool
+        Whether a hovering point lies in the lowest tenth of the box (then enlarge it: K_low).
+    unresolved : int
+        Sample points whose orbit ended otherwise (the flow's corner hits, grazing, step limits:
+        counted as not hovering).
+    phi, K, hovering : ndarray or None
+        Sample points and their membership, when ``keep_points`` was set.
+    """
+
+    area: float
+    error: float
+    sampling_error: float
+    iteration_error: float
+    theory: float
+    areas: dict
+    n_samples: int
+    box: tuple
+    impact_fraction_F0: float
+    floor_touched: bool
+    unresolved: int = 0
+    phi: Optional[np.ndarray] = field(default=None, repr=False)
+    K: Optional[np.ndarray] = field(default=None, repr=False)
+    hovering: Optional[np.ndarray] = field(default=None, repr=False)
+
+
+
+def _stratified(samples: int, K_low: float, rng) -> tuple:
+    """One uniform point in each cell of a near-square grid over [-pi, pi) x [K_low, 0).
+
+    The grid has at most ``samples + n_phi`` cells whatever the box's aspect ratio (a thin box
+    gets one row, not millions of columns).
+    """
+    H = -K_low
+    n_phi = int(min(max(1, round(math.sqrt(samples * 2 * math.pi / H))), samples))
+    n_K = max(1, int(math.ceil(samples / n_phi)))
+    i, j = np.meshgrid(np.arange(n_phi), np.arange(n_K), indexing="ij")
+    phi = -math.pi + (i.ravel() + rng.random(i.size)) * (2 * math.pi / n_phi)
+    K = K_low + (j.ravel() + rng.random(j.size)) * (H / n_K)
+    K = np.minimum(K, -1e-300)  # the box is K < 0 (HOV lies in J_0)
+    return phi, K
+
+
+def default_depth(m) -> float:
+    """Depth of the default box below K = 0: twice the deepest leading-order curve through L1.
+
+    ``2 |eps| max_psi |G(psi)|`` (:class:`hovering.Theory`), i.e. ``2 |eps| / |sin(Omega0/2)|`` for
+    ``f = sin``; the band's depth when that is not finite (resonant Omega0).
+    """
+    th = m.theory()
+    psi = np.linspace(-math.pi, math.pi, 4001)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = 2.0 * abs(m.eps) * float(np.max(np.abs(th.G(psi)))) if th.forcing else float("nan")
+    return d if math.isfinite(d) and d > 0 else float("inf")
+
+
+def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optional[float] = None, seed: int = 0,
+                  n_threads: int = 0, keep_points: bool = False) -> HoveringArea:
+    """Area of the hovering set HOV(eps) of a map, by its definition.
+
+    HOV(eps) is the set of points that impact under F_0 (some iterate leaves J_0 u J_0u) and never
+    impact under F_eps (every iterate stays in J_0 u J_0u). It lies in J_0, so the box
+    ``[-pi, pi) x [K_low, 0)`` is sampled with one uniform point per cell of a near-square grid
+    (stratified sampling). Each point is iterated under F_0 (``m.with_eps(0)``) and under F_eps
+    with early exit: an orbit stops at its first impact, so only hovering orbits cost the full N
+    steps. For the flow, F_0 is the eps = 0 flow in its own normal coordinates (see the module
+    docstring); an orbit that hits the corner or grazes counts as impacting.
+
+    Parameters
+    ----------
+    m : TruncatedMap, TruncatedFamily or FlowMap
+        The map F_eps.
+    n_steps : int, optional
+        N: iterates that count as "never" (estimates at N/4 and N/2 come from the same run).
+    samples : int, optional
+        Number of sample points (rounded up to fill the grid).
+    K_low : float, optional
+        Bottom of the box. Default: twice the deepest leading-order critical curve (see
+        :func:`default_depth`; ``-2 |eps| / |sin(Omega0/2)|`` for f = sin), clipped to the band.
+    seed : int, optional
+        Seed of the jitter.
+    n_threads : int, optional
+        Worker threads (0 = all cores).
+    keep_points : bool, optional
+        Keep the sample points and their membership in the result (for plotting).
+
+    Returns
+    -------
+    HoveringArea
+
+    Raises
+    ------
+    ValueError
+        For counts that are not integers in range, or a K_low outside the band below 0.
+    """
+    n_steps = _count("n_steps", n_steps, 4)
+    samples = _count("samples", samples, 1)
+    lo = m.valid_band()[0]
+    if K_low is None:
+        depth = default_depth(m) if m.eps != 0 else 0.1
+        K_low = max(-depth, lo * (1 - 1e-9))
+    K_low = float(K_low)
+    if not (lo < K_low < 0):
+        raise ValueError(f"K_low must lie in the band below 0, ({lo}, 0), got {K_low}")
+    rng = np.random.default_rng(seed)
+    phi, K = _stratified(samples, K_low, rng)
+    n = phi.size
+    no_impact = ("0u", "0")
+
+    # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
+    r0 = m.with_eps(0.0).iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
+                                 n_threads=n_threads)
+    impacts0 = np.isin(r0.status, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
+    # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
+    r = m.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
+    stayed = r.status == Status.OK
+    box_area = 2 * math.pi * (-K_low)
+    areas = {}
+    for N in (n_steps // 4, n_steps // 2, n_steps):
+        # Stopped at or after N steps for any reason (exit, escape, the flow's corner hits): survived N.
+        survive = stayed | (r.steps_done >= N)
+        areas[N] = box_area * np.count_nonzero(impacts0 & survive) / n
+    hov = impacts0 & stayed
+    p = np.count_nonzero(hov) / n
+    sampling = box_area * math.sqrt(max(p * (1 - p), 1.0 / n) / n)
+    iteration = areas[n_steps // 2] - areas[n_steps]
+    theory = m.theory().area
+    floor_touched = bool(np.any(hov & (K < 0.9 * K_low)))
+    unresolved = int(np.count_nonzero(~np.isin(r.status, [int(Status.OK), int(Status.EXITED), int(Status.ESCAPED)])))
+    return HoveringArea(
+        area=areas[n_steps],
+        error=2 * sampling + iteration,
+        sampling_error=sampling,
+        iteration_error=iteration,
+        theory=float(theory),
+        areas=areas,
+        n_samples=n,
+        box=(-math.pi, math.pi, K_low, 0.0),
+        impact_fraction_F0=float(np.count_nonzero(impacts0) / n),
+        floor_touched=floor_touched,
+        unresolved=unresolved,
+        phi=phi if keep_points else None,
+        K=K if keep_points else None,
+        hovering=hov if keep_points else None,
+    )
+
+
+def _count(name: str, value, least: int) -> int:
+    """An integer count >= least, or a ValueError naming it."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer >= {least}, got {value!r}")
+    if value < least:
+        raise ValueError(f"{name} must be >= {least}, got {value}")
+    return int(value)

@@ -1,0 +1,236 @@
+"""The oscillators-step system of sec:setup: potentials, coupling, geometry and onset parameters."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from typing import Optional
+
+from .. import _core
+from .._common import Geometry
+from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
+
+__all__ = [
+    "Harmonic",
+    "Tan",
+    "Numerical",
+    "Potential",
+    "Bilinear",
+    "Polynomial",
+    "StepSystem",
+    "onset_parameters",
+    "OnsetParameters",
+]
+
+_GEOMETRIES = ("none", "wall", "step")
+
+
+@dataclass(frozen=True)
+class Bilinear:
+    """The coupling ``Vc(q1, q2) = q1 q2``."""
+
+    def __call__(self, q1, q2):
+        """Vc(q1, q2).
+
+        Parameters
+        ----------
+        q1, q2 : float or array_like
+            Positions.
+
+        Returns
+        -------
+        float or ndarray
+        """
+        return q1 * q2
+
+
+@dataclass(frozen=True)
+class Polynomial:
+    """The coupling ``Vc(q1, q2) = sum c_ij q1^i q2^j``.
+
+    Parameters
+    ----------
+    coefficients : dict
+        ``{(i, j): c_ij}`` with integer exponents in [0, 20].
+    """
+
+    coefficients: dict
+
+    def __post_init__(self):
+        for (i, j), c in self.coefficients.items():
+            if not (int(i) == i and int(j) == j and 0 <= i <= 20 and 0 <= j <= 20):
+                raise ValueError(f"exponents must be integers in [0, 20], got ({i}, {j})")
+            if not math.isfinite(c):
+                raise ValueError(f"coefficient of q1^{i} q2^{j} must be finite, got {c}")
+
+    def __call__(self, q1, q2):
+        """Vc(q1, q2).
+
+        Parameters
+        ----------
+        q1, q2 : float or array_like
+            Positions.
+
+        Returns
+        -------
+        float or ndarray
+        """
+        return sum(c * q1**i * q2**j for (i, j), c in self.coefficients.items())
+
+
+def _terms(coupling) -> list:
+    if coupling is None:
+        return []
+    if isinstance(coupling, Bilinear):
+        return [(1.0, 1.0, 1.0)]
+    if isinstance(coupling, Polynomial):
+        return [(float(c), float(i), float(j)) for (i, j), c in coupling.coefficients.items()]
+    raise ValueError(f"coupling must be hovering.Bilinear() or hovering.Polynomial({{(i, j): c}}), got {coupling!r}")
+
+
+@dataclass(frozen=True)
+class StepSystem:
+    """``H = p1^2/2 + V1(q1) + p2^2/2 + V2(q2) + eps Vc(q1, q2)`` with a step ``{q1 < qw1, q2 < qw2}``.
+
+    Parameters
+    ----------
+    V1, V2 : Potential
+        Single-well potentials (``hovering.Harmonic``, ``hovering.Tan``, ...).
+    coupling : object, optional
+        ``Vc`` (e.g. :class:`Bilinear`); ignored (not evaluated) when ``eps == 0``.
+    eps : float, optional
+        Coupling strength.
+    qw1, qw2 : float
+        Corner of the step, both < 0 (the minima lie outside the step) and inside the wells.
+    geometry : {"none", "wall", "step"}, optional
+        Which walls the flow sees: none, the right wall q1 = qw1 only, or the step.
+
+    Raises
+    ------
+    ValueError
+        Naming the bad value and its allowed range.
+    """
+
+    V1: Potential
+    V2: Potential
+    coupling: Optional[object] = None
+    eps: float = 0.0
+    qw1: float = -1.0
+    qw2: float = -0.5
+    geometry: str = "step"
+
+    def __post_init__(self):
+        for name in ("V1", "V2"):
+            pot = getattr(self, name)
+            if not isinstance(pot, Potential):
+                raise ValueError(f"{name} must be a hovering potential (Harmonic, Tan, CustomPotential, ...), got {pot!r}")
+            # The core computes Harmonic and Tan forces from their parameters: a Python override of
+            # V or dV in a subclass of them would be silently ignored by the flow.
+            for base in (Harmonic, Tan):
+                if isinstance(pot, base) and any(getattr(type(pot), f) is not getattr(base, f) for f in ("V", "dV")):
+                    raise ValueError(f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "
+                                     "core would ignore; subclass hovering.Potential (or use CustomPotential) instead")
+        for name in ("eps", "qw1", "qw2"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise ValueError(f"{name} must be a real number, got {v!r}")
+            object.__setattr__(self, name, float(v))
+        if not math.isfinite(self.eps):
+            raise ValueError(f"eps must be finite, got {self.eps}")
+        if self.eps != 0 and self.coupling is None:
+            raise ValueError("eps != 0 needs a coupling (e.g. hovering.Bilinear())")
+        _terms(self.coupling)
+        if self.geometry not in _GEOMETRIES:
+            raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {self.geometry!r}")
+        for name, pot in (("qw1", self.V1), ("qw2", self.V2)):
+            q = getattr(self, name)
+            if not (math.isfinite(q) and q < 0):
+                raise ValueError(f"{name} must be finite and < 0 (the minimum lies outside the step), got {q}")
+            if not abs(q) < pot.q_limit:
+                raise ValueError(f"{name} = {q} lies outside the well of {pot!r} (|{name}| < {pot.q_limit})")
+
+        geometry = {"none": Geometry.NONE, "wall": Geometry.WALL, "step": Geometry.STEP}[self.geometry]
+        # The core's validated copy, built once (frozen: set through object.__setattr__).
+        object.__setattr__(self, "_core", _core.flow.FlowSystem(self.V1, self.V2, _terms(self.coupling), self.eps,
+                                                                self.qw1, self.qw2, geometry))
+
+    @property
+    def core(self) -> "_core.flow.FlowSystem":
+        """The core's FlowSystem of this system (what the compiled flow integrates)."""
+        return self._core
+
+    @property
+    def step_energy(self) -> float:
+        """``h_0^w = V1(qw1) + V2(qw2)``: above it, orbits can reach the corner (def:heps)."""
+        return self.V1.V(self.qw1) + self.V2.V(self.qw2)
+
+    @property
+    def python_defined(self) -> bool:
+        """Whether V1 or V2 calls back into Python (CustomPotential or a Python subclass)."""
+        return any(isinstance(p, _core.flow._CallablePotential) or not type(p).__module__.startswith("hovering._core")
+                   for p in (self.V1, self.V2))
+
+    def replace(self, **changes) -> "StepSystem":
+        """A copy with some fields changed (e.g. ``eps=0.0``, ``geometry="wall"``), validated again.
+
+        Parameters
+        ----------
+        **changes
+            Field values: V1, V2, coupling, eps, qw1, qw2, geometry.
+
+        Returns
+        -------
+        StepSystem
+        """
+        fields = dict(V1=self.V1, V2=self.V2, coupling=self.coupling, eps=self.eps, qw1=self.qw1, qw2=self.qw2,
+                      geometry=self.geometry)
+        unknown = set(changes) - set(fields)
+        if unknown:
+            raise ValueError(f"unknown StepSystem field(s) {sorted(unknown)}; allowed: {sorted(fields)}")
+        fields.update(changes)
+        return StepSystem(**fields)
+
+
+def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> OnsetParameters:
+    """Onset parameters Omega0, tau0, tau1, lam, theta_w (sec:parametersdef) at energy h.
+
+    Parameters
+    ----------
+    sys : StepSystem
+        The system (only V1, V2, qw1, qw2 enter: the parameters are defined at eps = 0).
+    h : float
+        Energy, above the step energy ``sys.step_energy``.
+    method : {"definitions", "quadrature", "closed_form"}, optional
+        ``"definitions"``: eq:omega0ofI .. eq:deftau1 with the potentials' own action-angle
+        variables (closed forms for Harmonic/Tan) and Richardson central differences for tau0,
+        tau1. ``"quadrature"``: the same with every period, action and angle by GSL quadrature
+        (any potential). ``"closed_form"``: the appendix formulas (Harmonic/Tan only), corrected
+        where they disagree with the definitions (tau0's last term over W1^3, not W1^4;
+        theta_w = arccos(+...), not arccos(-...)).
+
+    Returns
+    -------
+    OnsetParameters
+        ``.Omega0, .tau0, .tau1, .lam, .theta_w, .I_tan``.
+
+    Raises
+    ------
+    ValueError
+        If h is not above the step energy, or for an unknown method.
+    """
+    if method == "definitions":
+        return _core.flow._onset_parameters(sys.V1, sys.V2, sys.qw1, sys.qw2, float(h))
+    if method == "quadrature":
+        return _core.flow._onset_parameters(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, float(h))
+    if method == "closed_form":
+        def wa(p):
+            if isinstance(p, Tan):
+                return p.omega, p.alpha
+            if isinstance(p, Harmonic):
+                return p.omega, 0.0
+            raise ValueError(f"closed_form needs Harmonic or Tan potentials, got {p!r}")
+
+        (w1, a1), (w2, a2) = wa(sys.V1), wa(sys.V2)
+        return _core.flow._onset_parameters_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, float(h))
+    raise ValueError(f"method must be 'definitions', 'quadrature' or 'closed_form', got {method!r}")

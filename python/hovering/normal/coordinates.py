@@ -1,0 +1,329 @@
+"""Normal coordinates (phi, K) = (theta, I - I_tan^eps(theta)) of Sigma_h (eq:kphidef).
+
+* :class:`TangentialCurve`: the tangential curve measured on the flow without bisection: the
+  points that touch q1 = qw1 are known in closed form on the wall (eq:XiwallepsI) and are followed
+  backward to Sigma_h; the curve comes out as s -> (theta(s), I(s)), a closed curve whose
+  trigonometric interpolant converges spectrally, and it is a graph ``I = I_tan(theta)`` exactly
+  when theta(s) increases. Where it is not, the curve says so (no normal coordinates exist).
+* :func:`tangential_curve`: the same curve point by point, by bisection in I on the wall system's
+  itineraries (an independent check; its bracket widens itself).
+* :func:`forcing_function`, :func:`forcing_coefficients`: the odd forcing f of eq:defoff.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+
+import numpy as np
+
+from .. import _core
+from .._common import wrap
+from ..flow.section import FlowStatus, Section, flow_options
+
+__all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_coefficients", "to_normal", "from_normal"]
+
+_TWO_PI = 2 * np.pi
+
+
+class TangentialCurve:
+    """``I_tan^eps(theta)`` (Def:sing_curve) measured on the flow; see the module docstring.
+
+    Parameters
+    ----------
+    sec : Section
+        The section (system, energy). Only the line q1 = qw1 matters, whatever the geometry.
+    n : int, optional
+        Wall points traced (even, in [8, 4096]); the interpolant's error falls spectrally with n
+        (measured at eps = 0.05: 4e-12 with 32, 2e-15 with 64).
+    rtol : float, optional
+        Integration tolerance of the backward traces (atol = rtol / 100).
+    n_check : int, optional
+        Off-grid wall points traced to measure the interpolation error (0: skip).
+
+    Attributes
+    ----------
+    theta, values : ndarray
+        The measured points (theta_k, I_k) of the curve (one per wall point).
+    s : ndarray
+        Their wall angles.
+    interpolation_error : float
+        Largest |I| deviation of the interpolant from direct traces at the ``n_check`` off-grid
+        points (NaN if n_check = 0); ``interpolation_error_theta`` the same in theta.
+    is_graph : bool
+        Whether theta(s) increases, i.e. normal coordinates exist.
+    min_slope : float
+        min over s of dtheta/ds (> 0 for a graph).
+
+    Raises
+    ------
+    ValueError
+        If the wall tangency curve does not exist or is not a graph over the wall angle (eps too
+        large; the message says which and where), or for bad n, rtol.
+    """
+
+    def __init__(self, sec: Section, n: int = 64, rtol: float = 1e-12, n_check: int = 4):
+        if not isinstance(sec, Section):
+            raise ValueError(f"sec must be a hovering.Section, got {sec!r}")
+        try:
+            n = operator.index(n)
+            n_check = operator.index(n_check)
+        except TypeError:
+            raise ValueError(f"n and n_check must be integers, got {n!r}, {n_check!r}") from None
+        if not (8 <= n <= 4096 and n % 2 == 0):
+            raise ValueError(f"n must be an even integer in [8, 4096], got {n!r}")
+        if not 0 <= n_check <= n:
+            raise ValueError(f"n_check must be in [0, n], got {n_check!r}")
+        opts = flow_options(rtol=rtol, atol=rtol * 1e-2)
+        self.sec = sec
+        self._c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
+        self.s = self._c.s
+        self.theta = self._c.theta
+        self.values = self._c.I
+        et, eI = self._c.interpolation_error
+        self.interpolation_error = float(eI) if n_check else float("nan")
+        self.interpolation_error_theta = float(et) if n_check else float("nan")
+        self.is_graph = bool(self._c.is_graph)
+        self.min_slope = float(self._c.min_slope)
+
+    def __repr__(self) -> str:
+        return (f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "
+                f"interpolation_error={self.interpolation_error:.2g})")
+
+    @property
+    def I_tan0(self) -> float:
+        """The unperturbed tangent action ``I_tan(h) = H2^{-1}(h - V1(qw1))`` (eq:Itan)."""
+        return float(self._c.I_tan0)
+
+    @property
+    def not_graph_reason(self) -> str:
+        """Why the curve is not a graph (empty if it is)."""
+        return self._c.not_graph_reason
+
+    def _require_graph(self):
+        if not self.is_graph:
+            raise ValueError(self._c.not_graph_reason)
+
+    def __call__(self, theta) -> np.ndarray:
+        """``I_tan^eps`` at the angles ``theta`` (array_like; any real angle, wrapped).
+
+        Raises
+        ------
+        ValueError
+            If the curve is not a graph over theta.
+        """
+        self._require_graph()
+        th = np.asarray(theta, dtype=float)
+        out = self._c.I_tan(np.ascontiguousarray(wrap(th).ravel(), dtype=float)).reshape(th.shape)
+        return out if out.ndim else float(out)
+
+    def at(self, s):
+        """``(theta(s), I(s))`` of the closed curve at wall angles s (works for any curve)."""
+        a = np.ascontiguousarray(np.atleast_1d(np.asarray(s, dtype=float)))
+        return self._c.at(a)
+
+    def to_normal(self, theta, I):
+        """``(phi, K) = (theta, I - I_tan(theta))`` (eq:kphidef)."""
+        th = np.asarray(theta, dtype=float)
+        return th, np.asarray(I, dtype=float) - self(th)
+
+    def from_normal(self, phi, K):
+        """``(theta, I) = (phi, K + I_tan(phi))`` (eq:kphiinvdef)."""
+        ph = np.asarray(phi, dtype=float)
+        return ph, np.asarray(K, dtype=float) + self(ph)
+
+    def forcing(self, phi) -> np.ndarray:
+        """``eps f(phi) = I_tan(-phi) - I_tan(phi)`` (eq:defoff), divided by eps.
+
+        Raises
+        ------
+        ValueError
+            At eps = 0 (f is defined through a division by eps) or if the curve is not a graph.
+        """
+        eps = self.sec.sys.eps
+        if eps == 0:
+            raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
+        ph = np.asarray(phi, dtype=float)
+        return (self(-ph) - self(ph)) / eps
+
+    def forcing_coefficients(self, n_modes: int = 8, n_phi: int = 256) -> np.ndarray:
+        """Sine coefficients ``b_1 .. b_n_modes`` of f (eq:defoff), by least squares on n_phi angles.
+
+        Parameters
+        ----------
+        n_modes : int, optional
+            Number of sine modes.
+        n_phi : int, optional
+            Sample angles (equispaced): with n_phi > 2 n_modes the fit is the discrete sine
+            transform's (spectrally accurate for the smooth f).
+
+        Returns
+        -------
+        ndarray
+        """
+        if not (isinstance(n_modes, (int, np.integer)) and 1 <= n_modes and isinstance(n_phi, (int, np.integer))
+                and n_phi > 2 * n_modes):
+            raise ValueError(f"need integers n_modes >= 1 and n_phi > 2 n_modes, got {n_modes!r}, {n_phi!r}")
+        ph = -np.pi + _TWO_PI * (np.arange(n_phi) + 0.5) / n_phi
+        A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
+        return np.linalg.lstsq(A, self.forcing(ph), rcond=None)[0]
+
+
+def _wall_section(sec: Section) -> Section:
+    """The same system with the infinite wall q1 = qw1 (the tangential curve is about that line)."""
+    return Section(sec.sys.replace(geometry="wall"), sec.h)
+
+
+def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, iterations: int = 55) -> np.ndarray:
+    """The tangential curve ``I_tan^eps(theta)`` (Def:sing_curve) point by point, by bisection in I.
+
+    For each theta, the action at which the orbit from (theta, I) touches the line q1 = qw1
+    tangentially before its return: below it the orbit crosses the line (impacts the infinite
+    wall), above it the orbit turns back before the line. Found by a vectorised bisection between
+    ``I_tan (1 -+ bracket)`` (eq:Itan) on the wall system's itineraries; without a bracket it
+    starts at 0.2 and doubles until every theta is bracketed. Where the curve is not a graph over
+    theta the bisection would return one of several tangency actions: :class:`TangentialCurve`
+    detects that case and says so; prefer it for normal coordinates (one trace per wall point
+    instead of ~55 returns per angle).
+
+    Parameters
+    ----------
+    sec : Section
+        The section (its system's eps, potentials and qw1 are used).
+    theta : array_like
+        Angles.
+    rtol : float, optional
+        Integration tolerance of each return.
+    bracket : float, optional
+        Relative half-width of the initial bracket around I_tan(h), in (0, 1); default automatic.
+    iterations : int, optional
+        Bisection steps in [1, 200] (55 reach ~1e-16 relative).
+
+    Returns
+    -------
+    ndarray
+        ``I_tan^eps(theta)``.
+
+    Raises
+    ------
+    ValueError
+        For an empty theta, a bracket outside (0, 1) or bad iterations, or if no bracket up to
+        I_tan (1 -+ 0.95) contains the tangency for every theta.
+    """
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    if th.size == 0:
+        raise ValueError("theta must hold at least one angle")
+    if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 200:
+        raise ValueError(f"iterations must be an integer in [1, 200], got {iterations!r}")
+    if bracket is not None and not (isinstance(bracket, (int, float)) and 0 < bracket < 1):
+        raise ValueError(f"bracket must lie in (0, 1), got {bracket!r}")
+    ws = _wall_section(sec)
+    I0 = sec.sys.V2.action(sec.h - sec.sys.V1.V(sec.sys.qw1))
+
+    def crosses(I):
+        out = ws.return_map(th, I, rtol=rtol, atol=rtol * 1e-2)
+        return np.array(["R" in s for s in out.itinerary]) | (out.status == FlowStatus.GRAZING)
+
+    rel = 0.2 if bracket is None else float(bracket)
+    while True:
+        lo, hi = np.full(th.shape, I0 * (1 - rel)), np.full(th.shape, I0 * (1 + rel))
+        if crosses(lo).all() and not crosses(hi).any():
+            break
+        if bracket is not None or rel >= 0.95:
+            raise ValueError(f"the tangency is not inside I_tan (1 +- {rel}) for every theta (eps = {sec.sys.eps}); "
+                             "the curve may not be a graph: see hovering.TangentialCurve")
+        rel = min(0.95, 2 * rel)
+    for _ in range(int(iterations)):
+        mid = 0.5 * (lo + hi)
+        c = crosses(mid)
+        lo = np.where(c, mid, lo)
+        hi = np.where(c, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def forcing_function(sec: Section, phi, **kwargs) -> np.ndarray:
+    """``f(phi) = (I_tan^eps(-phi) - I_tan^eps(phi)) / eps`` (eq:defoff) by :func:`tangential_curve`.
+
+    Parameters
+    ----------
+    sec : Section
+        The section of a system with eps != 0.
+    phi : array_like
+        Angles.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    ndarray
+    """
+    if sec.sys.eps == 0:
+        raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
+    p = np.atleast_1d(np.asarray(phi, dtype=float))
+    both = tangential_curve(sec, np.concatenate([-p, p]), **kwargs)
+    return (both[: p.size] - both[p.size :]) / sec.sys.eps
+
+
+def forcing_coefficients(sec: Section, n_modes: int = 6, n_phi: int = 64, **kwargs) -> np.ndarray:
+    """Sine coefficients ``b_k`` of the measured forcing f (eq:defoff), least squares on n_phi angles.
+
+    Parameters
+    ----------
+    sec : Section
+        Section of a system with eps != 0.
+    n_modes : int, optional
+        Number of sine modes.
+    n_phi : int, optional
+        Sample angles in (-pi, pi).
+    **kwargs
+        Passed to :func:`forcing_function`.
+
+    Returns
+    -------
+    ndarray
+        ``b_1 .. b_n_modes``.
+    """
+    ph = np.linspace(-np.pi, np.pi, n_phi + 2)[1:-1]
+    f = forcing_function(sec, ph, **kwargs)
+    A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
+    return np.linalg.lstsq(A, f, rcond=None)[0]
+
+
+def to_normal(sec: Section, theta, I, **kwargs):
+    """Normal coordinates ``(phi, K) = (theta, I - I_tan^eps(theta))`` (eq:kphidef), by bisection.
+
+    Parameters
+    ----------
+    sec : Section
+        The section.
+    theta, I : array_like
+        Section coordinates.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    phi, K : ndarray
+    """
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    return th, np.asarray(I, dtype=float) - tangential_curve(sec, th, **kwargs)
+
+
+def from_normal(sec: Section, phi, K, **kwargs):
+    """Inverse of :func:`to_normal`: ``(theta, I) = (phi, K + I_tan^eps(phi))`` (eq:kphiinvdef).
+
+    Parameters
+    ----------
+    sec : Section
+        The section.
+    phi, K : array_like
+        Normal coordinates.
+    **kwargs
+        Passed to :func:`tangential_curve`.
+
+    Returns
+    -------
+    theta, I : ndarray
+    """
+    p = np.atleast_1d(np.asarray(phi, dtype=float))
+    return p, np.asarray(K, dtype=float) + tangential_curve(sec, p, **kwargs)

@@ -1,0 +1,444 @@
+"""The flow's return map to Sigma_h as a map you iterate: :class:`FlowMap`.
+
+It has the map interface of :class:`hovering.TruncatedMap` (``step``, ``step_inverse``,
+``region``, ``iterate -> IterateResult`` with the same records, statuses, regions and early exit),
+so every analysis (rotation numbers, regularity, hovering area, critical curve) runs on it
+unchanged. Iterations run in C++ on the core's thread pool with no Python between returns.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from dataclasses import dataclass
+from typing import Iterable, Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from .._common import FlowStatus, Region, Status, region_mask, wrap
+from .._protocols import MapAnalyses
+from ..flow.section import Section, _threads, flow_options
+from ..flow.system import StepSystem, onset_parameters
+from ..truncated import theory as _theory  # the module (hovering.truncated does not export the function)
+from ..truncated.maps import IterateResult, TruncatedFamily, TruncatedMap
+from .coordinates import TangentialCurve
+
+__all__ = ["FlowMap", "FlowSteps", "FLOW_RECORD_KEYS"]
+
+#: What :meth:`FlowMap.iterate` can record (nothing else is computed or stored).
+FLOW_RECORD_KEYS = ("orbit", "regions", "rotation", "section", "states", "times", "energy_error", "steps", "itinerary")
+
+
+@dataclass(frozen=True)
+class FlowSteps:
+    """One return of many points (:meth:`FlowMap.returns`), with what the flow reported.
+
+    Attributes
+    ----------
+    phi, K : ndarray
+        Images in map coordinates (NaN where the status is not OK).
+    status : ndarray of int8
+        :class:`FlowStatus` of each return (OFF_SECTION: the point has no point of Sigma_h).
+    region : ndarray of int8
+        :class:`Region` of each return (NONE unless OK).
+    itinerary : list of str
+        Impacts in order, or '0' / 'u' for a return without impact.
+    time, energy_error : ndarray
+        Return times and ``|H(image) - h|``.
+    steps : ndarray of int64
+        Accepted integrator steps.
+    z : ndarray
+        The image states (q1, p1, q2, p2), shape (n, 4).
+    """
+
+    phi: np.ndarray
+    K: np.ndarray
+    status: np.ndarray
+    region: np.ndarray
+    itinerary: list
+    time: np.ndarray
+    energy_error: np.ndarray
+    steps: np.ndarray
+    z: np.ndarray
+
+
+def _pair(phi, K, who: str):
+    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
+    try:
+        p, k = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
+    except ValueError:
+        raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {np.shape(phi)} and {np.shape(K)}") from None
+    return p, k, scalar
+
+
+class FlowMap(MapAnalyses):
+    """The impact flow's return map to Sigma_h on normal coordinates (phi, K) (or (theta, I)).
+
+    Each return starts on Sigma_h at energy h exactly (the image's coordinates are computed and
+    the next point of Sigma_h is solved from them), so iterating is bit for bit the same as
+    repeated :meth:`step`, and the energy error of the integrator does not accumulate.
+
+    Parameters
+    ----------
+    sys : StepSystem
+        The system (any geometry; regions need walls).
+    h : float
+        Energy of the section.
+    coordinates : {"normal", "section"}, optional
+        ``"normal"``: ``(phi, K) = (theta, I - I_tan^eps(theta))`` (eq:kphidef) from the measured
+        tangential curve, which must be a graph over theta (else a ValueError says so; use
+        ``"section"``). ``"section"``: ``(theta, I)`` of the unperturbed H2.
+    rtol : float, optional
+        Relative tolerance of the integrator (GSL step control).
+    atol : float, optional
+        Absolute tolerance (default ``rtol / 100``).
+    stepper : str, optional
+        GSL stepper (see :data:`hovering.flow.STEPPERS`).
+    curve : TangentialCurve, optional
+        The tangential curve of this section (measured with n = 64 wall points at rtol 1e-13 if
+        not given).
+    **options
+        ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol`` (see
+        :meth:`hovering.Section.return_map`).
+
+    Raises
+    ------
+    ValueError
+        For bad parameters (named, with the allowed range), or normal coordinates where the
+        tangential curve is not a graph.
+    """
+
+    def __init__(self, sys: StepSystem, h: float = 1.0, coordinates: str = "normal", rtol: float = 1e-10,
+                 atol: Optional[float] = None, stepper: str = "rk8pd", curve: Optional[TangentialCurve] = None,
+                 **options):
+        if not isinstance(sys, StepSystem):
+            raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
+        if coordinates not in ("normal", "section"):
+            raise ValueError(f"coordinates must be 'normal' or 'section', got {coordinates!r}")
+        self.section = Section(sys, h)
+        self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
+        atol = rtol * 1e-2 if atol is None and isinstance(rtol, (int, float)) else atol
+        unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
+        if unknown:
+            raise ValueError(f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
+                             "grazing_tol, corner_tol")
+        self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
+        self.integrator_options = dict(rtol=float(rtol), atol=float(atol), stepper=stepper, **options)
+        try:
+            self.onset = onset_parameters(sys, self.h)
+        except ValueError:
+            self.onset = None  # below the step energy: no tangential band, no lift model
+        self.curve = None
+        if coordinates == "normal":
+            self.curve = curve if curve is not None else TangentialCurve(self.section, n=64, rtol=1e-13)
+            if not isinstance(self.curve, TangentialCurve) or self.curve.sec.sys != sys or self.curve.sec.h != self.h:
+                raise ValueError("curve must be the TangentialCurve of this system at this h")
+            if not self.curve.is_graph:
+                raise ValueError(self.curve.not_graph_reason)
+        p = self.onset
+        lift = None if p is None else (p.Omega0, p.theta_w, p.tau0, p.tau1, p.lam)
+        self._core = _core.normal.FlowMap(sys.core, self.h, self._options, self.curve._c if self.curve else None, lift)
+        self._forcing = None
+
+    def __repr__(self) -> str:
+        return f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
+
+    # ---------------------------------------------------------------- the map interface
+
+    @property
+    def eps(self) -> float:
+        """Coupling strength eps of the system."""
+        return self.sys.eps
+
+    def returns(self, phi, K, inverse: bool = False, n_threads: int = 0) -> FlowSteps:
+        """One return (or, with ``inverse``, one step back) of many points, with the flow's report.
+
+        Parameters
+        ----------
+        phi, K : array_like
+            Points in map coordinates (broadcast together; phi any finite angle, wrapped).
+        inverse : bool, optional
+            Step back by time reversal (lem:timerevgen): ``F^{-1} = R2 F R2`` in (theta, I).
+        n_threads : int, optional
+            Worker threads (0 = all cores).
+
+        Returns
+        -------
+        FlowSteps
+            Flat arrays, one entry per point.
+
+        Raises
+        ------
+        KeyboardInterrupt
+            On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
+        """
+        p, k, _ = _pair(phi, K, "returns")
+        d = self._core.steps(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel()), bool(inverse),
+                             _threads(n_threads, self.sys.python_defined))
+        res = FlowSteps(phi=d["x"], K=d["y"], status=d["status"], region=d["region"], itinerary=d["itinerary"],
+                        time=d["time"], energy_error=d["energy_error"], steps=d["steps"], z=d["z"])
+        if d["interrupted"]:
+            exc = KeyboardInterrupt("returns interrupted; the finished ones are in .partial")
+            exc.partial = res
+            raise exc
+        return res
+
+    def step(self, phi, K):
+        """One return ``(phi, K) -> (phibar, Kbar)`` (NaN where the orbit does not return: see :meth:`returns`).
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points (broadcast together).
+
+        Returns
+        -------
+        phi1, K1 : ndarray or float
+            Images, ``phi1`` in ``[-pi, pi)``; floats when both inputs are scalars.
+        """
+        p, k, scalar = _pair(phi, K, "step")
+        r = self.returns(p, k)
+        a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
+        return (float(a), float(b)) if scalar else (a, b)
+
+    def step_inverse(self, phi, K):
+        """One step back, by time reversal (lem:timerevgen): the exact inverse of :meth:`step` up to
+        the integration tolerance.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Image points.
+
+        Returns
+        -------
+        phi0, K0 : ndarray or float
+        """
+        p, k, scalar = _pair(phi, K, "step_inverse")
+        r = self.returns(p, k, inverse=True)
+        a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
+        return (float(a), float(b)) if scalar else (a, b)
+
+    def region(self, phi, K):
+        """Region of the return from each point (costs one return per point).
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points.
+
+        Returns
+        -------
+        Region or ndarray of int8
+        """
+        p, k, scalar = _pair(phi, K, "region")
+        r = self.returns(p, k).region.reshape(p.shape)
+        return Region(int(r)) if scalar else r
+
+    def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ("orbit", "regions", "rotation"),
+                exit_regions: Optional[Iterable] = None, stop_on_exit: bool = False, n_threads: int = 0) -> IterateResult:
+        """Iterate many orbits in C++ (the core's thread pool, GIL released, no Python between returns).
+
+        Parameters
+        ----------
+        phi0, K0 : array_like
+            Initial points, broadcast together and flattened to ``n_orbits`` orbits.
+        n_steps : int
+            Returns per orbit (>= 0).
+        record : sequence of str, optional
+            What to keep besides the final state and status (nothing else is computed or stored):
+            ``"orbit"`` (phi, K), ``"regions"``, ``"rotation"`` (mean lifted angle advance, see
+            :meth:`step_rotations`), ``"section"`` (theta, I), ``"states"`` (points of Sigma_h),
+            ``"times"``, ``"energy_error"``, ``"steps"`` (integrator steps), ``"itinerary"``.
+        exit_regions : iterable of Region or str, optional
+            Regions to watch (e.g. ``{"0u", "0"}``): ``exit_step`` is the first return from a point
+            outside them.
+        stop_on_exit : bool, optional
+            Stop an orbit (status EXITED) when it first leaves ``exit_regions``.
+        n_threads : int, optional
+            Worker threads (0 = all cores; 1 when a potential is defined in Python).
+
+        Returns
+        -------
+        IterateResult
+            The same result type as the truncated map's. Per-orbit statuses: OK, EXITED,
+            INTERRUPTED, and the flow's CORNER, GRAZING, STEP_LIMIT, NON_FINITE, IMPACT_LIMIT,
+            OFF_SECTION (the orbit stops there, NaN after; the others go on).
+
+        Raises
+        ------
+        ValueError
+            For non-finite initial points, a negative ``n_steps``, unknown record keys or regions.
+        KeyboardInterrupt
+            On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
+        """
+        if isinstance(record, str):
+            record = (record,)
+        unknown = [r for r in record if r not in FLOW_RECORD_KEYS]
+        if unknown:
+            raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(FLOW_RECORD_KEYS)}")
+        try:
+            n_steps = operator.index(n_steps)
+        except TypeError:
+            raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
+        if n_steps < 0:
+            raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+        mask = region_mask(exit_regions) if exit_regions is not None else 0
+        if exit_regions is not None and mask == 0:
+            raise ValueError("exit_regions must name at least one region")
+        if stop_on_exit and mask == 0:
+            raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
+        p, k, _ = _pair(phi0, K0, "iterate")
+        p, k = np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel())
+        n_points = p.size * (n_steps + 1)
+        per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
+        if per_point * n_points * 8 > 2**36:
+            raise ValueError(f"recording {record} for {p.size} orbits x {n_steps} steps needs "
+                             f"{per_point * n_points * 8 / 2**30:.1f} GiB (> 64 GiB); record less or iterate in chunks")
+        d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit),
+                               _threads(n_threads, self.sys.python_defined))
+        res = IterateResult(phi=d.get("x"), K=d.get("y"), region=d.get("region"), rotation=d.get("rotation"),
+                            phi_final=d["x_final"], K_final=d["y_final"], status=d["status"], steps_done=d["steps_done"],
+                            exit_step=d.get("exit_step"), n_steps=n_steps, map=self, theta=d.get("theta"), I=d.get("I"),
+                            z=d.get("z"), time=d.get("time"), energy_error=d.get("energy_error"),
+                            integrator_steps=d.get("integrator_steps"), itinerary=d.get("itinerary"))
+        if d["interrupted"]:
+            exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
+            exc.partial = res
+            raise exc
+        return res
+
+    def with_eps(self, eps: float) -> "FlowMap":
+        """The same system, section and integrator at another eps (its own tangential curve).
+
+        Used for the hovering set's F_0: a point is carried to eps = 0 by its normal coordinates.
+
+        Parameters
+        ----------
+        eps : float
+            New coupling strength.
+
+        Returns
+        -------
+        FlowMap
+        """
+        return FlowMap(self.sys.replace(eps=eps), self.h, coordinates=self.coordinates, **self.integrator_options)
+
+    def valid_band(self) -> tuple:
+        """Range of K (or I) where Sigma_h has points: ``I > 0`` and ``H2(I) < h`` (approximately,
+        with the coupling); points outside are OFF_SECTION."""
+        I_hi = self.sys.V2.action(self.h) if self.h > 0 else 0.0
+        if self.curve is None:
+            return (0.0, I_hi)
+        I = self.curve.values
+        return (-float(np.min(I)), I_hi - float(np.max(I)))
+
+    # ---------------------------------------------------------------- theory and the model
+
+    def _require_onset(self):
+        if self.onset is None:
+            raise ValueError(f"h = {self.h} is not above the step energy {self.sys.step_energy}: no tangential band, "
+                             "no onset parameters")
+        if self.coordinates != "normal":
+            raise ValueError("the theory and the model live in normal coordinates: use coordinates='normal'")
+
+    def forcing_coefficients(self, n_modes: int = 8) -> np.ndarray:
+        """Sine coefficients of the measured forcing f (eq:defoff) of this section (cached).
+
+        At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit is used there,
+        measured on the system at eps = 1e-6.
+        """
+        if self._forcing is None or self._forcing.size != n_modes:
+            if self.curve is None:
+                raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
+            if self.eps != 0:
+                self._forcing = self.curve.forcing_coefficients(n_modes)
+            else:
+                tiny = TangentialCurve(Section(self.sys.replace(eps=1e-6, coupling=self.sys.coupling or _bilinear()),
+                                               self.h), n=64, rtol=1e-13)
+                self._forcing = tiny.forcing_coefficients(n_modes) if self.sys.coupling is not None else np.zeros(n_modes)
+        return self._forcing
+
+    def theory(self) -> "_theory.Theory":
+        """Leading-order predictions with this system's onset parameters and measured forcing.
+
+        Returns
+        -------
+        hovering.Theory
+            ``hovers``, ``hovering_sign`` (the sign of eps that hovers: that of sin(Omega0/2) b_1),
+            ``area`` (eq:hovsetsize with the measured forcing), ``K_crit``, ``rho_crit``, ``note``.
+        """
+        self._require_onset()
+        p = self.onset
+        b = self.forcing_coefficients()
+        if not np.any(b != 0):
+            b = np.array([1.0])
+        return _theory.theory(self.eps, p.Omega0, p.theta_w, p.tau0, forcing=tuple(b))
+
+    def L1(self, K):
+        """Angle of the line L1 at heights K (def:L1L2) with the onset Omega0 and tau0."""
+        self._require_onset()
+        return _theory.L1(K, self.onset.Omega0, self.onset.tau0)
+
+    def L2(self, K):
+        """Angle of the line L2 at heights K (def:L1L2) with the onset Omega0 and tau0."""
+        self._require_onset()
+        return _theory.L2(K, self.onset.Omega0, self.onset.tau0)
+
+    def truncated(self, forcing: str = "measured", n_modes: int = 8):
+        """The truncated model of this system (eq:trunceps1eps2), with no hand scaling.
+
+        The arcs are the onset parameters' (eq:omegaofalead); the forcing is the measured f of
+        eq:defoff: all ``n_modes`` sine modes (``forcing="measured"``, a TruncatedFamily) or its
+        first mode only (``forcing="first_mode"``: the paper's F_eps with amplitude ``eps b_1``, a
+        TruncatedMap). For arcs measured on the flow instead see
+        :func:`hovering.normal.truncated_from_flow`.
+
+        Parameters
+        ----------
+        forcing : {"measured", "first_mode"}, optional
+            Which forcing.
+        n_modes : int, optional
+            Sine modes kept for ``"measured"``.
+
+        Returns
+        -------
+        TruncatedFamily or TruncatedMap
+        """
+        self._require_onset()
+        if forcing not in ("measured", "first_mode"):
+            raise ValueError(f"forcing must be 'measured' or 'first_mode', got {forcing!r}")
+        p = self.onset
+        b = self.forcing_coefficients(n_modes)
+        m = TruncatedMap(eps=self.eps * b[0], Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
+        if forcing == "first_mode":
+            return m
+        depth = min(0.95 * -m.valid_band()[0], 1.0)
+        s = np.linspace(math.sqrt(depth), 0.0, 121)
+        Kgrid = np.concatenate([-s**2, np.linspace(depth / 60, depth, 40)])
+        return TruncatedFamily.from_map(m.with_eps(self.eps), Kgrid, forcing=tuple(b))
+
+    def step_rotations(self, res: IterateResult, i: int) -> np.ndarray:
+        """The rotation of each return of orbit i of ``res``: the angle advance ``phi_{n+1} - phi_n``
+        lifted to the branch nearest the onset model's ``omega_a(K_n)`` of the return's region (the
+        truncated map's own rotation, eq:omegaofalead), so the flow's and the model's rotation
+        numbers compare directly. Needs ``record=("orbit", "regions")``."""
+        if res.region is None:
+            raise ValueError("the flow's rotations need record=('orbit', 'regions')")
+        self._require_onset()
+        n = int(res.steps_done[i])
+        ph, K, reg = res.phi[i, : n + 1], res.K[i, : n + 1], res.region[i, :n]
+        p = self.onset
+        Kn = K[:n]
+        s = np.sqrt(np.maximum(-Kn, 0.0))
+        ref = p.Omega0 + p.tau0 * Kn
+        ref = np.where(reg == int(Region.UPPER), ref + 2 * (np.pi - p.theta_w) + p.tau1 * Kn, ref)
+        ref = np.where(reg == int(Region.RIGHT), ref - 2 * p.lam * s, ref)
+        return ref + wrap(np.diff(ph) - ref)
+
+
+def _bilinear():
+    from ..flow.system import Bilinear
+
+    return Bilinear()

@@ -1,0 +1,617 @@
+"""The truncated near-tangency map F_eps and the general family F_{eps1,eps2}.
+
+Thin Python layers over the compiled classes of :mod:`hovering._core.truncated`: argument
+conversion, broadcasting, enums and result objects. All numerics run in C++. :class:`IterateResult`
+is shared with :class:`hovering.FlowMap`, whose iterations add the flow's own records.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Optional, Sequence, Union
+
+import numpy as np
+
+from .. import _core
+from .._common import Region, Status, region_mask
+from .._protocols import MapAnalyses
+from . import theory as _geo
+
+__all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
+
+_RECORD_KEYS = ("orbit", "regions", "rotation")
+
+
+@dataclass(frozen=True)
+class IterateResult:
+    """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
+
+    Attributes
+    ----------
+    phi, K : ndarray or None
+        Orbits, shape ``(n_orbits, n_steps + 1)``, when ``"orbit"`` was recorded; NaN after an
+        orbit stopped (see ``status`` and ``steps_done``).
+    region : ndarray of int8 or None
+        Region code (:class:`Region`) of the point each step was taken from, shape
+        ``(n_orbits, n_steps)``, when ``"regions"`` was recorded; ``Region.NONE`` after a stop.
+    rotation : ndarray or None
+        The paper's rotation number rho: the mean of omega_a over the steps taken (NaN for an
+        orbit that took no step), when ``"rotation"`` was recorded.
+    phi_final, K_final : ndarray
+        Last state reached by each orbit.
+    status : ndarray of int8
+        Per-orbit :class:`Status`.
+    steps_done : ndarray of int64
+        Number of steps each orbit took.
+    exit_step : ndarray of int64 or None
+        First n at which the orbit point lay outside ``exit_regions`` (-1 if never), when
+        ``exit_regions`` was given.
+    n_steps : int
+        Steps requested per orbit.
+    map : TruncatedMap, TruncatedFamily or FlowMap
+        The map that produced the result (used by :func:`hovering.rotation_number`).
+    theta, I : ndarray or None
+        Flow only, record ``"section"``: section coordinates of the orbit points.
+    z : ndarray or None
+        Flow only, record ``"states"``: the points of Sigma_h, shape ``(n_orbits, n_steps + 1, 4)``.
+    time, energy_error : ndarray or None
+        Flow only, records ``"times"``, ``"energy_error"``: per return, shape ``(n_orbits, n_steps)``
+        (``|H - h|`` of each image before it is put back on Sigma_h).
+    integrator_steps : ndarray of int64 or None
+        Flow only, record ``"steps"``: accepted integrator steps of each return.
+    itinerary : list of list of str or None
+        Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'.
+    """
+
+    phi: Optional[np.ndarray]
+    K: Optional[np.ndarray]
+    region: Optional[np.ndarray]
+    rotation: Optional[np.ndarray]
+    phi_final: np.ndarray
+    K_final: np.ndarray
+    status: np.ndarray
+    steps_done: np.ndarray
+    exit_step: Optional[np.ndarray]
+    n_steps: int
+    map: object = field(default=None, repr=False, compare=False)
+    theta: Optional[np.ndarray] = None
+    I: Optional[np.ndarray] = None
+    z: Optional[np.ndarray] = None
+    time: Optional[np.ndarray] = None
+    energy_error: Optional[np.ndarray] = None
+    integrator_steps: Optional[np.ndarray] = None
+    itinerary: Optional[list] = None
+
+    @property
+    def n_orbits(self) -> int:
+        """Number of orbits."""
+        return int(self.status.shape[0])
+
+    def count(self, status: Union[Status, int]) -> int:
+        """Number of orbits with the given status.
+
+        Parameters
+        ----------
+        status : Status or int
+            The outcome to count.
+
+        Returns
+        -------
+        int
+        """
+        return int(np.count_nonzero(self.status == int(status)))
+
+
+def _finite_float(name: str, value) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    return v
+
+
+def _pair(phi, K, who: str):
+    """Broadcast (phi, K) to one shape of contiguous doubles; remember whether both were scalars."""
+    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
+    p = np.asarray(phi, dtype=float)
+    k = np.asarray(K, dtype=float)
+    try:
+        p, k = np.broadcast_arrays(p, k)
+    except ValueError:
+        raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {p.shape} and {k.shape}") from None
+    # np.ascontiguousarray would turn 0-d into 1-d; the binding copies non-contiguous views itself.
+    return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
+
+
+class _MapAPI(MapAnalyses):
+    """Methods shared by every member of the truncated family (mixed into the compiled classes)."""
+
+    def step(self, phi, K):
+        """One forward step ``(phi, K) -> (phibar, Kbar)``.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points (broadcast together). ``K`` must lie in :meth:`valid_band`.
+
+        Returns
+        -------
+        phi1, K1 : ndarray or float
+            Image points; ``phi1`` in ``[-pi, pi)``. Floats when both inputs are scalars.
+
+        Raises
+        ------
+        ValueError
+            For a non-finite value or a K outside the band (the message names it and the band).
+        """
+        p, k, scalar = _pair(phi, K, "step")
+        a, b = self._step(p, k)
+        return (float(a), float(b)) if scalar else (a, b)
+
+    def step_inverse(self, phi, K):
+        """One backward step: the exact inverse of :meth:`step`.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Image points; the preimage height ``K - eps f(phi)`` must lie in the band.
+
+        Returns
+        -------
+        phi0, K0 : ndarray or float
+            Preimages, ``phi0`` in ``[-pi, pi)``.
+
+        Raises
+        ------
+        ValueError
+            For a non-finite value or a preimage outside the band.
+        """
+        p, k, scalar = _pair(phi, K, "step_inverse")
+        a, b = self._step_inverse(p, k)
+        return (float(a), float(b)) if scalar else (a, b)
+
+    def region(self, phi, K):
+        """Region of each point: which arc of the circle K it lies on.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points in the band.
+
+        Returns
+        -------
+        Region or ndarray of int8
+            A :class:`Region` for scalar input, else an int8 array of region codes.
+        """
+        p, k, scalar = _pair(phi, K, "region")
+        r, _ = self._region_rotation(p, k, "region")
+        return Region(int(r)) if scalar else r
+
+    def rotation(self, phi, K):
+        """The rotation ``omega_a(K)`` applied to each point (eq:omegaofadef), not reduced mod 2 pi.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points in the band.
+
+        Returns
+        -------
+        ndarray or float
+        """
+        p, k, scalar = _pair(phi, K, "rotation")
+        _, w = self._region_rotation(p, k, "rotation")
+        return float(w) if scalar else w
+
+    def reversal(self, phi, K):
+        """The time-reversal involution ``R_eps(phi, K) = (-phi, K - eps f(phi))`` (thm:reversalinkphi).
+
+        ``R_eps F R_eps = F^{-1}`` holds for every member of the family (lem:truncreturnmap).
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points.
+
+        Returns
+        -------
+        phi_r, K_r : ndarray or float
+        """
+        p, k, scalar = _pair(phi, K, "reversal")
+        out = (_geo.wrap(-p), k - self.eps * self.forcing_at(p))
+        return (float(out[0]), float(out[1])) if scalar else out
+
+    def arcs(self, K):
+        """Arc lengths and left ends of J_1, J_R, J_0 on the circles K (eq:Jdeftrunc, corrected).
+
+        Parameters
+        ----------
+        K : array_like or float
+            Heights in the band.
+
+        Returns
+        -------
+        dict of ndarray
+            ``len_1, len_R, len_0`` (|J_1|, |J_R|, |J_0|; 0, 0, 2 pi for K >= 0) and ``start_1,
+            start_R, start_0`` (left ends in [-pi, pi), NaN for K >= 0). The left ends are the
+            corner-singularity curves: ``start_1 = phi_01``, ``start_R = phi_1R``, ``start_0 = phi_R0``.
+        """
+        k = np.ascontiguousarray(np.asarray(K, dtype=float).ravel())
+        a = self._arcs(k)
+        shape = np.shape(K)
+        keys = ("len_1", "len_R", "len_0", "start_1", "start_R", "start_0")
+        return {key: a[:, j].reshape(shape) for j, key in enumerate(keys)}
+
+    def corner_curves(self, K):
+        """The corner-singularity curves ``phi_01, phi_1R, phi_R0`` at heights K < 0 (thm:cornersing).
+
+        Parameters
+        ----------
+        K : array_like
+            Heights in the band (NaN is returned for K >= 0, where the arcs do not exist).
+
+        Returns
+        -------
+        dict of ndarray
+            Keys ``'01'``, ``'1R'``, ``'R0'``: angles in ``[-pi, pi)``.
+        """
+        a = self.arcs(K)
+        return {"01": a["start_1"], "1R": a["start_R"], "R0": a["start_0"]}
+
+    def iterate(
+        self,
+        phi0,
+        K0,
+        n_steps: int,
+        record: Sequence[str] = ("orbit", "regions", "rotation"),
+        exit_regions: Optional[Iterable] = None,
+        stop_on_exit: bool = False,
+        n_threads: int = 0,
+        kernel: str = "simd",
+        sin_ulp: float = 1.0,
+    ) -> IterateResult:
+        """Iterate many orbits at once in C++ (multi-threaded, GIL released).
+
+        Parameters
+        ----------
+        phi0, K0 : array_like
+            Initial points, broadcast together and flattened to ``n_orbits`` orbits.
+        n_steps : int
+            Steps per orbit (>= 0).
+        record : sequence of str, optional
+            What to keep besides the final state and status: any of ``"orbit"`` (full orbits),
+            ``"regions"`` (itinerary), ``"rotation"`` (rho = mean omega_a). Nothing else is stored.
+        exit_regions : iterable of Region or str, optional
+            A set of regions (e.g. ``{"0u", "0"}``, the no-impact set) to watch: ``exit_step`` is
+            the first n at which an orbit point lies outside it.
+        stop_on_exit : bool, optional
+            Stop an orbit (status ``EXITED``) when it first leaves ``exit_regions``.
+        n_threads : int, optional
+            Worker threads; 0 uses every core.
+        kernel : {"simd", "scalar"}, optional
+            ``"simd"``: Eigen arrays + SLEEF vector sin over chunks of orbits. ``"scalar"``: one
+            orbit at a time with libm sin (the reference the SIMD path is tested against).
+        sin_ulp : {1.0, 3.5}, optional
+            Maximum error of the SIMD kernel's sin (SLEEF): 1.0 ulp (default) or 3.5 ulp, about
+            20% faster per step. Either error (<4e-16 in K per step) is far below what the chaotic
+            dynamics amplifies from any other rounding; the scalar kernel always uses libm.
+
+        Returns
+        -------
+        IterateResult
+
+        Raises
+        ------
+        ValueError
+            For non-finite initial points, a negative ``n_steps``, an unknown ``record`` key,
+            region or kernel.
+        KeyboardInterrupt
+            On Ctrl-C during a long run; its ``partial`` attribute holds the IterateResult with
+            every orbit's state at the interruption (status ``INTERRUPTED``).
+
+        Notes
+        -----
+        An orbit whose image leaves the band stops with status ``ESCAPED`` and keeps that image
+        as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps.
+        """
+        if isinstance(record, str):
+            record = (record,)
+        unknown = [r for r in record if r not in _RECORD_KEYS]
+        if unknown:
+            raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(_RECORD_KEYS)}")
+        try:
+            n_steps = operator.index(n_steps)
+        except TypeError:
+            raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
+        if n_steps < 0:
+            raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+        if kernel not in ("simd", "scalar"):
+            raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
+        if sin_ulp not in (1.0, 3.5):
+            raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
+        if not 0 <= n_threads <= 4096:
+            raise ValueError(f"n_threads must be in [0, 4096] (0 = all cores), got {n_threads}")
+        mask = region_mask(exit_regions) if exit_regions is not None else 0
+        if exit_regions is not None and mask == 0:
+            raise ValueError("exit_regions must name at least one region")
+        if stop_on_exit and mask == 0:
+            raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
+        p, k, _ = _pair(phi0, K0, "iterate")
+        d = self._iterate(
+            np.ascontiguousarray(p.ravel()),
+            np.ascontiguousarray(k.ravel()),
+            n_steps,
+            "orbit" in record,
+            "regions" in record,
+            "rotation" in record,
+            mask,
+            bool(stop_on_exit),
+            int(n_threads),
+            kernel,
+            float(sin_ulp),
+        )
+        res = IterateResult(
+            phi=d.get("phi"),
+            K=d.get("K"),
+            region=d.get("region"),
+            rotation=d.get("rotation"),
+            phi_final=d["phi_final"],
+            K_final=d["K_final"],
+            status=d["status"],
+            steps_done=d["steps_done"],
+            exit_step=d.get("exit_step"),
+            n_steps=n_steps,
+            map=self,
+        )
+        if d["interrupted"]:
+            exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
+            exc.partial = res
+            raise exc
+        return res
+
+
+class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
+    """The paper's truncated map F_eps (eq:truncatedmap), corrected as in shared/PAPER-NOTES.md.
+
+    ``Kbar = K + eps sin(phibar)``, ``phibar = phi + omega_a(K)`` for ``phi`` in the arc ``J_a(K)``;
+    for ``K < 0`` the circle is cut into J_1 (length ``2 lam sqrt(-K)``), J_R (``2(pi - theta_w) +
+    tau1 K``) and J_0, placed by eq:phi1rsymmetric so that the map is reversible.
+
+    Parameters
+    ----------
+    eps : float
+        Perturbation amplitude (any finite value; the paper studies |eps| <= 0.92).
+    Omega0 : float
+        Rotation at the tangency circle.
+    theta_w : float
+        Wall angle, in the open interval (0, pi).
+    tau0 : float, optional
+        Twist (default 1).
+    tau1 : float, optional
+        Twist of the upper-wall reflection (default 0.5).
+    lam : float, optional
+        Square-root coefficient, > 0 (default 0.5).
+    K_max : float, optional
+        Upper end of the band (default +inf: F_eps is the shifted standard map for K >= 0).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter and its allowed range, for non-finite values, theta_w outside
+        (0, pi), lam <= 0 or K_max <= 0.
+    """
+
+    def __init__(self, eps, Omega0, theta_w, tau0=1.0, tau1=0.5, lam=0.5, K_max=math.inf):
+        vals = {"eps": eps, "Omega0": Omega0, "theta_w": theta_w, "tau0": tau0, "tau1": tau1, "lam": lam}
+        vals = {name: _finite_float(name, v) for name, v in vals.items()}
+        try:
+            K_max = float(K_max)
+        except (TypeError, ValueError):
+            raise ValueError(f"K_max must be a real number > 0, got {K_max!r}") from None
+        _core.truncated.TruncatedMap.__init__(self, **vals, K_max=K_max)
+
+    def __repr__(self) -> str:
+        return (
+            f"TruncatedMap(eps={self.eps!r}, Omega0={self.Omega0!r}, theta_w={self.theta_w!r}, "
+            f"tau0={self.tau0!r}, tau1={self.tau1!r}, lam={self.lam!r})"
+        )
+
+    @property
+    def params(self) -> dict:
+        """The six parameters as a dict (``eps, Omega0, theta_w, tau0, tau1, lam``)."""
+        return dict(eps=self.eps, Omega0=self.Omega0, theta_w=self.theta_w, tau0=self.tau0, tau1=self.tau1, lam=self.lam)
+
+    def forcing_at(self, phi):
+        """The forcing ``f(phi) = sin(phi)``.
+
+        Parameters
+        ----------
+        phi : array_like
+            Angles.
+
+        Returns
+        -------
+        ndarray or float
+        """
+        return np.sin(phi)
+
+    def L1(self, K):
+        """Angle of the line L1 at heights K (def:L1L2); see :func:`hovering.truncated.theory.L1`."""
+        return _geo.L1(K, self.Omega0, self.tau0)
+
+    def L2(self, K):
+        """Angle of the line L2 at heights K (def:L1L2); see :func:`hovering.truncated.theory.L2`."""
+        return _geo.L2(K, self.Omega0, self.tau0)
+
+    def K_crit(self) -> float:
+        """eq:kcrit evaluated formally: the critical curve's height on L1 when ``eps sin(Omega0/2) > 0``.
+
+        For the other sign the value is positive and no hovering critical curve exists (thm:hovering);
+        :meth:`theory` says so (``hovers``, ``note``) and gives NaN for ``K_crit`` there.
+        """
+        return float(_geo.K_crit(self.eps, self.theta_w, self.Omega0))
+
+    def rho_crit(self) -> float:
+        """eq:rhocrit evaluated formally (meaningful in the hovering case, see :meth:`K_crit`)."""
+        return float(_geo.rho_crit(self.eps, self.theta_w, self.Omega0, self.tau0))
+
+    def theory(self) -> "_geo.Theory":
+        """Leading-order predictions for every Omega0: hovering sign, |HOV|, K_c, rho_c (:func:`hovering.theory`)."""
+        return _geo.theory(self.eps, self.Omega0, self.theta_w, self.tau0)
+
+    def k_eps1(self, phi, K0=0.0):
+        """Leading-order invariant curve through L1 at height K0 (eq:keps1)."""
+        return _geo.k_eps1(phi, K0, self.eps, self.Omega0, self.tau0)
+
+    def k_eps2(self, phi, K0=0.0):
+        """Leading-order invariant curve through L2 at height K0 (eq:keps2)."""
+        return _geo.k_eps2(phi, K0, self.eps, self.Omega0, self.tau0)
+
+    def with_eps(self, eps) -> "TruncatedMap":
+        """The same map with another eps (e.g. the mirror map F_{-eps}).
+
+        Parameters
+        ----------
+        eps : float
+            New perturbation amplitude.
+
+        Returns
+        -------
+        TruncatedMap
+        """
+        p = self.params
+        p["eps"] = eps
+        return TruncatedMap(**p, K_max=self.valid_band()[1])
+
+
+def _as_table(name: str, values, K: np.ndarray) -> np.ndarray:
+    if callable(values):
+        values = np.asarray([values(k) for k in K], dtype=float)
+    a = np.asarray(values, dtype=float)
+    if a.shape != K.shape:
+        raise ValueError(f"{name} must have the shape of K {K.shape}, got {a.shape}")
+    return a
+
+
+class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
+    """The general truncated family F_{eps1,eps2} (eq:trunceps1eps2) with tabulated arcs.
+
+    ``Kbar = K + eps f(phibar)`` with ``f(phi) = sum_k b_k sin(k phi)``, and an interval exchange
+    built from Omega(K), |J_R|(K), |J_1|(K) placed by eq:phi1rsymmetric, so that every member is
+    reversible (lem:truncreturnmap). Omega and |J_R| are splined in K, |J_1| in ``sqrt(-K)``
+    (it is smooth in ``sqrt(-K)``, not in K: thm:cornersing); GSL natural cubic splines.
+
+    Parameters
+    ----------
+    eps : float
+        Forcing amplitude eps_1.
+    K : array_like
+        Strictly increasing grid containing 0, with >= 3 points K <= 0 and max K > 0.
+    Omega, JR, J1 : array_like or callable
+        Values on the grid (or functions of K sampled on it). JR and J1 are used only for K <= 0;
+        J1 must vanish at K = 0.
+    forcing : sequence of float, optional
+        Sine coefficients ``b_1, b_2, ...`` of f (default ``(1.0,)``: f = sin).
+    K_max : float, optional
+        Upper end of the band (default: the top of the grid).
+
+    Raises
+    ------
+    ValueError
+        For malformed tables (naming the offending entry) or tables with no valid band below 0.
+    """
+
+    def __init__(self, eps, K, Omega, JR, J1, forcing=(1.0,), K_max=math.inf):
+        eps = _finite_float("eps", eps)
+        Kg = np.asarray(K, dtype=float)
+        if Kg.ndim != 1:
+            raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")
+        tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]
+        b = np.atleast_1d(np.asarray(forcing, dtype=float))
+        _core.truncated.TruncatedFamily.__init__(self, eps, list(Kg), *(list(t) for t in tabs), list(b), float(K_max))
+        self._tables = (Kg.copy(), *(t.copy() for t in tabs))
+        self._K_max = float(K_max)
+
+    def forcing_at(self, phi):
+        """The forcing ``f(phi) = sum_k b_k sin(k phi)``.
+
+        Parameters
+        ----------
+        phi : array_like
+            Angles.
+
+        Returns
+        -------
+        ndarray or float
+        """
+        phi = np.asarray(phi, dtype=float)
+        out = sum(b * np.sin((k + 1) * phi) for k, b in enumerate(self.forcing))
+        return float(out) if out.ndim == 0 else out
+
+    def onset(self) -> tuple:
+        """``(Omega0, theta_w, tau0)`` of the tables at the tangency: ``Omega(0)``, ``pi - |J_R|(0)/2``
+        and ``Omega'(0)`` (one-sided difference above 0, 1e-7 wide: Omega is splined in K)."""
+        d = 1e-7
+        Om0 = float(self.rotation(0.0, 0.0))
+        tau0 = (float(self.rotation(0.0, d)) - Om0) / d
+        theta_w = math.pi - 0.5 * float(self.arcs(-1e-300)["len_R"])
+        return Om0, theta_w, tau0
+
+    def theory(self) -> "_geo.Theory":
+        """Leading-order predictions with the tables' onset values and this family's forcing (:func:`hovering.theory`)."""
+        Om0, theta_w, tau0 = self.onset()
+        return _geo.theory(self.eps, Om0, theta_w, tau0, forcing=tuple(self.forcing))
+
+    def L1(self, K):
+        """Angle of the line L1 at heights K (def:L1L2) with the tables' Omega(0) and Omega'(0)."""
+        Om0, _, tau0 = self.onset()
+        return _geo.L1(K, Om0, tau0)
+
+    def L2(self, K):
+        """Angle of the line L2 at heights K (def:L1L2) with the tables' Omega(0) and Omega'(0)."""
+        Om0, _, tau0 = self.onset()
+        return _geo.L2(K, Om0, tau0)
+
+    def with_eps(self, eps) -> "TruncatedFamily":
+        """The same tables and forcing with another forcing amplitude (e.g. F_0).
+
+        Parameters
+        ----------
+        eps : float
+            New amplitude eps_1.
+
+        Returns
+        -------
+        TruncatedFamily
+        """
+        K, Om, JR, J1 = self._tables
+        return TruncatedFamily(eps, K, Om, JR, J1, forcing=tuple(self.forcing), K_max=self._K_max)
+
+    @classmethod
+    def from_map(cls, m: TruncatedMap, K, forcing=(1.0,)) -> "TruncatedFamily":
+        """Tabulate the arcs of a :class:`TruncatedMap` on a grid (useful as a starting point).
+
+        Parameters
+        ----------
+        m : TruncatedMap
+            Map whose Omega, |J_R|, |J_1| are sampled.
+        K : array_like
+            Grid (see the class parameters).
+        forcing : sequence of float, optional
+            Sine coefficients of the forcing.
+
+        Returns
+        -------
+        TruncatedFamily
+        """
+        Kg = np.asarray(K, dtype=float)
+        neg = np.minimum(Kg, 0.0)
+        s = np.sqrt(-neg)
+        Omega = m.Omega0 + m.tau0 * Kg
+        JR = np.where(Kg <= 0, 2 * (np.pi - m.theta_w) + m.tau1 * neg, 0.0)
+        J1 = 2 * m.lam * s
+        return cls(m.eps, Kg, Omega, JR, J1, forcing=forcing)

@@ -1,0 +1,435 @@
+"""Closed-form geometry and leading-order predictions of the paper (sec:truncatedmapnum).
+
+All functions are vectorised over NumPy arrays. Equation labels are the paper's ``\\label`` names.
+
+The paper states its theory for ``Omega0`` in ``(0, 2 pi)`` and ``f = sin``. Written with
+``sin(Omega0 / 2)`` it holds for every ``Omega0`` (the map is ``4 pi``-periodic in ``Omega0``, and
+``Omega0 -> Omega0 + 2 pi`` is ``eps -> -eps`` with ``phi -> phi + pi``): the sign of eps that
+hovers is the sign of ``sin(Omega0 / 2)``. :func:`theory` also takes any odd forcing
+``f = sum_k b_k sin(k phi)`` (the measured forcing of a physical system has ``b_2 = O(eps)``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from .._common import wrap
+
+__all__ = [
+    "OMEGA_G",
+    "wrap",
+    "Theory",
+    "theory",
+    "L1",
+    "L2",
+    "k_eps1",
+    "k_eps2",
+    "rho1",
+    "rho2",
+    "K_crit",
+    "rho_crit",
+    "hovering_area_theory",
+    "golden_family",
+]
+
+#: The golden-mean rotation ``2 pi (sqrt(5) - 1) / 2`` used in the paper's figures.
+OMEGA_G = float(np.pi * (np.sqrt(5.0) - 1.0))
+
+
+def L1(K, Omega0, tau0):
+    """Angle of the line L1 at height K (def:L1L2): ``-(Omega0 + tau0 K) / 2``, wrapped.
+
+    Near L1 the invariant curves of the shifted standard map have their minima for
+    ``eps sin((Omega0 + tau0 K)/2) > 0`` (thm:minmaxinvriantcurves); L1 is the midline of J_0.
+
+    Parameters
+    ----------
+    K : array_like
+        Heights.
+    Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray or float
+        ``phi_m1(K)`` in ``[-pi, pi)``.
+    """
+    return wrap(-0.5 * (Omega0 + tau0 * np.asarray(K, dtype=float)))
+
+
+def L2(K, Omega0, tau0):
+    """Angle of the line L2 at height K (def:L1L2): ``pi - (Omega0 + tau0 K) / 2``, wrapped.
+
+    Parameters
+    ----------
+    K : array_like
+        Heights.
+    Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray or float
+        ``phi_m2(K)`` in ``[-pi, pi)``.
+    """
+    return wrap(np.pi - 0.5 * (Omega0 + tau0 * np.asarray(K, dtype=float)))
+
+
+def _half_rotation(K0, Omega0, tau0):
+    return 0.5 * (Omega0 + tau0 * np.asarray(K0, dtype=float))
+
+
+def k_eps1(phi, K0, eps, Omega0, tau0):
+    """Leading-order invariant curve through L1 at height K0 (eq:keps1).
+
+    ``k = K0 + eps (1 - cos(phi + a)) / (2 sin a)`` with ``a = (Omega0 + tau0 K0)/2``; valid to
+    ``O(eps^2)`` for a Diophantine rotation.
+
+    Parameters
+    ----------
+    phi : array_like
+        Angles at which to evaluate the curve.
+    K0 : float
+        Height at which the curve crosses L1.
+    eps, Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray
+        Heights of the curve at ``phi``.
+    """
+    a = _half_rotation(K0, Omega0, tau0)
+    return K0 + eps * (1.0 - np.cos(np.asarray(phi, dtype=float) + a)) / (2.0 * np.sin(a))
+
+
+def k_eps2(phi, K0, eps, Omega0, tau0):
+    """Leading-order invariant curve through L2 at height K0 (eq:keps2).
+
+    Parameters
+    ----------
+    phi : array_like
+        Angles at which to evaluate the curve.
+    K0 : float
+        Height at which the curve crosses L2.
+    eps, Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray
+        ``K0 - eps (1 + cos(phi + a)) / (2 sin a)``, ``a = (Omega0 + tau0 K0)/2``.
+    """
+    a = _half_rotation(K0, Omega0, tau0)
+    return K0 - eps * (1.0 + np.cos(np.asarray(phi, dtype=float) + a)) / (2.0 * np.sin(a))
+
+
+def rho1(K0, eps, Omega0, tau0):
+    """Leading-order rotation of the invariant curve crossing L1 at K0 (eq:rotationscaled).
+
+    Parameters
+    ----------
+    K0 : array_like
+        Crossing heights.
+    eps, Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray or float
+        ``Omega0 + tau0 K0 + (tau0 eps / 2) / sin((Omega0 + tau0 K0)/2)``.
+    """
+    a = _half_rotation(K0, Omega0, tau0)
+    return 2 * a + 0.5 * tau0 * eps / np.sin(a)
+
+
+def rho2(K0, eps, Omega0, tau0):
+    """Leading-order rotation of the invariant curve crossing L2 at K0 (eq:rotationscaled2).
+
+    Parameters
+    ----------
+    K0 : array_like
+        Crossing heights.
+    eps, Omega0, tau0 : float
+        Map parameters.
+
+    Returns
+    -------
+    ndarray or float
+        ``Omega0 + tau0 K0 - (tau0 eps / 2) / sin((Omega0 + tau0 K0)/2)``.
+    """
+    a = _half_rotation(K0, Omega0, tau0)
+    return 2 * a - 0.5 * tau0 * eps / np.sin(a)
+
+
+def K_crit(eps, theta_w, Omega0):
+    """Predicted lowest height of the critical invariant curve on L1 (eq:kcrit), evaluated formally.
+
+    Negative in the hovering case ``eps sin(Omega0/2) > 0``; positive otherwise, where no
+    hovering critical curve exists (use :func:`theory`, whose ``K_crit`` is NaN there).
+
+    Parameters
+    ----------
+    eps, theta_w, Omega0 : float or array_like
+        Map parameters.
+
+    Returns
+    -------
+    float or ndarray
+        ``-eps (1 - cos theta_w) / (2 sin(Omega0/2))``.
+    """
+    return -eps * (1.0 - np.cos(theta_w)) / (2.0 * np.sin(0.5 * np.asarray(Omega0, dtype=float)))
+
+
+def rho_crit(eps, theta_w, Omega0, tau0):
+    """Predicted rotation number of the critical invariant curve (eq:rhocrit).
+
+    Parameters
+    ----------
+    eps, theta_w, Omega0, tau0 : float or array_like
+        Map parameters.
+
+    Returns
+    -------
+    float or ndarray
+        ``Omega0 + eps tau0 cos(theta_w) / (2 sin(Omega0/2))``.
+    """
+    return Omega0 + eps * tau0 * np.cos(theta_w) / (2.0 * np.sin(0.5 * np.asarray(Omega0, dtype=float)))
+
+
+def hovering_area_theory(eps, theta_w, Omega0):
+    """Leading-order area of the hovering set (eq:hovsetsize), for every Omega0 and either sign of eps.
+
+    ``|eps| (sin theta_w - theta_w cos theta_w) / |sin(Omega0/2)|`` when ``eps sin(Omega0/2) > 0``
+    (the hovering case of lemma:mininj0jr), 0 otherwise (the minima of the invariant curves lie
+    near L2, in J_R: thm:hovering's destruction). NaN at ``sin(Omega0/2) = 0`` (resonant).
+
+    Parameters
+    ----------
+    eps, theta_w, Omega0 : float or array_like
+        Map parameters.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    e = np.asarray(eps, dtype=float)
+    s = np.sin(0.5 * np.asarray(Omega0, dtype=float))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.where(e * s > 0, np.abs(e) * (np.sin(theta_w) - theta_w * np.cos(theta_w)) / np.abs(s), 0.0)
+    a = np.where(s == 0, np.nan, a)
+    return a if np.ndim(a) else float(a)
+
+
+def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
+    """Parameters ``(Omega0, theta_w)`` of the family of thm:hoveringc.
+
+    The critical curve of this family has rotation ``Omega_G + O(eps^2)``.
+
+    Parameters
+    ----------
+    eps : float
+        Perturbation amplitude.
+    c : float
+        Family parameter, ``|c| < |tau0|``.
+    tau0 : float, optional
+        Twist (default 1).
+    Omega_G : float, optional
+        Target rotation (default the golden mean :data:`OMEGA_G`).
+
+    Returns
+    -------
+    tuple of float
+        ``(Omega0, theta_w)`` with ``Omega0 = Omega_G - c eps / 2`` and
+        ``theta_w = arccos((c / tau0) sin(Omega_G/2 - c eps / 4))``.
+
+    Raises
+    ------
+    ValueError
+        If ``|c| >= |tau0|`` (theta_w would leave (0, pi)) or a value is not finite.
+    """
+    for name, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G)):
+        if not np.isfinite(v):
+            raise ValueError(f"{name} must be finite, got {v}")
+    if not abs(c) < abs(tau0):
+        raise ValueError(f"c must satisfy |c| < |tau0| = {abs(tau0)}, got c = {c}")
+    Omega0 = Omega_G - 0.5 * c * eps
+    theta_w = float(np.arccos((c / tau0) * np.sin(0.5 * Omega_G - 0.25 * c * eps)))
+    return float(Omega0), theta_w
+
+
+# ------------------------------------------------------------------------------------------------
+# The theory of sec:truncinvcurves for any Omega0 and any odd forcing
+
+
+@dataclass(frozen=True)
+class Theory:
+    """Leading-order predictions of sec:truncinvcurves for one set of map parameters.
+
+    At first order in eps, the invariant curves of ``K' = K + eps f(phi')``, ``phi' = phi + Omega0
+    + tau0 K`` with ``f = sum_k b_k sin(k phi)`` that cross L1 at height K0 are
+    ``K = K0 + eps G(phi + Omega0/2)``, ``G(psi) = sum_k b_k (1 - cos k psi) / (2 sin(k Omega0/2))``
+    (eq:keps1 for ``f = sin``). At K = 0 the no-impact arc J_0 is ``|psi| < theta_w``. The critical
+    curve is the lowest of them that stays at K >= 0 outside J_0, so
+    ``K_c = -min_{|psi| >= theta_w} eps G(psi)``; HOV is the part of J_0 between it and K = 0,
+    ``|HOV| = int max(0, -K_c - eps G) dpsi`` (eq:hovsetsize for ``f = sin``), and its rotation is
+    ``Omega0 + tau0 (K_c + eps <G>)`` (eq:rhocrit). With ``eps sin(Omega0/2) < 0`` and ``f = sin``
+    this lowest curve is ``k_{eps,2}(phi, rho_2(0))``, touching K = 0 at L2 inside J_R: no
+    hovering set (thm:hovering). The corrections are O(eps^2) (the corner curves' ``lam sqrt(-K)``
+    shifts the crossing angles by O(eps) only, see the proof of thm:hovering).
+
+    Attributes
+    ----------
+    eps, Omega0, theta_w, tau0 : float
+        The parameters.
+    forcing : tuple of float
+        Sine coefficients ``b_k`` of f.
+    area : float
+        Leading-order ``|HOV|`` (0 where nothing hovers; NaN when resonant).
+    hovers : bool
+        Whether a hovering set is predicted (``area > 0``).
+    hovering_sign : int
+        The sign of eps for which these parameters hover (+1 or -1), 0 if neither or both signs do
+        (or eps-independent degeneracies: resonance, theta_w outside (0, pi)).
+    K_crit : float
+        Height of the critical curve on L1 (its minimum for ``f = sin``); NaN if nothing hovers.
+    rho_crit : float
+        Its rotation number; NaN if nothing hovers.
+    K_lowest : float
+        Height on L1 of the lowest invariant curve that avoids the impacting arcs at K = 0 (the
+        critical curve when hovering, else the curve k^{u0}, which lies in K >= 0).
+    note : str
+        Why the prediction is what it is (sign, resonance, missing twist), in words.
+    """
+
+    eps: float
+    Omega0: float
+    theta_w: float
+    tau0: float
+    forcing: tuple
+    area: float
+    hovers: bool
+    hovering_sign: int
+    K_crit: float
+    rho_crit: float
+    K_lowest: float
+    note: str
+
+    def G(self, psi):
+        """The first-order shape ``G(psi)``, ``psi = phi + Omega0/2``, of the curves through L1."""
+        psi = np.asarray(psi, dtype=float)
+        return sum(b * (1 - np.cos((k + 1) * psi)) / (2 * math.sin(0.5 * (k + 1) * self.Omega0))
+                   for k, b in enumerate(self.forcing) if b != 0)
+
+    def curve(self, phi):
+        """The lowest curve avoiding the impacting arcs (critical curve if hovering, else k^{u0}) at phi."""
+        return self.K_lowest + self.eps * self.G(np.asarray(phi, dtype=float) + 0.5 * self.Omega0)
+
+
+def _lowest(eps: float, theta_w: float, G, n: int) -> tuple:
+    """(|HOV|, K_low): the lowest curve K_low + eps G >= 0 outside J_0 = {|psi| < theta_w}, and the
+    area between it and K = 0 inside J_0 (trapezoid rule on grids that contain +-theta_w exactly)."""
+    out = np.linspace(theta_w, math.pi, n)
+    K_low = -float(min(np.min(eps * G(out)), np.min(eps * G(-out))))
+    inside = np.linspace(-theta_w, theta_w, n)
+    depth = np.maximum(0.0, -(K_low + eps * G(inside)))
+    area = float(np.sum(0.5 * (depth[1:] + depth[:-1])) * (inside[1] - inside[0]))
+    return area, K_low
+
+
+def _first_mode(base: dict, e: float) -> Theory:
+    """The closed forms for f = b_1 sin (e = eps b_1): eq:kcrit, eq:rhocrit, eq:hovsetsize and k^{u0}."""
+    Omega0, theta_w, tau0 = base["Omega0"], base["theta_w"], base["tau0"]
+    s = math.sin(0.5 * Omega0)
+    hovers = e * s > 0
+    K_c = -e * (1 - math.cos(theta_w)) / (2 * s)
+    K_low = K_c if hovers else -e / s  # k_{eps,2}(phi, rho_2(0)) = -e (1 + cos psi) / (2 s) on L1
+    area = abs(e) * (math.sin(theta_w) - theta_w * math.cos(theta_w)) / abs(s) if hovers else 0.0
+    sign = 1 if s * (base["forcing"][0] if base["forcing"] else 0) > 0 else -1 if s * (base["forcing"][0] if base["forcing"] else 0) < 0 else 0
+    if e == 0:
+        note = "eps = 0: the hovering set is empty by definition"
+    elif hovers:
+        note = (f"hovering case: eps b_1 sin(Omega0/2) = {e * s:.4g} > 0, the minima of the invariant curves lie near "
+                "L1 inside J_0 (lemma:mininj0jr)")
+    else:
+        note = (f"impacting case: eps b_1 sin(Omega0/2) = {e * s:.4g} < 0, the minima of the invariant curves lie near "
+                "L2 inside J_R (lemma:mininj0jr): no hovering set; the lowest curve avoiding the impacts is k^{u0} >= 0")
+    if tau0 == 0:
+        note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
+    nan = float("nan")
+    return Theory(**base, area=area, hovers=hovers, hovering_sign=sign, K_crit=K_c if hovers else nan,
+                  rho_crit=Omega0 + e * tau0 * math.cos(theta_w) / (2 * s) if hovers else nan, K_lowest=K_low, note=note)
+
+
+def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing: Sequence[float] = (1.0,),
+           n_grid: int = 100_001) -> Theory:
+    """Leading-order hovering set, critical curve and its rotation for any Omega0 and odd forcing.
+
+    Parameters
+    ----------
+    eps : float
+        Forcing amplitude.
+    Omega0, theta_w, tau0 : float
+        Rotation at tangency, wall angle (in (0, pi)) and twist.
+    forcing : sequence of float, optional
+        Sine coefficients ``b_1, b_2, ...`` of f (default ``f = sin``).
+    n_grid : int, optional
+        Points of the grids in psi for a forcing with more than one mode (the integral converges
+        as n_grid^-2: ~1e-10 relative at the default; f = b_1 sin uses the closed forms).
+
+    Returns
+    -------
+    Theory
+
+    Raises
+    ------
+    ValueError
+        For non-finite parameters, an empty forcing or ``n_grid < 101``.
+    """
+    for name, v in (("eps", eps), ("Omega0", Omega0), ("theta_w", theta_w), ("tau0", tau0)):
+        if not (isinstance(v, (int, float, np.floating, np.integer)) and math.isfinite(v)):
+            raise ValueError(f"{name} must be a finite number, got {v!r}")
+    b = tuple(float(x) for x in np.atleast_1d(np.asarray(forcing, dtype=float)))
+    if not b or not all(math.isfinite(x) for x in b):
+        raise ValueError(f"forcing must be a non-empty sequence of finite sine coefficients, got {forcing!r}")
+    if int(n_grid) < 101:
+        raise ValueError(f"n_grid must be >= 101, got {n_grid}")
+    nan = float("nan")
+    base = dict(eps=float(eps), Omega0=float(Omega0), theta_w=float(theta_w), tau0=float(tau0), forcing=b)
+    if not 0 < theta_w < math.pi:
+        return Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan,
+                      note=f"theta_w = {theta_w} outside (0, pi): no arc structure at the tangency")
+    res = [k + 1 for k, x in enumerate(b) if x != 0 and abs(math.sin(0.5 * (k + 1) * Omega0)) < 1e-9]
+    if res:
+        return Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan,
+                      note=f"resonant: sin({res[0]} Omega0 / 2) = 0 (Omega0 = {Omega0}), the first-order "
+                           "invariant curves do not exist there")
+    probe = Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan, note="")
+    modes = [k + 1 for k, x in enumerate(b) if x != 0]
+    if modes == [1] or not modes:
+        return _first_mode(base, float(eps) * (b[0] if modes else 0.0))
+    n = int(n_grid)
+    area_p, _ = _lowest(1.0, theta_w, probe.G, n)
+    area_m, _ = _lowest(-1.0, theta_w, probe.G, n)
+    sign = 1 if area_p > 0 and area_m == 0 else -1 if area_m > 0 and area_p == 0 else 0
+    area, K_low = _lowest(float(eps), theta_w, probe.G, n)
+    mean_G = sum(x / (2 * math.sin(0.5 * (k + 1) * Omega0)) for k, x in enumerate(b))
+    hovers = area > 0
+    s = math.sin(0.5 * Omega0)
+    if eps == 0:
+        note = "eps = 0: the hovering set is empty by definition"
+    elif hovers:
+        note = (f"hovering case: eps sin(Omega0/2) = {eps * s:.4g} > 0, the minima of the invariant curves lie "
+                "near L1 inside J_0 (lemma:mininj0jr)") if len(b) == 1 else "hovering: the critical curve dips into J_0"
+    else:
+        note = (f"impacting case: eps sin(Omega0/2) = {eps * s:.4g} < 0, the minima of the invariant curves lie near "
+                "L2 inside J_R (lemma:mininj0jr): no hovering set; the lowest curve avoiding the impacts is k^{u0} >= 0"
+                ) if len(b) == 1 else "no curve dips into J_0 while avoiding the impacting arcs: no hovering set"
+    if tau0 == 0:
+        note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
+    return Theory(**base, area=area, hovers=hovers, hovering_sign=sign, K_crit=K_low if hovers else nan,
+                  rho_crit=Omega0 + tau0 * (K_low + eps * mean_G) if hovers else nan, K_lowest=K_low, note=note)
