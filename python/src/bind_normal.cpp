@@ -149,6 +149,11 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
         out.exit_step = a.mutable_data();
         d["exit_step"] = a;
     }
+    if (has("visited")) {
+        py::array_t<std::int8_t> a(n);
+        out.visited = a.mutable_data();
+        d["visited"] = a;
+    }
     std::atomic<bool> cancel{false};
     opt.cancel = &cancel;
     const bool interrupted =

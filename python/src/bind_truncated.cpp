@@ -45,7 +45,7 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
 template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
                  bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
-                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp) {
+                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp, bool record_visited) {
     if (phi0.ndim() != 1 || K0.ndim() != 1)
         throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
@@ -102,6 +102,11 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
         py::array_t<std::int64_t> ex(n);
         out.exit_step = ex.mutable_data();
         res["exit_step"] = ex;
+    }
+    if (record_visited) {
+        py::array_t<std::int8_t> vis(n);
+        out.visited = vis.mutable_data();
+        res["visited"] = vis;
     }
 
     std::atomic<bool> cancel{false};
@@ -162,7 +167,8 @@ void bind_common(Cls& cls) {
              })
         .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
              py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
-             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"))
+             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"),
+             py::arg("record_visited") = false)
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def("valid_band",
              [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },

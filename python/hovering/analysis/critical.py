@@ -44,8 +44,8 @@ class CriticalCurve:
     ----------
     K0 : float
         Height where the critical orbit starts on the search line (L1 or L2).
-    K_min : float
-        Lowest K along the critical orbit (the curve's minimum).
+    K_min, K_max : float
+        Lowest and highest K along the critical orbit (the curve's extent).
     rotation : float
         Weighted Birkhoff rotation number of the critical orbit.
     rotation_mean : float
@@ -79,14 +79,15 @@ class CriticalCurve:
     K_fail: float
     phi: np.ndarray = field(repr=False)
     K: np.ndarray = field(repr=False)
+    K_max: float = float("nan")
     line: str = "L1"
     hovers: bool = True
     note: str = ""
 
 
 def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] = None,
-                   regions=("0u", "0"), line: Optional[str] = None, grid: int = 64, digits: float = 8.0,
-                   tol: float = 1e-6, n_threads: int = 0) -> CriticalCurve:
+                   regions=("0u", "0"), line=None, grid: int = 64, digits: Optional[float] = None,
+                   tol: float = 1e-6, n_threads: int = 0, search: str = "lowest") -> CriticalCurve:
     """Search the lowest invariant curve that stays in ``regions``, along the line L1 (or L2).
 
     A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps``, its
@@ -112,17 +113,25 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     regions : iterable, optional
         The no-impact set: ``("0u", "0")`` for the hovering critical curve, ``("0u",)`` for the
         curve k^{u0} (lowest curve in K >= 0).
-    line : {"L1", "L2"}, optional
+    line : {"L1", "L2"} or float, optional
         Search line. Default: L1 in the hovering case, L2 otherwise (minima of the curves lie near
-        L1 when ``eps sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves).
+        L1 when ``eps sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves). A number
+        is a vertical line phi = line (any rotational invariant curve crosses it once).
     grid : int, optional
         Grid points of the first scan (>= 2).
     digits : float, optional
-        Regularity threshold, in (0, 16].
+        Regularity threshold, in (0, 16]. Default: the map's ``regularity_digits`` (8 for the
+        truncated maps, exact to rounding; 6 for the flow, whose per-return integration error
+        limits the agreement of the two half-orbit averages on an invariant curve to 7-9 digits
+        at rtol 1e-10, where chaotic orbits give 2-4).
     tol : float, optional
         Bisection tolerance on K0, > 0 (at least 1e-14 times the scale of K0).
     n_threads : int, optional
         Worker threads for the scan.
+    search : {"lowest", "highest"}, optional
+        ``"lowest"``: the lowest passing start (the floor of a no-impact region above the impacts,
+        as the hovering critical curve). ``"highest"``: the highest passing start (the roof of a
+        no-impact region under the impacts, as the flow's lower boundary of the impact zone).
 
     Returns
     -------
@@ -140,14 +149,23 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     hover_search = any(Region.parse(r) == Region.ABOVE for r in regions)
     if line is None:
         line = "L2" if hover_search and not th.hovers and m.eps != 0 else "L1"
-    if line not in ("L1", "L2"):
-        raise ValueError(f"line must be 'L1' or 'L2', got {line!r}")
+    if search not in ("lowest", "highest"):
+        raise ValueError(f"search must be 'lowest' or 'highest', got {search!r}")
+    if isinstance(line, (int, float, np.floating)) and not isinstance(line, bool) and math.isfinite(line):
+        phi_line = float(line)
+        line = f"phi = {phi_line:g}"
+        line_fn = lambda K: np.full(np.shape(K), phi_line)  # noqa: E731
+    elif line in ("L1", "L2"):
+        line_fn = m.L1 if line == "L1" else m.L2
+    else:
+        raise ValueError(f"line must be 'L1', 'L2' or a finite angle, got {line!r}")
+    if digits is None:
+        digits = getattr(m, "regularity_digits", 8.0)
     for name, v, least in (("n_steps", n_steps, 16), ("grid", grid, 2)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
             raise ValueError(f"{name} must be an integer >= {least}, got {v!r}")
     if not (isinstance(digits, (int, float, np.floating)) and 0 < digits <= 16):
         raise ValueError(f"digits must be a number in (0, 16], got {digits!r}")
-    line_fn = m.L1 if line == "L1" else m.L2
     lo, hi = m.valid_band()
     s = abs(math.sin(0.5 * th.Omega0))
     scale = abs(m.eps) * max(abs(b) for b in th.forcing) / max(s, 1e-3)
@@ -183,11 +201,16 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         raise RuntimeError(
             f"no invariant curve in regions {tuple(regions)} found on {line} for K0 in [{K_a}, {K_b}] "
             f"with {n_steps} steps and {digits} digits{why}")
-    j = int(np.argmax(ok))
-    K_pass = K_grid[j]
-    K_fail = K_grid[j - 1] if j > 0 else K_a
-    if j > 0:
-        while K_pass - K_fail > tol:
+    if search == "lowest":
+        j = int(np.argmax(ok))
+        K_pass = K_grid[j]
+        K_fail = K_grid[j - 1] if j > 0 else K_a
+    else:  # the highest passing start: an invariant curve, so nothing below it gets out
+        j = int(np.flatnonzero(ok)[-1])
+        K_pass = K_grid[j]
+        K_fail = K_grid[j + 1] if j + 1 < grid else K_b
+    if K_fail != K_pass:
+        while abs(K_pass - K_fail) > tol:
             mid = 0.5 * (K_pass + K_fail)
             if test([mid])[0][0]:
                 K_pass = mid
@@ -204,6 +227,7 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     return CriticalCurve(
         K0=float(K_pass),
         K_min=float(np.min(res.K[0])),
+        K_max=float(np.max(res.K[0])),
         rotation=float(rho_w),
         rotation_mean=float(rho_m),
         digits=float(dig[0]),

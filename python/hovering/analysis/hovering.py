@@ -15,7 +15,7 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import Status
+from .._common import Region, Status
 
 __all__ = ["HoveringArea", "hovering_area"]
 
@@ -48,11 +48,18 @@ class HoveringArea:
         Fraction of the box that impacts under F_0 within N steps (part of the definition).
     floor_touched : bool
         Whether a hovering point lies in the lowest tenth of the box (then enlarge it: K_low).
+    area_both_sides : float
+        The part of ``area`` whose orbits visit both J_0 and J_0u: the paper's hovering orbits,
+        "sometimes above the step and sometimes to its side". The rest, ``area - area_both_sides``,
+        never impacts but never passes beside the step either: orbits below the impact zone (the
+        flow's region under the deformed torus tangent to the upper wall) or islands inside J_0;
+        the definition counts them, eq:hovsetsize does not.
     unresolved : int
         Sample points whose orbit ended otherwise (the flow's corner hits, grazing, step limits:
         counted as not hovering).
-    phi, K, hovering : ndarray or None
-        Sample points and their membership, when ``keep_points`` was set.
+    phi, K, hovering, both_sides : ndarray or None
+        Sample points, their membership, and whether their orbit visits both J_0 and J_0u, when
+        ``keep_points`` was set.
     """
 
     area: float
@@ -65,10 +72,12 @@ class HoveringArea:
     box: tuple
     impact_fraction_F0: float
     floor_touched: bool
+    area_both_sides: float = float("nan")
     unresolved: int = 0
     phi: Optional[np.ndarray] = field(default=None, repr=False)
     K: Optional[np.ndarray] = field(default=None, repr=False)
     hovering: Optional[np.ndarray] = field(default=None, repr=False)
+    both_sides: Optional[np.ndarray] = field(default=None, repr=False)
 
 
 
@@ -159,7 +168,7 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
                                  n_threads=n_threads)
     impacts0 = np.isin(r0.status, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
     # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
-    r = m.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
+    r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
     stayed = r.status == Status.OK
     box_area = 2 * math.pi * (-K_low)
     areas = {}
@@ -168,6 +177,8 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         survive = stayed | (r.steps_done >= N)
         areas[N] = box_area * np.count_nonzero(impacts0 & survive) / n
     hov = impacts0 & stayed
+    both = (1 << int(Region.BESIDE)) | (1 << int(Region.ABOVE))
+    hov_both = hov & ((r.visited & both) == both)
     p = np.count_nonzero(hov) / n
     sampling = box_area * math.sqrt(max(p * (1 - p), 1.0 / n) / n)
     iteration = areas[n_steps // 2] - areas[n_steps]
@@ -185,10 +196,12 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         box=(-math.pi, math.pi, K_low, 0.0),
         impact_fraction_F0=float(np.count_nonzero(impacts0) / n),
         floor_touched=floor_touched,
+        area_both_sides=box_area * np.count_nonzero(hov_both) / n,
         unresolved=unresolved,
         phi=phi if keep_points else None,
         K=K if keep_points else None,
         hovering=hov if keep_points else None,
+        both_sides=hov_both if keep_points else None,
     )
 
 

@@ -21,7 +21,7 @@ from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 
-_RECORD_KEYS = ("orbit", "regions", "rotation")
+_RECORD_KEYS = ("orbit", "regions", "rotation", "visited")
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,10 @@ class IterateResult:
         Flow only, record ``"steps"``: accepted integrator steps of each return.
     itinerary : list of list of str or None
         Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'.
+    visited : ndarray of int8 or None
+        Record ``"visited"``: per orbit, bit r set when it took a step from a point of Region r
+        (including the point where it left ``exit_regions``); e.g. a hovering orbit has the bits of
+        both J_0 (ABOVE) and J_0u (BESIDE).
     """
 
     phi: Optional[np.ndarray]
@@ -83,6 +87,7 @@ class IterateResult:
     energy_error: Optional[np.ndarray] = None
     integrator_steps: Optional[np.ndarray] = None
     itinerary: Optional[list] = None
+    visited: Optional[np.ndarray] = None
 
     @property
     def n_orbits(self) -> int:
@@ -284,7 +289,8 @@ class _MapAPI(MapAnalyses):
             Steps per orbit (>= 0).
         record : sequence of str, optional
             What to keep besides the final state and status: any of ``"orbit"`` (full orbits),
-            ``"regions"`` (itinerary), ``"rotation"`` (rho = mean omega_a). Nothing else is stored.
+            ``"regions"`` (itinerary), ``"rotation"`` (rho = mean omega_a), ``"visited"`` (the set
+            of regions each orbit went through, one byte per orbit). Nothing else is stored.
         exit_regions : iterable of Region or str, optional
             A set of regions (e.g. ``{"0u", "0"}``, the no-impact set) to watch: ``exit_step`` is
             the first n at which an orbit point lies outside it.
@@ -353,6 +359,7 @@ class _MapAPI(MapAnalyses):
             int(n_threads),
             kernel,
             float(sin_ulp),
+            "visited" in record,
         )
         res = IterateResult(
             phi=d.get("phi"),
@@ -366,6 +373,7 @@ class _MapAPI(MapAnalyses):
             exit_step=d.get("exit_step"),
             n_steps=n_steps,
             map=self,
+            visited=d.get("visited"),
         )
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")

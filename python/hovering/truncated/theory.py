@@ -221,7 +221,7 @@ def hovering_area_theory(eps, theta_w, Omega0):
     s = np.sin(0.5 * np.asarray(Omega0, dtype=float))
     with np.errstate(divide="ignore", invalid="ignore"):
         a = np.where(e * s > 0, np.abs(e) * (np.sin(theta_w) - theta_w * np.cos(theta_w)) / np.abs(s), 0.0)
-    a = np.where(s == 0, np.nan, a)
+    a = np.where(np.abs(s) < 1e-12, np.nan, a)  # resonant: sin(Omega0/2) = 0 up to rounding of Omega0
     return a if np.ndim(a) else float(a)
 
 
@@ -420,15 +420,15 @@ def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing
     mean_G = sum(x / (2 * math.sin(0.5 * (k + 1) * Omega0)) for k, x in enumerate(b))
     hovers = area > 0
     s = math.sin(0.5 * Omega0)
+    first = f"eps b_1 sin(Omega0/2) = {eps * b[0] * s:.4g}"
     if eps == 0:
         note = "eps = 0: the hovering set is empty by definition"
     elif hovers:
-        note = (f"hovering case: eps sin(Omega0/2) = {eps * s:.4g} > 0, the minima of the invariant curves lie "
-                "near L1 inside J_0 (lemma:mininj0jr)") if len(b) == 1 else "hovering: the critical curve dips into J_0"
+        note = (f"hovering: the critical curve dips into J_0 near L1 ({first}; modes 2..{len(b)} of f shape it "
+                "at O(their size))")
     else:
-        note = (f"impacting case: eps sin(Omega0/2) = {eps * s:.4g} < 0, the minima of the invariant curves lie near "
-                "L2 inside J_R (lemma:mininj0jr): no hovering set; the lowest curve avoiding the impacts is k^{u0} >= 0"
-                ) if len(b) == 1 else "no curve dips into J_0 while avoiding the impacting arcs: no hovering set"
+        note = (f"no hovering set: every first-order invariant curve that dips below K = 0 does so in the impacting "
+                f"arcs ({first}); the lowest curve avoiding the impacts stays in K >= 0")
     if tau0 == 0:
         note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
     return Theory(**base, area=area, hovers=hovers, hovering_sign=sign, K_crit=K_low if hovers else nan,

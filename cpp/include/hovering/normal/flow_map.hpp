@@ -52,6 +52,7 @@ struct FlowIterateOutput {
     std::int8_t* status = nullptr;    ///< (n) Status, always written when non-null
     std::int64_t* steps_done = nullptr;  ///< (n) returns taken
     std::int64_t* exit_step = nullptr;   ///< (n) first return outside the watched set, else -1
+    std::int8_t* visited = nullptr;      ///< (n) bit r: a return of Region r was taken (as IterateOutput)
 };
 
 /// One return of the map: the image, its region and what the flow reported.

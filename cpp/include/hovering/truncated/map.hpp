@@ -33,6 +33,9 @@ struct IterateOutput {
     std::int8_t* status = nullptr;     ///< (n_orbits,) Status, always written when non-null
     std::int64_t* steps_done = nullptr;  ///< (n_orbits,) steps actually taken
     std::int64_t* exit_step = nullptr;   ///< (n_orbits,) first n with region(x_n) outside the set, else -1
+    /// (n_orbits,) bit r set: the orbit reached a point of Region r (the points steps were taken
+    /// from, and the one where it left the watched set)
+    std::int8_t* visited = nullptr;
 };
 
 /// What a batch iteration does besides stepping.

@@ -175,7 +175,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         }
     };
     // An orbit's outputs once it stops, and the NaN / None tails of its recorded arrays.
-    auto finish = [&](std::int64_t i, double x, double y, double rot, std::int64_t steps, Status st) {
+    auto finish = [&](std::int64_t i, double x, double y, double rot, std::int64_t steps, Status st, int visited) {
+        if (out.visited) out.visited[i] = static_cast<std::int8_t>(visited);
         if (out.x_final) out.x_final[i] = x;
         if (out.y_final) out.y_final[i] = y;
         if (out.rotation) out.rotation[i] = steps > 0 ? rot / double(steps) : kNaN;
@@ -211,13 +212,14 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             std::array<double, 4> z{};
             if (!state(x, y, z)) {
                 record_point(i, 0, x, y, nullptr);
-                finish(i, x, y, 0.0, 0, Status::OffSection);
+                finish(i, x, y, 0.0, 0, Status::OffSection, 0);
                 continue;
             }
             record_point(i, 0, x, y, &z);
             Status status = Status::Ok;
             std::int64_t k = 0;
             bool reported = false;
+            int visited = 0;
             for (; k < ns; ++k) {
                 if (cancelled()) {
                     status = Status::Interrupted;
@@ -229,6 +231,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                     break;
                 }
                 const int r = int(st.region);
+                if (r >= 0) visited |= 1 << r;
                 if (opt.exit_mask && !reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
                     if (out.exit_step) out.exit_step[i] = k;
                     reported = true;
@@ -248,7 +251,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 y = st.y;
                 record_point(i, k + 1, x, y, nullptr);
             }
-            finish(i, x, y, rot, k, status);
+            finish(i, x, y, rot, k, status, visited);
         }
     });
 }

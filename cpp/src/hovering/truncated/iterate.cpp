@@ -81,8 +81,9 @@ struct Finisher {
         if (out.exit_step) out.exit_step[i] = -1;
     }
     void operator()(std::int64_t i, double phi, double K, double rotsum, std::int64_t steps,
-                    Status st) const {
+                    Status st, int visited = 0) const {
         const std::int64_t ns = opt.n_steps;
+        if (out.visited) out.visited[i] = static_cast<std::int8_t>(visited);
         if (out.phi_final) out.phi_final[i] = phi;
         if (out.K_final) out.K_final[i] = K;
         if (out.rotation) out.rotation[i] = steps > 0 ? rotsum / double(steps) : kNaN;
@@ -118,7 +119,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     const std::int64_t ns = opt.n_steps;
     const double lo = m.band().lo, hi = m.band().hi;
     const bool watch = opt.exit_mask != 0;
-    const bool need_reg = watch || out.regions;  // region codes are only built when read
+    const bool need_reg = watch || out.regions || out.visited;  // region codes are only built when read
     const Packet zero = ei::pset1<Packet>(0.0), one = ei::pset1<Packet>(1.0), two = ei::pset1<Packet>(2.0),
                  three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
                  twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
@@ -129,6 +130,10 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
 
     Packet phi[kP], K[kP], rot[kP], live[kP], fresh[kP], reg[kP], omega[kP];
     alignas(64) double lphi[kLanes], lK[kLanes], lrot[kLanes], llive[kLanes], lfresh[kLanes], lreg[kLanes];
+    // Regions visited (record "visited" only): one all-ones mask per region code 0..3 and lane.
+    Packet seen[4][kP];
+    alignas(64) double lseen[4][kLanes];
+    const Packet code[4] = {zero, one, two, three};
     std::int64_t idx[kLanes], start[kLanes];
     std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
 
@@ -139,6 +144,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             ei::pstore(lrot + q * kW, rot[q]);
             ei::pstore(llive + q * kW, live[q]);
             ei::pstore(lfresh + q * kW, fresh[q]);
+            if (out.visited)
+                for (int r = 0; r < 4; ++r) ei::pstore(lseen[r] + q * kW, seen[r][q]);
         }
     };
     auto pack = [&] {
@@ -148,10 +155,18 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             rot[q] = ei::pload<Packet>(lrot + q * kW);
             live[q] = ei::pload<Packet>(llive + q * kW);
             fresh[q] = ei::pload<Packet>(lfresh + q * kW);
+            if (out.visited)
+                for (int r = 0; r < 4; ++r) seen[r][q] = ei::pload<Packet>(lseen[r] + q * kW);
         }
     };
     const double on = [] { double x; const std::uint64_t b = ~std::uint64_t(0); std::memcpy(&x, &b, 8); return x; }();
     auto is_live = [&](int j) { return std::memcmp(&llive[j], &on, 8) == 0; };
+    auto visited = [&](int j) {
+        int v = 0;
+        if (out.visited)
+            for (int r = 0; r < 4; ++r) v |= std::memcmp(&lseen[r][j], &on, 8) == 0 ? 1 << r : 0;
+        return v;
+    };
     // Put the next orbit that starts inside the band into lane j (orbits starting outside finish
     // at once); with no work left the lane computes a harmless point that is ignored everywhere.
     auto fill = [&](int j) {
@@ -170,6 +185,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             lrot[j] = 0.0;
             llive[j] = on;
             lfresh[j] = on;  // not yet reported as leaving the watched regions
+            for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
             idx[j] = i;
             start[j] = it;
             return true;
@@ -179,6 +195,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         lrot[j] = 0.0;
         llive[j] = 0.0;
         lfresh[j] = 0.0;
+        for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
         return false;
     };
     int nlive = 0;
@@ -196,7 +213,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         if ((it & 63) == 0 && cancelled(opt)) {
             unpack();
             for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted);
+                if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted, visited(j));
             for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
                 finish.start(i, phi0[i], K0[i]);
                 const bool inside = K0[i] > lo && K0[i] < hi;
@@ -217,6 +234,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
             if (!need_reg) continue;
             reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
+            if (out.visited)
+                for (int r = 0; r < 4; ++r) seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
             if (watch) {
                 const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
                                   ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
@@ -234,7 +253,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 if (out.exit_step) out.exit_step[idx[j]] = it - start[j];
                 lfresh[j] = 0.0;
                 if (opt.stop_on_exit) {
-                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Exited);
+                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Exited, visited(j));
                     nlive -= !fill(j);
                     refilled = true;
                 }
@@ -281,9 +300,9 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             for (int j = 0; j < kLanes; ++j) {
                 if (!is_live(j)) continue;
                 if (!(lK[j] > lo && lK[j] < hi))
-                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Escaped);
+                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Escaped, visited(j));
                 else if (it - start[j] == ns)
-                    finish(idx[j], lphi[j], lK[j], lrot[j], ns, Status::Ok);
+                    finish(idx[j], lphi[j], lK[j], lrot[j], ns, Status::Ok, visited(j));
                 else
                     continue;
                 nlive -= !fill(j);
@@ -301,6 +320,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
     const std::int64_t ns = opt.n_steps;
     for (std::int64_t i; src.pop(i);) {
         double phi = phi0[i], K = K0[i], rot = 0.0;
+        int vis = 0;
         finish.start(i, phi, K);
         bool reported = false;
         std::int64_t n = 0;
@@ -315,6 +335,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
                 break;
             }
             const Classified c = classify(phi, K, m.arcs().at(K));
+            vis |= 1 << int(c.region);
             if (opt.exit_mask && !reported && !((opt.exit_mask >> int(c.region)) & 1u)) {
                 if (out.exit_step) out.exit_step[i] = n;
                 reported = true;
@@ -335,7 +356,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
                 break;
             }
         }
-        finish(i, phi, K, rot, n, st);
+        finish(i, phi, K, rot, n, st, vis);
     }
 }
 

@@ -1,0 +1,60 @@
+"""One interface for both models: the analyses run on TruncatedMap, TruncatedFamily and FlowMap
+alike, and the enums are the core's own."""
+
+from __future__ import annotations
+
+import enum
+import math
+
+import numpy as np
+import pytest
+
+import hovering as hv
+from hovering import Region, Status
+
+
+@pytest.fixture(scope="module")
+def maps():
+    m = hv.TruncatedMap(eps=0.1, Omega0=hv.OMEGA_G, theta_w=3 * math.pi / 4)
+    fam = hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1.0, 0.0, 81) ** 2, np.linspace(0.02, 1.0, 30)]))
+    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=-0.05, qw1=-1.0, qw2=-0.5)
+    return {"TruncatedMap": m, "TruncatedFamily": fam, "FlowMap": hv.FlowMap(sys, h=1.0)}
+
+
+@pytest.mark.parametrize("kind", ["TruncatedMap", "TruncatedFamily", "FlowMap"])
+def test_every_analysis_runs_on_every_map(maps, kind):
+    m = maps[kind]
+    assert isinstance(m, hv.ReturnMap)
+    th = m.theory()
+    assert th.hovers  # all three hover (the flow at eps = -0.05: sin(Omega0/2) < 0)
+    hov = hv.hovering_area(m, n_steps=400, samples=400)
+    assert hov.area > 0 and abs(hov.area - th.area) < hov.error + 0.25 * th.area
+    assert hov.area_both_sides == pytest.approx(hov.area)  # near the tangency all of HOV is hovering proper
+    cc = m.critical_curve(n_steps=600, grid=16, tol=1e-3)
+    # eq:kcrit: within O(eps^2) (and the flow's forcing b_1 eps) of the prediction, rotation to O(eps^2)
+    assert cc.hovers and abs(cc.K_min - th.K_crit) < 0.5 * abs(th.K_crit)
+    assert abs(cc.rotation - th.rho_crit) < 0.05
+    res = m.iterate(m.L1(np.array([0.02])), np.array([0.02]), 400, record=("orbit", "regions"))
+    rho_b = hv.rotation_number(res, "birkhoff")[0]
+    rho_m = hv.rotation_number(res, "mean")[0]
+    assert abs(rho_b - rho_m) < 0.01 and hv.regularity(res)[0] > 5
+    assert abs(rho_b - (th.Omega0 + th.tau0 * 0.02)) < 0.1  # rho1(K0) to O(eps)
+
+
+def test_enums_are_the_cores():
+    # Bound from C++ (py::native_enum), not mirrored by hand: the classes are the core's.
+    for E in (Region, Status, hv.FlowStatus, hv.Geometry):
+        assert issubclass(E, enum.IntEnum) and E is getattr(hv._core, E.__name__)
+    assert [r.label for r in Region] == ["-", "0u", "0", "1", "R", "m"]
+    assert Region.parse("0u") is Region.BESIDE and Region.parse(4) is Region.MULTI
+    assert int(Status.OFF_SECTION) == 9 and Status(2) is Status.EXITED
+    with pytest.raises(ValueError, match="unknown region"):
+        Region.parse("above the step")
+
+
+def test_old_module_paths_still_work():
+    from hovering import fullmap, geometry, maps, potentials, system
+
+    assert maps.TruncatedMap is hv.TruncatedMap and geometry.K_crit is hv.K_crit
+    assert fullmap.TangentialCurve is hv.TangentialCurve and system.Section is hv.Section
+    assert potentials.CustomPotential is hv.CustomPotential
