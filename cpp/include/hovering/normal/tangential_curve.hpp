@@ -57,7 +57,7 @@ public:
     /// Where that minimum lies (wall angle s).
     double min_slope_at() const { return min_slope_s_; }
     /// I_tan(theta); throws std::invalid_argument if the curve is not a graph. One evaluation of a
-    /// trigonometric interpolant in theta (built by inverting theta(s) at 2n equispaced angles).
+    /// trigonometric interpolant in theta (built by inverting theta(s) at n equispaced angles).
     double I_tan(double theta) const;
     /// The wall angle s with theta(s) = theta (mod 2 pi); same condition.
     double parameter_of(double theta) const;
@@ -77,7 +77,7 @@ public:
 private:
     std::vector<double> s_, theta_, I_;
     TrigInterpolant u_, Ifun_;  // theta(s) = s + u(s), I(s)
-    TrigInterpolant Itheta_;    // I_tan(theta) itself, from the inverted curve at 2n equispaced theta
+    TrigInterpolant Itheta_;    // I_tan(theta) itself, from the inverted curve at n equispaced theta
     double min_slope_ = 0, min_slope_s_ = 0;
     double err_theta_ = 0, err_I_ = 0;
     double I0_ = 0, h_ = 0, eps_ = 0;
