@@ -58,3 +58,22 @@ def test_old_module_paths_still_work():
     assert maps.TruncatedMap is hv.TruncatedMap and geometry.K_crit is hv.K_crit
     assert fullmap.TangentialCurve is hv.TangentialCurve and system.Section is hv.Section
     assert potentials.CustomPotential is hv.CustomPotential
+
+
+def test_stubs_name_what_the_compiled_module_has():
+    # One stub per compiled submodule (boost-histogram's pattern): every class and function a stub
+    # declares exists in the module, and every public name of the module has a stub.
+    import ast
+    import pathlib
+
+    stubs = pathlib.Path(hv.__file__).parent / "_core"
+    for name, mod in (("__init__", hv._core), ("truncated", hv._core.truncated), ("flow", hv._core.flow),
+                      ("normal", hv._core.normal)):
+        tree = ast.parse((stubs / f"{name}.pyi").read_text())
+        # names starting with "_" and capitalised are stub-only helper types (no runtime object)
+        declared = {n.name for n in tree.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))
+                    and not (n.name.startswith("_") and n.name[1:2].isupper())}
+        assert declared <= set(dir(mod)), (name, declared - set(dir(mod)))
+        public = {k for k, v in vars(mod).items() if not k.startswith("__") and (callable(v) or isinstance(v, type))
+                  and not isinstance(v, type(hv._core))}
+        assert public <= declared, (name, public - declared)

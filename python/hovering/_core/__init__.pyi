@@ -1,119 +1,46 @@
-"""Type stubs of the compiled module hovering._core (use the wrappers in hovering.maps)."""
+"""Type stubs of the compiled module hovering._core: the core's enums, one submodule per topic."""
 
-from typing import Callable
+import enum
 
-import numpy as np
-import numpy.typing as npt
+from . import flow as flow
+from . import normal as normal
+from . import truncated as truncated
 
-class _MapCore:
-    @property
-    def eps(self) -> float: ...
-    def valid_band(self) -> tuple[float, float]: ...
-    def _step(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
-    def _step_inverse(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
-    def _region_rotation(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64], who: str) -> tuple[np.ndarray, np.ndarray]: ...
-    def _arcs(self, K: npt.NDArray[np.float64]) -> np.ndarray: ...
-    def _iterate(
-        self,
-        phi0: npt.NDArray[np.float64],
-        K0: npt.NDArray[np.float64],
-        n_steps: int,
-        record_orbit: bool,
-        record_regions: bool,
-        record_rotation: bool,
-        exit_mask: int,
-        stop_on_exit: bool,
-        n_threads: int,
-        kernel: str,
-        sin_ulp: float,
-    ) -> dict[str, object]: ...
+class Region(enum.IntEnum):
+    NONE = -1
+    BESIDE = 0
+    ABOVE = 1
+    UPPER = 2
+    RIGHT = 3
+    MULTI = 4
 
-class TruncatedMap(_MapCore):
-    def __init__(self, eps: float, Omega0: float, theta_w: float, tau0: float, tau1: float, lam: float, K_max: float) -> None: ...
-    @property
-    def Omega0(self) -> float: ...
-    @property
-    def theta_w(self) -> float: ...
-    @property
-    def tau0(self) -> float: ...
-    @property
-    def tau1(self) -> float: ...
-    @property
-    def lam(self) -> float: ...
+class Status(enum.IntEnum):
+    OK = 0
+    ESCAPED = 1
+    EXITED = 2
+    INTERRUPTED = 3
+    CORNER = 4
+    GRAZING = 5
+    STEP_LIMIT = 6
+    NON_FINITE = 7
+    IMPACT_LIMIT = 8
+    OFF_SECTION = 9
 
-class TruncatedFamily(_MapCore):
-    def __init__(
-        self, eps: float, K: list[float], Omega: list[float], JR: list[float], J1: list[float], forcing: list[float], K_max: float
-    ) -> None: ...
-    @property
-    def forcing(self) -> list[float]: ...
+class FlowStatus(enum.IntEnum):
+    OK = 0
+    CORNER = 1
+    GRAZING = 2
+    STEP_LIMIT = 3
+    NON_FINITE = 4
+    IMPACT_LIMIT = 5
+    OFF_SECTION = 6
+    INTERRUPTED = 7
 
-def simd_is_avx2() -> bool: ...
+class Geometry(enum.IntEnum):
+    NONE = 0
+    WALL = 1
+    STEP = 2
 
-class Potential:
-    def __init__(self) -> None: ...
-    @property
-    def name(self) -> str: ...
-    @property
-    def q_limit(self) -> float: ...
-    def V(self, q: float) -> float: ...
-    def dV(self, q: float) -> float: ...
-    def turning_points(self, h: float) -> tuple[float, float]: ...
-    def period(self, h: float) -> float: ...
-    def frequency(self, h: float) -> float: ...
-    def action(self, h: float) -> float: ...
-    def energy(self, I: float) -> float: ...
-    def angle_of(self, q: float, h: float) -> float: ...
-    def point_at(self, theta: float, h: float) -> tuple[float, float]: ...
-    def angle_of_point(self, q: float, p: float, h: float) -> float: ...
-
-class Harmonic(Potential):
-    def __init__(self, omega: float) -> None: ...
-    @property
-    def omega(self) -> float: ...
-
-class Tan(Potential):
-    def __init__(self, omega: float, alpha: float) -> None: ...
-    @property
-    def omega(self) -> float: ...
-    @property
-    def alpha(self) -> float: ...
-
-class Numerical(Potential):
-    def __init__(self, base: Potential) -> None: ...
-
-class _CallablePotential(Potential):
-    def __init__(self, V: Callable[[float], float], dV: Callable[[float], float], q_limit: float, name: str) -> None: ...
-    @property
-    def V_callable(self) -> Callable[[float], float]: ...
-    @property
-    def dV_callable(self) -> Callable[[float], float]: ...
-
-class OnsetParameters:
-    Omega0: float
-    tau0: float
-    tau1: float
-    lam: float
-    theta_w: float
-    I_tan: float
-
-def _onset_parameters(V1: Potential, V2: Potential, qw1: float, qw2: float, h: float) -> OnsetParameters: ...
-def _onset_parameters_closed_form(
-    omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float
-) -> OnsetParameters: ...
-
-_SystemArgs = tuple[Potential, Potential, list[tuple[float, float, float]], float, float, float, int]
-
-def _section_points(
-    V1: Potential, V2: Potential, terms: list[tuple[float, float, float]], eps: float, qw1: float, qw2: float,
-    geometry: int, h: float, theta: npt.NDArray[np.float64], I: npt.NDArray[np.float64]
-) -> np.ndarray: ...
-def _section_coordinates(
-    V1: Potential, V2: Potential, terms: list[tuple[float, float, float]], eps: float, qw1: float, qw2: float,
-    geometry: int, z: npt.NDArray[np.float64]
-) -> np.ndarray: ...
-def _return_maps(
-    V1: Potential, V2: Potential, terms: list[tuple[float, float, float]], eps: float, qw1: float, qw2: float,
-    geometry: int, z0: npt.NDArray[np.float64], stepper: str, rtol: float, atol: float, event_tol: float,
-    max_steps: int, max_impacts: int, grazing_tol: float, corner_tol: float, n_threads: int
-) -> dict[str, object]: ...
+class Kernel(enum.IntEnum):
+    SIMD = 0
+    SCALAR = 1

@@ -1,0 +1,34 @@
+"""Type stubs of hovering._core.normal (use hovering.TangentialCurve and hovering.FlowMap)."""
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+
+from .flow import FlowOptions, FlowSystem
+
+class TangentialCurve:
+    def __init__(self, system: FlowSystem, h: float, n: int, options: FlowOptions, n_check: int) -> None: ...
+    def I_tan(self, theta: npt.NDArray[np.float64]) -> np.ndarray: ...
+    def parameter_of(self, theta: npt.NDArray[np.float64]) -> np.ndarray: ...
+    def at(self, s: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
+    is_graph: bool
+    min_slope: float
+    min_slope_at: float
+    interpolation_error: tuple[float, float]
+    not_graph_reason: str
+    I_tan0: float
+    h: float
+    s: np.ndarray
+    theta: np.ndarray
+    I: np.ndarray
+
+class FlowMap:
+    def __init__(self, system: FlowSystem, h: float, options: FlowOptions, curve: Optional[TangentialCurve],
+                 lift: Optional[tuple[float, float, float, float, float]]) -> None: ...
+    def steps(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], inverse: bool, n_threads: int) -> dict[str, object]: ...
+    def iterate(self, x0: npt.NDArray[np.float64], y0: npt.NDArray[np.float64], n_steps: int, record: set[str],
+                exit_mask: int, stop_on_exit: bool, n_threads: int) -> dict[str, object]: ...
+    def to_section(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
+    def from_section(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
+    h: float
