@@ -59,3 +59,16 @@ def test_readme_fullmap_block():
     assert np.nanmax(np.abs(c.GK)) < 2 * 0.05 * 0.015
     assert np.nanmax(np.abs(c.dphi)) < 2 * 0.05
     np.testing.assert_allclose(ns["curves"].JR + ns["curves"].J0 + ns["curves"].J1, 2 * np.pi, atol=1e-9)
+
+
+def test_readme_flowmap_block():
+    # The FlowMap block's claims: the region of (0.3, -0.02), the theory's sign and area, b1.
+    ns: dict = {}
+    for code in _python_blocks():
+        exec(compile(code, str(README), "exec"), ns)
+    fm, th, tm = ns["fm"], ns["th"], ns["tm"]
+    assert fm.region(0.3, -0.02) is hovering.Region.ABOVE
+    assert th.hovers and abs(th.area - 0.0745) < 1e-4
+    assert abs(tm.forcing[0] - 0.564) < 1e-3 and abs(tm.forcing[1] + 0.020) < 1e-3
+    assert np.all(ns["flow_res"].status == hovering.Status.OK)
+    assert ns["small"].area > 0  # a small box estimate, but it hovers
