@@ -77,7 +77,7 @@ from .truncated import (
     rho_crit,
 )
 from .truncated.theory import theory
-from . import geometry, fullmap  # noqa: E402  (old module paths, one release)
+from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one release)
 
 __version__ = "0.2.0"
 

@@ -10,7 +10,8 @@ import numpy as np
 
 from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
-__all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS"]
+__all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
+           "iterate_arguments"]
 
 #: The paper's label of each region code (``'m'``: more than one impact, the flow only).
 REGION_LABELS = {-1: "-", 0: "0u", 1: "0", 2: "1", 3: "R", 4: "m"}
@@ -91,3 +92,34 @@ def wrap(x):
     y = np.where(y >= np.pi, y - 2 * np.pi, y)
     y = np.where(y < -np.pi, y + 2 * np.pi, y)
     return y if np.ndim(y) else float(y)
+
+
+def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> tuple:
+    """Check the arguments every map's ``iterate`` shares; ``(record tuple, n_steps, exit mask)``.
+
+    Raises
+    ------
+    ValueError
+        Naming the unknown record key, the bad step count or region, or an exit set that is
+        empty or missing where ``stop_on_exit`` needs it.
+    """
+    import operator
+
+    if isinstance(record, str):
+        record = (record,)
+    record = tuple(record)
+    unknown = [r for r in record if r not in allowed]
+    if unknown:
+        raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(allowed)}")
+    try:
+        n_steps = operator.index(n_steps)
+    except TypeError:
+        raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
+    if n_steps < 0:
+        raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+    mask = region_mask(exit_regions) if exit_regions is not None else 0
+    if exit_regions is not None and mask == 0:
+        raise ValueError("exit_regions must name at least one region")
+    if stop_on_exit and mask == 0:
+        raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
+    return record, n_steps, mask

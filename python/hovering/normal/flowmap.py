@@ -9,14 +9,13 @@ unchanged. Iterations run in C++ on the core's thread pool with no Python betwee
 from __future__ import annotations
 
 import math
-import operator
 from dataclasses import dataclass
 from typing import Iterable, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
-from .._common import FlowStatus, Region, Status, region_mask, wrap
+from .._common import Region, iterate_arguments, wrap
 from .._protocols import MapAnalyses
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -281,22 +280,7 @@ class FlowMap(MapAnalyses):
         KeyboardInterrupt
             On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
         """
-        if isinstance(record, str):
-            record = (record,)
-        unknown = [r for r in record if r not in FLOW_RECORD_KEYS]
-        if unknown:
-            raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(FLOW_RECORD_KEYS)}")
-        try:
-            n_steps = operator.index(n_steps)
-        except TypeError:
-            raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
-        if n_steps < 0:
-            raise ValueError(f"n_steps must be >= 0, got {n_steps}")
-        mask = region_mask(exit_regions) if exit_regions is not None else 0
-        if exit_regions is not None and mask == 0:
-            raise ValueError("exit_regions must name at least one region")
-        if stop_on_exit and mask == 0:
-            raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
+        record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         p, k, _ = _pair(phi0, K0, "iterate")
         p, k = np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel())
         n_points = p.size * (n_steps + 1)

@@ -8,14 +8,13 @@ is shared with :class:`hovering.FlowMap`, whose iterations add the flow's own re
 from __future__ import annotations
 
 import math
-import operator
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Optional, Sequence, Union
+from typing import Iterable, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
-from .._common import Region, Status, region_mask
+from .._common import Region, Status, iterate_arguments
 from .._protocols import MapAnalyses
 from . import theory as _geo
 
@@ -324,28 +323,13 @@ class _MapAPI(MapAnalyses):
         An orbit whose image leaves the band stops with status ``ESCAPED`` and keeps that image
         as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps.
         """
-        if isinstance(record, str):
-            record = (record,)
-        unknown = [r for r in record if r not in _RECORD_KEYS]
-        if unknown:
-            raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(_RECORD_KEYS)}")
-        try:
-            n_steps = operator.index(n_steps)
-        except TypeError:
-            raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
-        if n_steps < 0:
-            raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+        record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         if kernel not in ("simd", "scalar"):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
         if sin_ulp not in (1.0, 3.5):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
         if not 0 <= n_threads <= 4096:
             raise ValueError(f"n_threads must be in [0, 4096] (0 = all cores), got {n_threads}")
-        mask = region_mask(exit_regions) if exit_regions is not None else 0
-        if exit_regions is not None and mask == 0:
-            raise ValueError("exit_regions must name at least one region")
-        if stop_on_exit and mask == 0:
-            raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
         p, k, _ = _pair(phi0, K0, "iterate")
         d = self._iterate(
             np.ascontiguousarray(p.ravel()),
