@@ -42,6 +42,7 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& o) : field_(s), a
         step_ = gsl_odeiv2_step_alloc(T, std::size_t(field_.dim));
         if (!step_) throw std::bad_alloc();
         order_ = int(gsl_odeiv2_step_order(step_));
+        grow_below_ = std::pow(0.9, order_);
     }
 }
 
@@ -101,14 +102,15 @@ int Integrator::hadjust(const double* y, const double* err, double* h) const {
     // three square roots: GSL's pow took 5% of a return's time, and cbrt for the 9th root more.
     double rmax = std::numeric_limits<double>::min();
     for (int i = 0; i < field_.dim; ++i) rmax = std::max(rmax, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
-    // The root: rmax^(1/order) (three square roots for rk8pd).
-    const double root = order_ == 8 ? std::sqrt(std::sqrt(std::sqrt(rmax))) : std::pow(rmax, 1.0 / order_);
+    // The root rmax^(1/order) (three square roots for rk8pd) only where the step changes: above
+    // 1.1, and below 0.9^order where the growth factor exceeds 1 (in between GSL's rule keeps h).
+    auto root = [&] { return order_ == 8 ? std::sqrt(std::sqrt(std::sqrt(rmax))) : std::pow(rmax, 1.0 / order_); };
     if (rmax > 1.1) {
-        *h *= std::max(0.2, 0.9 / root);
+        *h *= std::max(0.2, 0.9 / root());
         return GSL_ODEIV_HADJ_DEC;
     }
     if (rmax < 0.5) {
-        *h *= std::min(5.0, std::max(1.0, 0.9 / root));
+        if (rmax < grow_below_) *h *= std::min(5.0, 0.9 / root());
         return GSL_ODEIV_HADJ_INC;
     }
     return GSL_ODEIV_HADJ_NIL;

@@ -61,7 +61,8 @@ private:
     int ext_sub_ = 1;                      // substeps of the extension
     double t_ms_ = 0;                      // msadams: running time (its history is in time)
     double atol_, rtol_;
-    int order_ = 8;  // one-step methods: the stepper's order, for the step-size rule
+    int order_ = 8;             // one-step methods: the stepper's order, for the step-size rule
+    double grow_below_ = 0.43;  // 0.9^order: below this scaled error the step grows
 };
 
 }  // namespace hovering::detail

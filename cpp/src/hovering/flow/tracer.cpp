@@ -151,12 +151,12 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         auto wall = [&](int gi, double off, Ev cross, Ev graze) {
             const int pi = gi + 1;
             const double g0 = y0[gi] - off, g1 = y[gi] - off;
-            Candidate c{};
             if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
                 if (wall_absent(gi)) {
                     crossed = crossed || gi == 0;  // q1 = qw1 crossed above the step
                     return;
                 }
+                Candidate c;
                 c.kind = cross;
                 c.tau = locate(in_, y0, d0, y, d1, gi, off, h, opt.event_tol, c.y);
                 cands_.push_back(c);
@@ -167,6 +167,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
                 double ym[kMaxDim], dm[kMaxDim];
                 const double tm = locate(in_, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
                 const double gm = ym[gi] - off;
+                Candidate c;
                 if (gm < -opt.grazing_tol) {
                     c.kind = cross;
                     field(ym, dm);
