@@ -340,17 +340,18 @@ class FlowMap(MapAnalyses):
         """Sine coefficients of the measured forcing f (eq:defoff) of this section (cached).
 
         At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit is used there,
-        measured on the system at eps = 1e-6.
+        measured on the system at eps = 1e-6 (zeros without a coupling).
         """
         if self._forcing is None or self._forcing.size != n_modes:
             if self.curve is None:
                 raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
             if self.eps != 0:
                 self._forcing = self.curve.forcing_coefficients(n_modes)
+            elif self.sys.coupling is None:
+                self._forcing = np.zeros(n_modes)
             else:
-                tiny = TangentialCurve(Section(self.sys.replace(eps=1e-6, coupling=self.sys.coupling or _bilinear()),
-                                               self.h), rtol=1e-13)
-                self._forcing = tiny.forcing_coefficients(n_modes) if self.sys.coupling is not None else np.zeros(n_modes)
+                tiny = TangentialCurve(Section(self.sys.replace(eps=1e-6), self.h), rtol=1e-13)
+                self._forcing = tiny.forcing_coefficients(n_modes)
         return self._forcing
 
     def theory(self) -> "_theory.Theory":
@@ -475,8 +476,3 @@ class FlowMap(MapAnalyses):
         ref = np.where(reg == int(Region.RIGHT), ref - 2 * p.lam * s, ref)
         return ref + wrap(np.diff(ph) - ref)
 
-
-def _bilinear():
-    from ..flow.system import Bilinear
-
-    return Bilinear()
