@@ -83,7 +83,7 @@ FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, 
     }
     st.ret = tr.trace(z, false, cancel);
     if (st.ret.status != FlowStatus::Ok) return st;
-    st.ret.energy_error = std::fabs(s_.energy(st.ret.z.data()) - h_);
+    // ret.energy_error is |H(image) - H(start)|; the start solves H = h to rounding (1e-16).
     auto c = section_coordinates(s_, st.ret.z.data());
     if (inverse) {
         c[0] = wrap(-c[0]);
