@@ -31,7 +31,7 @@ darray map1(const darray& a, F f) {
     const double* in = a.data();
     double* o = out.mutable_data();
     {
-        py::gil_scoped_release release;
+        hovering_py::GilRelease release;
         for (py::ssize_t i = 0; i < a.size(); ++i) o[i] = f(in[i]);
     }
     return out;
@@ -177,7 +177,7 @@ void register_normal(py::module_& m) {
     py::class_<TangentialCurve, std::shared_ptr<TangentialCurve>>(
         m, "TangentialCurve", "I_tan^eps(theta) measured on the flow (use hovering.TangentialCurve).")
         .def(py::init([](const FlowSystem& s, double h, int n, const FlowOptions& o, int n_check) {
-                 py::gil_scoped_release release;
+                 hovering_py::GilRelease release;
                  return std::make_shared<TangentialCurve>(TangentialCurve::measure(s, h, n, o, n_check));
              }),
              py::arg("system"), py::arg("h"), py::arg("n"), py::arg("options"), py::arg("n_check"))

@@ -15,6 +15,7 @@
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/system.hpp"
 #include "pybind.hpp"
+#include "signals.hpp"
 
 using namespace hovering;
 
@@ -31,7 +32,7 @@ using hovering::detail::fmt;  // all 17 digits: a message names the value the co
 /// return). Threads Python created are left alone: Python deletes their states itself.
 class CallbackGil {
 public:
-    CallbackGil() : fresh_(PyGILState_GetThisThreadState() == nullptr), gil_() {
+    CallbackGil() : fresh_(park_if_finalizing() && PyGILState_GetThisThreadState() == nullptr), gil_() {
         if (fresh_) {
             gil_.inc_ref();
             keeper().kept = true;
@@ -39,6 +40,12 @@ public:
     }
 
 private:
+    // Taking the GIL while the interpreter finalises would end this thread by forced unwinding
+    // through C++ frames (std::terminate): park it until the process ends (see GilRelease).
+    static bool park_if_finalizing() {
+        while (hovering_py::GilRelease::finalizing()) std::this_thread::sleep_for(std::chrono::seconds(1));
+        return true;
+    }
     struct Keeper {
         bool kept = false;
         ~Keeper() {

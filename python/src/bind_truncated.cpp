@@ -30,7 +30,7 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
     double *a = o1.mutable_data(), *b = o2.mutable_data();
     const py::ssize_t n = phi.size();
     {
-        py::gil_scoped_release release;
+        hovering_py::GilRelease release;
         for (py::ssize_t i = 0; i < n; ++i) {
             auto r = fn(m, p[i], k[i]);
             a[i] = r.first;
@@ -136,7 +136,7 @@ void bind_common(Cls& cls) {
                  auto* r = reg.mutable_data();
                  auto* w = rot.mutable_data();
                  {
-                     py::gil_scoped_release release;
+                     hovering_py::GilRelease release;
                      for (py::ssize_t i = 0; i < phi.size(); ++i) {
                          const auto c = m.classify_point(p[i], k[i], who.c_str());
                          r[i] = static_cast<std::int8_t>(c.first);

@@ -19,6 +19,34 @@
 
 namespace hovering_py {
 
+/// Releases the GIL for a pure C++ computation and takes it back at the end, like
+/// py::gil_scoped_release, except when the interpreter is finalising by then (the call ran on a
+/// daemon thread, or on a thread the main thread stopped waiting for): taking the GIL would make
+/// CPython exit the thread by forced unwinding, which through this (noexcept) destructor ends in
+/// std::terminate ("terminate called without an active exception", exit 134). The thread then
+/// parks until the process ends instead, as CPython 3.14 itself does with daemon threads.
+class GilRelease {
+public:
+    GilRelease() : state_(PyEval_SaveThread()) {}
+    ~GilRelease() {
+        while (finalizing()) std::this_thread::sleep_for(std::chrono::seconds(1));
+        PyEval_RestoreThread(state_);
+    }
+    GilRelease(const GilRelease&) = delete;
+    GilRelease& operator=(const GilRelease&) = delete;
+    /// Whether the interpreter is shutting down (taking the GIL would end the calling thread).
+    static bool finalizing() {
+#if PY_VERSION_HEX >= 0x030D0000
+        return Py_IsFinalizing() != 0;
+#else
+        return _Py_IsFinalizing() != 0;
+#endif
+    }
+
+private:
+    PyThreadState* state_;
+};
+
 /// Whether the calling thread (GIL held) is Python's main thread.
 inline bool on_main_thread() {
     const auto threading = py::module_::import("threading");
@@ -35,7 +63,7 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch) {
     bool interrupted = false;
     std::unique_ptr<py::error_already_set> handler_error;
     {
-        py::gil_scoped_release release;
+        GilRelease release;
         if (!watch) {
             work();
         } else {
