@@ -53,7 +53,7 @@ CTRL_C_IN_JOIN = textwrap.dedent(
 
 def test_ctrl_c_while_the_main_thread_waits_in_join():
     # KeyboardInterrupt in the main thread while another thread iterates: the interpreter ends with
-    # the interrupt (exit 1 or 130), never an abort (134), and the worker's run is not corrupted.
+    # the interrupt (exit 1, 130 or by SIGINT), never an abort (134).
     r = subprocess.run([sys.executable, "-c", CTRL_C_IN_JOIN], capture_output=True, text=True, timeout=120)
-    assert r.returncode in (1, 130), (r.returncode, r.stderr[-500:])
+    assert r.returncode in (1, 130, -2), (r.returncode, r.stderr[-500:])  # -2: Python re-raises SIGINT at exit
     assert "KeyboardInterrupt" in r.stderr and "terminate called" not in r.stderr
