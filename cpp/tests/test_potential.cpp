@@ -91,7 +91,45 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
     CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, 0.5), "h must exceed the step energy");
     CHECK_INVALID(onset_parameters(H, T, 1.0, -0.5, 2.0), "qw1 must be < 0");
     CHECK_INVALID(onset_parameters(H, T, -1.0, -3.0, 2.0), "qw2 must be < 0 and inside the well of V2");
-    CHECK_INVALID(Harmonic(-1.0), "omega must be finite and > 0");
-    CHECK_INVALID(Tan(1.0, NAN), "alpha must be finite and > 0");
+    CHECK_INVALID(Harmonic(-1.0), "omega must lie in [1e-100, 1e100], got -1");
+    CHECK_INVALID(Tan(1.0, NAN), "alpha must lie in [1e-100, 1e100], got nan");
+    // omega^2 = 1e-600 underflows: the period was 2 pi / sqrt(0 + 2e600) = 0 without a word.
+    CHECK_INVALID(Tan(1e-300, 1e300), "omega must lie in [1e-100, 1e100], got 1e-300");
     CHECK_INVALID(H.period(-1.0), "energy must be finite and > 0");
+
+    // A point of another level is bad input, not an angle (atan2 would answer anything).
+    for (const Potential* pot : {static_cast<const Potential*>(&H), static_cast<const Potential*>(&T)}) {
+        CHECK_INVALID(pot->angle_of_point(0.9, 0.0, 0.1), "not on the level h = 0.10000000000000001");
+        CHECK_INVALID(pot->angle_of_point(0.1, NAN, 1.0), "q and p must be finite");
+    }
+    Numerical NH(std::make_shared<Harmonic>(1.0));
+    CHECK_INVALID(NH.angle_of_point(0.5, NAN, 1.0), "q and p must be finite");
+    // ... but the energy drift of an accurate orbit (1e-12) passes and gives the exact angle.
+    CHECKF(std::fabs(H.angle_of_point(1.0, -1e-12, 0.5) - 1e-12) < 1e-15, "level check tolerates a 1e-12 drift");
+
+    // Tan beyond its wall is outside the well, not a periodic copy of it.
+    CHECKF(std::isinf(T.V(3.0)) && T.V(3.0) > 0 && std::isinf(T.V(-3.0)), "Tan.V = +inf beyond q_limit = %g", T.q_limit());
+    CHECKF(T.dV(3.0) == INFINITY && T.dV(-3.0) == -INFINITY, "Tan.dV = sign(q) inf beyond q_limit");
+    CHECKF(std::isnan(T.V(NAN)), "Tan.V(nan) is nan");
+
+    // Small energies: the turning points are bracketed geometrically, so the generic path keeps
+    // full accuracy down to h = 1e-300 (it used to stop converging below h ~ 1e-63).
+    for (double h : {1e-70, 1e-150, 1e-300}) {
+        CHECKF(std::fabs(NH.period(h) - 2 * kPi) < 1e-13, "Numerical period at h = %g", h);
+        CHECKF(std::fabs(NH.action(h) / h - 1) < 1e-13, "Numerical action at h = %g", h);
+    }
+    // A quadrature failure (here V = h on the interval [1, 2]: a plateau at the level) is a named
+    // bad energy, not an internal error.
+    struct Plateau final : Potential {
+        double V(double q) const override {
+            const double a = std::fabs(q);
+            return a < 1 ? 0.5 * a * a : a <= 2 ? 0.5 : 0.5 + 0.5 * (a - 2) * (a - 2);
+        }
+        double dV(double q) const override {
+            const double a = std::fabs(q);
+            return a < 1 ? q : a <= 2 ? 0.0 : std::copysign(a - 2, q);
+        }
+        std::string name() const override { return "Plateau"; }
+    } plateau;
+    CHECK_INVALID(plateau.period(0.5), "Plateau.period: the quadrature over the level h = 0.5 did not converge");
 }

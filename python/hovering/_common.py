@@ -6,12 +6,22 @@ drift from the kernels'); this module only adds the paper's labels and a parser.
 
 from __future__ import annotations
 
+import math
+import numbers
+import operator
+import os
+
 import numpy as np
 
 from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
-           "iterate_arguments"]
+           "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
+           "check_memory", "thread_count", "MAX_ANGLE"]
+
+#: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
+#: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
+MAX_ANGLE = 1e6
 
 #: The paper's label of each region code (``'m'``: more than one impact, the flow only).
 REGION_LABELS = {-1: "-", 0: "0u", 1: "0", 2: "1", 3: "R", 4: "m"}
@@ -57,22 +67,125 @@ Region.parse = classmethod(_parse)
 
 
 def region_mask(regions) -> int:
-    """Bit mask (bit r = Region r) of a collection of regions.
+    """Bit mask (bit r = Region r) of a collection of regions (or of one region).
 
     Parameters
     ----------
-    regions : iterable of Region, str or int
-        Regions in any form accepted by ``Region.parse``.
+    regions : Region, str, int or iterable of them
+        Regions in any form accepted by ``Region.parse``; a single label such as ``"0u"`` is one
+        region, not the characters of its name.
 
     Returns
     -------
     int
         The mask, 0 for an empty collection.
     """
+    if isinstance(regions, (str, int, np.integer, Region)):
+        regions = (regions,)
+    try:
+        items = list(regions)
+    except TypeError:
+        raise ValueError(f"regions must be a region or a collection of regions, got {regions!r}") from None
     mask = 0
-    for r in regions:
+    for r in items:
         mask |= 1 << int(Region.parse(r))
     return mask
+
+
+def real_number(name: str, value, lo=None, lo_open=True, hi=None, hi_open=True) -> float:
+    """A finite real number (not a bool, string or complex) in an optional interval, or a ValueError naming it.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name (for the message).
+    value : object
+        What was passed.
+    lo, hi : float, optional
+        Interval ends (None: unbounded).
+    lo_open, hi_open : bool, optional
+        Whether the ends are excluded.
+
+    Returns
+    -------
+    float
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and (v >= hi if hi_open else v > hi)):
+        rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{')' if hi_open else ']'}"
+        raise ValueError(f"{name} must lie in {rng}, got {v}")
+    return v
+
+
+def integer(name: str, value, lo: int, hi: int) -> int:
+    """An integer (not a bool, float or string) in [lo, hi], or a ValueError naming it and the range."""
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise ValueError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}") from None
+    if isinstance(value, (bool, np.bool_)) or not lo <= v <= hi:
+        raise ValueError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
+    return v
+
+
+def thread_count(value) -> int:
+    """The ``n_threads`` argument every parallel call takes: an integer in [0, 4096], 0 = all cores."""
+    try:
+        v = operator.index(value)
+    except TypeError:
+        v = None
+    if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= 4096:
+        raise ValueError(f"n_threads must be an integer in [0, 4096] (0 = all cores), got {value!r}")
+    return v
+
+
+def real_array(name: str, value) -> np.ndarray:
+    """``value`` as a float array; a ValueError naming it for strings, objects, booleans or complex numbers."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be real numbers, got {value!r}") from None
+    if a.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be real numbers, got dtype {a.dtype} ({_short(value)})")
+    return a.astype(float, copy=False)
+
+
+def require_finite(name: str, a) -> None:
+    """Raise a ValueError naming the first non-finite entry of ``a``."""
+    a = np.asarray(a)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
+        raise ValueError(f"{name} must be finite, got {a[i]}" + (f" at index {i[0] if len(i) == 1 else i}" if a.ndim else ""))
+
+
+def require_angles(name: str, a) -> None:
+    """Raise unless every entry is a finite angle that can be wrapped accurately (|x| <= MAX_ANGLE)."""
+    require_finite(name, a)
+    a = np.asarray(a)
+    if a.size and np.max(np.abs(a)) > MAX_ANGLE:
+        raise ValueError(f"{name} must be angles with |{name}| <= 1e6 (larger ones cannot be wrapped to [-pi, pi) "
+                         f"accurately in double precision), got {a.flat[int(np.argmax(np.abs(a)))]}")
+
+
+def check_memory(what: str, nbytes: int) -> None:
+    """Refuse, before any work, a result that would need more than half of this machine's memory."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = 2**36
+    if nbytes > total // 2:
+        raise ValueError(f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
+                         f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")
+
+
+def _short(value) -> str:
+    r = repr(value)
+    return r if len(r) <= 60 else r[:57] + "..."
 
 
 def wrap(x):
@@ -81,14 +194,25 @@ def wrap(x):
     Parameters
     ----------
     x : array_like
-        Angles in radians.
+        Angles in radians, |x| <= 1e6 (NaN stays NaN: a missing value, e.g. of a stopped orbit).
 
     Returns
     -------
     ndarray or float
         ``x`` shifted by a multiple of ``2 pi`` into ``[-pi, pi)``.
+
+    Raises
+    ------
+    ValueError
+        For an infinite angle or one beyond 1e6, which cannot be wrapped accurately.
     """
-    y = np.asarray(x, dtype=float) - 2 * np.pi * np.floor((np.asarray(x, dtype=float) + np.pi) / (2 * np.pi))
+    x = real_array("angle", x)
+    with np.errstate(invalid="ignore"):
+        if np.any(np.abs(x) > MAX_ANGLE):
+            bad = x[np.abs(x) > MAX_ANGLE] if x.ndim else x
+            raise ValueError(f"angles to wrap must satisfy |x| <= 1e6 (beyond, 2 pi floor(x / 2 pi) loses accuracy), "
+                             f"got {np.ravel(bad)[0]}")
+    y = x - 2 * np.pi * np.floor((x + np.pi) / (2 * np.pi))
     y = np.where(y >= np.pi, y - 2 * np.pi, y)
     y = np.where(y < -np.pi, y + 2 * np.pi, y)
     return y if np.ndim(y) else float(y)
@@ -103,11 +227,12 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
         Naming the unknown record key, the bad step count or region, or an exit set that is
         empty or missing where ``stop_on_exit`` needs it.
     """
-    import operator
-
     if isinstance(record, str):
         record = (record,)
-    record = tuple(record)
+    try:
+        record = tuple(record)
+    except TypeError:
+        raise ValueError(f"record must be a sequence of keys from {list(allowed)} (or () for none), got {record!r}") from None
     unknown = [r for r in record if r not in allowed]
     if unknown:
         raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(allowed)}")
@@ -117,6 +242,10 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
         raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
     if n_steps < 0:
         raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+    if n_steps > 2**53:
+        raise ValueError(f"n_steps must be <= 2**53, got {n_steps}")
+    if isinstance(stop_on_exit, (bool, np.bool_)) is False:
+        raise ValueError(f"stop_on_exit must be True or False, got {stop_on_exit!r}")
     mask = region_mask(exit_regions) if exit_regions is not None else 0
     if exit_regions is not None and mask == 0:
         raise ValueError("exit_regions must name at least one region")

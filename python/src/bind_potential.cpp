@@ -8,6 +8,7 @@
 // exception travels up through the core (and GSL's frames) as pybind11::error_already_set, which
 // the flow's thread pool hands to the calling thread.
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
@@ -235,7 +236,8 @@ void register_potential(py::module_& m) {
         .def("point_at", &Potential::point_at, py::arg("theta"), py::arg("h"),
              "(q, p) at angle theta in [-pi, pi] on the level h (sign(p) = -sign(theta)).")
         .def("angle_of_point", &Potential::angle_of_point, py::arg("q"), py::arg("p"), py::arg("h"),
-             "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q).")
+             "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q) (ValueError if "
+             "p^2/2 + V(q) differs from h by more than 1e-8 h).")
         .def_property_readonly("name", &Potential::name)
         .def_property_readonly("q_limit", &Potential::q_limit, "Largest |q| inside the well (inf if unbounded).")
         .def("__repr__", &Potential::name);
@@ -266,9 +268,14 @@ void register_potential(py::module_& m) {
         .def_readonly("theta_w", &OnsetParameters::theta_w)
         .def_readonly("I_tan", &OnsetParameters::I_tan)
         .def("__repr__", [](const OnsetParameters& p) {
-            return "OnsetParameters(Omega0=" + std::to_string(p.Omega0) + ", tau0=" + std::to_string(p.tau0) +
-                   ", tau1=" + std::to_string(p.tau1) + ", lam=" + std::to_string(p.lam) +
-                   ", theta_w=" + std::to_string(p.theta_w) + ", I_tan=" + std::to_string(p.I_tan) + ")";
+            // %.10g: std::to_string's fixed %f printed tau1 = 1.7e-7 as 0.000000.
+            auto g = [](double v) {
+                char b[32];
+                std::snprintf(b, sizeof b, "%.10g", v);
+                return std::string(b);
+            };
+            return "OnsetParameters(Omega0=" + g(p.Omega0) + ", tau0=" + g(p.tau0) + ", tau1=" + g(p.tau1) +
+                   ", lam=" + g(p.lam) + ", theta_w=" + g(p.theta_w) + ", I_tan=" + g(p.I_tan) + ")";
         });
     m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"));
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),

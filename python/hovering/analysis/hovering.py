@@ -15,7 +15,7 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import Region, Status
+from .._common import Region, Status, check_memory, integer, real_number, thread_count
 
 __all__ = ["HoveringArea", "hovering_area"]
 
@@ -151,11 +151,14 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     """
     n_steps = _count("n_steps", n_steps, 4)
     samples = _count("samples", samples, 1)
+    seed = integer("seed", seed, 0, 2**63 - 1)
+    n_threads = thread_count(n_threads)
+    check_memory(f"hovering_area with {samples} samples", 64 * samples)
     lo = m.valid_band()[0]
     if K_low is None:
         depth = default_depth(m) if m.eps != 0 else 0.1
         K_low = max(-depth, lo * (1 - 1e-9))
-    K_low = float(K_low)
+    K_low = real_number("K_low", K_low)
     if not (lo < K_low < 0):
         raise ValueError(f"K_low must lie in the band below 0, ({lo}, 0), got {K_low}")
     rng = np.random.default_rng(seed)

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import math
 import numbers
+
+import numpy as np
 from dataclasses import dataclass
 from typing import Optional
 
 from .. import _core
-from .._common import Geometry
+from .._common import Geometry, real_number
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
 
 __all__ = [
@@ -58,11 +60,16 @@ class Polynomial:
     coefficients: dict
 
     def __post_init__(self):
-        for (i, j), c in self.coefficients.items():
-            if not (int(i) == i and int(j) == j and 0 <= i <= 20 and 0 <= j <= 20):
-                raise ValueError(f"exponents must be integers in [0, 20], got ({i}, {j})")
-            if not math.isfinite(c):
-                raise ValueError(f"coefficient of q1^{i} q2^{j} must be finite, got {c}")
+        if not isinstance(self.coefficients, dict) or not self.coefficients:
+            raise ValueError(f"coefficients must be a non-empty dict {{(i, j): c}}, got {self.coefficients!r}")
+        for key, c in self.coefficients.items():
+            if not (isinstance(key, tuple) and len(key) == 2):
+                raise ValueError(f"each key must be a pair of exponents (i, j) for c q1^i q2^j, got {key!r}")
+            i, j = key
+            if not all(isinstance(e, (int, np.integer)) and not isinstance(e, bool) and 0 <= e <= 20 for e in (i, j)):
+                raise ValueError(f"exponents must be integers in [0, 20], got ({i!r}, {j!r})")
+            if isinstance(c, bool) or not isinstance(c, numbers.Real) or not math.isfinite(c):
+                raise ValueError(f"coefficient of q1^{i} q2^{j} must be a finite real number, got {c!r}")
 
     def __call__(self, q1, q2):
         """Vc(q1, q2).
@@ -219,6 +226,9 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> 
     ValueError
         If h is not above the step energy, or for an unknown method.
     """
+    if not isinstance(sys, StepSystem):
+        raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
+    h = real_number("h", h)
     if method == "definitions":
         return _core.flow._onset_parameters(sys.V1, sys.V2, sys.qw1, sys.qw2, float(h))
     if method == "quadrature":

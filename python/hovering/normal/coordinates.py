@@ -17,7 +17,7 @@ import operator
 import numpy as np
 
 from .. import _core
-from .._common import wrap
+from .._common import real_array, require_angles, require_finite, wrap
 from ..flow.section import FlowStatus, Section, flow_options
 
 __all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_coefficients", "to_normal", "from_normal"]
@@ -128,14 +128,16 @@ class TangentialCurve:
         return self._c.at(a)
 
     def to_normal(self, theta, I):
-        """``(phi, K) = (theta, I - I_tan(theta))`` (eq:kphidef)."""
-        th = np.asarray(theta, dtype=float)
-        return th, np.asarray(I, dtype=float) - self(th)
+        """``(phi, K) = (theta, I - I_tan(theta))`` (eq:kphidef); theta, I finite, I > 0."""
+        th, I = _section_pair(theta, I)
+        return th, I - self(th)
 
     def from_normal(self, phi, K):
-        """``(theta, I) = (phi, K + I_tan(phi))`` (eq:kphiinvdef)."""
-        ph = np.asarray(phi, dtype=float)
-        return ph, np.asarray(K, dtype=float) + self(ph)
+        """``(theta, I) = (phi, K + I_tan(phi))`` (eq:kphiinvdef); a ValueError where I would be <= 0."""
+        ph, K = _finite_pair("phi", phi, "K", K)
+        I = K + self(ph)
+        _positive_action(I, K)
+        return ph, I
 
     def forcing(self, phi) -> np.ndarray:
         """``eps f(phi) = I_tan(-phi) - I_tan(phi)`` (eq:defoff), divided by eps.
@@ -172,6 +174,27 @@ class TangentialCurve:
         ph = -np.pi + _TWO_PI * (np.arange(n_phi) + 0.5) / n_phi
         A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
         return np.linalg.lstsq(A, self.forcing(ph), rcond=None)[0]
+
+
+def _finite_pair(na, a, nb, b):
+    a, b = real_array(na, a), real_array(nb, b)
+    require_angles(na, a)
+    require_finite(nb, b)
+    return a, b
+
+
+def _section_pair(theta, I):
+    th, I = _finite_pair("theta", theta, "I", I)
+    if np.any(I <= 0):
+        raise ValueError(f"I must be > 0 (an action), got {np.ravel(I)[np.argmax(np.ravel(I) <= 0)]}")
+    return th, I
+
+
+def _positive_action(I, K):
+    if np.any(I <= 0):
+        i = int(np.argmax(np.ravel(I) <= 0))
+        raise ValueError(f"K = {np.ravel(K)[i]} gives the action I = {np.ravel(I)[i]} <= 0: no point of Sigma_h "
+                         "(K must exceed -I_tan(phi))")
 
 
 def _wall_section(sec: Section) -> Section:
@@ -215,9 +238,10 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         For an empty theta, a bracket outside (0, 1) or bad iterations, or if no bracket up to
         I_tan (1 -+ 0.95) contains the tangency for every theta.
     """
-    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    th = np.atleast_1d(real_array("theta", theta))
     if th.size == 0:
         raise ValueError("theta must hold at least one angle")
+    require_angles("theta", th)
     if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 200:
         raise ValueError(f"iterations must be an integer in [1, 200], got {iterations!r}")
     if bracket is not None and not (isinstance(bracket, (int, float)) and 0 < bracket < 1):
@@ -310,8 +334,8 @@ def to_normal(sec: Section, theta, I, **kwargs):
     -------
     phi, K : ndarray
     """
-    th = np.atleast_1d(np.asarray(theta, dtype=float))
-    return th, np.asarray(I, dtype=float) - tangential_curve(sec, th, **kwargs)
+    th, I = _section_pair(np.atleast_1d(theta), I)
+    return th, I - tangential_curve(sec, th, **kwargs)
 
 
 def from_normal(sec: Section, phi, K, **kwargs):
@@ -330,5 +354,7 @@ def from_normal(sec: Section, phi, K, **kwargs):
     -------
     theta, I : ndarray
     """
-    p = np.atleast_1d(np.asarray(phi, dtype=float))
-    return p, np.asarray(K, dtype=float) + tangential_curve(sec, p, **kwargs)
+    p, K = _finite_pair("phi", np.atleast_1d(phi), "K", K)
+    I = K + tangential_curve(sec, p, **kwargs)
+    _positive_action(I, K)
+    return p, I

@@ -15,7 +15,7 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import Region, iterate_arguments, wrap
+from .._common import Region, check_memory, iterate_arguments, real_array, wrap
 from .._protocols import MapAnalyses
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -66,7 +66,7 @@ class FlowSteps:
 def _pair(phi, K, who: str):
     scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
     try:
-        p, k = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
+        p, k = np.broadcast_arrays(real_array(f"{who}: phi", phi), real_array(f"{who}: K", K))
     except ValueError:
         raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {np.shape(phi)} and {np.shape(K)}") from None
     return p, k, scalar
@@ -285,9 +285,10 @@ class FlowMap(MapAnalyses):
         p, k = np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel())
         n_points = p.size * (n_steps + 1)
         per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
-        if per_point * n_points * 8 > 2**36:
-            raise ValueError(f"recording {record} for {p.size} orbits x {n_steps} steps needs "
-                             f"{per_point * n_points * 8 / 2**30:.1f} GiB (> 64 GiB); record less or iterate in chunks")
+        per_return = 8 * sum(key in record for key in ("times", "energy_error", "steps")) + ("regions" in record) + \
+            64 * ("itinerary" in record)
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns",
+                     8 * per_point * n_points + per_return * p.size * n_steps)
         d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit),
                                _threads(n_threads, self.sys.python_defined))
         res = IterateResult(phi=d.get("x"), K=d.get("y"), region=d.get("region"), rotation=d.get("rotation"),

@@ -14,7 +14,8 @@ from typing import Iterable, Optional, Sequence, Union
 import numpy as np
 
 from .. import _core
-from .._common import Region, Status, iterate_arguments
+from .._common import (Region, Status, check_memory, iterate_arguments, real_array, real_number,
+                       require_angles, require_finite, thread_count)
 from .._protocols import MapAnalyses
 from . import theory as _geo
 
@@ -109,20 +110,14 @@ class IterateResult:
 
 
 def _finite_float(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {v}")
-    return v
+    return real_number(name, value)
 
 
 def _pair(phi, K, who: str):
     """Broadcast (phi, K) to one shape of contiguous doubles; remember whether both were scalars."""
     scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
-    p = np.asarray(phi, dtype=float)
-    k = np.asarray(K, dtype=float)
+    p = real_array(f"{who}: phi", phi)
+    k = real_array(f"{who}: K", K)
     try:
         p, k = np.broadcast_arrays(p, k)
     except ValueError:
@@ -226,6 +221,8 @@ class _MapAPI(MapAnalyses):
         phi_r, K_r : ndarray or float
         """
         p, k, scalar = _pair(phi, K, "reversal")
+        require_angles("reversal: phi", p)
+        require_finite("reversal: K", k)
         out = (_geo.wrap(-p), k - self.eps * self.forcing_at(p))
         return (float(out[0]), float(out[1])) if scalar else out
 
@@ -328,9 +325,11 @@ class _MapAPI(MapAnalyses):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
         if sin_ulp not in (1.0, 3.5):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
-        if not 0 <= n_threads <= 4096:
-            raise ValueError(f"n_threads must be in [0, 4096] (0 = all cores), got {n_threads}")
+        n_threads = thread_count(n_threads)
         p, k, _ = _pair(phi0, K0, "iterate")
+        n_points = p.size * (n_steps + 1)
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps",
+                     16 * n_points * ("orbit" in record) + p.size * n_steps * ("regions" in record))
         d = self._iterate(
             np.ascontiguousarray(p.ravel()),
             np.ascontiguousarray(k.ravel()),
@@ -519,7 +518,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
 
     def __init__(self, eps, K, Omega, JR, J1, forcing=(1.0,), K_max=math.inf):
         eps = _finite_float("eps", eps)
-        Kg = np.asarray(K, dtype=float)
+        Kg = real_array("K", K)
         if Kg.ndim != 1:
             raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")
         tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]

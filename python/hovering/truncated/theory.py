@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .._common import wrap
+from .._common import real_array, require_finite, wrap
 
 __all__ = [
     "OMEGA_G",
@@ -58,7 +58,7 @@ def L1(K, Omega0, tau0):
     ndarray or float
         ``phi_m1(K)`` in ``[-pi, pi)``.
     """
-    return wrap(-0.5 * (Omega0 + tau0 * np.asarray(K, dtype=float)))
+    return wrap(-0.5 * (Omega0 + tau0 * _finite("K", K)))
 
 
 def L2(K, Omega0, tau0):
@@ -76,7 +76,26 @@ def L2(K, Omega0, tau0):
     ndarray or float
         ``phi_m2(K)`` in ``[-pi, pi)``.
     """
-    return wrap(np.pi - 0.5 * (Omega0 + tau0 * np.asarray(K, dtype=float)))
+    return wrap(np.pi - 0.5 * (Omega0 + tau0 * _finite("K", K)))
+
+
+def _finite(name, x) -> np.ndarray:
+    a = real_array(name, x)
+    require_finite(name, a)
+    return a
+
+
+def _sin_half(Omega0) -> np.ndarray:
+    """sin(Omega0 / 2), NaN where it vanishes (resonant Omega0: the first-order theory has no curve)."""
+    s = np.sin(0.5 * _finite("Omega0", Omega0))
+    return np.where(np.abs(s) < 1e-12, np.nan, s)
+
+
+def _wall_angle(theta_w) -> np.ndarray:
+    tw = _finite("theta_w", theta_w)
+    if np.any((tw <= 0) | (tw >= np.pi)):
+        raise ValueError(f"theta_w must lie in (0, pi), got {np.ravel(tw)[np.argmax(np.ravel((tw <= 0) | (tw >= np.pi)))]}")
+    return tw
 
 
 def _half_rotation(K0, Omega0, tau0):
@@ -170,7 +189,8 @@ def K_crit(eps, theta_w, Omega0):
     """Predicted lowest height of the critical invariant curve on L1 (eq:kcrit), evaluated formally.
 
     Negative in the hovering case ``eps sin(Omega0/2) > 0``; positive otherwise, where no
-    hovering critical curve exists (use :func:`theory`, whose ``K_crit`` is NaN there).
+    hovering critical curve exists (use :func:`theory`, whose ``K_crit`` is NaN there). NaN at a
+    resonant Omega0 (sin(Omega0/2) = 0); theta_w must lie in (0, pi).
 
     Parameters
     ----------
@@ -182,7 +202,8 @@ def K_crit(eps, theta_w, Omega0):
     float or ndarray
         ``-eps (1 - cos theta_w) / (2 sin(Omega0/2))``.
     """
-    return -eps * (1.0 - np.cos(theta_w)) / (2.0 * np.sin(0.5 * np.asarray(Omega0, dtype=float)))
+    out = -_finite("eps", eps) * (1.0 - np.cos(_wall_angle(theta_w))) / (2.0 * _sin_half(Omega0))
+    return out if np.ndim(out) else float(out)
 
 
 def rho_crit(eps, theta_w, Omega0, tau0):
@@ -198,7 +219,8 @@ def rho_crit(eps, theta_w, Omega0, tau0):
     float or ndarray
         ``Omega0 + eps tau0 cos(theta_w) / (2 sin(Omega0/2))``.
     """
-    return Omega0 + eps * tau0 * np.cos(theta_w) / (2.0 * np.sin(0.5 * np.asarray(Omega0, dtype=float)))
+    out = Omega0 + _finite("eps", eps) * tau0 * np.cos(_wall_angle(theta_w)) / (2.0 * _sin_half(Omega0))
+    return out if np.ndim(out) else float(out)
 
 
 def hovering_area_theory(eps, theta_w, Omega0):
@@ -217,11 +239,12 @@ def hovering_area_theory(eps, theta_w, Omega0):
     -------
     float or ndarray
     """
-    e = np.asarray(eps, dtype=float)
-    s = np.sin(0.5 * np.asarray(Omega0, dtype=float))
+    e = _finite("eps", eps)
+    tw = _wall_angle(theta_w)
+    s = _sin_half(Omega0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        a = np.where(e * s > 0, np.abs(e) * (np.sin(theta_w) - theta_w * np.cos(theta_w)) / np.abs(s), 0.0)
-    a = np.where(np.abs(s) < 1e-12, np.nan, a)  # resonant: sin(Omega0/2) = 0 up to rounding of Omega0
+        a = np.where(e * s > 0, np.abs(e) * (np.sin(tw) - tw * np.cos(tw)) / np.abs(s), 0.0)
+    a = np.where(np.isnan(s), np.nan, a)  # resonant: sin(Omega0/2) = 0 up to rounding of Omega0
     return a if np.ndim(a) else float(a)
 
 

@@ -41,8 +41,11 @@ public:
     virtual double angle_of(double q, double h) const;
     /// Inverse of the angle: (q, p) on the level h at angle theta in [-pi, pi] (sign(p) = -sign(theta)).
     virtual std::pair<double, double> point_at(double theta, double h) const;
-    /// Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q).
-    virtual double angle_of_point(double q, double p, double h) const;
+    /// Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q); throws
+    /// std::invalid_argument unless (q, p) lies on that level to 1e-8 relative.
+    double angle_of_point(double q, double p, double h) const;
+    /// angle_of_point without the level check, for callers that computed h from (q, p) themselves.
+    virtual double angle_on_level(double q, double p, double h) const;
 
 protected:
     void check_energy(double h, const char* who) const;
@@ -51,7 +54,7 @@ protected:
 /// V = omega^2 q^2 / 2.
 class Harmonic final : public Potential {
 public:
-    /// Throws std::invalid_argument unless omega > 0 and finite.
+    /// Throws std::invalid_argument unless omega lies in [1e-100, 1e100] (omega^2 stays a normal double).
     explicit Harmonic(double omega);
     double V(double q) const override;
     double dV(double q) const override;
@@ -62,7 +65,7 @@ public:
     double energy(double I) const override;
     double angle_of(double q, double h) const override;
     std::pair<double, double> point_at(double theta, double h) const override;
-    double angle_of_point(double q, double p, double h) const override;
+    double angle_on_level(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
 
@@ -71,9 +74,10 @@ private:
 };
 
 /// V = omega^2 / (2 alpha^2) tan^2(alpha q), |q| < pi / (2 alpha): H(I) = omega I + alpha^2 I^2 / 2.
+/// Beyond the wall of the well (|q| >= pi / (2 alpha)) V = +inf and V' = sign(q) inf.
 class Tan final : public Potential {
 public:
-    /// Throws std::invalid_argument unless omega > 0, alpha > 0, both finite.
+    /// Throws std::invalid_argument unless omega and alpha lie in [1e-100, 1e100].
     Tan(double omega, double alpha);
     double V(double q) const override;
     double dV(double q) const override;
@@ -85,7 +89,7 @@ public:
     double energy(double I) const override;
     double angle_of(double q, double h) const override;
     std::pair<double, double> point_at(double theta, double h) const override;
-    double angle_of_point(double q, double p, double h) const override;
+    double angle_on_level(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
     /// The nonlinearity alpha.

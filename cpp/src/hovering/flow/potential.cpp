@@ -28,8 +28,10 @@ using detail::kPi;
 
 double call(double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); }
 
-// int_a^b (x - a)^al (b - x)^be f(x) dx by GSL QAWS.
-double qaws(const std::function<double(double)>& f, double a, double b, double al, double be) {
+// int_a^b (x - a)^al (b - x)^be f(x) dx by GSL QAWS. A failure is bad input, not a bug: the level
+// h is too small for the well's width to be resolved, or V has a plateau (V = h on an interval).
+double qaws(const std::function<double(double)>& f, double a, double b, double al, double be, const Potential& pot,
+            const char* who, double h) {
     gsl_quiet();
     gsl_integration_qaws_table* t = gsl_integration_qaws_table_alloc(al, be, 0, 0);
     gsl_integration_workspace* w = gsl_integration_workspace_alloc(200);
@@ -39,7 +41,9 @@ double qaws(const std::function<double(double)>& f, double a, double b, double a
     gsl_integration_workspace_free(w);
     gsl_integration_qaws_table_free(t);
     if (st != GSL_SUCCESS && st != GSL_EROUND && !(err <= 1e-10 * std::fabs(r)))
-        throw std::runtime_error(std::string("quadrature did not converge: ") + gsl_strerror(st));
+        bad(pot.name() + "." + who + ": the quadrature over the level h = " + fmt(h) + " did not converge (" +
+            gsl_strerror(st) + "); the turning points [" + fmt(a) + ", " + fmt(b) +
+            "] are too close to resolve, or V is flat there. Use a larger h or a closed-form potential");
     return r;
 }
 
@@ -58,8 +62,10 @@ double near_end(double q, double a, double b, double at_a, double at_b, double t
     return f();
 }
 
-void require_positive(double v, const char* name) {
-    if (!std::isfinite(v) || !(v > 0)) bad(std::string(name) + " must be finite and > 0, got " + fmt(v));
+// Parameters whose square (and the ratios omega^2 / alpha^2 of Tan) stay normal doubles: outside,
+// V underflows to 0 or the period to 0 and every answer would be silently wrong.
+void require_scale(double v, const char* name) {
+    if (!(v >= 1e-100 && v <= 1e100)) bad(std::string(name) + " must lie in [1e-100, 1e100], got " + fmt(v));
 }
 
 }  // namespace
@@ -84,6 +90,10 @@ std::pair<double, double> Potential::turning_points(double h) const {
             inner = outer;
             outer = std::isfinite(lim) ? lim - 0.5 * (lim - outer) : 2 * outer;
         }
+        // For small h, halve toward 0 first: a bracket [x/2, x] lets Brent reach full relative
+        // accuracy; [0, 1] around a root 1e-35 exhausted its iterations at a point 1e-31.
+        while (inner == 0 && outer > 1e-300 && V(sgn * 0.5 * outer) >= h) outer *= 0.5;
+        if (inner == 0) inner = 0.5 * outer;
         return sgn * brent([&](double x) { return V(sgn * x) - h; }, inner, outer);
     };
     return {side(-1.0), side(1.0)};
@@ -94,14 +104,14 @@ double Potential::period(double h) const {
     // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V)))
     const double ra = std::sqrt((b - a) / (2 * -dV(a))), rb = std::sqrt((b - a) / (2 * dV(b)));
     return 2 * qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt((q - a) * (b - q) / (2 * (h - V(q)))); }); },
-                    a, b, -0.5, -0.5);
+                    a, b, -0.5, -0.5, *this, "period", h);
 }
 
 double Potential::action(double h) const {
     const auto [a, b] = turning_points(h);
     const double ra = std::sqrt(2 * -dV(a) / (b - a)), rb = std::sqrt(2 * dV(b) / (b - a));
     return qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt(2 * (h - V(q)) / ((q - a) * (b - q))); }); },
-                a, b, 0.5, 0.5) / kPi;
+                a, b, 0.5, 0.5, *this, "action", h) / kPi;
 }
 
 double Potential::energy(double I) const {
@@ -134,12 +144,12 @@ double Potential::angle_of(double q, double h) const {
         if (b - q <= 1e-12 * (b - a)) return w * std::sqrt(2 * (b - q) / dV(b));
         const double rb = std::sqrt(1 / (2 * dV(b)));
         return w * qaws([&](double x) { return near_end(x, -kInf, b, 0.0, rb, 1e-9 * (b - a), [&] { return std::sqrt((b - x) / (2 * (h - V(x)))); }); },
-                        q, b, 0.0, -0.5);
+                        q, b, 0.0, -0.5, *this, "angle_of", h);
     }
     if (q - a <= 1e-12 * (b - a)) return kPi - w * std::sqrt(2 * (q - a) / -dV(a));
     const double ra = std::sqrt(1 / (2 * -dV(a)));
     return kPi - w * qaws([&](double x) { return near_end(x, a, kInf, ra, 0.0, 1e-9 * (b - a), [&] { return std::sqrt((x - a) / (2 * (h - V(x)))); }); },
-                          a, q, -0.5, 0.0);
+                          a, q, -0.5, 0.0, *this, "angle_of", h);
 }
 
 std::pair<double, double> Potential::point_at(double theta, double h) const {
@@ -162,6 +172,18 @@ std::pair<double, double> Potential::point_at(double theta, double h) const {
 }
 
 double Potential::angle_of_point(double q, double p, double h) const {
+    check_energy(h, "angle_of_point");
+    if (!std::isfinite(q) || !std::isfinite(p))
+        bad(name() + ".angle_of_point: q and p must be finite, got q = " + fmt(q) + ", p = " + fmt(p));
+    // 1e-8 relative: the energy drift of an accurate orbit passes, a point of another level does not.
+    const double e = 0.5 * p * p + V(q);
+    if (!(std::fabs(e - h) <= 1e-8 * h))
+        bad(name() + ".angle_of_point: (q, p) = (" + fmt(q) + ", " + fmt(p) + ") has energy p^2/2 + V(q) = " + fmt(e) +
+            ", not on the level h = " + fmt(h) + " (allowed: within 1e-8 h)");
+    return angle_on_level(q, p, h);
+}
+
+double Potential::angle_on_level(double q, double p, double h) const {
     const auto [a, b] = turning_points(h);
     const double th = angle_of(std::min(std::max(q, a), b), h);
     return p > 0 ? -th : th;
@@ -169,7 +191,7 @@ double Potential::angle_of_point(double q, double p, double h) const {
 
 // ------------------------------------------------------------------------------- closed forms
 
-Harmonic::Harmonic(double omega) : omega_(omega) { require_positive(omega, "Harmonic: omega"); }
+Harmonic::Harmonic(double omega) : omega_(omega) { require_scale(omega, "Harmonic: omega"); }
 double Harmonic::V(double q) const { return 0.5 * omega_ * omega_ * q * q; }
 double Harmonic::dV(double q) const { return omega_ * omega_ * q; }
 std::string Harmonic::name() const { return "Harmonic(omega=" + fmt(omega_) + ")"; }
@@ -202,21 +224,24 @@ std::pair<double, double> Harmonic::point_at(double theta, double h) const {
     return {A * std::cos(theta), -A * omega_ * std::sin(theta)};
 }
 
-double Harmonic::angle_of_point(double q, double p, double) const {
+double Harmonic::angle_on_level(double q, double p, double) const {
     return std::atan2(-p / omega_, q);  // (q, p) = A (cos theta, -omega sin theta): no arccos near +-1
 }
 
 Tan::Tan(double omega, double alpha) : omega_(omega), alpha_(alpha) {
-    require_positive(omega, "Tan: omega");
-    require_positive(alpha, "Tan: alpha");
+    require_scale(omega, "Tan: omega");
+    require_scale(alpha, "Tan: alpha");
 }
 double Tan::V(double q) const {
+    // tan is periodic: without this, a q beyond the wall would land in another copy of the well.
+    if (!(std::fabs(q) < q_limit())) return std::isnan(q) ? q : kInf;
     const double t = std::tan(alpha_ * q);
     return 0.5 * omega_ * omega_ / (alpha_ * alpha_) * t * t;
 }
 double Tan::dV(double q) const {
     // tan / cos^2 = tan (1 + tan^2): one transcendental call per force evaluation, the flow's
     // dominant cost.
+    if (!(std::fabs(q) < q_limit())) return std::isnan(q) ? q : std::copysign(kInf, q);
     const double t = std::tan(alpha_ * q);
     return omega_ * omega_ / alpha_ * t * (1 + t * t);
 }
@@ -260,7 +285,7 @@ std::pair<double, double> Tan::point_at(double theta, double h) const {
     return {q, p};
 }
 
-double Tan::angle_of_point(double q, double p, double h) const {
+double Tan::angle_on_level(double q, double p, double h) const {
     // cos theta = sin(alpha q) / k and sin theta = -p alpha cos(alpha q) / (omega(h) k), k > 0.
     const double w = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
     return std::atan2(-p * alpha_ * std::cos(alpha_ * q) / w, std::sin(alpha_ * q));

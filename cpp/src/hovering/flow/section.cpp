@@ -88,7 +88,7 @@ std::array<double, 4> section_point(const FlowSystem& s, double h, double theta,
 
 std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) {
     const double e2 = 0.5 * z[3] * z[3] + s.V2->V(z[2]);
-    double th = s.V2->angle_of_point(z[2], z[3], e2);
+    double th = s.V2->angle_on_level(z[2], z[3], e2);
     if (th >= kPi) th -= 2 * kPi;  // [-pi, pi)
     return {th, s.V2->action(e2)};
 }

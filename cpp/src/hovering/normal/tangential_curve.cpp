@@ -130,7 +130,7 @@ std::pair<double, double> trace_back(detail::Tracer& tr, double h, double s, dou
             std::to_string(int(r.status)) + ")");
     const double q2 = r.z[2], p2 = -r.z[3];
     const double e2 = 0.5 * p2 * p2 + sys.V2->V(q2);
-    return {wrap(sys.V2->angle_of_point(q2, p2, e2)), sys.V2->action(e2)};
+    return {wrap(sys.V2->angle_on_level(q2, p2, e2)), sys.V2->action(e2)};
 }
 
 }  // namespace
