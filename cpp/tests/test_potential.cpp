@@ -99,7 +99,7 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
 
     // A point of another level is bad input, not an angle (atan2 would answer anything).
     for (const Potential* pot : {static_cast<const Potential*>(&H), static_cast<const Potential*>(&T)}) {
-        CHECK_INVALID(pot->angle_of_point(0.9, 0.0, 0.1), "not on the level h = 0.10000000000000001");
+        CHECK_INVALID(pot->angle_of_point(0.9, 0.0, 0.1), "not on the level h = 0.1 ");
         CHECK_INVALID(pot->angle_of_point(0.1, NAN, 1.0), "q and p must be finite");
     }
     Numerical NH(std::make_shared<Harmonic>(1.0));

@@ -12,6 +12,21 @@ import sys
 import time
 
 
+def _checked(kind, lo, hi):
+    """An argparse type: a finite number of ``kind`` in [lo, hi], or a usage error naming the range."""
+
+    def parse(text):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'an integer' if kind is int else 'a number'}") from None
+        if not (lo <= v <= hi):  # also rejects nan
+            raise argparse.ArgumentTypeError(f"{text} is out of range; allowed: [{lo}, {hi}]")
+        return v
+
+    return parse
+
+
 def _demo(args) -> int:
     import matplotlib
 
@@ -31,6 +46,7 @@ def _demo(args) -> int:
         print(f"eps={eps:+g}: {args.orbits} orbits x {args.steps} steps, {esc} escaped the band; "
               f"rho_c predicted {m.rho_crit():.4f}")
     fig.suptitle("Truncated map F_eps: orbits from L1, coloured by region (fig:smallepsmany)")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=args.dpi)
     print(f"wrote {args.out} in {time.perf_counter() - t0:.2f} s")
     return 0
@@ -42,12 +58,15 @@ def _scene(args) -> int:
     matplotlib.use("Agg")
     from .scenes import format_summary, load_scene, run_scene
 
+    from ._common import output_path
+
     try:
         scene = load_scene(args.path)
+        out = output_path("--out", args.out) if args.out is not None else None
     except (OSError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    summary = run_scene(scene, out=args.out, quick=args.quick)
+    summary = run_scene(scene, out=out, quick=args.quick)
     print(format_summary(summary))
     return 0
 
@@ -69,10 +88,12 @@ def main(argv=None) -> int:
     sub = p.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="phase portraits of F_eps for +eps and -eps (fig:smallepsmany)")
     d.add_argument("--out", default="hovering_demo.png", help="output PNG (default %(default)s)")
-    d.add_argument("--eps", type=float, default=0.3, help="|eps| (default %(default)s)")
-    d.add_argument("--orbits", type=int, default=30, help="initial conditions on L1 (default %(default)s)")
-    d.add_argument("--steps", type=int, default=20000, help="iterates per orbit (default %(default)s)")
-    d.add_argument("--dpi", type=int, default=130, help="PNG resolution (default %(default)s)")
+    d.add_argument("--eps", type=_checked(float, 0.0, 10.0), default=0.3, help="|eps| in [0, 10] (default %(default)s)")
+    d.add_argument("--orbits", type=_checked(int, 1, 10_000), default=30,
+                   help="initial conditions on L1, 1..10000 (default %(default)s)")
+    d.add_argument("--steps", type=_checked(int, 1, 10_000_000), default=20000,
+                   help="iterates per orbit, 1..1e7 (default %(default)s)")
+    d.add_argument("--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)")
     sc = sub.add_parser("scene", help="make one figure of the paper from a scene file (examples/scenes/*.toml)")
     sc.add_argument("path", help="scene file (TOML)")
     sc.add_argument("--out", default=None, help="output PNG (default: the scene's 'output'); an NPZ is written next to it")
@@ -80,6 +101,12 @@ def main(argv=None) -> int:
                     help="divide the iterate counts by 50 (a fast check, not the paper's figure)")
     args = p.parse_args(argv)
     if args.cmd == "demo":
+        from ._common import output_path
+
+        try:  # before computing: a bad path must not cost the simulation
+            args.out = output_path("--out", args.out)
+        except ValueError as e:
+            p.exit(2, f"python -m hovering demo: error: {e}\n")
         return _demo(args)
     if args.cmd == "scene":
         return _scene(args)

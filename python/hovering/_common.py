@@ -17,7 +17,7 @@ from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
            "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
-           "check_memory", "thread_count", "MAX_ANGLE"]
+           "check_memory", "thread_count", "output_path", "MAX_ANGLE"]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -168,7 +168,7 @@ def require_angles(name: str, a) -> None:
     require_finite(name, a)
     a = np.asarray(a)
     if a.size and np.max(np.abs(a)) > MAX_ANGLE:
-        raise ValueError(f"{name} must be angles with |{name}| <= 1e6 (larger ones cannot be wrapped to [-pi, pi) "
+        raise ValueError(f"{name} must be angles in [-1e6, 1e6] (larger ones cannot be wrapped to [-pi, pi) "
                          f"accurately in double precision), got {a.flat[int(np.argmax(np.abs(a)))]}")
 
 
@@ -181,6 +181,53 @@ def check_memory(what: str, nbytes: int) -> None:
     if nbytes > total // 2:
         raise ValueError(f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
                          f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")
+
+
+def output_path(where: str, path) -> "os.PathLike":
+    """A figure path checked before any computation: its format is one matplotlib writes and its
+    directory exists (or can be created) and is writable.
+
+    Parameters
+    ----------
+    where : str
+        What the path is (``"--out"``, ``"scene.output"``) for the message.
+    path : path-like
+        The requested file. Without a suffix, ``.png`` is added (what ``savefig`` would write), so
+        the path reported afterwards is the file that exists.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        Naming the path and the allowed formats, or the directory that cannot be written.
+    """
+    from pathlib import Path
+
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise ValueError(f"{where} must be a file path, got {path!r}")
+    p = Path(path)
+    if p.suffix == "":
+        p = p.with_suffix(".png")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if p.suffix[1:].lower() not in formats:
+        raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "
+                         f"allowed suffixes: {', '.join('.' + f for f in sorted(formats))}")
+    if p.exists() and p.is_dir():
+        raise ValueError(f"{where} = {str(path)!r} is a directory, not a file")
+    parent = p.parent if str(p.parent) else Path(".")
+    anc = parent
+    while not anc.exists() and anc != anc.parent:
+        anc = anc.parent
+    if not anc.is_dir():
+        raise ValueError(f"{where} = {str(path)!r}: {anc} is not a directory")
+    if not os.access(anc, os.W_OK | os.X_OK):
+        raise ValueError(f"{where} = {str(path)!r}: the directory {anc} is not writable")
+    return p
 
 
 def _short(value) -> str:

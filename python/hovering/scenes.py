@@ -52,6 +52,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ._common import output_path
 from .truncated.theory import OMEGA_G, golden_family
 from .sweeps import Checkpoint
 from .truncated.maps import TruncatedMap
@@ -399,14 +400,21 @@ def _eval_expr(node):
     raise ValueError("unsupported expression")
 
 
+#: Longest expression string accepted: a parameter is a formula like "2 * pi * (sqrt(5) - 1) / 2",
+#: never a program; a 50,000-deep one exhausted the parser's memory.
+_MAX_EXPR = 200
+
+
 def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
     """A finite real number (or an expression string of numbers, pi, OMEGA_G) inside a range."""
     if isinstance(value, bool):
         raise ValueError(f"{where} must be a number, got {value!r}")
     if isinstance(value, str):
+        if len(value) > _MAX_EXPR:
+            raise ValueError(f"{where}: expression of {len(value)} characters; allowed: at most {_MAX_EXPR}")
         try:
             v = float(_eval_expr(ast.parse(value, mode="eval")))
-        except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError):
+        except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError, RecursionError, MemoryError):
             raise ValueError(
                 f"{where}: cannot evaluate {value!r}; allowed: a number or an expression of numbers, "
                 f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos") from None
@@ -446,6 +454,17 @@ def _str(where: str, value, choices=None) -> str:
     if choices is not None and value not in choices:
         raise ValueError(f"{where} = {value!r} is not allowed; allowed: {', '.join(repr(c) for c in choices)}")
     return value
+
+
+def _color(where: str, value) -> str:
+    """A colour matplotlib understands, checked when the scene is read (not at savefig time)."""
+    from matplotlib.colors import is_color_like
+
+    v = _str(where, value)
+    if not is_color_like(v):
+        raise ValueError(f"{where} = {value!r} is not a matplotlib colour; allowed: a name ('red'), 'C0'..'C9', "
+                         f"or hex '#rrggbb'")
+    return v
 
 
 def _pair(where: str, value, increasing=True) -> tuple:
@@ -581,7 +600,7 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None) -> Scene:
         name=name,
         kind=kind,
         title=_str(f"{where}.title", data["title"]) if "title" in data else name,
-        output=Path(_str(f"{where}.output", data["output"])),
+        output=output_path(f"{where}.output", _str(f"{where}.output", data["output"])),
         n_steps=_int(f"{where}.n_steps", data["n_steps"], 1, 10_000_000),
         dpi=_int(f"{where}.dpi", data["dpi"], 30, 1200) if "dpi" in data else 130,
         figsize=_size(f"{where}.figsize", data["figsize"]) if "figsize" in data else None,
@@ -687,7 +706,7 @@ def _parse_crit_panel(pw: str, pt: dict, scene_map: dict, n_steps: int) -> Panel
                 K0=_real(f"{ow}.K0", ot["K0"]),
                 phi0=_real(f"{ow}.phi0", ot["phi0"]) if "phi0" in ot else None,
                 line=_str(f"{ow}.line", ot["line"], ("L1", "L2")) if "line" in ot else None,
-                color=_str(f"{ow}.color", ot["color"]) if "color" in ot else None,
+                color=_color(f"{ow}.color", ot["color"]) if "color" in ot else None,
             )
             _check_band(f"{ow}.K0", m, [o.K0])
             orbits.append(o)
@@ -707,7 +726,7 @@ def _parse_crit_panel(pw: str, pt: dict, scene_map: dict, n_steps: int) -> Panel
                 n_steps=_int(f"{cw}.n_steps", ct["n_steps"], 4, 10_000_000) if "n_steps" in ct else n_steps,
                 K_range=kr,
                 line=_str(f"{cw}.line", ct["line"], ("L1", "L2")) if "line" in ct else "L1",
-                color=_str(f"{cw}.color", ct["color"]) if "color" in ct else "C4",
+                color=_color(f"{cw}.color", ct["color"]) if "color" in ct else "C4",
             )
     labels = list(special) + [o.label for o in orbits] + (["critical"] if critical else [])
     dup = {x for x in labels if labels.count(x) > 1}
@@ -803,7 +822,7 @@ def _parse_hovering_area(where: str, data: dict, scene_map: dict, common: dict) 
                 if k not in vals:
                     raise ValueError(f"{sw}: missing required key {k!r} (in [map] or the series), or 'golden_c'")
         s = SeriesSpec(label=_str(f"{sw}.label", st["label"]), golden_c=c,
-                       color=_str(f"{sw}.color", st["color"]) if "color" in st else None,
+                       color=_color(f"{sw}.color", st["color"]) if "color" in st else None,
                        K_low=_real(f"{sw}.K_low", st["K_low"], hi=0.0, hi_open=True) if "K_low" in st else None,
                        **{k: vals[k] for k in _MAP_KEYS})
         for e in eps:
@@ -997,7 +1016,7 @@ def run_scene(scene: Scene, out: Optional[os.PathLike] = None, quick: bool = Fal
     from . import figures
 
     t0 = time.perf_counter()
-    png = Path(out) if out is not None else scene.output
+    png = output_path("out", out) if out is not None else scene.output
     png.parent.mkdir(parents=True, exist_ok=True)
     npz = png.with_suffix(".npz")
     n_steps = _scaled(scene, quick)

@@ -27,19 +27,37 @@ class Checkpoint:
     ----------
     path : path-like
         The JSON-lines file (created on the first :meth:`put`). A last line cut short by an
-        interruption is ignored.
+        interruption (no final newline) is removed from the file, and any line that is not a
+        complete record is ignored: their points are recomputed.
+
+    Attributes
+    ----------
+    dropped : int
+        How many torn or damaged lines were found on opening.
     """
 
     def __init__(self, path: os.PathLike):
         self.path = Path(path)
         self._rows: dict = {}
+        self.dropped = 0
         if self.path.exists():
-            for line in self.path.read_text().splitlines():
+            data = self.path.read_bytes()
+            if data and not data.endswith(b"\n"):
+                # Killed mid-write: the last line is incomplete. Cut it off, or the next put()
+                # would be glued onto it and both points lost.
+                keep = data.rfind(b"\n") + 1
+                with open(self.path, "r+b") as f:
+                    f.truncate(keep)
+                    f.flush()
+                    os.fsync(f.fileno())
+                data = data[:keep]
+                self.dropped += 1
+            for line in data.decode("utf-8", errors="replace").splitlines():
                 try:
                     rec = json.loads(line)
                     self._rows[_canonical(rec["key"])] = rec["row"]
                 except (ValueError, KeyError, TypeError):
-                    continue  # a line torn by an interruption: recomputed
+                    self.dropped += 1  # a damaged line: its point is recomputed
 
     def __len__(self) -> int:
         return len(self._rows)

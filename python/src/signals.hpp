@@ -13,6 +13,7 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "pybind.hpp"
@@ -71,16 +72,24 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch) {
             std::mutex mu;
             std::condition_variable cv;
             bool done = false;
-            std::thread runner([&] {
-                try {
-                    work();
-                } catch (...) {
-                    err = std::current_exception();
-                }
-                std::lock_guard<std::mutex> lock(mu);
-                done = true;
-                cv.notify_one();
-            });
+            std::thread runner;
+            try {
+                runner = std::thread([&] {
+                    try {
+                        work();
+                    } catch (...) {
+                        err = std::current_exception();
+                    }
+                    std::lock_guard<std::mutex> lock(mu);
+                    done = true;
+                    cv.notify_one();
+                });
+            } catch (const std::system_error&) {
+                // No thread to spare (ulimit -u, a container's pids limit): compute here; only
+                // Ctrl-C's promptness is lost, not the result.
+                work();
+                return false;
+            }
             std::unique_lock<std::mutex> lock(mu);
             while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
                 lock.unlock();

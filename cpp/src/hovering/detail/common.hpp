@@ -5,6 +5,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
+#include <charconv>
 #include <cmath>
 #include <functional>
 
@@ -22,12 +23,12 @@ inline constexpr double kTwoPi = 2.0 * kPi;
 inline constexpr double kInvTwoPi = 1.0 / kTwoPi;
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// A double with all 17 significant digits, for error messages that name the offending value.
+/// A double in its shortest round-trip form (1e+200, not 9.9999999999999997e+199), for error
+/// messages that name the offending value exactly as the user typed it.
 inline std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
 }
 
 /// Throw the bad-input exception (pybind11 turns it into ValueError).

@@ -62,7 +62,7 @@ inline std::int64_t balanced_block(std::int64_t n, int threads, std::int64_t cap
 
 /// Run body(cursor) on `threads` workers, the calling thread being one of them. The first
 /// exception a worker throws stops the queue (the others drain no more work) and is rethrown once
-/// all have returned; a thread the system refuses to start is reported the same way, with a hint.
+/// all have returned. Threads the system refuses to start are done without: the others share their work.
 template <class Body>
 void run_workers(int threads, WorkQueue& q, Body&& body) {
     std::exception_ptr error;
@@ -81,11 +81,10 @@ void run_workers(int threads, WorkQueue& q, Body&& body) {
     pool.reserve(std::size_t(std::max(0, threads - 1)));
     try {
         for (int k = 1; k < threads; ++k) pool.emplace_back(work);
-    } catch (const std::system_error& e) {
-        q.stop();
-        for (auto& t : pool) t.join();
-        throw std::runtime_error("could not start worker thread " + std::to_string(pool.size() + 2) + " of " +
-                                 std::to_string(threads) + " (" + e.what() + "): ask for fewer threads (n_threads)");
+    } catch (const std::system_error&) {
+        // The system refused more threads (ulimit -u, a container's pids limit): the workers share
+        // one queue and each orbit's result does not depend on who computes it, so the ones that
+        // started (and this thread) finish the job, only slower.
     }
     work();
     for (auto& t : pool) t.join();

@@ -1,0 +1,160 @@
+"""Every bad input the reliability audit found (issue 11) is a ValueError naming the parameter, its
+value and what is allowed, raised before any long computation; helpers that used to return
+silent garbage now refuse or answer NaN where the quantity does not exist.
+
+Each case is one line: the call and a regular expression the message must match. The regexes name
+the parameter *and* the range, so a message that loses either fails here."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+import hovering as hv
+from hovering.sweeps import Checkpoint
+
+M = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
+FAM = hv.TruncatedFamily.from_map(M, np.concatenate([-np.linspace(1.0, 0.0, 41) ** 2, np.linspace(0.02, 1.0, 10)]))
+SYS = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5)
+SEC = hv.Section(SYS, 1.0)
+NAN = float("nan")
+
+BAD = {
+    # hangs and silent skips
+    "critical tol=0": (lambda: M.critical_curve(tol=0), r"tol must be finite and >= 1e-14 .* got 0"),
+    "critical tol=1e-18": (lambda: M.critical_curve(tol=1e-18), r"tol must be finite and >= 1e-14"),
+    "critical tol=-1": (lambda: M.critical_curve(tol=-1), r"tol must be finite and >= 1e-14 .* got -1"),
+    "critical tol=nan": (lambda: M.critical_curve(tol=NAN), r"tol must be finite .* got nan"),
+    # unclear errors
+    "critical grid=0": (lambda: M.critical_curve(grid=0), r"grid must be an integer >= 2, got 0"),
+    "critical n_steps=0": (lambda: M.critical_curve(n_steps=0), r"n_steps must be an integer >= 16, got 0"),
+    "critical digits=nan": (lambda: M.critical_curve(digits=NAN), r"digits must be a number in \(0, 16\], got nan"),
+    "critical K_range 3": (lambda: M.critical_curve(K_range=(-0.3, -0.2, 0.1)), r"K_range must be a pair \(K_lo, K_hi\)"),
+    "area samples=nan": (lambda: M.hovering_area(samples=NAN), r"samples must be an integer >= 1, got nan"),
+    "area samples=inf": (lambda: M.hovering_area(samples=math.inf), r"samples must be an integer >= 1, got inf"),
+    "area samples=2.5": (lambda: M.hovering_area(samples=2.5), r"samples must be an integer >= 1, got 2.5"),
+    "area seed=-1": (lambda: M.hovering_area(seed=-1), r"seed must be an integer in \[0, \d+\], got -1"),
+    "area n_steps='100'": (lambda: M.hovering_area(n_steps="100"), r"n_steps must be an integer >= 4, got '100'"),
+    "return_map stepper=None": (lambda: SEC.return_map([0.1], [0.3], stepper=None), r"stepper must be one of \('rk8pd'"),
+    "return_map max_steps=2**70": (lambda: SEC.return_map([0.1], [0.3], max_steps=2**70),
+                                   r"max_steps must be an integer in \[1, 4611686018427387904\], got 1180591620717411303424"),
+    "return_map max_steps=1.5": (lambda: SEC.return_map([0.1], [0.3], max_steps=1.5), r"max_steps must be an integer in \[1, "),
+    "return_map n_threads=2**40": (lambda: SEC.return_map([0.1], [0.3], n_threads=2**40),
+                                   r"n_threads must be an integer in \[0, 4096\] \(0 = all cores\), got 1099511627776"),
+    "return_map n_threads=1.7": (lambda: SEC.return_map([0.1], [0.3], n_threads=1.7), r"n_threads must be an integer in \[0, 4096\]"),
+    "return_map n_threads='2'": (lambda: SEC.return_map([0.1], [0.3], n_threads="2"), r"n_threads must be an integer in \[0, 4096\]"),
+    "iterate n_threads=1.7": (lambda: M.iterate([0.1], [0.1], 3, n_threads=1.7), r"n_threads must be an integer in \[0, 4096\]"),
+    "iterate n_threads='2'": (lambda: M.iterate([0.1], [0.1], 3, n_threads="2"), r"n_threads must be an integer in \[0, 4096\]"),
+    "tangential empty theta": (lambda: hv.tangential_curve(SEC, []), r"theta must hold at least one angle"),
+    "tangential bracket=1": (lambda: hv.tangential_curve(SEC, [0.1], bracket=1.0), r"bracket must lie in \(0, 1\), got 1.0"),
+    "tangential iterations=-1": (lambda: hv.tangential_curve(SEC, [0.1], iterations=-1),
+                                 r"iterations must be an integer in \[1, 200\], got -1"),
+    "StepSystem eps='a'": (lambda: hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), eps="a"),
+                           r"eps must be a real number, got 'a'"),
+    "Section h=None": (lambda: hv.Section(SYS, None), r"h must be a real number, got None"),
+    "Polynomial {1: 1}": (lambda: hv.Polynomial({1: 1.0}), r"each key must be a pair of exponents \(i, j\)"),
+    "family reversed grid": (lambda: hv.TruncatedFamily(0.1, [1.0, 0.5, 0.0, -0.5, -1.0], [2.0] * 5, [1.0] * 5, [0.0] * 5),
+                             r"K (grid )?must|strictly increasing|extend above"),
+    "onset_parameters('x', 1)": (lambda: hv.onset_parameters("x", 1), r"sys must be a hovering.StepSystem, got 'x'"),
+    "coordinates(nan)": (lambda: SEC.coordinates(NAN), r"z must be states \(q1, p1, q2, p2\) of shape \(n, 4\)"),
+    # silent garbage
+    "reversal(nan)": (lambda: M.reversal(NAN, 0.1), r"phi must be finite, got nan"),
+    "reversal(1e300)": (lambda: M.reversal(1e300, 0.1), r"phi must be angles in \[-1e6, 1e6\] .*got 1e\+300"),
+    "L1(nan)": (lambda: M.L1(NAN), r"K must be finite, got nan"),
+    "wrap(1e300)": (lambda: hv.wrap(1e300), r"angles to wrap must satisfy \|x\| <= 1e6.*got 1e\+300"),
+    "wrap(inf)": (lambda: hv.wrap(math.inf), r"angles to wrap must satisfy \|x\| <= 1e6"),
+    "K_crit theta_w=4": (lambda: hv.K_crit(0.1, 4.0, 1.0), r"theta_w must lie in \(0, pi\), got 4.0"),
+    "to_normal I=nan": (lambda: hv.to_normal(SEC, [0.1], [NAN]), r"I must be finite, got nan"),
+    "from_normal K=-100": (lambda: hv.from_normal(SEC, [0.1], [-100.0]), r"K = -100.0 gives the action I = -99.7\d* <= 0"),
+    "Harmonic angle off the level": (lambda: hv.Harmonic(1.0).angle_of_point(5.0, 0.0, 1.0),
+                                     r"\(q, p\) = \(5, 0\) has energy p\^2/2 \+ V\(q\) = 12.5, not on the level h = 1"),
+    "Tan angle off the level": (lambda: hv.Tan(1.4, 0.7).angle_of_point(0.1, 3.0, 1.0), r"not on the level h = 1"),
+    "Numerical angle p=nan": (lambda: hv.Numerical(hv.Harmonic(1.0)).angle_of_point(0.5, NAN, 1.0),
+                              r"q and p must be finite, got q = 0.5, p = nan"),
+    "Tan(1e-300, 1e300)": (lambda: hv.Tan(1e-300, 1e300), r"omega must lie in \[1e-100, 1e100\], got 1e-300"),
+    "Harmonic(1e200)": (lambda: hv.Harmonic(1e200), r"omega must lie in \[1e-100, 1e100\], got 1e\+200"),
+    # small things
+    "TruncatedMap eps=True": (lambda: hv.TruncatedMap(eps=True, Omega0=1.0, theta_w=2.0), r"eps must be a real number, got True"),
+    "iterate complex phi": (lambda: M.iterate(np.array([0.1 + 1j]), [0.1], 3), r"phi must be real numbers, got dtype complex128"),
+    "iterate record=None": (lambda: M.iterate([0.1], [0.1], 3, record=None), r"record must be a sequence of keys from \["),
+    "iterate n_steps=2**63-1 orbit": (lambda: M.iterate([0.1], [0.1], 2**63 - 1, record=("orbit",)), r"n_steps must be <= 2\*\*53"),
+    "iterate orbit beyond memory": (lambda: M.iterate(np.zeros(100_000), np.zeros(100_000), 10**7, record=("orbit",)),
+                                    r"recording \('orbit',\) for 100000 orbits x 10000000 steps needs [\d.e+]+ GiB, more than half"),
+}
+
+
+@pytest.mark.parametrize("name", list(BAD))
+def test_bad_input_is_a_named_value_error(name):
+    call, pattern = BAD[name]
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=pattern):
+        call()
+    # Refused before any long computation: the slowest valid call above (a critical curve) takes
+    # seconds; a refusal takes microseconds. 0.5 s leaves room for a loaded CI machine.
+    assert time.perf_counter() - t0 < 0.5, name
+
+
+def test_family_accepted_wherever_a_map_is():
+    # hovering_area and critical_curve took only TruncatedMap (AttributeError 'Omega0' on a family).
+    a = hv.hovering_area(FAM, samples=400, n_steps=200, seed=1)
+    assert 0 <= a.area <= 2 * math.pi * abs(a.box[2] - a.box[3]) and a.error >= 0
+
+
+def test_exit_regions_label_is_one_region_not_its_characters():
+    # "0u" used to be parsed per character ('0' and 'u'); it is J_0u.
+    assert hv.region_mask("0u") == 1 << int(hv.Region.BESIDE)
+    assert hv.region_mask(["0u", "0"]) == (1 << int(hv.Region.BESIDE)) | (1 << int(hv.Region.ABOVE))
+
+
+def test_theory_at_resonance_is_nan_not_a_huge_number():
+    # At Omega0 = 2 pi, sin(Omega0 / 2) = 0 (to rounding: 1.2e-16): K_crit and rho_crit do not
+    # exist (eq:Kcrit divides by it), and the formulas gave ~1e15.
+    assert math.isnan(hv.K_crit(0.1, 2.0, 2 * math.pi))
+    assert math.isnan(hv.rho_crit(0.1, 2.0, 2 * math.pi, 1.0))
+    assert math.isnan(hv.hovering_area_theory(0.1, 2.0, 2 * math.pi))
+
+
+def test_tan_is_infinite_beyond_its_wall():
+    # tan is periodic: V(3.0) used to be the value in the next copy of the well (5.85).
+    T = hv.Tan(1.4, 0.7)
+    assert T.V(3.0) == math.inf and T.V(-3.0) == math.inf
+    assert T.dV(3.0) == math.inf and T.dV(-3.0) == -math.inf
+    assert math.isfinite(T.V(0.99 * T.q_limit))
+
+
+def test_onset_repr_keeps_small_values():
+    # std::to_string printed tau1 = 1.7e-7 as 0.000000.
+    r = repr(hv.onset_parameters(SYS, 1.0))
+    vals = dict(kv.split("=") for kv in r[r.index("(") + 1:-1].split(", "))
+    d = hv.onset_parameters(SYS, 1.0)
+    for k, v in vals.items():
+        assert float(v) == pytest.approx(getattr(d, k), rel=1e-9), k
+
+
+def test_generic_action_angle_exact_at_tiny_energies():
+    # Turning points are bracketed geometrically from q = 1 down; before, Brent stopped 4 decades
+    # above the root for h < 1e-63 and the quadrature failed. Tolerance 1e-13: QAWS's own.
+    N = hv.Numerical(hv.Harmonic(1.0))
+    for h in (1e-70, 1e-200, 1e-300):
+        assert N.turning_points(h)[1] == pytest.approx(math.sqrt(2 * h), rel=1e-14)
+        assert N.period(h) == pytest.approx(2 * math.pi, rel=1e-13)
+
+
+def test_checkpoint_cuts_a_torn_last_line_and_appends_cleanly(tmp_path):
+    # A killed process leaves a line without its newline; the next put() was glued onto it and
+    # both points were lost on the next read.
+    path = tmp_path / "c.jsonl"
+    c = Checkpoint(path)
+    c.put({"eps": 0.1}, {"area": 1.0})
+    with open(path, "a") as f:
+        f.write('{"key": {"eps": 0.2}, "row": {"area": 2.')
+    again = Checkpoint(path)
+    assert again.dropped == 1 and len(again) == 1
+    again.put({"eps": 0.2}, {"area": 2.0})
+    third = Checkpoint(path)
+    assert third.dropped == 0 and len(third) == 2
+    assert third.get({"eps": 0.2}) == {"area": 2.0}
+    assert path.read_text().count("\n") == 2
