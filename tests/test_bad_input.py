@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -29,8 +30,9 @@ BAD = {
     "critical tol=-1": (lambda: M.critical_curve(tol=-1), r"tol must be finite and >= 1e-14 .* got -1"),
     "critical tol=nan": (lambda: M.critical_curve(tol=NAN), r"tol must be finite .* got nan"),
     # unclear errors
-    "critical grid=0": (lambda: M.critical_curve(grid=0), r"grid must be an integer >= 2, got 0"),
-    "critical n_steps=0": (lambda: M.critical_curve(n_steps=0), r"n_steps must be an integer >= 16, got 0"),
+    "critical grid=0": (lambda: M.critical_curve(grid=0), r"grid must be an integer in \[2, 1000000\], got 0"),
+    "critical grid=2**63": (lambda: M.critical_curve(grid=2**63), r"grid must be an integer in \[2, 1000000\]"),
+    "critical n_steps=0": (lambda: M.critical_curve(n_steps=0), r"n_steps must be an integer in \[16, \d+\], got 0"),
     "critical digits=nan": (lambda: M.critical_curve(digits=NAN), r"digits must be a number in \(0, 16\], got nan"),
     "critical K_range 3": (lambda: M.critical_curve(K_range=(-0.3, -0.2, 0.1)), r"K_range must be a pair \(K_lo, K_hi\)"),
     "area samples=nan": (lambda: M.hovering_area(samples=NAN), r"samples must be an integer >= 1, got nan"),
@@ -48,7 +50,6 @@ BAD = {
     "return_map n_threads='2'": (lambda: SEC.return_map([0.1], [0.3], n_threads="2"), r"n_threads must be an integer in \[0, 4096\]"),
     "iterate n_threads=1.7": (lambda: M.iterate([0.1], [0.1], 3, n_threads=1.7), r"n_threads must be an integer in \[0, 4096\]"),
     "iterate n_threads='2'": (lambda: M.iterate([0.1], [0.1], 3, n_threads="2"), r"n_threads must be an integer in \[0, 4096\]"),
-    "tangential empty theta": (lambda: hv.tangential_curve(SEC, []), r"theta must hold at least one angle"),
     "tangential bracket=1": (lambda: hv.tangential_curve(SEC, [0.1], bracket=1.0), r"bracket must lie in \(0, 1\), got 1.0"),
     "tangential iterations=-1": (lambda: hv.tangential_curve(SEC, [0.1], iterations=-1),
                                  r"iterations must be an integer in \[1, 200\], got -1"),
@@ -62,12 +63,12 @@ BAD = {
     "coordinates(nan)": (lambda: SEC.coordinates(NAN), r"z must be states \(q1, p1, q2, p2\) of shape \(n, 4\)"),
     # silent garbage
     "reversal(nan)": (lambda: M.reversal(NAN, 0.1), r"phi must be finite, got nan"),
-    "reversal(1e300)": (lambda: M.reversal(1e300, 0.1), r"phi must be angles in \[-1e6, 1e6\] .*got 1e\+300"),
+    "reversal(1e300)": (lambda: M.reversal(1e300, 0.1), r"phi must be an angle in \[-1e6, 1e6\] .*got 1e\+300"),
     "L1(nan)": (lambda: M.L1(NAN), r"K must be finite, got nan"),
     "wrap(1e300)": (lambda: hv.wrap(1e300), r"angles to wrap must satisfy \|x\| <= 1e6.*got 1e\+300"),
     "wrap(inf)": (lambda: hv.wrap(math.inf), r"angles to wrap must satisfy \|x\| <= 1e6"),
     "K_crit theta_w=4": (lambda: hv.K_crit(0.1, 4.0, 1.0), r"theta_w must lie in \(0, pi\), got 4.0"),
-    "to_normal I=nan": (lambda: hv.to_normal(SEC, [0.1], [NAN]), r"I must be finite, got nan"),
+    "to_normal I=nan": (lambda: hv.to_normal(SEC, [0.1], [NAN]), r"I\[0\] must be finite, got nan"),
     "from_normal K=-100": (lambda: hv.from_normal(SEC, [0.1], [-100.0]), r"K = -100.0 gives the action I = -99.7\d* <= 0"),
     "Harmonic angle off the level": (lambda: hv.Harmonic(1.0).angle_of_point(5.0, 0.0, 1.0),
                                      r"\(q, p\) = \(5, 0\) has energy p\^2/2 \+ V\(q\) = 12.5, not on the level h = 1"),
@@ -158,3 +159,47 @@ def test_checkpoint_cuts_a_torn_last_line_and_appends_cleanly(tmp_path):
     assert third.dropped == 0 and len(third) == 2
     assert third.get({"eps": 0.2}) == {"area": 2.0}
     assert path.read_text().count("\n") == 2
+
+
+@pytest.mark.parametrize("argv,text", [
+    (["--eps", "nan"], "argument --eps: nan is out of range; allowed: [0.0, 10.0]"),
+    (["--orbits", "-3"], "argument --orbits: -3 is out of range; allowed: [1, 10000]"),
+    (["--steps", "-1"], "argument --steps: -1 is out of range; allowed: [1, 10000000]"),
+    (["--dpi", "0"], "argument --dpi: 0 is out of range; allowed: [30, 1200]"),
+    (["--orbits", "2.5"], "argument --orbits: '2.5' is not an integer"),
+    (["--out", "fig.xyz"], "--out = 'fig.xyz': matplotlib cannot write '.xyz' files"),
+])
+def test_demo_cli_refuses_bad_options_before_computing(argv, text, capsys):
+    from hovering.__main__ import main
+
+    t0 = time.perf_counter()
+    with pytest.raises(SystemExit) as e:
+        main(["demo", *argv])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert text in err and "Traceback" not in err
+    assert time.perf_counter() - t0 < 2.0  # the demo itself takes seconds
+
+
+def test_scene_cli_refuses_a_bad_out_path(tmp_path, capsys):
+    from hovering.__main__ import main
+
+    scene = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_smalleps.toml"
+    assert main(["scene", str(scene), "--out", str(tmp_path / "x.nope")]) == 2
+    assert "matplotlib cannot write '.nope' files" in capsys.readouterr().err
+
+
+def test_output_path_names_the_file_savefig_writes(tmp_path):
+    # savefig("out/x") writes out/x.png: the summary used to name "out/x".
+    from hovering._common import output_path
+
+    assert output_path("out", tmp_path / "sub" / "x") == tmp_path / "sub" / "x.png"
+    assert output_path("out", tmp_path / "x.pdf") == tmp_path / "x.pdf"
+    with pytest.raises(ValueError, match="is a directory"):
+        output_path("out", _dir_png(tmp_path))
+
+
+def _dir_png(tmp_path):
+    d = tmp_path / "d.png"
+    d.mkdir()
+    return d

@@ -273,7 +273,7 @@ I0 = 29  # index of K = 0 in _table()'s grid
 
 BAD_TABLES = [
     (_with(K=lambda t: np.concatenate([t["K"][:3], t["K"][2:3], t["K"][4:]])), r"grid must be strictly increasing"),
-    (_with(K=lambda t: np.concatenate([t["K"][:2], t["K"][3:4], t["K"][2:3], t["K"][4:]])), r"grid must be strictly increasing, but grid\[3\]"),
+    (_with(K=lambda t: np.concatenate([t["K"][:2], t["K"][3:4], t["K"][2:3], t["K"][4:]])), r"grid must be strictly increasing, but K\[3\]"),
     (_with(J1=_set("J1", I0, 0.1)), r"J1 must vanish at K = 0"),
     (_with(Omega=_set("Omega", 5, np.nan)), r"Omega\[5\] must be finite"),
     (_with(JR=_set("JR", 3, np.inf)), r"JR\[3\] must be finite"),

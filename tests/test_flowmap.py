@@ -188,7 +188,7 @@ def test_records_are_only_what_is_asked(fm005):
     assert np.abs(H - 1.0).max() < 1e-14  # every point is put on Sigma_h at energy h exactly
     assert res.theta.shape == (1, 5) and abs(res.theta[0, 0] - 0.1) < 1e-15
     assert abs(res.I[0, 0] - fm005.curve.from_normal(0.1, 0.01)[1]) < 1e-15
-    with pytest.raises(ValueError, match="unknown record key"):
+    with pytest.raises(ValueError, match="record: unknown key"):
         fm005.iterate([0.1], [0.01], 4, record=("everything",))
 
 

@@ -25,7 +25,7 @@ def test_readme_examples_run_and_agree_with_the_text():
     m, res = ns["m"], ns["res"]
     # Claims made in the README's comments:
     lo, hi = m.valid_band()
-    assert abs(lo + np.pi) < 1e-12 and np.isinf(hi)  # "(-3.14159..., inf)"
+    assert abs(lo + np.pi) < 1e-12 and hi == 1e6 - m.Omega0  # "(-3.14159..., 999996.1)", tau0 = 1
     assert m.region(0.3, -0.2) is hovering.Region.ABOVE
     assert abs(m.rho_crit() - 3.7694) < 1e-4  # "eq:rhocrit = 3.7694..."
     # The early-exit example: statuses are OK or EXITED, exit_step is -1 exactly for OK orbits.

@@ -165,6 +165,12 @@ BAD = [
     ("fig_hov_vs_eps", ("eps",), [0.1, "x"], ["eps[1]", "'x'"]),
     ("fig_hov_vs_eps", ("series", 3, "K_low"), -10.0, ["K_low", "band floor"]),
     ("fig_hov_vs_eps", ("samples",), 0, ["samples", "out of range"]),
+    # Checked at load, not at savefig after the simulation (issue 11):
+    ("fig_hov_vs_eps", ("series", 0, "color"), "C99x", ["series[0].color", "'C99x'", "not a matplotlib colour"]),
+    ("fig_epsbig", ("panels", 1, "orbits", 0, "color"), "bluish", ["orbits[0].color", "'bluish'"]),
+    ("fig_smalleps", ("output",), "out/fig.xyz", ["output", "'.xyz'", ".png", ".pdf"]),
+    ("fig_smalleps", ("output",), str(SCENE_DIR / "fig_smalleps.toml" / "x.png"), ["output", "is not a directory"]),
+    ("fig_smalleps", ("panels", 0, "eps"), "(" * 30000 + "1" + ")" * 30000, ["eps", "60001 characters", "at most 200"]),
 ]
 
 

@@ -43,8 +43,15 @@ TEST_CASE("F_eps: band, bad input, exact inverse, reversibility, eps = 0 interva
         TruncatedMap m = make_truncated_map(0.1, 1.0, p.tw, 1.0, p.tau1, p.lam);
         double scan = band_by_scan(p.tw, p.tau1, p.lam);
         CHECKF(std::fabs(m.band().lo - scan) <= 1.01e-5, "tw=%g tau1=%g lam=%g: band lo %.12g vs scan %.12g", p.tw, p.tau1, p.lam, m.band().lo, scan);
-        CHECKF(std::isinf(m.band().hi), "hi should be +inf");
+        // The top is where the rotation Omega0 + tau0 K reaches 1e6 rad (wrapping stays accurate).
+        CHECKF(m.band().hi == 1e6 - 1.0, "hi = (1e6 - Omega0) / tau0, got %.17g", m.band().hi);
     }
+    CHECKF(std::isinf(make_truncated_map(0.1, 1.0, 2.0, 0.0, 0.5, 0.5).band().hi), "tau0 = 0: no top");
+    CHECKF(make_truncated_map(0.1, 1.0, 2.0, -2.0, 0.5, 0.5).band().hi == (1e6 + 1.0) / 2.0, "tau0 < 0");
+    CHECK_INVALID(make_truncated_map(0.1, -2.4e39, 2.0, 1.0, 0.5, 0.5), "Omega0 must lie in [-1e6, 1e6]");
+    // ... and below 0 too: with tau0 = 4e20 the band is |K| < 2.3e-15 (phi stayed 0 before).
+    const auto tb = make_truncated_map(0.1, 1.0, 2.0, 4e20, 0.5, 0.5).band();
+    CHECKF(tb.lo == -(1e6 + 1.0) / 4e20 && tb.hi == (1e6 - 1.0) / 4e20, "band [%g, %g] for tau0 = 4e20", tb.lo, tb.hi);
     // eq:kmindef would give -min((pi/lam)^2, 2(pi - tw)/tau1) = -11.9 here; |J_0| closes first (typo 3).
     CHECKF(make_truncated_map(0.1, 1.0, 0.1, 1.0, 0.5, 0.5).band().lo > -0.06, "typo-3 case");
 

@@ -17,7 +17,7 @@ from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
            "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
-           "check_memory", "thread_count", "output_path", "MAX_ANGLE"]
+           "check_memory", "thread_count", "is_choice", "output_path", "MAX_ANGLE"]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -132,6 +132,11 @@ def integer(name: str, value, lo: int, hi: int) -> int:
     return v
 
 
+def is_choice(value, choices) -> bool:
+    """Whether value is one of the string choices (False, not an error, for arrays and other types)."""
+    return isinstance(value, str) and value in choices
+
+
 def thread_count(value) -> int:
     """The ``n_threads`` argument every parallel call takes: an integer in [0, 4096], 0 = all cores."""
     try:
@@ -160,7 +165,7 @@ def require_finite(name: str, a) -> None:
     bad = ~np.isfinite(a)
     if bad.any():
         i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
-        raise ValueError(f"{name} must be finite, got {a[i]}" + (f" at index {i[0] if len(i) == 1 else i}" if a.ndim else ""))
+        raise ValueError(f"{_entry(name, i)} must be finite, got {a[i]}")
 
 
 def require_angles(name: str, a) -> None:
@@ -168,8 +173,9 @@ def require_angles(name: str, a) -> None:
     require_finite(name, a)
     a = np.asarray(a)
     if a.size and np.max(np.abs(a)) > MAX_ANGLE:
-        raise ValueError(f"{name} must be angles in [-1e6, 1e6] (larger ones cannot be wrapped to [-pi, pi) "
-                         f"accurately in double precision), got {a.flat[int(np.argmax(np.abs(a)))]}")
+        i = np.unravel_index(int(np.argmax(np.abs(a.ravel()) > MAX_ANGLE)), a.shape)
+        raise ValueError(f"{_entry(name, i)} must be an angle in [-1e6, 1e6] (larger ones cannot be wrapped to "
+                         f"[-pi, pi) accurately in double precision), got {a[i]}")
 
 
 def check_memory(what: str, nbytes: int) -> None:
@@ -230,6 +236,11 @@ def output_path(where: str, path) -> "os.PathLike":
     return p
 
 
+def _entry(name: str, index: tuple) -> str:
+    """``name[i]`` (or ``name[i, j]``, or ``name`` for a scalar): the entry a message is about."""
+    return f"{name}[{', '.join(str(int(k)) for k in index)}]" if index else name
+
+
 def _short(value) -> str:
     r = repr(value)
     return r if len(r) <= 60 else r[:57] + "..."
@@ -280,9 +291,9 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
         record = tuple(record)
     except TypeError:
         raise ValueError(f"record must be a sequence of keys from {list(allowed)} (or () for none), got {record!r}") from None
-    unknown = [r for r in record if r not in allowed]
+    unknown = [r for r in record if not is_choice(r, allowed)]
     if unknown:
-        raise ValueError(f"unknown record key(s) {unknown}; allowed: {list(allowed)}")
+        raise ValueError(f"record: unknown key(s) {unknown}; allowed: {list(allowed)}")
     try:
         n_steps = operator.index(n_steps)
     except TypeError:
@@ -293,7 +304,10 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
         raise ValueError(f"n_steps must be <= 2**53, got {n_steps}")
     if isinstance(stop_on_exit, (bool, np.bool_)) is False:
         raise ValueError(f"stop_on_exit must be True or False, got {stop_on_exit!r}")
-    mask = region_mask(exit_regions) if exit_regions is not None else 0
+    try:
+        mask = region_mask(exit_regions) if exit_regions is not None else 0
+    except ValueError as e:
+        raise ValueError(f"exit_regions: {e}") from None
     if exit_regions is not None and mask == 0:
         raise ValueError("exit_regions must name at least one region")
     if stop_on_exit and mask == 0:

@@ -223,30 +223,50 @@ void register_potential(py::module_& m) {
         m, "Potential",
         "A single-well potential V(q), V(0) = 0, q V'(q) > 0. Subclass it in Python by defining V(self, q) and "
         "dV(self, q) (and optionally name, q_limit); every energy question is then answered by quadrature.");
+    // Every argument goes through real_arg: a wrong type is a ValueError naming the method and the
+    // parameter, not pybind11's list of overloads.
+    auto one = [](auto f, const char* who, const char* a) {
+        return [f, who, a](const Potential& self, py::handle x) { return (self.*f)(real_arg(x, who, a)); };
+    };
+    auto two = [](auto f, const char* who, const char* a, const char* b) {
+        return [f, who, a, b](const Potential& self, py::handle x, py::handle y) {
+            return (self.*f)(real_arg(x, who, a), real_arg(y, who, b));
+        };
+    };
     pot.def(py::init<>())
-        .def("V", &Potential::V, py::arg("q"), "V(q).")
-        .def("dV", &Potential::dV, py::arg("q"), "V'(q).")
-        .def("turning_points", &Potential::turning_points, py::arg("h"), "Turning points (q_min, q_max) of the level V = h.")
-        .def("period", &Potential::period, py::arg("h"), "Period T(h).")
-        .def("frequency", &Potential::frequency, py::arg("h"), "omega(h) = 2 pi / T(h) = dH/dI.")
-        .def("action", &Potential::action, py::arg("h"), "Action I(h).")
-        .def("energy", &Potential::energy, py::arg("I"), "Energy H(I), inverse of action().")
-        .def("angle_of", &Potential::angle_of, py::arg("q"), py::arg("h"),
+        .def("V", one(&Potential::V, "V", "q"), py::arg("q"), "V(q).")
+        .def("dV", one(&Potential::dV, "dV", "q"), py::arg("q"), "V'(q).")
+        .def("turning_points", one(&Potential::turning_points, "turning_points", "h"), py::arg("h"),
+             "Turning points (q_min, q_max) of the level V = h.")
+        .def("period", one(&Potential::period, "period", "h"), py::arg("h"), "Period T(h).")
+        .def("frequency", one(&Potential::frequency, "frequency", "h"), py::arg("h"), "omega(h) = 2 pi / T(h) = dH/dI.")
+        .def("action", one(&Potential::action, "action", "h"), py::arg("h"), "Action I(h).")
+        .def("energy", one(&Potential::energy, "energy", "I"), py::arg("I"), "Energy H(I), inverse of action().")
+        .def("angle_of", two(&Potential::angle_of, "angle_of", "q", "h"), py::arg("q"), py::arg("h"),
              "Angle of (q, p < 0) on the level h: omega(h) x time from q to q_max (paper's convention).")
-        .def("point_at", &Potential::point_at, py::arg("theta"), py::arg("h"),
+        .def("point_at", two(&Potential::point_at, "point_at", "theta", "h"), py::arg("theta"), py::arg("h"),
              "(q, p) at angle theta in [-pi, pi] on the level h (sign(p) = -sign(theta)).")
-        .def("angle_of_point", &Potential::angle_of_point, py::arg("q"), py::arg("p"), py::arg("h"),
+        .def("angle_of_point",
+             [](const Potential& self, py::handle q, py::handle p, py::handle h) {
+                 return self.angle_of_point(real_arg(q, "angle_of_point", "q"), real_arg(p, "angle_of_point", "p"),
+                                            real_arg(h, "angle_of_point", "h"));
+             },
+             py::arg("q"), py::arg("p"), py::arg("h"),
              "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q) (ValueError if "
              "p^2/2 + V(q) differs from h by more than 1e-8 h).")
         .def_property_readonly("name", &Potential::name)
         .def_property_readonly("q_limit", &Potential::q_limit, "Largest |q| inside the well (inf if unbounded).")
         .def("__repr__", &Potential::name);
     py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>>(m, "Harmonic", "V = omega^2 q^2 / 2 (closed-form action-angle).")
-        .def(py::init<double>(), py::arg("omega"))
+        .def(py::init([](py::handle omega) { return std::make_shared<Harmonic>(real_arg(omega, "Harmonic", "omega")); }),
+             py::arg("omega"))
         .def_property_readonly("omega", &Harmonic::omega);
     py::class_<Tan, Potential, std::shared_ptr<Tan>>(m, "Tan",
                                                     "V = omega^2 / (2 alpha^2) tan^2(alpha q) (closed-form action-angle).")
-        .def(py::init<double, double>(), py::arg("omega"), py::arg("alpha"))
+        .def(py::init([](py::handle omega, py::handle alpha) {
+                 return std::make_shared<Tan>(real_arg(omega, "Tan", "omega"), real_arg(alpha, "Tan", "alpha"));
+             }),
+             py::arg("omega"), py::arg("alpha"))
         .def_property_readonly("omega", &Tan::omega)
         .def_property_readonly("alpha", &Tan::alpha);
     py::class_<Numerical, Potential, std::shared_ptr<Numerical>>(

@@ -7,6 +7,24 @@
 
 namespace py = pybind11;
 
+#include <string>
+
+/// A Python real number (int, float, numpy scalar; not bool, str, complex, None or an array) as a
+/// double, or a ValueError "who: name must be a real number, got ..." instead of pybind11's
+/// overload listing.
+inline double real_arg(py::handle o, const char* who, const char* name) {
+    // Leaked on purpose: a static py::object would be released after the interpreter is gone.
+    static PyObject* real = py::object(py::module_::import("numbers").attr("Real")).release().ptr();
+    if (!PyBool_Check(o.ptr()) && PyObject_IsInstance(o.ptr(), real) == 1) {
+        const double v = PyFloat_AsDouble(o.ptr());
+        if (!(v == -1.0 && PyErr_Occurred())) return v;
+    }
+    PyErr_Clear();
+    std::string r = py::repr(o).cast<std::string>();
+    if (r.size() > 60) r = r.substr(0, 57) + "...";
+    throw py::value_error(std::string(who) + ": " + name + " must be a real number (within the range of a double), got " + r);
+}
+
 /// Input arrays: C-contiguous doubles, converted (copied) only when the caller's array is not.
 using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 

@@ -11,7 +11,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .._common import Region, Status
+from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask
 from .rotation import regularity, rotation_number
 
 __all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
@@ -146,24 +146,32 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         says when the sign of eps does not hover.
     """
     th = m.theory()
-    hover_search = any(Region.parse(r) == Region.ABOVE for r in regions)
+    try:
+        mask = region_mask(regions)
+    except ValueError as e:
+        raise ValueError(f"regions: {e}") from None
+    if mask == 0:
+        raise ValueError(f"regions must name at least one region, got {regions!r}")
+    regions = tuple(REGION_LABELS[r] for r in range(5) if mask >> r & 1)  # labels, in the paper's order
+    hover_search = bool(mask >> int(Region.ABOVE) & 1)
     if line is None:
         line = "L2" if hover_search and not th.hovers and m.eps != 0 else "L1"
-    if search not in ("lowest", "highest"):
+    if not is_choice(search, ("lowest", "highest")):
         raise ValueError(f"search must be 'lowest' or 'highest', got {search!r}")
     if isinstance(line, (int, float, np.floating)) and not isinstance(line, bool) and math.isfinite(line):
         phi_line = float(line)
         line = f"phi = {phi_line:g}"
         line_fn = lambda K: np.full(np.shape(K), phi_line)  # noqa: E731
-    elif line in ("L1", "L2"):
+    elif is_choice(line, ("L1", "L2")):
         line_fn = m.L1 if line == "L1" else m.L2
     else:
         raise ValueError(f"line must be 'L1', 'L2' or a finite angle, got {line!r}")
     if digits is None:
         digits = getattr(m, "regularity_digits", 8.0)
-    for name, v, least in (("n_steps", n_steps, 16), ("grid", grid, 2)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
-            raise ValueError(f"{name} must be an integer >= {least}, got {v!r}")
+    # grid <= 1e6: more starts than that resolve nothing the bisection does not (and cost memory).
+    for name, v, least, most in (("n_steps", n_steps, 16, 2**53), ("grid", grid, 2, 10**6)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not least <= v <= most:
+            raise ValueError(f"{name} must be an integer in [{least}, {most}], got {v!r}")
     if not (isinstance(digits, (int, float, np.floating)) and 0 < digits <= 16):
         raise ValueError(f"digits must be a number in (0, 16], got {digits!r}")
     lo, hi = m.valid_band()
@@ -172,10 +180,11 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     if K_range is None:
         K_a = 3 * th.K_crit if th.hovers else -2 * scale
         K_range = (max(K_a, lo * (1 - 1e-9)), min(max(scale, 1e-6), hi))
-    K_range = tuple(K_range)
-    if len(K_range) != 2:
+    kr = real_array("K_range", K_range) if not isinstance(K_range, str) else None
+    if kr is None or kr.shape != (2,):
         raise ValueError(f"K_range must be a pair (K_lo, K_hi), got {K_range!r}")
-    K_a, K_b = map(float, K_range)
+    K_a, K_b = map(float, kr)
+    K_range = (K_a, K_b)
     if not (lo < K_a < K_b < hi):
         raise ValueError(f"K_range must be increasing inside the band ({lo}, {hi}), got {K_range}")
     if not (isinstance(tol, (int, float, np.floating)) and math.isfinite(tol) and tol >= 1e-14 * max(abs(K_a), abs(K_b))):

@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 
+from .._common import is_choice
+
 __all__ = ["birkhoff_weights", "birkhoff_average", "rotation_number", "regularity"]
 
 
@@ -96,7 +98,7 @@ def rotation_number(res, method: str = "mean") -> np.ndarray:
     ndarray
         Shape (n_orbits,); NaN for an orbit that took no step.
     """
-    if method not in ("mean", "birkhoff"):
+    if not is_choice(method, ("mean", "birkhoff")):
         raise ValueError(f"method must be 'mean' or 'birkhoff', got {method!r}")
     if method == "mean" and res.rotation is not None:
         return res.rotation

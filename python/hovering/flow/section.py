@@ -8,7 +8,7 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from .._common import FlowStatus, integer, real_array, real_number, thread_count
+from .._common import FlowStatus, integer, is_choice, real_array, real_number, thread_count
 from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
@@ -31,7 +31,7 @@ def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd
     -------
     hovering._core.flow.FlowOptions
     """
-    if stepper not in STEPPERS:
+    if not is_choice(stepper, STEPPERS):
         raise ValueError(f"stepper must be one of {STEPPERS} (the implicit GSL steppers need a Jacobian the flow does "
                          f"not provide), got {stepper!r}")
     return _core.flow.FlowOptions(
@@ -140,7 +140,10 @@ class Section:
 
     def _points(self, theta, I):
         """Points of Sigma_h, a mask of those that exist, and why the others do not."""
-        t, i = np.broadcast_arrays(real_array("theta", theta), real_array("I", I))
+        try:
+            t, i = np.broadcast_arrays(real_array("theta", theta), real_array("I", I))
+        except ValueError:
+            raise ValueError(f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}") from None
         return _core.flow.section_points(self.sys.core, self.h, np.ascontiguousarray(t.ravel()),
                                          np.ascontiguousarray(i.ravel()))
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from .. import _core
-from .._common import Geometry, real_number
+from .._common import Geometry, is_choice, real_number
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
 
 __all__ = [
@@ -148,7 +148,7 @@ class StepSystem:
         if self.eps != 0 and self.coupling is None:
             raise ValueError("eps != 0 needs a coupling (e.g. hovering.Bilinear())")
         _terms(self.coupling)
-        if self.geometry not in _GEOMETRIES:
+        if not is_choice(self.geometry, _GEOMETRIES):
             raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {self.geometry!r}")
         for name, pot in (("qw1", self.V1), ("qw2", self.V2)):
             q = getattr(self, name)

@@ -177,10 +177,15 @@ class TangentialCurve:
 
 
 def _finite_pair(na, a, nb, b):
+    """(angle wrapped to [-pi, pi), finite value), broadcast together; ValueErrors name the argument."""
     a, b = real_array(na, a), real_array(nb, b)
     require_angles(na, a)
     require_finite(nb, b)
-    return a, b
+    try:
+        a, b = np.broadcast_arrays(np.asarray(wrap(a), dtype=float), b)
+    except ValueError:
+        raise ValueError(f"{na} and {nb} must have broadcastable shapes, got {np.shape(a)} and {np.shape(b)}") from None
+    return np.array(a), np.array(b)
 
 
 def _section_pair(theta, I):
@@ -238,14 +243,15 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         For an empty theta, a bracket outside (0, 1) or bad iterations, or if no bracket up to
         I_tan (1 -+ 0.95) contains the tangency for every theta.
     """
-    th = np.atleast_1d(real_array("theta", theta))
-    if th.size == 0:
-        raise ValueError("theta must hold at least one angle")
+    shape = np.shape(theta) if np.ndim(theta) else (1,)
+    th = np.atleast_1d(real_array("theta", theta)).ravel()
     require_angles("theta", th)
     if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 200:
         raise ValueError(f"iterations must be an integer in [1, 200], got {iterations!r}")
     if bracket is not None and not (isinstance(bracket, (int, float)) and 0 < bracket < 1):
         raise ValueError(f"bracket must lie in (0, 1), got {bracket!r}")
+    if th.size == 0:
+        return np.zeros(shape)
     ws = _wall_section(sec)
     I0 = sec.sys.V2.action(sec.h - sec.sys.V1.V(sec.sys.qw1))
 
@@ -267,7 +273,7 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         c = crosses(mid)
         lo = np.where(c, mid, lo)
         hi = np.where(c, hi, mid)
-    return 0.5 * (lo + hi)
+    return (0.5 * (lo + hi)).reshape(shape)
 
 
 def forcing_function(sec: Section, phi, **kwargs) -> np.ndarray:

@@ -15,7 +15,7 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import Region, check_memory, iterate_arguments, real_array, wrap
+from .._common import Region, check_memory, is_choice, iterate_arguments, real_array, require_angles, require_finite, wrap
 from .._protocols import MapAnalyses
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -120,7 +120,7 @@ class FlowMap(MapAnalyses):
                  **options):
         if not isinstance(sys, StepSystem):
             raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
-        if coordinates not in ("normal", "section"):
+        if not is_choice(coordinates, ("normal", "section")):
             raise ValueError(f"coordinates must be 'normal' or 'section', got {coordinates!r}")
         self.section = Section(sys, h)
         self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
@@ -249,7 +249,8 @@ class FlowMap(MapAnalyses):
         Parameters
         ----------
         phi0, K0 : array_like
-            Initial points, broadcast together and flattened to ``n_orbits`` orbits.
+            Initial points, broadcast together and flattened to ``n_orbits`` orbits; phi0 (|phi0| <= 1e6)
+            is wrapped to [-pi, pi).
         n_steps : int
             Returns per orbit (>= 0).
         record : sequence of str, optional
@@ -282,7 +283,10 @@ class FlowMap(MapAnalyses):
         """
         record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         p, k, _ = _pair(phi0, K0, "iterate")
-        p, k = np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel())
+        require_angles("phi0", p)
+        require_finite("K0", k)
+        # The recorded orbit starts on [-pi, pi) like every later point.
+        p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
         n_points = p.size * (n_steps + 1)
         per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
         per_return = 8 * sum(key in record for key in ("times", "energy_error", "steps")) + ("regions" in record) + \
@@ -402,7 +406,7 @@ class FlowMap(MapAnalyses):
         TruncatedFamily or TruncatedMap
         """
         self._require_onset()
-        if forcing not in ("measured", "first_mode"):
+        if not is_choice(forcing, ("measured", "first_mode")):
             raise ValueError(f"forcing must be 'measured' or 'first_mode', got {forcing!r}")
         p = self.onset
         b = self.forcing_coefficients(n_modes)

@@ -8,14 +8,15 @@ is shared with :class:`hovering.FlowMap`, whose iterations add the flow's own re
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Iterable, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
-from .._common import (Region, Status, check_memory, iterate_arguments, real_array, real_number,
-                       require_angles, require_finite, thread_count)
+from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
+                       require_angles, require_finite, thread_count, wrap)
 from .._protocols import MapAnalyses
 from . import theory as _geo
 
@@ -241,7 +242,7 @@ class _MapAPI(MapAnalyses):
             start_R, start_0`` (left ends in [-pi, pi), NaN for K >= 0). The left ends are the
             corner-singularity curves: ``start_1 = phi_01``, ``start_R = phi_1R``, ``start_0 = phi_R0``.
         """
-        k = np.ascontiguousarray(np.asarray(K, dtype=float).ravel())
+        k = np.ascontiguousarray(real_array("K", K).ravel())
         a = self._arcs(k)
         shape = np.shape(K)
         keys = ("len_1", "len_R", "len_0", "start_1", "start_R", "start_0")
@@ -280,7 +281,8 @@ class _MapAPI(MapAnalyses):
         Parameters
         ----------
         phi0, K0 : array_like
-            Initial points, broadcast together and flattened to ``n_orbits`` orbits.
+            Initial points, broadcast together and flattened to ``n_orbits`` orbits; phi0 (|phi0| <= 1e6)
+            is wrapped to [-pi, pi).
         n_steps : int
             Steps per orbit (>= 0).
         record : sequence of str, optional
@@ -321,12 +323,14 @@ class _MapAPI(MapAnalyses):
         as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps.
         """
         record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
-        if kernel not in ("simd", "scalar"):
+        if not is_choice(kernel, ("simd", "scalar")):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
-        if sin_ulp not in (1.0, 3.5):
+        if isinstance(sin_ulp, (bool, np.bool_)) or not isinstance(sin_ulp, numbers.Real) or float(sin_ulp) not in (1.0, 3.5):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
         n_threads = thread_count(n_threads)
         p, k, _ = _pair(phi0, K0, "iterate")
+        require_angles("phi0", p)
+        p = np.asarray(wrap(p), dtype=float)  # the recorded orbit starts on [-pi, pi) like every later point
         n_points = p.size * (n_steps + 1)
         check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps",
                      16 * n_points * ("orbit" in record) + p.size * n_steps * ("regions" in record))

@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .._common import real_array, require_finite, wrap
+from .._common import real_array, real_number, require_finite, wrap
 
 __all__ = [
     "OMEGA_G",
@@ -58,7 +58,7 @@ def L1(K, Omega0, tau0):
     ndarray or float
         ``phi_m1(K)`` in ``[-pi, pi)``.
     """
-    return wrap(-0.5 * (Omega0 + tau0 * _finite("K", K)))
+    return wrap(-0.5 * _rotation(K, Omega0, tau0))
 
 
 def L2(K, Omega0, tau0):
@@ -76,13 +76,26 @@ def L2(K, Omega0, tau0):
     ndarray or float
         ``phi_m2(K)`` in ``[-pi, pi)``.
     """
-    return wrap(np.pi - 0.5 * (Omega0 + tau0 * _finite("K", K)))
+    return wrap(np.pi - 0.5 * _rotation(K, Omega0, tau0))
 
 
 def _finite(name, x) -> np.ndarray:
     a = real_array(name, x)
     require_finite(name, a)
     return a
+
+
+def _rotation(K, Omega0, tau0, name="K") -> np.ndarray:
+    """Omega0 + tau0 K, refused (naming K) where it is too large an angle to wrap accurately."""
+    k = _finite(name, K)
+    with np.errstate(over="ignore", invalid="ignore"):
+        Om = _finite("Omega0", Omega0) + _finite("tau0", tau0) * k
+    if np.any(~(np.abs(Om) <= 1e6)):
+        i = int(np.argmax(~(np.ravel(np.abs(Om)) <= 1e6)))
+        raise ValueError(f"{name} = {np.ravel(k + np.zeros_like(Om))[i]} gives the rotation Omega0 + tau0 {name} = "
+                         f"{np.ravel(Om)[i]:.6g}; allowed: |Omega0 + tau0 {name}| <= 1e6 (the ends of the band, where "
+                         f"angles can still be wrapped)")
+    return Om
 
 
 def _sin_half(Omega0) -> np.ndarray:
@@ -99,7 +112,13 @@ def _wall_angle(theta_w) -> np.ndarray:
 
 
 def _half_rotation(K0, Omega0, tau0):
-    return 0.5 * (Omega0 + tau0 * np.asarray(K0, dtype=float))
+    return 0.5 * _rotation(K0, Omega0, tau0, "K0")
+
+
+def _sin_of(a) -> np.ndarray:
+    """sin(a), NaN where it vanishes: the first-order curves divide by it and do not exist there."""
+    s = np.sin(a)
+    return np.where(np.abs(s) < 1e-12, np.nan, s)
 
 
 def k_eps1(phi, K0, eps, Omega0, tau0):
@@ -123,7 +142,8 @@ def k_eps1(phi, K0, eps, Omega0, tau0):
         Heights of the curve at ``phi``.
     """
     a = _half_rotation(K0, Omega0, tau0)
-    return K0 + eps * (1.0 - np.cos(np.asarray(phi, dtype=float) + a)) / (2.0 * np.sin(a))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return K0 + _finite("eps", eps) * (1.0 - np.cos(_finite("phi", phi) + a)) / (2.0 * _sin_of(a))
 
 
 def k_eps2(phi, K0, eps, Omega0, tau0):
@@ -144,7 +164,8 @@ def k_eps2(phi, K0, eps, Omega0, tau0):
         ``K0 - eps (1 + cos(phi + a)) / (2 sin a)``, ``a = (Omega0 + tau0 K0)/2``.
     """
     a = _half_rotation(K0, Omega0, tau0)
-    return K0 - eps * (1.0 + np.cos(np.asarray(phi, dtype=float) + a)) / (2.0 * np.sin(a))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return K0 - _finite("eps", eps) * (1.0 + np.cos(_finite("phi", phi) + a)) / (2.0 * _sin_of(a))
 
 
 def rho1(K0, eps, Omega0, tau0):
@@ -163,7 +184,8 @@ def rho1(K0, eps, Omega0, tau0):
         ``Omega0 + tau0 K0 + (tau0 eps / 2) / sin((Omega0 + tau0 K0)/2)``.
     """
     a = _half_rotation(K0, Omega0, tau0)
-    return 2 * a + 0.5 * tau0 * eps / np.sin(a)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return 2 * a + 0.5 * _finite("tau0", tau0) * _finite("eps", eps) / _sin_of(a)
 
 
 def rho2(K0, eps, Omega0, tau0):
@@ -182,7 +204,8 @@ def rho2(K0, eps, Omega0, tau0):
         ``Omega0 + tau0 K0 - (tau0 eps / 2) / sin((Omega0 + tau0 K0)/2)``.
     """
     a = _half_rotation(K0, Omega0, tau0)
-    return 2 * a - 0.5 * tau0 * eps / np.sin(a)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return 2 * a - 0.5 * _finite("tau0", tau0) * _finite("eps", eps) / _sin_of(a)
 
 
 def K_crit(eps, theta_w, Omega0):
@@ -202,7 +225,8 @@ def K_crit(eps, theta_w, Omega0):
     float or ndarray
         ``-eps (1 - cos theta_w) / (2 sin(Omega0/2))``.
     """
-    out = -_finite("eps", eps) * (1.0 - np.cos(_wall_angle(theta_w))) / (2.0 * _sin_half(Omega0))
+    with np.errstate(over="ignore"):  # huge eps: inf, as IEEE says
+        out = -_finite("eps", eps) * (1.0 - np.cos(_wall_angle(theta_w))) / (2.0 * _sin_half(Omega0))
     return out if np.ndim(out) else float(out)
 
 
@@ -219,7 +243,9 @@ def rho_crit(eps, theta_w, Omega0, tau0):
     float or ndarray
         ``Omega0 + eps tau0 cos(theta_w) / (2 sin(Omega0/2))``.
     """
-    out = Omega0 + _finite("eps", eps) * tau0 * np.cos(_wall_angle(theta_w)) / (2.0 * _sin_half(Omega0))
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = _finite("Omega0", Omega0) + _finite("eps", eps) * _finite("tau0", tau0) * np.cos(_wall_angle(theta_w)) / (
+            2.0 * _sin_half(Omega0))
     return out if np.ndim(out) else float(out)
 
 
@@ -242,7 +268,7 @@ def hovering_area_theory(eps, theta_w, Omega0):
     e = _finite("eps", eps)
     tw = _wall_angle(theta_w)
     s = _sin_half(Omega0)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         a = np.where(e * s > 0, np.abs(e) * (np.sin(tw) - tw * np.cos(tw)) / np.abs(s), 0.0)
     a = np.where(np.isnan(s), np.nan, a)  # resonant: sin(Omega0/2) = 0 up to rounding of Omega0
     return a if np.ndim(a) else float(a)
@@ -275,9 +301,7 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
     ValueError
         If ``|c| >= |tau0|`` (theta_w would leave (0, pi)) or a value is not finite.
     """
-    for name, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G)):
-        if not np.isfinite(v):
-            raise ValueError(f"{name} must be finite, got {v}")
+    eps, c, tau0, Omega_G = (real_number(n, v) for n, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G)))
     if not abs(c) < abs(tau0):
         raise ValueError(f"c must satisfy |c| < |tau0| = {abs(tau0)}, got c = {c}")
     Omega0 = Omega_G - 0.5 * c * eps

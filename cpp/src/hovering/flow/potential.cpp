@@ -43,7 +43,8 @@ double qaws(const std::function<double(double)>& f, double a, double b, double a
     if (st != GSL_SUCCESS && st != GSL_EROUND && !(err <= 1e-10 * std::fabs(r)))
         bad(pot.name() + "." + who + ": the quadrature over the level h = " + fmt(h) + " did not converge (" +
             gsl_strerror(st) + "); the turning points [" + fmt(a) + ", " + fmt(b) +
-            "] are too close to resolve, or V is flat there. Use a larger h or a closed-form potential");
+            "] are too close to resolve, or V is flat there; allowed: a level the quadrature resolves (a larger h) or a "
+            "closed-form potential");
     return r;
 }
 
@@ -81,6 +82,8 @@ void Potential::check_energy(double h, const char* who) const {
 
 std::pair<double, double> Potential::turning_points(double h) const {
     check_energy(h, "turning_points");
+    // Subnormal levels: h - V(q) has too few significant bits for any quadrature.
+    if (h < 1e-300) bad(name() + ": energy must be >= 1e-300 on the quadrature path (no closed form), got " + fmt(h));
     auto side = [&](double sgn) {
         // Bracket V = h on one side: expand outward (or toward the edge of a bounded well).
         const double lim = q_limit();

@@ -35,6 +35,11 @@ bool try_section_point(const FlowSystem& s, double h, double theta, double I, st
     };
     if (!(I > 0)) return fail("no point of Sigma_h at I = " + fmt(I) + ": actions are > 0");
     const double e2 = s.V2->energy(I);
+    // An action so large that H2(I) overflows (I = 1e154) has no point either; point_at would
+    // refuse the infinite energy as bad input. (Finite H2 >= h is decided below: eps Vc can be < 0.)
+    if (!std::isfinite(e2))
+        return fail("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): H2(I) = " + fmt(e2) +
+                    " >= h = " + fmt(h) + " leaves no energy for oscillator 1");
     const auto [q2, p2] = s.V2->point_at(theta, e2);
     // p1 = 0: V1(q1) + eps Vc(q1, q2) = h - H2; the root with q1 > 0 (near q1's maximum).
     const double rest = h - e2;

@@ -38,6 +38,10 @@ double wrap_angle(double x) {
 
 void AnalyticArcs::validate() const {
     require_finite(Omega0, "Omega0");
+    // The rotation of a step must be wrappable: Omega0 = -2.4e39 iterated to phi = 3e23 "OK".
+    if (!(std::fabs(Omega0) <= detail::kMaxAngle))
+        bad("Omega0 must lie in [-1e6, 1e6] (a larger rotation per step cannot be wrapped to [-pi, pi) "
+            "accurately), got " + fmt(Omega0));
     require_finite(theta_w, "theta_w");
     require_finite(tau0, "tau0");
     require_finite(tau1, "tau1");
@@ -141,6 +145,13 @@ void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
         require_finite(Omega[i], "Omega[" + std::to_string(i) + "]");
         require_finite(JR[i], "JR[" + std::to_string(i) + "]");
         require_finite(J1[i], "J1[" + std::to_string(i) + "]");
+        if (!(std::fabs(Omega[i]) <= detail::kMaxAngle))
+            bad("Omega[" + std::to_string(i) + "] must lie in [-1e6, 1e6] (a larger rotation per step cannot be "
+                "wrapped accurately), got " + fmt(Omega[i]));
+        // Before the K = 0 and band checks, whose messages would mislead for a reversed grid.
+        if (i > 0 && !(K[i] > K[i - 1]))
+            bad("the K grid must be strictly increasing, but K[" + std::to_string(i) + "] = " + fmt(K[i]) +
+                " <= K[" + std::to_string(i - 1) + "] = " + fmt(K[i - 1]));
     }
     for (std::size_t i = 0; i < K.size(); ++i) {
         if (K[i] == 0.0) {

@@ -23,7 +23,19 @@ using detail::require_finite;
 // MapCore
 
 namespace {
-double arcs_kmax(const AnalyticArcs&) { return kInf; }
+// The band ends where the rotation |Omega0 + tau0 K| reaches 1e6 rad: beyond, phi + Omega cannot
+// be wrapped meaningfully (K0 = 1e21 iterated to phi = 1.3e5, "OK"; tau0 = 4e20 the same below 0).
+double arcs_kmax(const AnalyticArcs& a) {
+    if (a.tau0 > 0) return (detail::kMaxAngle - a.Omega0) / a.tau0;
+    if (a.tau0 < 0) return (detail::kMaxAngle + a.Omega0) / -a.tau0;
+    return kInf;
+}
+double arcs_kmin(const AnalyticArcs& a) {
+    if (a.tau0 > 0) return -(detail::kMaxAngle + a.Omega0) / a.tau0;
+    if (a.tau0 < 0) return -(detail::kMaxAngle - a.Omega0) / -a.tau0;
+    return -kInf;
+}
+double arcs_kmin(const TabulatedArcs&) { return -kInf; }
 double arcs_kmax(const TabulatedArcs& a) { return a.kmax(); }
 void validate_arcs(const AnalyticArcs& a) { a.validate(); }
 void validate_arcs(const TabulatedArcs&) {}
@@ -42,7 +54,7 @@ MapCore<A, F>::MapCore(double eps, A arcs, F forcing, double K_max)
     validate_arcs(arcs_);
     validate_forcing(forcing_);
     if (std::isnan(K_max) || !(K_max > 0.0)) bad("K_max must be > 0 (or inf), got " + fmt(K_max));
-    band_ = {arcs_.band_lo(), std::min(K_max, arcs_kmax(arcs_))};
+    band_ = {std::max(arcs_.band_lo(), arcs_kmin(arcs_)), std::min(K_max, arcs_kmax(arcs_))};
 }
 
 template <class A, class F>
