@@ -87,6 +87,77 @@ BAD = {
 }
 
 
+# Found by a second, adversarial pass over the whole public API (after the issue's list was fixed).
+FM = hv.FlowMap(SYS, 1.0)
+CURVE1, CURVE2 = FM.curve, hv.TangentialCurve(hv.Section(SYS, 2.0))  # measured once, outside the timed calls
+BAD.update({
+    # unbounded work or memory
+    "theory 1000 modes": (lambda: hv.theory(0.3, hv.OMEGA_G, 2.0, forcing=[1.0] * 1000),
+                          r"forcing must be a 1-D sequence of 1 to 64 sine coefficients, got shape \(1000,\)"),
+    "theory n_grid=1e10": (lambda: hv.theory(0.3, hv.OMEGA_G, 2.0, forcing=(1.0, 0.2), n_grid=10**10),
+                           r"n_grid must be an integer in \[101, 10000000\]"),
+    "corner_curves n_phi=1e9": (lambda: hv.corner_curves(SEC, [-0.05], n_phi=10**9), r"n_phi must be an integer in \[16, 65536\]"),
+    "forcing_coefficients n_phi=1e7": (lambda: hv.forcing_coefficients(SEC, 3, 10**7), r"n_phi .* in \[7, 65536\], got 10000000"),
+    # silent garbage
+    "K_crit Omega0=1e300": (lambda: hv.K_crit(0.3, 2.0, 1e300), r"Omega0 must lie in \[-1e6, 1e6\]"),
+    "golden_family eps=1e300": (lambda: hv.golden_family(1e300, 0.5), r"eps = 1e\+300 and c = 0.5 give Omega0"),
+    "family complex table": (lambda: hv.TruncatedFamily(0.3, [-2, -1, -0.5, 0, 1.0], np.full(5, 3.9) + 1j, [1.6] * 5,
+                                                        [1, 0.8, 0.5, 0, 0]), r"Omega must be real numbers, got dtype complex128"),
+    "family bool table": (lambda: hv.TruncatedFamily(0.3, [-2, -1, -0.5, 0, 1.0], [True] * 5, [1.6] * 5, [1, 0.8, 0.5, 0, 0]),
+                          r"Omega must be real numbers, got dtype bool"),
+    "theory forcing='12'": (lambda: hv.theory(0.3, hv.OMEGA_G, 2.0, forcing="12"), r"forcing must be a sequence of sine coefficients"),
+    "forcing_at(1e300)": (lambda: M.forcing_at(1e300), r"phi must be an angle in \[-1e6, 1e6\]"),
+    "corner_curves curve of h = 2": (lambda: hv.corner_curves(SEC, [-0.05], n_phi=32, bisections=5,
+                                                              curve=CURVE2),
+                                     r"curve must be the TangentialCurve of this section .*it belongs to h = 2.0"),
+    "rtol=1e-300": (lambda: hv.FlowMap(SYS, 1.0, rtol=1e-300), r"rtol must lie in \[1e-16, 1\), got 1e-300"),
+    "step_rotations of another map": (lambda: FM.step_rotations(M.iterate([0.3], [-0.02], 3, record=("orbit", "regions")), 0),
+                                      r"res must be the IterateResult of this FlowMap's iterate"),
+    # unclear errors
+    "region_mask(NONE)": (lambda: hv.region_mask(hv.Region.NONE), r"Region.NONE \(no return\) is not a region"),
+    "exit_regions={NONE}": (lambda: M.iterate([0.1], [-0.1], 3, exit_regions={hv.Region.NONE}), r"exit_regions: Region.NONE"),
+    "birkhoff axis=5": (lambda: hv.birkhoff_average([[1.0, 2.0], [3, 4]], axis=5), r"axis must be an integer in \[-2, 1\]"),
+    "rotation_number(None)": (lambda: hv.rotation_number(None), r"res must be the IterateResult of a map's iterate"),
+    "hovering_area(None)": (lambda: hv.hovering_area(None), r"m must be a map \(hovering.TruncatedMap, TruncatedFamily or FlowMap\)"),
+    "tangential_curve(None)": (lambda: hv.tangential_curve(None, [0.1]), r"sec must be a hovering.Section"),
+    "truncated_from_flow(None)": (lambda: hv.truncated_from_flow(None, 0.05), r"cc must be the CornerCurves"),
+    "forcing_coefficients n_modes=0": (lambda: hv.forcing_coefficients(SEC, 0, 16), r"n_modes must be an integer in \[1, 64\], got 0"),
+    "k_eps1 shapes": (lambda: M.k_eps1([0.1, 0.2], K0=[1, 2, 3]), r"phi and K0 must have broadcastable shapes"),
+    "compare_maps shapes": (lambda: hv.compare_maps(SEC, CURVE1, M, [0.1, 0.2], [-0.05, -0.02, 0.0]),
+                            r"phi and K must have broadcastable shapes, got \(2,\) and \(3,\)"),
+    "count('FOO')": (lambda: M.iterate([0.1], [-0.1], 3).count("FOO"), r"status must be one of OK, ESCAPED"),
+    "FlowMap.step('a', 0)": (lambda: FM.step("a", 0), r"step: phi must be real numbers"),
+    "Section.point('a', 0.3)": (lambda: SEC.point("a", 0.3), r"theta must be real numbers"),
+    "hovering_area empty band": (lambda: hv.hovering_area(hv.TruncatedMap(eps=0.3, Omega0=3.0, theta_w=2.0, lam=1e300)),
+                                 r"band has no part below K = 0"),
+    "FlowMap h=1e300": (lambda: hv.FlowMap(SYS, 1e300), r"h must lie in \(-inf, 1e\+100\], got 1e\+300"),
+    # small things
+    "iterate n_steps=True": (lambda: M.iterate([0.1], [-0.1], True), r"n_steps must be an integer >= 0, got True"),
+    "returns inverse='yes'": (lambda: FM.returns(0.3, -0.02, inverse="yes"), r"inverse must be True or False, got 'yes'"),
+    "keep_points='yes'": (lambda: hv.hovering_area(M, n_steps=100, samples=100, keep_points="yes"), r"keep_points must be True or False"),
+    "CustomPotential q_limit=True": (lambda: hv.CustomPotential(lambda q: q * q / 2, lambda q: q, q_limit=True),
+                                     r"q_limit must be a float > 0"),
+})
+
+
+def test_enums_and_labels_from_either_side_agree():
+    # The two status enums number their members differently (OFF_SECTION = 9 vs 6): count()
+    # goes by name, so the "other" enum counts the same orbits instead of silently none.
+    r = SEC.return_map([0.1], [-0.3])
+    assert r.count(hv.FlowStatus.OFF_SECTION) == r.count(hv.Status.OFF_SECTION) == r.count("off_section") == 1
+    f = FM.iterate([0.3], [-100.0], 3)
+    assert f.count(hv.Status.OFF_SECTION) == f.count(hv.FlowStatus.OFF_SECTION) == 1
+    assert hv.Region.parse("u") is hv.Region.BESIDE  # the itinerary's letter
+    s = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), geometry=hv.Geometry.WALL)
+    assert s.geometry == "wall"
+
+
+def test_zero_dimensional_arrays_are_numbers():
+    a = hv.TruncatedMap(eps=0.3, Omega0=3.0, theta_w=np.array(2.0))
+    assert a.theta_w == 2.0
+    assert hv.Harmonic(np.array(2.0)).omega == 2.0
+
+
 @pytest.mark.parametrize("name", list(BAD))
 def test_bad_input_is_a_named_value_error(name):
     call, pattern = BAD[name]
@@ -195,7 +266,7 @@ def test_output_path_names_the_file_savefig_writes(tmp_path):
 
     assert output_path("out", tmp_path / "sub" / "x") == tmp_path / "sub" / "x.png"
     assert output_path("out", tmp_path / "x.pdf") == tmp_path / "x.pdf"
-    with pytest.raises(ValueError, match="is a directory"):
+    with pytest.raises(ValueError, match="exists and is not a regular file"):
         output_path("out", _dir_png(tmp_path))
 
 
@@ -203,3 +274,48 @@ def _dir_png(tmp_path):
     d = tmp_path / "d.png"
     d.mkdir()
     return d
+
+
+def test_scene_cli_reports_values_only_the_run_can_check_in_one_line(tmp_path, capsys):
+    # eps = 1e6 passes the scene schema but puts L1's rotation beyond the band's top: the run
+    # refuses it; the CLI used to print a traceback (exit 1) instead of one line (exit 2).
+    from hovering.__main__ import main
+
+    src = (Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_smalleps.toml").read_text()
+    assert "eps = 0.3" in src
+    bad = tmp_path / "bad.toml"
+    bad.write_text(src.replace("eps = 0.3", "eps = 1e6", 1))
+    assert main(["scene", str(bad), "--quick", "--out", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "1e6" in err and "Traceback" not in err
+    assert main(["scene", "/dev/zero"]) == 2  # not read forever
+    assert "not a regular file" in capsys.readouterr().err
+
+
+def test_output_path_refuses_what_savefig_would_fail_on(tmp_path):
+    from hovering._common import output_path
+
+    with pytest.raises(ValueError, match="no NUL byte"):
+        output_path("out", str(tmp_path / "a\0b.png"))
+    (tmp_path / "plain").write_text("x")
+    with pytest.raises(ValueError, match="exists and is not a figure file"):
+        output_path("out", tmp_path / "plain")  # would have written plain.png beside it
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o500)
+    try:
+        # The verdict must match reality: non-root cannot write here (refused), root can (accepted).
+        try:
+            (ro / "probe").write_text("")
+            (ro / "probe").unlink()
+            writable = True
+        except OSError:
+            writable = False
+        if writable:
+            assert output_path("out", ro / "x.png") == ro / "x.png"
+        else:
+            with pytest.raises(ValueError, match="not writable|cannot be written"):
+                output_path("out", ro / "x.png")
+    finally:
+        ro.chmod(0o700)
+    assert not list(tmp_path.rglob("*.png"))  # the check leaves no file behind

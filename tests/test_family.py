@@ -302,7 +302,10 @@ def test_malformed_tables_raise(table, match):
     "kw,match",
     [
         (dict(forcing=(1.0, np.nan)), r"forcing\[1\] must be finite"),
-        (dict(forcing=()), r"forcing needs at least one sine coefficient"),
+        (dict(forcing=()), r"forcing must be a 1-D sequence of 1 to 64 sine coefficients, got shape \(0,\)"),
+        (dict(forcing=[[1.0]]), r"forcing must be a 1-D sequence of 1 to 64 sine coefficients, got shape \(1, 1\)"),
+        (dict(forcing="12"), r"forcing must be a sequence of sine coefficients, got '12'"),
+        (dict(forcing=[1.0] * 65), r"1 to 64 sine coefficients, got shape \(65,\)"),
         (dict(K_max=0.0), r"K_max must be > 0"),
         (dict(K_max=np.nan), r"K_max must be > 0"),
     ],

@@ -170,6 +170,8 @@ BAD = [
     ("fig_epsbig", ("panels", 1, "orbits", 0, "color"), "bluish", ["orbits[0].color", "'bluish'"]),
     ("fig_smalleps", ("output",), "out/fig.xyz", ["output", "'.xyz'", ".png", ".pdf"]),
     ("fig_smalleps", ("output",), str(SCENE_DIR / "fig_smalleps.toml" / "x.png"), ["output", "is not a directory"]),
+    ("fig_smalleps", ("panels",), [{"id": f"p{i}"} for i in range(37)], ["panels", "37 panels", "at most 36"]),
+    ("fig_hov_vs_eps", ("seed",), 2**70, ["seed", "out of range"]),
     ("fig_smalleps", ("panels", 0, "eps"), "(" * 30000 + "1" + ")" * 30000, ["eps", "60001 characters", "at most 200"]),
 ]
 

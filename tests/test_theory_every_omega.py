@@ -88,5 +88,5 @@ def test_resonant_and_degenerate_cases_are_named():
     assert math.isnan(hv.hovering_area_theory(0.1, 2.0, 2 * math.pi))
     assert hv.hovering_area_theory(-0.1, 2.0, hv.OMEGA_G) == 0.0  # the old formula gave a negative area
     assert "no twist" in hv.theory(0.1, 1.0, 2.0, tau0=0.0).note
-    with pytest.raises(ValueError, match="eps must be a finite number"):
+    with pytest.raises(ValueError, match="eps must be finite, got nan"):
         hv.theory(float("nan"), 1.0, 2.0)

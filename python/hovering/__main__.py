@@ -66,7 +66,11 @@ def _scene(args) -> int:
     except (OSError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    summary = run_scene(scene, out=out, quick=args.quick)
+    try:
+        summary = run_scene(scene, out=out, quick=args.quick)
+    except ValueError as e:  # a value only the computation can check (e.g. a K beyond the band's top)
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     print(format_summary(summary))
     return 0
 

@@ -17,7 +17,7 @@ from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
            "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
-           "check_memory", "thread_count", "is_choice", "output_path", "MAX_ANGLE"]
+           "check_memory", "thread_count", "is_choice", "status_code", "require_map", "flag", "require_type", "forcing_array", "MAX_MODES", "output_path", "MAX_ANGLE"]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -53,6 +53,8 @@ def _parse(cls, value) -> "Region":
         return value
     if isinstance(value, str):
         key = value.strip()
+        if key == "u":  # the itinerary's letter for a return beside the step
+            return cls.BESIDE
         for r in cls:
             if r is not cls.NONE and key in (r.name, r.name.lower(), REGION_LABELS[int(r)]):
                 return r
@@ -88,6 +90,9 @@ def region_mask(regions) -> int:
         raise ValueError(f"regions must be a region or a collection of regions, got {regions!r}") from None
     mask = 0
     for r in items:
+        if isinstance(r, Region) and r is Region.NONE:
+            raise ValueError("Region.NONE (no return) is not a region an orbit can be in; allowed: "
+                             + ", ".join(f"{x.name} ('{REGION_LABELS[int(x)]}')" for x in Region if x is not Region.NONE))
         mask |= 1 << int(Region.parse(r))
     return mask
 
@@ -110,9 +115,14 @@ def real_number(name: str, value, lo=None, lo_open=True, hi=None, hi_open=True) 
     -------
     float
     """
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()  # a 0-d array is a number, as numpy scalars are
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
-    v = float(value)
+        raise ValueError(f"{name} must be a real number, got {_short(value)}")
+    try:
+        v = float(value)
+    except OverflowError:
+        raise ValueError(f"{name} must be a real number within the range of a double, got {_short(value)}") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {v}")
     if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and (v >= hi if hi_open else v > hi)):
@@ -123,6 +133,8 @@ def real_number(name: str, value, lo=None, lo_open=True, hi=None, hi_open=True) 
 
 def integer(name: str, value, lo: int, hi: int) -> int:
     """An integer (not a bool, float or string) in [lo, hi], or a ValueError naming it and the range."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iu":
+        value = value.item()
     try:
         v = operator.index(value)
     except TypeError:
@@ -130,6 +142,42 @@ def integer(name: str, value, lo: int, hi: int) -> int:
     if isinstance(value, (bool, np.bool_)) or not lo <= v <= hi:
         raise ValueError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
     return v
+
+
+def flag(name: str, value) -> bool:
+    """A True/False argument (not 'yes', None or 1), or a ValueError naming it."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {_short(value)}")
+    return bool(value)
+
+
+def require_type(name: str, value, cls, what: str):
+    """``value`` if it is an instance of cls, else a ValueError naming the parameter and what it must be."""
+    if not isinstance(value, cls):
+        raise ValueError(f"{name} must be {what}, got {_short(value)}")
+    return value
+
+
+def status_code(cls, value) -> int:
+    """The code of a status in the enum ``cls`` (Status or FlowStatus) from a member of either enum
+    (by name: their numbers differ), its name (``"OFF_SECTION"``, any case) or its code."""
+    if isinstance(value, (Status, FlowStatus)) or isinstance(value, str):
+        name = value.name if not isinstance(value, str) else value.strip().upper()
+        if name in cls.__members__:
+            return int(cls.__members__[name])
+    elif isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        if int(value) in {int(m) for m in cls}:
+            return int(value)
+    raise ValueError(f"status must be one of {', '.join(cls.__members__)} ({cls.__name__}), got {_short(value)}")
+
+
+def require_map(name: str, m):
+    """``m`` if it is a return map (TruncatedMap, TruncatedFamily, FlowMap: the ReturnMap protocol)."""
+    from ._protocols import ReturnMap
+
+    if not isinstance(m, ReturnMap):
+        raise ValueError(f"{name} must be a map (hovering.TruncatedMap, TruncatedFamily or FlowMap), got {_short(m)}")
+    return m
 
 
 def is_choice(value, choices) -> bool:
@@ -146,6 +194,22 @@ def thread_count(value) -> int:
     if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= 4096:
         raise ValueError(f"n_threads must be an integer in [0, 4096] (0 = all cores), got {value!r}")
     return v
+
+
+#: Most sine coefficients of a forcing f: the theory's cost grows with each (1000 took 20 s) and the
+#: measured f of the flow needs ~8.
+MAX_MODES = 64
+
+
+def forcing_array(value) -> np.ndarray:
+    """Sine coefficients ``b_1, b_2, ...`` of a forcing: 1 to MAX_MODES finite real numbers."""
+    if isinstance(value, str):
+        raise ValueError(f"forcing must be a sequence of sine coefficients, got {value!r}")
+    b = np.atleast_1d(real_array("forcing", value))
+    if b.ndim != 1 or not 1 <= b.size <= MAX_MODES:
+        raise ValueError(f"forcing must be a 1-D sequence of 1 to {MAX_MODES} sine coefficients, got shape {b.shape}")
+    require_finite("forcing", b)
+    return b
 
 
 def real_array(name: str, value) -> np.ndarray:
@@ -214,17 +278,20 @@ def output_path(where: str, path) -> "os.PathLike":
 
     from matplotlib.backend_bases import FigureCanvasBase
 
-    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
-        raise ValueError(f"{where} must be a file path, got {path!r}")
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip() or "\0" in str(path):
+        raise ValueError(f"{where} must be a file path (non-empty, no NUL byte), got {path!r}")
     p = Path(path)
     if p.suffix == "":
+        if p.exists():  # "out" meaning out.png would silently write next to an existing out/ or /dev/null
+            raise ValueError(f"{where} = {str(path)!r} exists and is not a figure file; give a name with a suffix "
+                             f"(.png, .pdf, .svg, ...)")
         p = p.with_suffix(".png")
     formats = FigureCanvasBase.get_supported_filetypes()
     if p.suffix[1:].lower() not in formats:
         raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "
                          f"allowed suffixes: {', '.join('.' + f for f in sorted(formats))}")
-    if p.exists() and p.is_dir():
-        raise ValueError(f"{where} = {str(path)!r} is a directory, not a file")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{where} = {str(path)!r} exists and is not a regular file")
     parent = p.parent if str(p.parent) else Path(".")
     anc = parent
     while not anc.exists() and anc != anc.parent:
@@ -233,6 +300,16 @@ def output_path(where: str, path) -> "os.PathLike":
         raise ValueError(f"{where} = {str(path)!r}: {anc} is not a directory")
     if not os.access(anc, os.W_OK | os.X_OK):
         raise ValueError(f"{where} = {str(path)!r}: the directory {anc} is not writable")
+    if anc == parent:
+        # os.access says yes to root everywhere (/proc, read-only mounts): try it, leaving no trace.
+        existed = p.exists()
+        try:
+            with open(p, "ab"):
+                pass
+        except OSError as e:
+            raise ValueError(f"{where} = {str(path)!r} cannot be written: {e.strerror}") from None
+        if not existed:
+            p.unlink()
     return p
 
 
@@ -295,6 +372,8 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
     if unknown:
         raise ValueError(f"record: unknown key(s) {unknown}; allowed: {list(allowed)}")
     try:
+        if isinstance(n_steps, (bool, np.bool_)):
+            raise TypeError
         n_steps = operator.index(n_steps)
     except TypeError:
         raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None

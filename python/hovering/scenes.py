@@ -400,6 +400,14 @@ def _eval_expr(node):
     raise ValueError("unsupported expression")
 
 
+#: Most panels (or hovering-area series) in one figure: a scene is a figure, not a sweep; 200
+#: panels took 4 minutes and 300 MB.
+MAX_PANELS = 36
+#: Most eps values of one hovering-area scene.
+MAX_SERIES_POINTS = 200
+#: Largest scene file read (a scene is a few hundred bytes; /dev/zero must not be read forever).
+MAX_SCENE_BYTES = 1 << 20
+
 #: Longest expression string accepted: a parameter is a formula like "2 * pi * (sqrt(5) - 1) / 2",
 #: never a program; a 50,000-deep one exhausted the parser's memory.
 _MAX_EXPR = 200
@@ -640,6 +648,8 @@ def _parse_orbit_scene(where: str, kind: str, data: dict, scene_map: dict, commo
     raw = data["panels"]
     if not isinstance(raw, list) or not raw:
         raise ValueError(f"{where}.panels must be a non-empty array of tables ([[panels]]), got {raw!r}")
+    if len(raw) > MAX_PANELS:
+        raise ValueError(f"{where}.panels: {len(raw)} panels; allowed: at most {MAX_PANELS} (one figure)")
     panels = []
     for i, pt in enumerate(raw):
         pw = f"{where}.panels[{i}]"
@@ -795,12 +805,16 @@ def _parse_hovering_area(where: str, data: dict, scene_map: dict, common: dict) 
     ev = data["eps"]
     if not isinstance(ev, list) or not ev:
         raise ValueError(f"{where}.eps must be a non-empty list of numbers, got {ev!r}")
+    if len(ev) > MAX_SERIES_POINTS:
+        raise ValueError(f"{where}.eps: {len(ev)} values; allowed: at most {MAX_SERIES_POINTS} (use a sweep for more)")
     eps = tuple(_real(f"{where}.eps[{i}]", e) for i, e in enumerate(ev))
     if len(set(eps)) != len(eps):
         raise ValueError(f"{where}.eps = {ev!r} lists a value twice")
     sv = data["series"]
     if not isinstance(sv, list) or not sv:
         raise ValueError(f"{where}.series must be a non-empty array of tables ([[series]]), got {sv!r}")
+    if len(sv) > MAX_PANELS:
+        raise ValueError(f"{where}.series: {len(sv)} series; allowed: at most {MAX_PANELS}")
     series = []
     for i, st in enumerate(sv):
         sw = f"{where}.series[{i}]"
@@ -837,7 +851,7 @@ def _parse_hovering_area(where: str, data: dict, scene_map: dict, common: dict) 
     return Scene(
         eps=eps,
         samples=_int(f"{where}.samples", data["samples"], 1, 100_000_000) if "samples" in data else 100_000,
-        seed=_int(f"{where}.seed", data["seed"], 0) if "seed" in data else 0,
+        seed=_int(f"{where}.seed", data["seed"], 0, 2**63 - 1) if "seed" in data else 0,
         series=tuple(series),
         **common,
     )
@@ -864,11 +878,18 @@ def load_scene(path: os.PathLike) -> Scene:
         value: the message names the key, the value and the allowed keys or range.
     """
     p = Path(path)
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{p}: not a regular file (a scene is a .toml file)")
     with open(p, "rb") as f:
-        try:
-            data = tomllib.load(f)
-        except tomllib.TOMLDecodeError as e:
-            raise ValueError(f"{p.name}: not valid TOML: {e}") from None
+        raw = f.read(MAX_SCENE_BYTES + 1)
+    if len(raw) > MAX_SCENE_BYTES:
+        raise ValueError(f"{p.name}: larger than {MAX_SCENE_BYTES} bytes; a scene file is a few hundred")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{p.name}: not UTF-8 text (TOML files are UTF-8): byte {e.start}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ValueError(f"{p.name}: not valid TOML: {e}") from None
     return parse_scene(data, p)
 
 

@@ -11,7 +11,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask
+from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask, require_map
 from .rotation import regularity, rotation_number
 
 __all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
@@ -145,7 +145,7 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         If no start in ``K_range`` passes (no invariant curve found: widen the range); the message
         says when the sign of eps does not hover.
     """
-    th = m.theory()
+    th = require_map("m", m).theory()
     try:
         mask = region_mask(regions)
     except ValueError as e:

@@ -15,7 +15,7 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import Region, Status, check_memory, integer, real_number, thread_count
+from .._common import Region, Status, check_memory, flag, integer, real_number, require_map, thread_count
 
 __all__ = ["HoveringArea", "hovering_area"]
 
@@ -149,12 +149,17 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     ValueError
         For counts that are not integers in range, or a K_low outside the band below 0.
     """
+    require_map("m", m)
     n_steps = _count("n_steps", n_steps, 4)
     samples = _count("samples", samples, 1)
+    keep_points = flag("keep_points", keep_points)
     seed = integer("seed", seed, 0, 2**63 - 1)
     n_threads = thread_count(n_threads)
     check_memory(f"hovering_area with {samples} samples", 64 * samples)
     lo = m.valid_band()[0]
+    if not lo < 0:
+        raise ValueError(f"this map's band has no part below K = 0 (lower end {lo}): no point impacts under F_0, "
+                         f"nothing can hover")
     if K_low is None:
         depth = default_depth(m) if m.eps != 0 else 0.1
         K_low = max(-depth, lo * (1 - 1e-9))

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from .._common import is_choice
+from .._common import is_choice, real_array
 
 __all__ = ["birkhoff_weights", "birkhoff_average", "rotation_number", "regularity"]
 
@@ -57,7 +57,13 @@ def birkhoff_average(values, axis: int = -1) -> np.ndarray:
     ndarray or float
         The weighted average (the time axis removed).
     """
-    v = np.moveaxis(np.asarray(values, dtype=float), axis, -1)
+    v = real_array("values", values)
+    if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, (int, np.integer)) or not -max(v.ndim, 1) <= axis < max(v.ndim, 1):
+        raise ValueError(f"axis must be an integer in [-{max(v.ndim, 1)}, {max(v.ndim, 1) - 1}] (values has {v.ndim} "
+                         f"dimension(s)), got {axis!r}")
+    if v.ndim == 0:
+        raise ValueError("values must be a time series (at least 1-D), got a number")
+    v = np.moveaxis(v, int(axis), -1)
     if v.shape[-1] == 0:
         raise ValueError("birkhoff_average needs at least one sample along the time axis")
     if not np.all(np.isfinite(v)):
@@ -79,6 +85,14 @@ def _omegas(res, i: int) -> np.ndarray:
     return res.map.rotation(res.phi[i, :n], res.K[i, :n])
 
 
+def _result(name: str, res):
+    from ..truncated.maps import IterateResult
+
+    if not isinstance(res, IterateResult):
+        raise ValueError(f"{name} must be the IterateResult of a map's iterate(...), got {type(res).__name__}")
+    return res
+
+
 def rotation_number(res, method: str = "mean") -> np.ndarray:
     """Rotation number of each orbit of an iteration result.
 
@@ -98,6 +112,7 @@ def rotation_number(res, method: str = "mean") -> np.ndarray:
     ndarray
         Shape (n_orbits,); NaN for an orbit that took no step.
     """
+    _result("res", res)
     if not is_choice(method, ("mean", "birkhoff")):
         raise ValueError(f"method must be 'mean' or 'birkhoff', got {method!r}")
     if method == "mean" and res.rotation is not None:
@@ -127,6 +142,7 @@ def regularity(res) -> np.ndarray:
     ndarray
         Shape (n_orbits,); 16 means agreement to rounding; NaN for orbits with < 4 steps.
     """
+    _result("res", res)
     out = np.full(res.n_orbits, np.nan)
     for i in range(res.n_orbits):
         w = _omegas(res, i)

@@ -134,6 +134,8 @@ def check_potential(pot: Potential, check_extent: float = 10.0) -> None:
 
 def _q_limit(q_limit, label: str) -> float:
     try:
+        if isinstance(q_limit, (bool, str)):
+            raise TypeError
         lim = float(q_limit)
     except (TypeError, ValueError) as e:
         raise ValueError(f"{label}: q_limit must be a float > 0 (or math.inf), got {q_limit!r}") from e

@@ -8,7 +8,7 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from .._common import FlowStatus, integer, is_choice, real_array, real_number, thread_count
+from .._common import FlowStatus, integer, is_choice, status_code, real_array, real_number, thread_count
 from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
@@ -35,7 +35,7 @@ def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd
         raise ValueError(f"stepper must be one of {STEPPERS} (the implicit GSL steppers need a Jacobian the flow does "
                          f"not provide), got {stepper!r}")
     return _core.flow.FlowOptions(
-        stepper=stepper, rtol=real_number("rtol", rtol, 0, True, 1, True), atol=real_number("atol", atol, 0),
+        stepper=stepper, rtol=real_number("rtol", rtol, 1e-16, False, 1, True), atol=real_number("atol", atol, 0),
         event_tol=real_number("event_tol", event_tol, 0), max_steps=integer("max_steps", max_steps, 1, 2**62),
         max_impacts=integer("max_impacts", max_impacts, 1, 1_000_000),
         grazing_tol=real_number("grazing_tol", grazing_tol, 0, False), corner_tol=real_number("corner_tol", corner_tol, 0, False))
@@ -86,8 +86,8 @@ class ReturnMapResult:
     region: Optional[np.ndarray] = None
 
     def count(self, status) -> int:
-        """Number of orbits with the given :class:`FlowStatus`."""
-        return int(np.count_nonzero(self.status == int(status)))
+        """Number of orbits with the given :class:`FlowStatus` (or its name, or the Status of that name)."""
+        return int(np.count_nonzero(self.status == status_code(FlowStatus, status)))
 
 
 class Section:
@@ -110,7 +110,8 @@ class Section:
         if not isinstance(sys, StepSystem):
             raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
         self.sys = sys
-        self.h = real_number("h", h)
+        # 1e100: far above any physical level, and the potentials' energy questions stay finite.
+        self.h = real_number("h", h, hi=1e100, hi_open=False)
 
     def __repr__(self) -> str:
         return f"Section({self.sys!r}, h={self.h!r})"
@@ -140,8 +141,9 @@ class Section:
 
     def _points(self, theta, I):
         """Points of Sigma_h, a mask of those that exist, and why the others do not."""
+        t, i = real_array("theta", theta), real_array("I", I)  # type errors first, named
         try:
-            t, i = np.broadcast_arrays(real_array("theta", theta), real_array("I", I))
+            t, i = np.broadcast_arrays(t, i)
         except ValueError:
             raise ValueError(f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}") from None
         return _core.flow.section_points(self.sys.core, self.h, np.ascontiguousarray(t.ravel()),

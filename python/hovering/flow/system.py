@@ -139,15 +139,14 @@ class StepSystem:
                     raise ValueError(f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "
                                      "core would ignore; subclass hovering.Potential (or use CustomPotential) instead")
         for name in ("eps", "qw1", "qw2"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Real):
-                raise ValueError(f"{name} must be a real number, got {v!r}")
-            object.__setattr__(self, name, float(v))
+            object.__setattr__(self, name, real_number(name, getattr(self, name)))
         if not math.isfinite(self.eps):
             raise ValueError(f"eps must be finite, got {self.eps}")
         if self.eps != 0 and self.coupling is None:
             raise ValueError("eps != 0 needs a coupling (e.g. hovering.Bilinear())")
         _terms(self.coupling)
+        if isinstance(self.geometry, Geometry):  # the core's enum is as good as its name
+            object.__setattr__(self, "geometry", self.geometry.name.lower())
         if not is_choice(self.geometry, _GEOMETRIES):
             raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {self.geometry!r}")
         for name, pot in (("qw1", self.V1), ("qw2", self.V2)):
@@ -228,7 +227,7 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> 
     """
     if not isinstance(sys, StepSystem):
         raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
-    h = real_number("h", h)
+    h = real_number("h", h, hi=1e100, hi_open=False)
     if method == "definitions":
         return _core.flow._onset_parameters(sys.V1, sys.V2, sys.qw1, sys.qw2, float(h))
     if method == "quadrature":

@@ -9,10 +9,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._common import Region, wrap
+from .._common import Region, forcing_array, real_number, require_type, wrap
 from ..flow.section import Section
-from ..truncated.maps import TruncatedFamily
-from .coordinates import TangentialCurve
+from ..truncated.maps import TruncatedFamily, TruncatedMap
+from .coordinates import TangentialCurve, _curve_of, _finite_pair, _section
 from .corners import CornerCurves, _labels
 
 __all__ = ["truncated_from_flow", "MapComparison", "compare_maps"]
@@ -44,6 +44,9 @@ def truncated_from_flow(cc: CornerCurves, eps: float, forcing=(1.0,)) -> Truncat
     ValueError
         If the grid lacks circles on either side of 0 or an arc is missing (NaN) below 0.
     """
+    require_type("cc", cc, CornerCurves, "the CornerCurves of hovering.corner_curves(...)")
+    eps = real_number("eps", eps)
+    forcing = forcing_array(forcing)
     K = cc.K
     order = np.argsort(K)
     K, JR, J1, Om = K[order], cc.JR[order], cc.J1[order], cc.Omega[order]
@@ -114,8 +117,13 @@ def compare_maps(sec: Section, curve: TangentialCurve, trunc, phi, K, rtol: floa
     -------
     MapComparison
     """
-    ph = np.atleast_1d(np.asarray(phi, dtype=float))
-    Kk = np.broadcast_to(np.asarray(K, dtype=float), ph.shape).copy()
+    _section("sec", sec)
+    curve = _curve_of(sec, curve)
+    require_type("trunc", trunc, (TruncatedMap, TruncatedFamily), "a TruncatedMap or TruncatedFamily")
+    ph, Kk = _finite_pair("phi", phi, "K", K)
+    if ph.ndim > 1:
+        raise ValueError(f"phi and K must be numbers or 1-D arrays, got shape {ph.shape}")
+    ph, Kk = np.atleast_1d(ph), np.atleast_1d(Kk)
     lab, out = _labels(sec, curve, ph, Kk, rtol)
     pb, Kb = curve.to_normal(out.theta, out.I)
     pt, Kt = trunc.step(ph, Kk)

@@ -17,7 +17,7 @@ import operator
 import numpy as np
 
 from .. import _core
-from .._common import real_array, require_angles, require_finite, wrap
+from .._common import MAX_MODES, integer, real_array, require_angles, require_finite, require_type, wrap
 from ..flow.section import FlowStatus, Section, flow_options
 
 __all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_coefficients", "to_normal", "from_normal"]
@@ -118,14 +118,16 @@ class TangentialCurve:
             If the curve is not a graph over theta.
         """
         self._require_graph()
-        th = np.asarray(theta, dtype=float)
+        th = real_array("theta", theta)
+        require_angles("theta", th)
         out = self._c.I_tan(np.ascontiguousarray(np.ravel(wrap(th)), dtype=float)).reshape(th.shape)
         return out if out.ndim else float(out)
 
     def at(self, s):
         """``(theta(s), I(s))`` of the closed curve at wall angles s (works for any curve)."""
-        a = np.ascontiguousarray(np.atleast_1d(np.asarray(s, dtype=float)))
-        return self._c.at(a)
+        a = np.atleast_1d(real_array("s", s))
+        require_angles("s", a)
+        return self._c.at(np.ascontiguousarray(a.ravel()))
 
     def to_normal(self, theta, I):
         """``(phi, K) = (theta, I - I_tan(theta))`` (eq:kphidef); theta, I finite, I > 0."""
@@ -150,7 +152,8 @@ class TangentialCurve:
         eps = self.sec.sys.eps
         if eps == 0:
             raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
-        ph = np.asarray(phi, dtype=float)
+        ph = real_array("phi", phi)
+        require_angles("phi", ph)
         return (self(-ph) - self(ph)) / eps
 
     def forcing_coefficients(self, n_modes: int = 8, n_phi: int = 256) -> np.ndarray:
@@ -168,12 +171,34 @@ class TangentialCurve:
         -------
         ndarray
         """
-        if not (isinstance(n_modes, (int, np.integer)) and 1 <= n_modes and isinstance(n_phi, (int, np.integer))
-                and n_phi > 2 * n_modes):
-            raise ValueError(f"need integers n_modes >= 1 and n_phi > 2 n_modes, got {n_modes!r}, {n_phi!r}")
+        n_modes, n_phi = _mode_counts(n_modes, n_phi)
         ph = -np.pi + _TWO_PI * (np.arange(n_phi) + 0.5) / n_phi
         A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
         return np.linalg.lstsq(A, self.forcing(ph), rcond=None)[0]
+
+
+def _mode_counts(n_modes, n_phi) -> tuple:
+    """(n_modes, n_phi) of a sine fit: 1 <= n_modes <= MAX_MODES, 2 n_modes < n_phi <= 65536 (beyond,
+    each sample is a flow trace and the fit gains nothing)."""
+    n_modes = integer("n_modes", n_modes, 1, MAX_MODES)
+    return n_modes, integer("n_phi (> 2 n_modes, so the fit is determined)", n_phi, 2 * n_modes + 1, 65536)
+
+
+def _section(name: str, sec) -> Section:
+    return require_type(name, sec, Section, "a hovering.Section (hovering.Section(system, h))")
+
+
+def _curve_of(sec: Section, curve) -> "TangentialCurve":
+    """The tangential curve of sec (measured if None); a ValueError for any other object or the
+    curve of another system or energy (whose normal coordinates mean something else)."""
+    if curve is None:
+        return TangentialCurve(sec)
+    if not isinstance(curve, TangentialCurve) or curve.sec.sys != sec.sys or curve.sec.h != sec.h:
+        raise ValueError(f"curve must be the TangentialCurve of this section (same system, h = {sec.h}), got "
+                         f"{curve!r}" if not isinstance(curve, TangentialCurve) else
+                         f"curve must be the TangentialCurve of this section (same system, h = {sec.h}); it belongs "
+                         f"to h = {curve.sec.h}" + ("" if curve.sec.sys == sec.sys else " of another system"))
+    return curve
 
 
 def _finite_pair(na, a, nb, b):
@@ -243,6 +268,7 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         For an empty theta, a bracket outside (0, 1) or bad iterations, or if no bracket up to
         I_tan (1 -+ 0.95) contains the tangency for every theta.
     """
+    _section("sec", sec)
     shape = np.shape(theta) if np.ndim(theta) else (1,)
     th = np.atleast_1d(real_array("theta", theta)).ravel()
     require_angles("theta", th)
@@ -292,9 +318,10 @@ def forcing_function(sec: Section, phi, **kwargs) -> np.ndarray:
     -------
     ndarray
     """
-    if sec.sys.eps == 0:
+    if _section("sec", sec).sys.eps == 0:
         raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
-    p = np.atleast_1d(np.asarray(phi, dtype=float))
+    p = np.atleast_1d(real_array("phi", phi)).ravel()
+    require_angles("phi", p)
     both = tangential_curve(sec, np.concatenate([-p, p]), **kwargs)
     return (both[: p.size] - both[p.size :]) / sec.sys.eps
 
@@ -318,6 +345,8 @@ def forcing_coefficients(sec: Section, n_modes: int = 6, n_phi: int = 64, **kwar
     ndarray
         ``b_1 .. b_n_modes``.
     """
+    _section("sec", sec)
+    n_modes, n_phi = _mode_counts(n_modes, n_phi)
     ph = np.linspace(-np.pi, np.pi, n_phi + 2)[1:-1]
     f = forcing_function(sec, ph, **kwargs)
     A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
@@ -340,6 +369,7 @@ def to_normal(sec: Section, theta, I, **kwargs):
     -------
     phi, K : ndarray
     """
+    _section("sec", sec)
     th, I = _section_pair(np.atleast_1d(theta), I)
     return th, I - tangential_curve(sec, th, **kwargs)
 
@@ -360,6 +390,7 @@ def from_normal(sec: Section, phi, K, **kwargs):
     -------
     theta, I : ndarray
     """
+    _section("sec", sec)
     p, K = _finite_pair("phi", np.atleast_1d(phi), "K", K)
     I = K + tangential_curve(sec, p, **kwargs)
     _positive_action(I, K)

@@ -10,10 +10,10 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import wrap
+from .._common import integer, real_array, require_finite, wrap
 from ..flow.section import FlowStatus, Section
 from ..flow.system import onset_parameters
-from .coordinates import TangentialCurve
+from .coordinates import TangentialCurve, _curve_of, _section
 
 __all__ = ["CornerCurves", "corner_curves"]
 
@@ -97,16 +97,17 @@ def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_ph
     ValueError
         If the section is not a step system, or for bad counts.
     """
-    if sec.sys.geometry != "step":
+    if _section("sec", sec).sys.geometry != "step":
         raise ValueError(f"corner curves need geometry 'step', got {sec.sys.geometry!r}")
-    if not (isinstance(n_phi, (int, np.integer)) and n_phi >= 16):
-        raise ValueError(f"n_phi must be an integer >= 16, got {n_phi!r}")
-    if not (isinstance(bisections, (int, np.integer)) and 0 <= bisections <= 60):
-        raise ValueError(f"bisections must be an integer in [0, 60], got {bisections!r}")
-    Ks = np.atleast_1d(np.asarray(K, dtype=float))
-    if not np.all(np.isfinite(Ks)):
-        raise ValueError(f"K must be finite, got {Ks}")
-    curve = curve if curve is not None else TangentialCurve(sec)
+    # n_phi <= 65536: each sample is a flow return per bisection; 10^9 ran for minutes.
+    n_phi = integer("n_phi", n_phi, 16, 65536)
+    bisections = integer("bisections", bisections, 0, 60)
+    Ks = real_array("K", K)
+    if Ks.ndim > 1:
+        raise ValueError(f"K must be a number or a 1-D array of circles, got shape {Ks.shape}")
+    Ks = np.atleast_1d(Ks)
+    require_finite("K", Ks)
+    curve = _curve_of(sec, curve)
     nK = Ks.size
     ph = -np.pi + _TWO_PI * np.arange(n_phi) / n_phi
     P = np.tile(ph, nK)

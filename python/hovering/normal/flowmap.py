@@ -15,7 +15,8 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import Region, check_memory, is_choice, iterate_arguments, real_array, require_angles, require_finite, wrap
+from .._common import (MAX_MODES, Region, check_memory, flag, integer, is_choice, iterate_arguments, real_array,
+                       require_angles, require_finite, wrap)
 from .._protocols import MapAnalyses
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -65,8 +66,11 @@ class FlowSteps:
 
 def _pair(phi, K, who: str):
     scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
+    p, k = real_array(f"{who}: phi", phi), real_array(f"{who}: K", K)  # type errors first, named
+    require_angles(f"{who}: phi", p)
+    require_finite(f"{who}: K", k)
     try:
-        p, k = np.broadcast_arrays(real_array(f"{who}: phi", phi), real_array(f"{who}: K", K))
+        p, k = np.broadcast_arrays(p, k)
     except ValueError:
         raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {np.shape(phi)} and {np.shape(K)}") from None
     return p, k, scalar
@@ -180,7 +184,7 @@ class FlowMap(MapAnalyses):
             On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
         """
         p, k, _ = _pair(phi, K, "returns")
-        d = self._core.steps(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel()), bool(inverse),
+        d = self._core.steps(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel()), flag("inverse", inverse),
                              _threads(n_threads, self.sys.python_defined))
         res = FlowSteps(phi=d["x"], K=d["y"], status=d["status"], region=d["region"], itinerary=d["itinerary"],
                         time=d["time"], energy_error=d["energy_error"], steps=d["steps"], z=d["z"])
@@ -347,6 +351,7 @@ class FlowMap(MapAnalyses):
         At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit is used there,
         measured on the system at eps = 1e-6 (zeros without a coupling).
         """
+        n_modes = integer("n_modes", n_modes, 1, MAX_MODES)
         if self._forcing is None or self._forcing.size != n_modes:
             if self.curve is None:
                 raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
@@ -468,8 +473,11 @@ class FlowMap(MapAnalyses):
         lifted to the branch nearest the onset model's ``omega_a(K_n)`` of the return's region (the
         truncated map's own rotation, eq:omegaofalead), so the flow's and the model's rotation
         numbers compare directly. Needs ``record=("orbit", "regions")``."""
+        if not isinstance(res, IterateResult) or res.map is not self:
+            raise ValueError("res must be the IterateResult of this FlowMap's iterate(...)")
         if res.region is None:
             raise ValueError("the flow's rotations need record=('orbit', 'regions')")
+        i = integer("i (orbit index)", i, -res.n_orbits, res.n_orbits - 1)
         self._require_onset()
         n = int(res.steps_done[i])
         ph, K, reg = res.phi[i, : n + 1], res.K[i, : n + 1], res.region[i, :n]

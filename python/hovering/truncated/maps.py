@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import _core
 from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
-                       require_angles, require_finite, thread_count, wrap)
+                       require_angles, require_finite, status_code, thread_count, wrap, forcing_array)
 from .._protocols import MapAnalyses
 from . import theory as _geo
 
@@ -107,7 +107,7 @@ class IterateResult:
         -------
         int
         """
-        return int(np.count_nonzero(self.status == int(status)))
+        return int(np.count_nonzero(self.status == status_code(Status, status)))
 
 
 def _finite_float(name: str, value) -> float:
@@ -432,7 +432,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         -------
         ndarray or float
         """
-        return np.sin(phi)
+        return np.sin(_angles("phi", phi))
 
     def L1(self, K):
         """Angle of the line L1 at heights K (def:L1L2); see :func:`hovering.truncated.theory.L1`."""
@@ -483,10 +483,17 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         return TruncatedMap(**p, K_max=self.valid_band()[1])
 
 
+def _angles(name: str, phi):
+    """Finite angles with |phi| <= 1e6 (beyond, sin(k phi) is rounding noise), as an array or float."""
+    a = real_array(name, phi)
+    require_angles(name, a)
+    return a if a.ndim else float(a)
+
+
 def _as_table(name: str, values, K: np.ndarray) -> np.ndarray:
     if callable(values):
-        values = np.asarray([values(k) for k in K], dtype=float)
-    a = np.asarray(values, dtype=float)
+        values = [values(k) for k in K]
+    a = real_array(name, values)
     if a.shape != K.shape:
         raise ValueError(f"{name} must have the shape of K {K.shape}, got {a.shape}")
     return a
@@ -526,7 +533,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         if Kg.ndim != 1:
             raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")
         tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]
-        b = np.atleast_1d(np.asarray(forcing, dtype=float))
+        b = forcing_array(forcing)
         _core.truncated.TruncatedFamily.__init__(self, eps, list(Kg), *(list(t) for t in tabs), list(b), float(K_max))
         self._tables = (Kg.copy(), *(t.copy() for t in tabs))
         self._K_max = float(K_max)
@@ -543,7 +550,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         -------
         ndarray or float
         """
-        phi = np.asarray(phi, dtype=float)
+        phi = np.asarray(_angles("phi", phi), dtype=float)
         out = sum(b * np.sin((k + 1) * phi) for k, b in enumerate(self.forcing))
         return float(out) if out.ndim == 0 else out
 

@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .._common import real_array, real_number, require_finite, wrap
+from .._common import forcing_array, integer, real_array, real_number, require_finite, wrap
 
 __all__ = [
     "OMEGA_G",
@@ -89,7 +89,11 @@ def _rotation(K, Omega0, tau0, name="K") -> np.ndarray:
     """Omega0 + tau0 K, refused (naming K) where it is too large an angle to wrap accurately."""
     k = _finite(name, K)
     with np.errstate(over="ignore", invalid="ignore"):
-        Om = _finite("Omega0", Omega0) + _finite("tau0", tau0) * k
+        try:
+            Om = _omega0(Omega0) + _finite("tau0", tau0) * k
+        except ValueError:
+            raise ValueError(f"{name}, Omega0 and tau0 must have broadcastable shapes, got {np.shape(k)}, "
+                             f"{np.shape(Omega0)} and {np.shape(tau0)}") from None
     if np.any(~(np.abs(Om) <= 1e6)):
         i = int(np.argmax(~(np.ravel(np.abs(Om)) <= 1e6)))
         raise ValueError(f"{name} = {np.ravel(k + np.zeros_like(Om))[i]} gives the rotation Omega0 + tau0 {name} = "
@@ -98,9 +102,19 @@ def _rotation(K, Omega0, tau0, name="K") -> np.ndarray:
     return Om
 
 
+def _omega0(Omega0):
+    """Omega0 as a finite number (or array) with |Omega0| <= 1e6, the truncated map's own limit:
+    beyond, sin(Omega0 / 2) is rounding noise (K_crit(Omega0 = 1e300) was a confident 0.24)."""
+    om = _finite("Omega0", Omega0)
+    if np.any(np.abs(om) > 1e6):
+        raise ValueError(f"Omega0 must lie in [-1e6, 1e6] (a larger rotation cannot be reduced mod 2 pi accurately), "
+                         f"got {np.ravel(om)[int(np.argmax(np.ravel(np.abs(om)) > 1e6))]}")
+    return om if np.ndim(om) else float(om)
+
+
 def _sin_half(Omega0) -> np.ndarray:
     """sin(Omega0 / 2), NaN where it vanishes (resonant Omega0: the first-order theory has no curve)."""
-    s = np.sin(0.5 * _finite("Omega0", Omega0))
+    s = np.sin(0.5 * _omega0(Omega0))
     return np.where(np.abs(s) < 1e-12, np.nan, s)
 
 
@@ -109,6 +123,17 @@ def _wall_angle(theta_w) -> np.ndarray:
     if np.any((tw <= 0) | (tw >= np.pi)):
         raise ValueError(f"theta_w must lie in (0, pi), got {np.ravel(tw)[np.argmax(np.ravel((tw <= 0) | (tw >= np.pi)))]}")
     return tw
+
+
+def _broadcast_angle(phi, a):
+    """phi + a for angles phi (finite, |phi| <= 1e6) broadcast against the half rotations a(K0)."""
+    p = _finite("phi", phi)
+    if np.any(np.abs(p) > 1e6):
+        raise ValueError(f"phi must be angles in [-1e6, 1e6], got {np.ravel(p)[int(np.argmax(np.ravel(np.abs(p)) > 1e6))]}")
+    try:
+        return p + a
+    except ValueError:
+        raise ValueError(f"phi and K0 must have broadcastable shapes, got {np.shape(p)} and {np.shape(a)}") from None
 
 
 def _half_rotation(K0, Omega0, tau0):
@@ -143,7 +168,7 @@ def k_eps1(phi, K0, eps, Omega0, tau0):
     """
     a = _half_rotation(K0, Omega0, tau0)
     with np.errstate(over="ignore", invalid="ignore"):
-        return K0 + _finite("eps", eps) * (1.0 - np.cos(_finite("phi", phi) + a)) / (2.0 * _sin_of(a))
+        return K0 + _finite("eps", eps) * (1.0 - np.cos(_broadcast_angle(phi, a))) / (2.0 * _sin_of(a))
 
 
 def k_eps2(phi, K0, eps, Omega0, tau0):
@@ -165,7 +190,7 @@ def k_eps2(phi, K0, eps, Omega0, tau0):
     """
     a = _half_rotation(K0, Omega0, tau0)
     with np.errstate(over="ignore", invalid="ignore"):
-        return K0 - _finite("eps", eps) * (1.0 + np.cos(_finite("phi", phi) + a)) / (2.0 * _sin_of(a))
+        return K0 - _finite("eps", eps) * (1.0 + np.cos(_broadcast_angle(phi, a))) / (2.0 * _sin_of(a))
 
 
 def rho1(K0, eps, Omega0, tau0):
@@ -244,7 +269,7 @@ def rho_crit(eps, theta_w, Omega0, tau0):
         ``Omega0 + eps tau0 cos(theta_w) / (2 sin(Omega0/2))``.
     """
     with np.errstate(over="ignore", invalid="ignore"):
-        out = _finite("Omega0", Omega0) + _finite("eps", eps) * _finite("tau0", tau0) * np.cos(_wall_angle(theta_w)) / (
+        out = _omega0(Omega0) + _finite("eps", eps) * _finite("tau0", tau0) * np.cos(_wall_angle(theta_w)) / (
             2.0 * _sin_half(Omega0))
     return out if np.ndim(out) else float(out)
 
@@ -304,7 +329,11 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
     eps, c, tau0, Omega_G = (real_number(n, v) for n, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G)))
     if not abs(c) < abs(tau0):
         raise ValueError(f"c must satisfy |c| < |tau0| = {abs(tau0)}, got c = {c}")
+    _omega0(Omega_G)
     Omega0 = Omega_G - 0.5 * c * eps
+    if not abs(Omega0) <= 1e6:
+        raise ValueError(f"eps = {eps} and c = {c} give Omega0 = Omega_G - c eps / 2 = {Omega0:.6g}; allowed: "
+                         f"|Omega0| <= 1e6 (a larger rotation cannot be reduced mod 2 pi accurately)")
     theta_w = float(np.arccos((c / tau0) * np.sin(0.5 * Omega_G - 0.25 * c * eps)))
     return float(Omega0), theta_w
 
@@ -437,14 +466,10 @@ def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing
     ValueError
         For non-finite parameters, an empty forcing or ``n_grid < 101``.
     """
-    for name, v in (("eps", eps), ("Omega0", Omega0), ("theta_w", theta_w), ("tau0", tau0)):
-        if not (isinstance(v, (int, float, np.floating, np.integer)) and math.isfinite(v)):
-            raise ValueError(f"{name} must be a finite number, got {v!r}")
-    b = tuple(float(x) for x in np.atleast_1d(np.asarray(forcing, dtype=float)))
-    if not b or not all(math.isfinite(x) for x in b):
-        raise ValueError(f"forcing must be a non-empty sequence of finite sine coefficients, got {forcing!r}")
-    if int(n_grid) < 101:
-        raise ValueError(f"n_grid must be >= 101, got {n_grid}")
+    eps, theta_w, tau0 = (real_number(n, v) for n, v in (("eps", eps), ("theta_w", theta_w), ("tau0", tau0)))
+    Omega0 = _omega0(Omega0)
+    b = tuple(float(x) for x in forcing_array(forcing))
+    n_grid = integer("n_grid", n_grid, 101, 10**7)
     nan = float("nan")
     base = dict(eps=float(eps), Omega0=float(Omega0), theta_w=float(theta_w), tau0=float(tau0), forcing=b)
     if not 0 < theta_w < math.pi:

@@ -28,16 +28,97 @@ using detail::kPi;
 
 double call(double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); }
 
-// int_a^b (x - a)^al (b - x)^be f(x) dx by GSL QAWS. A failure is bad input, not a bug: the level
-// h is too small for the well's width to be resolved, or V has a plateau (V = h on an interval).
-double qaws(const std::function<double(double)>& f, double a, double b, double al, double be, const Potential& pot,
-            const char* who, double h) {
+// pi - kPi: the angle theta (a double) lies (kPi - theta) + kPiLow before pi, which matters
+// relatively for p near theta = +-pi (the closed forms' sin(theta) sees it too).
+constexpr double kPiLow = 1.2246467991473532e-16;
+
+// A level h of a potential: its turning points a < 0 < b and the energy deficit h - V near them.
+struct Level {
+    const Potential& pot;
+    double h, a, b;
+
+    Level(const Potential& p, double level, const char* who) : pot(p), h(level) {
+        const auto tp = p.turning_points(level);
+        a = tp.first;
+        b = tp.second;
+        // Everything below takes h - V = 0 at the turning points. Above the largest value V takes
+        // inside a bounded well (Tan: ~5e32 at the last double before its wall) the turning point
+        // is that last double, where h - V ~ h: the level has hard walls, which no quadrature here
+        // resolves. (Up to a factor 2 is rounding: near a wall V may change by 40% per ulp.)
+        for (const double e : {a, b}) {
+            const double v = p.V(e);
+            if (!(v >= 0.5 * h))
+                bad(p.name() + "." + who + ": the level h = " + fmt(h) + " lies above the largest value V reaches inside the wall q_limit = " +
+                    fmt(p.q_limit()) + " (V(" + fmt(e) + ") = " + fmt(v) + " at the turning point): it has no turning point the "
+                    "quadrature can resolve; allowed: h <= " + fmt(2 * v) + ", or a closed-form potential");
+        }
+    }
+
+    double end(int side) const { return side > 0 ? b : a; }
+
+    // (h - V(q)) / |q - end| at the point q = end - side d, d >= 0, inside the turning point `end`
+    // (side +1: b, -1: a), i.e. the mean of |V'| over [q, end]. h - V(q) loses the digits V shares
+    // with h as q nears the turning point (relative error ~eps h / (h - V), 1e-7 at 1e-9 of the
+    // width, enough to stop QAWS converging): below 1e-2 h the mean is instead 5-point
+    // Gauss-Legendre on V', exact for V' of degree 9; there d <~ 1e-2 h / |V'(end)|, a length on
+    // which V' changes little, so its error is ~(d / l)^10 for V' varying on the scale l.
+    // At d = 0 it is |V'(end)|, the limit the quadratures need at the turning points.
+    double slope(double d, int side) const {
+        const double e = end(side), q = e - side * d;
+        const double dq = side * (e - q);  // the distance q really has (q is rounded)
+        if (dq > 0) {
+            const double D = h - pot.V(q);
+            if (D >= 1e-2 * h) return D / dq;
+        }
+        static constexpr double x[5] = {0.0, 0.5384693101056831, -0.5384693101056831, 0.9061798459386640,
+                                        -0.9061798459386640};
+        static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
+                                        0.2369268850561891, 0.2369268850561891};
+        double s = 0;
+        for (int i = 0; i < 5; ++i) s += w[i] * pot.dV(e - side * (0.5 * d * (1 + x[i])));
+        return 0.5 * side * s;
+    }
+
+    // Smooth factor of the time to the turning point: dt/du = u^(-1/2) g(u) at distance u from it.
+    double g(double u, int side) const { return 1 / std::sqrt(2 * slope(u, side)); }
+
+    // Below this distance from a turning point the time to it is the local expansion of time():
+    // 1e-6 of the length on which V' changes (at most the width, h / |V'| at the end; both are
+    // that scale for power-law and Tan-like walls), where the expansion's relative error
+    // (4/45) (d / l)^2 ~ 1e-13 times an angle of ~1e-3 is ~1e-16 rad.
+    double window(int side) const {
+        const double e = end(side);
+        return 1e-6 * std::min(b - a, h / std::fabs(pot.dV(e)));
+    }
+
+    // int_lo^hi (u - lo)^al (hi - u)^be f(u) du by GSL QAWS (epsrel 1e-12). A failure is bad
+    // input, not a bug: V has a plateau (V = h on an interval), or the level is too small for the
+    // well's width to be resolved.
+    double qaws(const std::function<double(double)>& f, double lo, double hi, double al, double be,
+                const char* who) const;
+
+    // Time from the point at distance d inside the turning point `end` to it:
+    // int_0^d u^(-1/2) g(u) du. Within window(side) this is 2 sqrt(d) g(d / 3): with
+    // g = g0 + g1 u + g2 u^2 the integral is 2 sqrt(d) (g0 + g1 d / 3 + g2 d^2 / 5), the expansion
+    // 2 sqrt(d) (g0 + g1 d / 3 + g2 d^2 / 9). Beyond it QAWS in the local variable u, which keeps
+    // the interval's rounding off a short interval next to a turning point.
+    double time(double d, int side, double win, const char* who) const {
+        if (!(d > 0)) return 0;
+        if (d <= win) return 2 * std::sqrt(d) * g(d / 3, side);
+        return qaws([&](double u) { return g(u, side); }, 0.0, d, -0.5, 0.0, who);
+    }
+};
+
+double Level::qaws(const std::function<double(double)>& f, double lo, double hi, double al, double be,
+                   const char* who) const {
     gsl_quiet();
     gsl_integration_qaws_table* t = gsl_integration_qaws_table_alloc(al, be, 0, 0);
     gsl_integration_workspace* w = gsl_integration_workspace_alloc(200);
     gsl_function F{&call, const_cast<std::function<double(double)>*>(&f)};
     double r = 0, err = 0;
-    const int st = gsl_integration_qaws(&F, a, b, t, 1e-14, 1e-12, 200, w, &r, &err);
+    // Relative accuracy only: times and actions scale with 1 / omega and h / omega, and an
+    // absolute floor would stop at the first estimate for a stiff well (omega = 1e50).
+    const int st = gsl_integration_qaws(&F, lo, hi, t, 0.0, 1e-12, 200, w, &r, &err);
     gsl_integration_workspace_free(w);
     gsl_integration_qaws_table_free(t);
     if (st != GSL_SUCCESS && st != GSL_EROUND && !(err <= 1e-10 * std::fabs(r)))
@@ -51,16 +132,6 @@ double qaws(const std::function<double(double)>& f, double a, double b, double a
 // Root of f on [lo, hi] (f(lo), f(hi) of opposite signs) to ~1 ulp.
 double brent(const std::function<double(double)>& f, double lo, double hi) {
     return detail::brent(f, lo, hi, 4 * std::numeric_limits<double>::epsilon());
-}
-
-// The quadrature rules evaluate the smooth factor at the turning points, where its formula is
-// 0/0, and just inside them h - V cancels; there the factor is its limit, from V' at the end.
-// tol: 1e-9 of the level's width (the caller's turning points).
-template <class F>
-double near_end(double q, double a, double b, double at_a, double at_b, double tol, F f) {
-    if (q - a <= tol) return at_a;
-    if (b - q <= tol) return at_b;
-    return f();
 }
 
 // Parameters whose square (and the ratios omega^2 / alpha^2 of Tan) stay normal doubles: outside,
@@ -84,37 +155,62 @@ std::pair<double, double> Potential::turning_points(double h) const {
     check_energy(h, "turning_points");
     // Subnormal levels: h - V(q) has too few significant bits for any quadrature.
     if (h < 1e-300) bad(name() + ": energy must be >= 1e-300 on the quadrature path (no closed form), got " + fmt(h));
+    const double lim = q_limit();
     auto side = [&](double sgn) {
-        // Bracket V = h on one side: expand outward (or toward the edge of a bounded well).
-        const double lim = q_limit();
+        // Bracket V = h on one side: V(inner) < h <= V(outer) (or V(outer) not finite), expanding
+        // outward by doubling up to the largest double, or halving the distance to the wall of a
+        // bounded well until it reaches q_limit itself (~53 steps).
         double inner = 0, outer = std::isfinite(lim) ? 0.5 * lim : 1.0;
         for (int k = 0; V(sgn * outer) < h; ++k) {
-            if (k > 200) bad(name() + ": V never reaches the energy " + fmt(h) + " (not a single well?)");
+            double next = std::isfinite(lim) ? lim - 0.5 * (lim - outer) : 2 * outer;
+            if (next == outer) next = lim;  // lim - ulp / 2 rounded (to even) back to outer
+            if (k > 2100 || outer == lim || !std::isfinite(next))
+                bad(name() + ": V never reaches the energy " + fmt(h) + " (V(" + fmt(sgn * outer) + ") = " +
+                    fmt(V(sgn * outer)) + (std::isfinite(lim) ? " at the wall q_limit" : "") +
+                    "; allowed: a single well whose V rises above every level, to +inf at the wall of a bounded well)");
             inner = outer;
-            outer = std::isfinite(lim) ? lim - 0.5 * (lim - outer) : 2 * outer;
+            outer = next;
         }
         // For small h, halve toward 0 first: a bracket [x/2, x] lets Brent reach full relative
         // accuracy; [0, 1] around a root 1e-35 exhausted its iterations at a point 1e-31.
         while (inner == 0 && outer > 1e-300 && V(sgn * 0.5 * outer) >= h) outer *= 0.5;
         if (inner == 0) inner = 0.5 * outer;
+        // V(outer) = inf (Tan at its wall, an overflow) would make Brent return garbage: bisect
+        // until V(outer) is finite. If the bracket closes to adjacent doubles first, no double has
+        // h <= V(q) < inf, and inner is the largest q with V(q) <= h: Tan's V reaches only ~5e32
+        // at the last double before its wall, so every h above that has q_max = q_limit to 1 ulp.
+        for (double vo = V(sgn * outer); !std::isfinite(vo);) {
+            const double mid = inner + 0.5 * (outer - inner);
+            if (!(mid > inner && mid < outer)) return sgn * inner;
+            const double vm = V(sgn * mid);
+            if (vm < h) {
+                inner = mid;
+            } else {
+                outer = mid;
+                vo = vm;
+            }
+        }
         return sgn * brent([&](double x) { return V(sgn * x) - h; }, inner, outer);
     };
     return {side(-1.0), side(1.0)};
 }
 
 double Potential::period(double h) const {
-    const auto [a, b] = turning_points(h);
-    // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V)))
-    const double ra = std::sqrt((b - a) / (2 * -dV(a))), rb = std::sqrt((b - a) / (2 * dV(b)));
-    return 2 * qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt((q - a) * (b - q) / (2 * (h - V(q)))); }); },
-                    a, b, -0.5, -0.5, *this, "period", h);
+    const Level L(*this, h, "period");
+    const double a = L.a, b = L.b, mid = 0.5 * (a + b);
+    // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V))),
+    // h - V written as slope x distance to the nearer turning point (no cancellation there).
+    return 2 * L.qaws([&](double q) {
+        return q >= mid ? std::sqrt((q - a) / (2 * L.slope(b - q, 1))) : std::sqrt((b - q) / (2 * L.slope(q - a, -1)));
+    }, a, b, -0.5, -0.5, "period");
 }
 
 double Potential::action(double h) const {
-    const auto [a, b] = turning_points(h);
-    const double ra = std::sqrt(2 * -dV(a) / (b - a)), rb = std::sqrt(2 * dV(b) / (b - a));
-    return qaws([&](double q) { return near_end(q, a, b, ra, rb, 1e-9 * (b - a), [&] { return std::sqrt(2 * (h - V(q)) / ((q - a) * (b - q))); }); },
-                a, b, 0.5, 0.5, *this, "action", h) / kPi;
+    const Level L(*this, h, "action");
+    const double a = L.a, b = L.b, mid = 0.5 * (a + b);
+    return L.qaws([&](double q) {
+        return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) / (q - a)) : std::sqrt(2 * L.slope(q - a, -1) / (b - q));
+    }, a, b, 0.5, 0.5, "action") / kPi;
 }
 
 double Potential::energy(double I) const {
@@ -137,41 +233,65 @@ double Potential::energy(double I) const {
 double Potential::frequency(double h) const { return 2 * kPi / period(h); }
 
 double Potential::angle_of(double q, double h) const {
-    const auto [a, b] = turning_points(h);
-    if (!(q >= a && q <= b))
+    const Level L(*this, h, "angle_of");
+    const double a = L.a, b = L.b;
+    // The turning points are roots known to a few ulps: a q that far beyond one (a closed form's
+    // turning point, rounding elsewhere) is on the level, at its end.
+    const double tol = 8 * std::numeric_limits<double>::epsilon() * std::max(-a, b);
+    if (!(q >= a - tol && q <= b + tol))
         bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h) + ", [" + fmt(a) + ", " + fmt(b) + "]");
+    q = std::min(std::max(q, a), b);
     const double w = frequency(h);
-    // Integrate from the nearer turning point, where the weight takes the 1/sqrt; within 1e-12 of
-    // it the time is its square-root asymptote sqrt(2 d / |V'|).
-    if (q >= 0.5 * (a + b)) {
-        if (b - q <= 1e-12 * (b - a)) return w * std::sqrt(2 * (b - q) / dV(b));
-        const double rb = std::sqrt(1 / (2 * dV(b)));
-        return w * qaws([&](double x) { return near_end(x, -kInf, b, 0.0, rb, 1e-9 * (b - a), [&] { return std::sqrt((b - x) / (2 * (h - V(x)))); }); },
-                        q, b, 0.0, -0.5, *this, "angle_of", h);
-    }
-    if (q - a <= 1e-12 * (b - a)) return kPi - w * std::sqrt(2 * (q - a) / -dV(a));
-    const double ra = std::sqrt(1 / (2 * -dV(a)));
-    return kPi - w * qaws([&](double x) { return near_end(x, a, kInf, ra, 0.0, 1e-9 * (b - a), [&] { return std::sqrt((x - a) / (2 * (h - V(x)))); }); },
-                          a, q, -0.5, 0.0, *this, "angle_of", h);
+    // From the nearer turning point (exact distance: Sterbenz), where the time has its 1/sqrt.
+    if (q >= 0.5 * (a + b)) return w * L.time(b - q, 1, L.window(1), "angle_of");
+    return (kPi - w * L.time(q - a, -1, L.window(-1), "angle_of")) + kPiLow;
 }
 
 std::pair<double, double> Potential::point_at(double theta, double h) const {
     if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
-    const auto [a, b] = turning_points(h);
+    const Level L(*this, h, "point_at");
     const double th = std::fabs(theta), w = frequency(h), sg = theta > 0 ? -1.0 : 1.0;
-    // Within 1e-6 of a turning point, q - q_turn ~ theta^2 is below double resolution and
-    // sqrt(2(h - V)) would return rounding noise: use the local expansion (relative error
-    // O(theta^2) = 1e-12): time t to the turning point, p = V'(q_turn) t, q = q_turn - V' t^2 / 2.
-    if (th < 1e-6) {
-        const double t = th / w;
-        return {b - 0.5 * dV(b) * t * t, sg * dV(b) * t};
+    // The right half of the level (q >= its midpoint, distance dm from b) has the angles up to
+    // th_mid; beyond, the time from a is (pi - th) / omega. Either way: the distance d from the
+    // turning point at which time() equals the target t.
+    const double dm = 0.5 * (L.b - L.a);
+    const double th_mid = w * L.time(dm, 1, L.window(1), "point_at");
+    const int side = th <= th_mid ? 1 : -1;
+    const double t = (side > 0 ? th : (kPi - th) + kPiLow) / w, win = L.window(side);
+    const double t_win = L.time(win, side, win, "point_at"), t_mid = side > 0 ? th_mid / w : L.time(dm, -1, win, "point_at");
+    double d;
+    if (!(t > 0)) {
+        d = 0;
+    } else if (t <= t_win) {
+        // Invert the local expansion t = 2 sqrt(d) g(d / 3), i.e. d = t^2 slope(d / 3) / 2, by
+        // fixed-point iteration: slope changes by ~d / l relative across the window (<= 1e-6), so
+        // each step gains 6 digits.
+        d = 0.5 * t * t * L.slope(0.0, side);
+        for (int k = 0; k < 3; ++k) d = 0.5 * t * t * L.slope(d / 3, side);
+    } else if (t >= t_mid) {
+        d = dm;  // the two sides' times meet at the midpoint to ~1e-13
+    } else {
+        // Newton in r = sqrt(d), where the time is nearly linear (dt/dr = 2 g(r^2)), bracketed by
+        // bisection, from linear interpolation. It stops at 1e-14 relative in r: the times are
+        // quadratures good to ~1e-14, below which the corrections are their noise.
+        double lo = std::sqrt(win), hi = std::sqrt(dm);
+        double r = lo + (hi - lo) * (t - t_win) / (t_mid - t_win);
+        for (int it = 0; it < 60; ++it) {
+            const double f = L.time(r * r, side, win, "point_at") - t;
+            if (f == 0) break;
+            (f < 0 ? lo : hi) = r;
+            double rn = r - f / (2 * L.g(r * r, side));
+            if (!(rn > lo && rn < hi)) rn = 0.5 * (lo + hi);
+            const bool done = std::fabs(rn - r) <= 1e-14 * r || hi - lo <= 1e-14 * hi;
+            r = rn;
+            if (done) break;
+        }
+        d = r * r;
     }
-    if (kPi - th < 1e-6) {
-        const double t = (kPi - th) / w;
-        return {a - 0.5 * dV(a) * t * t, -sg * dV(a) * t};
-    }
-    const double q = brent([&](double x) { return angle_of(x, h) - th; }, a, b);
-    return {q, sg * std::sqrt(std::max(0.0, 2 * (h - V(q))))};
+    // p from the deficit h - V = slope x d, exact near the turning point where sqrt(2 (h - V(q)))
+    // would be rounding noise; d, not the distance of the rounded q: p ~ sqrt(d) would inherit
+    // the rounding of q relative to d (1 at theta = 1e-8).
+    return {L.end(side) - side * d, sg * std::sqrt(2 * d * L.slope(d, side))};
 }
 
 double Potential::angle_of_point(double q, double p, double h) const {
