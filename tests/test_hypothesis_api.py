@@ -367,3 +367,40 @@ def test_normal_coordinates(fn, names, a, b):
         for x in r:
             x = np.asarray(x, dtype=float)
             assert np.all(np.isfinite(x))
+
+
+# ------------------------------------------------------------------------------------------------
+# Everything else with arguments: one valid call each, every parameter fuzzed in turn
+
+
+_RES = M.iterate([0.1, 2.0], [-0.1, -0.2], 40, record=("orbit", "rotation"))
+_FAM = hv.TruncatedFamily(0.3, [-2.0, -1.0, -0.5, 0.0, 1.0], [3.9] * 5, [1.6] * 5, [1.0, 0.8, 0.5, 0.0, 0.0])
+OTHER = {
+    "birkhoff_average": (hv.birkhoff_average, dict(values=[[1.0, 2.0, 3.0], [3.0, 4.0, 5.0]], axis=-1)),
+    "rotation_number": (hv.rotation_number, dict(res=_RES, method="mean")),
+    "regularity": (hv.regularity, dict(res=_RES)),
+    "theory": (hv.theory, dict(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0, tau0=1.0, forcing=(1.0, 0.2), n_grid=1001)),
+    "TruncatedFamily": (hv.TruncatedFamily, dict(eps=0.3, K=[-2.0, -1.0, -0.5, 0.0, 1.0], Omega=[3.9] * 5, JR=[1.6] * 5,
+                                                 J1=[1.0, 0.8, 0.5, 0.0, 0.0], forcing=(1.0,))),
+    "family.step": (_FAM.step, dict(phi=0.1, K=-0.1)),
+    "forcing_at": (M.forcing_at, dict(phi=0.3)),
+    "k_eps2": (M.k_eps2, dict(phi=[0.1, 0.2], K0=-0.1)),
+    "count": (_RES.count, dict(status="OK")),
+    "region_mask": (hv.region_mask, dict(regions=("0u", "0"))),
+}
+_OTHER_CASES = [(k, p) for k, (_, kw) in OTHER.items() for p in kw]
+
+
+@pytest.mark.parametrize("case", _OTHER_CASES, ids=[f"{k}:{p}" for k, p in _OTHER_CASES])
+@SETTINGS
+@given(value=ANY)
+def test_other_entry_points(case, value):
+    name, param = case
+    fn, kw = OTHER[name]
+    r = outcome(lambda: fn(**{**kw, param: value}), param, param.rstrip("0"), "status", "region")
+    if r is not None and not isinstance(r, (hv.Theory, hv.TruncatedFamily)):
+        for x in (r if isinstance(r, tuple) else (r,)):
+            if isinstance(x, (int, float, np.ndarray)):
+                a = np.asarray(x, dtype=float)
+                # NaN only where documented (an orbit that took no step / a stopped tail); never inf.
+                assert huge(value) or not np.any(np.isinf(a))

@@ -160,3 +160,43 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     }
     CHECKF(ms_below == 40 && ms_above == 40, "msadams: 1e-9 below reflected %d, above free %d (of 40)", ms_below, ms_above);
 }
+
+TEST_CASE("section coordinates at the bottom of well 2; section points next to the turning points", "[flow]") {
+    FlowSystem s;
+    s.V1 = std::make_shared<Harmonic>(1.0);
+    s.coupling = Coupling::bilinear();
+    s.eps = 0.05;
+    s.qw1 = -1.0;
+    s.qw2 = -0.5;
+    // H2 = 0 (q2 = p2 = 0): the centre of the polar-like (theta, I), I = 0 exactly and theta = 0
+    // by convention, for closed-form and quadrature V2 alike (it was "Tan.action: energy must be
+    // finite and > 0, got 0").
+    const std::array<double, 4> rest{1.2, 0.0, 0.0, 0.0};
+    for (auto V2 : {std::shared_ptr<const Potential>(std::make_shared<Tan>(1.4, 0.7)), std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
+                    std::shared_ptr<const Potential>(std::make_shared<Numerical>(std::make_shared<Tan>(1.4, 0.7)))}) {
+        s.V2 = V2;
+        const auto c = section_coordinates(s, rest.data());
+        CHECKF(c[0] == 0.0 && c[1] == 0.0, "%s: (theta, I) = (%g, %g) at H2 = 0", V2->name().c_str(), c[0], c[1]);
+    }
+    // A V2 below its minimum V2(0) = 0 is not a single well: named, not an action error.
+    struct Negative final : Potential {
+        double V(double q) const override { return -0.5 * q * q; }
+        double dV(double q) const override { return -q; }
+        std::string name() const override { return "Negative"; }
+    };
+    s.V2 = std::make_shared<Negative>();
+    const std::array<double, 4> z{1.2, 0.0, 0.5, 0.0};
+    CHECK_INVALID(section_coordinates(s, z.data()), "H2 = p2^2/2 + V2(q2) = -0.125 at (q2, p2) = (0.5, 0) must be >= 0");
+
+    // Points of Sigma_h with a quadrature V2 next to its turning points (theta = pi - 2e-6 raised
+    // "quadrature ... did not converge" in point_at): the same point as the closed form's to the
+    // accuracy of point_at (1e-11, test_potential).
+    FlowSystem c = s, n = s;
+    c.V2 = std::make_shared<Tan>(1.4, 0.7);
+    n.V2 = std::make_shared<Numerical>(c.V2);
+    for (double th : {kPi - 2e-6, kPi - 1e-6, -kPi + 3e-7, 2e-6, -1e-6, 1e-12}) {
+        const auto zc = section_point(c, 1.0, th, 0.3), zn = section_point(n, 1.0, th, 0.3);
+        CHECKF(std::fabs(zc[0] - zn[0]) < 1e-11 && std::fabs(zc[2] - zn[2]) < 1e-11 && std::fabs(zc[3] - zn[3]) < 1e-11,
+               "theta = %.17g: (%.17g, %.17g, %.17g) vs (%.17g, %.17g, %.17g)", th, zn[0], zn[2], zn[3], zc[0], zc[2], zc[3]);
+    }
+}

@@ -1,6 +1,8 @@
 // Potentials and onset parameters: closed forms vs GSL quadrature, definitions vs the appendix.
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <vector>
 
 #include "testing.hpp"
 #include "hovering/flow/system.hpp"
@@ -9,6 +11,7 @@ using namespace hovering;
 
 namespace {
 const double kPi = 3.14159265358979323846;
+using hovering_test::msg;
 double rel(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
 }  // namespace
 
@@ -132,4 +135,85 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
         std::string name() const override { return "Plateau"; }
     } plateau;
     CHECK_INVALID(plateau.period(0.5), "Plateau.period: the quadrature over the level h = 0.5 did not converge");
+}
+
+TEST_CASE("generic turning points at every level", "[flow][potential]") {
+    const double eps = std::numeric_limits<double>::epsilon();
+    auto tan = std::make_shared<Tan>(1.4, 0.7);
+    Numerical num(tan);
+    // Tan's closed form q_max = atan(alpha sqrt(2h) / omega) / alpha. Brent stops at 4 eps relative
+    // and the closed form rounds to ~1 ulp: 8 eps relative. Tan's V reaches only ~8e30 at the last
+    // double before its wall (V = +inf from q_limit on), so above that the answer is that double,
+    // the largest q with V(q) <= h: q_limit to 1 ulp (the bracket used to end on V = inf, and
+    // Brent returned (-0, 1e-313)).
+    for (double h : {1e-300, 1e-10, 1.0, 1e10, 1e33, 1e100, 1e300}) {
+        const auto [a, b] = num.turning_points(h);
+        const double B = tan->turning_points(h).second;
+        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "h = %g: [%.17g, %.17g] vs +-%.17g", h, a, b, B);
+        CHECKF(num.V(b) <= h && num.V(-b) <= h, "h = %g: V(q_max) = %g <= h", h, num.V(b));
+        if (h >= 1e33) {
+            CHECKF(b == std::nextafter(tan->q_limit(), 0.0) && a == -b, "h = %g: q_max %.17g is the last double before q_limit %.17g", h, b,
+                   tan->q_limit());
+        }
+    }
+    // Unbounded wells: the bracket doubles up to the largest double (it stopped at 2^200 ~ 1.6e60).
+    Numerical nh(std::make_shared<Harmonic>(1.0));
+    for (double h : {1e-300, 1e-10, 1.0, 1e100, 1e300}) {
+        const double B = std::sqrt(2 * h);
+        const auto [a, b] = nh.turning_points(h);
+        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "Harmonic h = %g: %.17g vs %.17g", h, b, B);
+    }
+    // Above that value the level has hard walls (h - V ~ h at the turning points), which the
+    // quadratures cannot resolve: a named error, not garbage.
+    CHECK_INVALID(num.period(1e100), "the level h = 1e+100 lies above the largest value V reaches inside the wall q_limit");
+    CHECK_INVALID(num.point_at(1.0, 1e100), "point_at: the level h = 1e+100 lies above");
+    // ... and a bounded well that never reaches h before its wall is not a single well.
+    struct Shallow final : Potential {
+        double V(double q) const override { return 0.5 * q * q; }
+        double dV(double q) const override { return q; }
+        std::string name() const override { return "Shallow"; }
+        double q_limit() const override { return 1.0; }
+    } shallow;
+    CHECK_INVALID(shallow.turning_points(2.0), "Shallow: V never reaches the energy 2 (V(-1) = 0.5 at the wall q_limit");
+}
+
+TEST_CASE("generic angles next to the turning points", "[flow][potential]") {
+    const double eps = std::numeric_limits<double>::epsilon();
+    auto tan = std::make_shared<Tan>(1.4, 0.7);
+
+    // point_at and angle_of against the closed forms on a dense grid of angles and at 10^-k of
+    // 0 and pi (point_at raised "did not converge" for pi - theta in (5e-7, 5e-6)). Tolerances:
+    // (q, p) to 1e-11: period and times are QAWS quadratures (asked for 1e-12 relative, measured
+    // ~1e-15) and the inversion stops at 1e-14 relative; 1e-11 is 10x the requested accuracy.
+    // angle_of to 1e-11 plus its conditioning: the closed form's q is a double, good to ~1 ulp,
+    // and near a turning point theta ~ sqrt(q_max - q), dtheta/dq = omega / |p|, so 8 ulps of q
+    // (the turning point's 4 eps, the closed form's rounding) move theta by 8 eps |q| omega / |p|
+    // (1e-8 at theta = 1e-8: no method can do better from a double q).
+    std::vector<double> thetas{0.0, kPi, -kPi};
+    for (int k = 1; k <= 16; ++k)
+        for (double t : {std::pow(10.0, -k), kPi - std::pow(10.0, -k)}) {
+            thetas.push_back(t);
+            thetas.push_back(-t);
+        }
+    for (int i = 0; i <= 200; ++i) thetas.push_back(-kPi + 2 * kPi * i / 200);
+    for (auto base : {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.0)), std::shared_ptr<const Potential>(tan)}) {
+        Numerical n(base);
+        for (double h : {1e-6, 1.0, 100.0}) {
+            const double w = base->frequency(h), qm = base->turning_points(h).second;
+            double worst_qp = 0, worst_angle = 0;
+            for (double th : thetas) {
+                const auto [Q, P] = base->point_at(th, h);
+                const auto [q, p] = n.point_at(th, h);
+                worst_qp = std::max({worst_qp, std::fabs(q - Q), std::fabs(p - P)});
+                const double err = std::fabs(n.angle_of(Q, h) - std::fabs(th));
+                worst_angle = std::max(worst_angle, err / (1e-11 + 8 * eps * qm * w / std::fabs(P)));
+                CHECKF(std::fabs(q - Q) <= 1e-11 * std::max(1.0, qm) && std::fabs(p - P) <= 1e-11 * std::max(1.0, qm * w),
+                       "%s h = %g theta = %.17g: point_at (%.17g, %.17g) vs (%.17g, %.17g)", base->name().c_str(), h, th, q, p, Q, P);
+                CHECKF(err <= 1e-11 + 8 * eps * qm * w / std::fabs(P), "%s h = %g theta = %.17g: angle_of %.17g", base->name().c_str(), h,
+                       th, n.angle_of(Q, h));
+            }
+            INFO(msg("%s h = %g: worst |dq|, |dp| %.3g, worst angle error / tolerance %.3g", base->name().c_str(), h, worst_qp, worst_angle));
+            CHECK(worst_qp < 1e-11);
+        }
+    }
 }

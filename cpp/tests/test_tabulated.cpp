@@ -82,3 +82,28 @@ TEST_CASE("tabulated family equals F_eps on linear tables; any table + odd forci
     CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY), "no valid band");
     CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JR, J1), FourierForcing{{}}, INFINITY), "at least one sine coefficient");
 }
+
+TEST_CASE("tabulated arcs: nearly coincident circles are rejected, close but resolved ones kept", "[truncated]") {
+    // Linear tables (Omega = 2 + 3.1 K, ...): a natural cubic spline reproduces them exactly, so
+    // the fitted slope at K = 0 must be 3.1 to rounding amplified by range / spacing.
+    auto table = [](const std::vector<double>& K) {
+        std::vector<double> Om, JR, J1;
+        for (double k : K) {
+            Om.push_back(2.0 + 3.1 * k);
+            JR.push_back(k <= 0 ? 1.5 + 0.5 * k : 0.0);
+            J1.push_back(k <= 0 ? std::sqrt(-k) : 0.0);
+        }
+        return TabulatedArcs(K, Om, JR, J1);
+    };
+    // K = 1e-14 next to K = 0 (spacing 5e-15 of the range 2): the spline's slope at 0 carried the
+    // rounding of Omega times 1e14 (measured 3.1086 for these linear tables; -8e11 for measured
+    // ones). Now refused, naming both circles and the rule.
+    CHECK_INVALID(table({-1.0, -0.5, -0.2, -0.04, 0.0, 1e-14, 0.05, 0.5, 1.0}),
+                  "the K grid's points must be at least 1e-9 of its range (2) apart, but K[4] = 0 and K[5] = 1e-14 are 1e-14 apart");
+    CHECK_INVALID(table({-1.0, -0.5, -0.5 + 1e-12, 0.0, 0.5, 1.0}), "K[1] = -0.5 and K[2] = -0.499999999999");
+    // Just above the rule (spacing 2e-9 of the range) the grid is kept, and its slope at 0 is
+    // still good to rounding x range / spacing = 1e-16 x 5e8 ~ 1e-7.
+    const TabulatedArcs ok = table({-1.0, -0.5, -0.2, -0.04, 0.0, 4e-9, 0.05, 0.5, 1.0});
+    const double slope = (ok.at(1e-3).Omega - ok.at(0.0).Omega) / 1e-3;
+    CHECKF(std::fabs(slope - 3.1) < 1e-6, "Omega'(0) = %.12g on a grid with spacing 2e-9 of its range", slope);
+}

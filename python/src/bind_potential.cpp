@@ -63,8 +63,19 @@ private:
     py::gil_scoped_acquire gil_;
 };
 
+/// hovering.Potential.ReturnError, set by register_potential (leaked, like the module).
+PyObject* potential_return_error = nullptr;
+
+/// Raise Potential.ReturnError(msg) (GIL held): a method of a Python-defined potential returned the
+/// wrong kind of value. The class derives from ValueError, the module's exception for bad input,
+/// and from TypeError, which V and V' raised for it before (callers may catch either).
+[[noreturn]] void wrong_return(const std::string& msg) {
+    PyErr_SetString(potential_return_error ? potential_return_error : PyExc_ValueError, msg.c_str());
+    throw py::error_already_set();
+}
+
 /// The float value of what a Python V or V' returned (GIL held). Anything float() accepts (float,
-/// int, NumPy scalars) is a value; anything else is a TypeError naming the potential and the call.
+/// int, NumPy scalars) is a value; anything else is a Potential.ReturnError naming the potential and the call.
 /// A non-finite value at |q| < q_limit is a ValueError: inside the well it is a defect of the
 /// callable, and the generic quadrature and root finding would turn it into garbage. Outside the
 /// well (where only a rejected trial step of the integrator can look) it is passed on, so that the
@@ -77,10 +88,8 @@ double checked_value(const py::object& r, const Potential& pot, const char* fn, 
         v = PyFloat_AsDouble(r.ptr());
         if (v == -1.0 && PyErr_Occurred()) {
             PyErr_Clear();
-            std::string shown = py::repr(r).cast<std::string>();
-            if (shown.size() > 80) shown = shown.substr(0, 77) + "...";
-            throw py::type_error(pot.name() + "." + fn + "(" + fmt(q) + ") returned " + shown + " of type " +
-                                 std::string(Py_TYPE(r.ptr())->tp_name) + ": V and V' must return a float");
+            wrong_return(pot.name() + "." + fn + "(" + fmt(q) + ") returned " + short_repr(r, 80) + " of type " +
+                         std::string(Py_TYPE(r.ptr())->tp_name) + ": V and V' must return a real number (a float)");
         }
     }
     if (!std::isfinite(v)) {
@@ -98,13 +107,15 @@ py::handle python_self(const Potential* p) {
 }
 
 /// A subclass's own definition of `attr` (a class constant, a property or a method, which is
-/// called), or an empty object when only the base class's property would answer: that property
-/// calls back into the trampoline, so reading it here would recurse.
-py::object subclass_attr(py::handle self, const char* attr) {
+/// called: then *called is set), or an empty object when only the base class's property would
+/// answer: that property calls back into the trampoline, so reading it here would recurse.
+py::object subclass_attr(py::handle self, const char* attr, bool* called = nullptr) {
     const py::object mine = py::getattr(py::type::handle_of(self), attr, py::none());
     if (mine.is(py::type::of<Potential>().attr(attr))) return py::object();
     py::object v = py::getattr(self, attr);
-    if (PyCallable_Check(v.ptr())) v = v();
+    const bool call = PyCallable_Check(v.ptr());
+    if (call) v = v();
+    if (called) *called = call;
     return v;
 }
 
@@ -119,23 +130,34 @@ public:
         CallbackGil gil;
         const py::handle self = python_self(this);
         if (!self) return "Potential(<Python object released>)";
-        // The name goes into the core's error messages: a failing name must not replace them.
+        const std::string fallback = py::type::handle_of(self).attr("__name__").cast<std::string>() + "()";
+        // The name goes into the core's error messages: a name that raises must not replace them.
+        // One of the wrong type is a defect of the class, named like any other wrong return.
+        py::object v;
+        bool called = false;
         try {
-            const py::object v = subclass_attr(self, "name");
-            if (v) return py::str(v).cast<std::string>();
+            v = subclass_attr(self, "name", &called);
         } catch (py::error_already_set&) {
+            return fallback;
         }
-        return py::type::handle_of(self).attr("__name__").cast<std::string>() + "()";
+        if (!v) return fallback;
+        if (!PyUnicode_Check(v.ptr()))
+            wrong_return(fallback + ": name" + (called ? "() must return" : " must be") + " a str, got " + short_repr(v) +
+                         " of type " + std::string(Py_TYPE(v.ptr())->tp_name));
+        return v.cast<std::string>();
     }
 
     double q_limit() const override {  // asked once per orbit, on the worker threads too
         CallbackGil gil;
         const py::handle self = python_self(this);
         if (!self) return kInf;
-        const py::object v = subclass_attr(self, "q_limit");
+        bool called = false;
+        const py::object v = subclass_attr(self, "q_limit", &called);
         if (!v) return kInf;
-        const double lim = v.cast<double>();
-        if (!(lim > 0)) throw py::value_error(name() + ": q_limit must be > 0 (or inf), got " + fmt(lim));
+        double lim;
+        if (!as_real(v, &lim) || !(lim > 0))
+            wrong_return(name() + ": q_limit" + (called ? "() must return" : " must be") +
+                         " a real number > 0 or inf, got " + short_repr(v));
         return lim;
     }
 
@@ -219,6 +241,7 @@ std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
 }  // namespace
 
 void register_potential(py::module_& m) {
+
     py::class_<Potential, PyPotential, std::shared_ptr<Potential>> pot(
         m, "Potential",
         "A single-well potential V(q), V(0) = 0, q V'(q) > 0. Subclass it in Python by defining V(self, q) and "
@@ -257,6 +280,16 @@ void register_potential(py::module_& m) {
         .def_property_readonly("name", &Potential::name)
         .def_property_readonly("q_limit", &Potential::q_limit, "Largest |q| inside the well (inf if unbounded).")
         .def("__repr__", &Potential::name);
+    // Potential.ReturnError(ValueError, TypeError), built by type() because pybind11's
+    // py::exception takes one base; nested in Potential (qualified name, so it pickles) rather
+    // than a new name of the module.
+    py::object err = py::reinterpret_borrow<py::object>(reinterpret_cast<PyObject*>(&PyType_Type))(
+        "ReturnError", py::make_tuple(py::handle(PyExc_ValueError), py::handle(PyExc_TypeError)),
+        py::dict(py::arg("__module__") = m.attr("__name__"), py::arg("__qualname__") = "Potential.ReturnError",
+                 py::arg("__doc__") = "A method of a potential defined in Python (V, dV, q_limit, name) returned a value "
+                                      "of the wrong kind: a ValueError, and the TypeError V and V' raised for it before."));
+    pot.attr("ReturnError") = err;
+    potential_return_error = err.release().ptr();
     py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>>(m, "Harmonic", "V = omega^2 q^2 / 2 (closed-form action-angle).")
         .def(py::init([](py::handle omega) { return std::make_shared<Harmonic>(real_arg(omega, "Harmonic", "omega")); }),
              py::arg("omega"))

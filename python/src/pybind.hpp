@@ -9,20 +9,42 @@ namespace py = pybind11;
 
 #include <string>
 
-/// A Python real number (int, float, numpy scalar; not bool, str, complex, None or an array) as a
-/// double, or a ValueError "who: name must be a real number, got ..." instead of pybind11's
-/// overload listing.
-inline double real_arg(py::handle o, const char* who, const char* name) {
+/// The value of a Python real number: int, float, a NumPy scalar or a 0-d NumPy array of integer or
+/// float dtype (np.array(2.0)); not bool, str, complex, None or an array with a dimension (even of one
+/// element). False, with no Python error set, for anything else (or an int beyond a double's range).
+inline bool as_real(py::handle o, double* v) {
     // Leaked on purpose: a static py::object would be released after the interpreter is gone.
     static PyObject* real = py::object(py::module_::import("numbers").attr("Real")).release().ptr();
-    if (!PyBool_Check(o.ptr()) && PyObject_IsInstance(o.ptr(), real) == 1) {
-        const double v = PyFloat_AsDouble(o.ptr());
-        if (!(v == -1.0 && PyErr_Occurred())) return v;
+    bool number = !PyBool_Check(o.ptr()) && PyObject_IsInstance(o.ptr(), real) == 1;
+    // A 0-d array is what NumPy reductions and indexing with () return; it is not registered as
+    // numbers.Real, but float() reads it exactly like the scalar it holds.
+    if (!number && py::isinstance<py::array>(o)) {
+        const auto a = py::reinterpret_borrow<py::array>(o);
+        const char kind = a.dtype().kind();
+        number = a.ndim() == 0 && (kind == 'i' || kind == 'u' || kind == 'f');
+    }
+    if (number) {
+        *v = PyFloat_AsDouble(o.ptr());
+        if (!(*v == -1.0 && PyErr_Occurred())) return true;
     }
     PyErr_Clear();
+    return false;
+}
+
+/// repr(o), cut to `width` characters, for messages.
+inline std::string short_repr(py::handle o, std::size_t width = 60) {
     std::string r = py::repr(o).cast<std::string>();
-    if (r.size() > 60) r = r.substr(0, 57) + "...";
-    throw py::value_error(std::string(who) + ": " + name + " must be a real number (within the range of a double), got " + r);
+    if (r.size() > width) r = r.substr(0, width - 3) + "...";
+    return r;
+}
+
+/// A Python real number (see as_real) as a double, or a ValueError "who: name must be a real
+/// number, got ..." instead of pybind11's overload listing.
+inline double real_arg(py::handle o, const char* who, const char* name) {
+    double v;
+    if (as_real(o, &v)) return v;
+    throw py::value_error(std::string(who) + ": " + name + " must be a real number (within the range of a double), got " +
+                          short_repr(o));
 }
 
 /// Input arrays: C-contiguous doubles, converted (copied) only when the caller's array is not.

@@ -65,9 +65,9 @@ def birkhoff_average(values, axis: int = -1) -> np.ndarray:
         raise ValueError("values must be a time series (at least 1-D), got a number")
     v = np.moveaxis(v, int(axis), -1)
     if v.shape[-1] == 0:
-        raise ValueError("birkhoff_average needs at least one sample along the time axis")
+        raise ValueError("values must hold at least one sample along the time axis")
     if not np.all(np.isfinite(v)):
-        raise ValueError("birkhoff_average: values must be finite (an orbit that stopped early has NaN tails)")
+        raise ValueError("values must be finite (an orbit that stopped early has NaN tails: cut them off)")
     out = v @ birkhoff_weights(v.shape[-1])
     return float(out) if np.ndim(out) == 0 else out
 

@@ -467,7 +467,7 @@ def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing
         For non-finite parameters, an empty forcing or ``n_grid < 101``.
     """
     eps, theta_w, tau0 = (real_number(n, v) for n, v in (("eps", eps), ("theta_w", theta_w), ("tau0", tau0)))
-    Omega0 = _omega0(Omega0)
+    Omega0 = _omega0(real_number("Omega0", Omega0))
     b = tuple(float(x) for x in forcing_array(forcing))
     n_grid = integer("n_grid", n_grid, 101, 10**7)
     nan = float("nan")

@@ -26,9 +26,13 @@ public:
     /// Largest |q| for which V is defined (infinity if unbounded).
     virtual double q_limit() const;
 
-    /// Turning points (q_min < 0 < q_max) with V = h > 0.
+    /// Turning points (q_min < 0 < q_max) with V = h > 0. Generic path: on each side the largest
+    /// |q| with V(q) <= h (the root to 1 ulp; for a bounded well whose V stays below h up to its
+    /// wall in double precision, e.g. Tan above ~1e31, the last double before q_limit).
     virtual std::pair<double, double> turning_points(double h) const;
-    /// Period T(h) = 2 int dq / sqrt(2 (h - V)).
+    /// Period T(h) = 2 int dq / sqrt(2 (h - V)). The generic energy-dependent quantities (period,
+    /// action, angle_of, point_at) throw std::invalid_argument for a level above the largest value
+    /// V reaches before the wall of a bounded well: its turning points are the wall to rounding.
     virtual double period(double h) const;
     /// Action I(h) = (1/pi) int sqrt(2 (h - V)) dq over [q_min, q_max].
     virtual double action(double h) const;
@@ -37,7 +41,8 @@ public:
     /// omega(h) = 2 pi / T(h) = dH/dI.
     double frequency(double h) const;
     /// Angle of the point (q, p < 0) on the level h: omega(h) times the time from q to q_max,
-    /// in [0, pi] (theta_w of eq:thw for q = q_w).
+    /// in [0, pi] (theta_w of eq:thw for q = q_w). q in [q_min, q_max]; the generic path also takes
+    /// a q up to 8 ulps beyond a turning point (roots known to rounding) as that turning point.
     virtual double angle_of(double q, double h) const;
     /// Inverse of the angle: (q, p) on the level h at angle theta in [-pi, pi] (sign(p) = -sign(theta)).
     virtual std::pair<double, double> point_at(double theta, double h) const;

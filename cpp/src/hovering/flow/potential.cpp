@@ -1,6 +1,7 @@
 // Potentials and their action-angle variables. Generic quantities use GSL: QAWS
 // quadrature (its Chebyshev moments absorb the (q - a)^(-1/2) (b - q)^(-1/2) endpoint behaviour,
-// so the smooth remainder is integrated to ~1e-13) and Brent root finding.
+// so the smooth remainder is integrated to ~1e-13; near the turning points h - V comes from V',
+// Level::slope) and Brent root finding.
 
 #include "hovering/flow/potential.hpp"
 
@@ -42,12 +43,13 @@ struct Level {
         a = tp.first;
         b = tp.second;
         // Everything below takes h - V = 0 at the turning points. Above the largest value V takes
-        // inside a bounded well (Tan: ~5e32 at the last double before its wall) the turning point
-        // is that last double, where h - V ~ h: the level has hard walls, which no quadrature here
-        // resolves. (Up to a factor 2 is rounding: near a wall V may change by 40% per ulp.)
+        // inside a bounded well (Tan(1.4, 0.7): ~8e30 at the last double before its wall) the
+        // turning point is that last double, where h - V ~ h: the level has hard walls, which no
+        // quadrature here resolves. Near a wall V may also jump 3x from one double to the next
+        // (the root lies between them): that level is resolved to rounding and passes.
         for (const double e : {a, b}) {
             const double v = p.V(e);
-            if (!(v >= 0.5 * h))
+            if (!(v >= 0.5 * h) && !std::isfinite(p.V(std::nextafter(e, e > 0 ? kInf : -kInf))))
                 bad(p.name() + "." + who + ": the level h = " + fmt(h) + " lies above the largest value V reaches inside the wall q_limit = " +
                     fmt(p.q_limit()) + " (V(" + fmt(e) + ") = " + fmt(v) + " at the turning point): it has no turning point the "
                     "quadrature can resolve; allowed: h <= " + fmt(2 * v) + ", or a closed-form potential");
@@ -161,25 +163,33 @@ std::pair<double, double> Potential::turning_points(double h) const {
         // outward by doubling up to the largest double, or halving the distance to the wall of a
         // bounded well until it reaches q_limit itself (~53 steps).
         double inner = 0, outer = std::isfinite(lim) ? 0.5 * lim : 1.0;
-        for (int k = 0; V(sgn * outer) < h; ++k) {
+        double vo = V(sgn * outer);  // V(outer), kept: each V may be a call into Python
+        for (int k = 0; vo < h; ++k) {
             double next = std::isfinite(lim) ? lim - 0.5 * (lim - outer) : 2 * outer;
             if (next == outer) next = lim;  // lim - ulp / 2 rounded (to even) back to outer
             if (k > 2100 || outer == lim || !std::isfinite(next))
-                bad(name() + ": V never reaches the energy " + fmt(h) + " (V(" + fmt(sgn * outer) + ") = " +
-                    fmt(V(sgn * outer)) + (std::isfinite(lim) ? " at the wall q_limit" : "") +
+                bad(name() + ": V never reaches the energy " + fmt(h) + " (V(" + fmt(sgn * outer) + ") = " + fmt(vo) +
+                    (std::isfinite(lim) ? " at the wall q_limit" : "") +
                     "; allowed: a single well whose V rises above every level, to +inf at the wall of a bounded well)");
             inner = outer;
             outer = next;
+            vo = V(sgn * outer);
         }
         // For small h, halve toward 0 first: a bracket [x/2, x] lets Brent reach full relative
         // accuracy; [0, 1] around a root 1e-35 exhausted its iterations at a point 1e-31.
-        while (inner == 0 && outer > 1e-300 && V(sgn * 0.5 * outer) >= h) outer *= 0.5;
+        while (inner == 0 && outer > 1e-300) {
+            const double v = V(sgn * 0.5 * outer);
+            if (!(v >= h)) break;
+            outer *= 0.5;
+            vo = v;
+        }
         if (inner == 0) inner = 0.5 * outer;
         // V(outer) = inf (Tan at its wall, an overflow) would make Brent return garbage: bisect
         // until V(outer) is finite. If the bracket closes to adjacent doubles first, no double has
-        // h <= V(q) < inf, and inner is the largest q with V(q) <= h: Tan's V reaches only ~5e32
-        // at the last double before its wall, so every h above that has q_max = q_limit to 1 ulp.
-        for (double vo = V(sgn * outer); !std::isfinite(vo);) {
+        // h <= V(q) < inf, and inner is the largest q with V(q) <= h: Tan(1.4, 0.7)'s V reaches
+        // only ~8e30 at the last double before its wall, so every h above that has q_max = q_limit
+        // to 1 ulp.
+        while (!std::isfinite(vo)) {
             const double mid = inner + 0.5 * (outer - inner);
             if (!(mid > inner && mid < outer)) return sgn * inner;
             const double vm = V(sgn * mid);
@@ -190,7 +200,17 @@ std::pair<double, double> Potential::turning_points(double h) const {
                 vo = vm;
             }
         }
-        return sgn * brent([&](double x) { return V(sgn * x) - h; }, inner, outer);
+        // Brent ends within ~4 eps of the root, on either side: step to the largest q with
+        // V(q) <= h (a few ulps, 2-3 evaluations), so that h - V >= 0 on the whole level and the
+        // answer does not depend on where Brent stopped.
+        double x = brent([&](double y) { return V(sgn * y) - h; }, inner, outer);
+        for (int k = 0; k < 16 && x > inner && V(sgn * x) > h; ++k) x = std::nextafter(x, 0.0);
+        for (int k = 0; k < 16 && x < outer; ++k) {
+            const double up = std::nextafter(x, kInf);
+            if (!(V(sgn * up) <= h)) break;
+            x = up;
+        }
+        return sgn * x;
     };
     return {side(-1.0), side(1.0)};
 }
@@ -258,7 +278,8 @@ std::pair<double, double> Potential::point_at(double theta, double h) const {
     const double th_mid = w * L.time(dm, 1, L.window(1), "point_at");
     const int side = th <= th_mid ? 1 : -1;
     const double t = (side > 0 ? th : (kPi - th) + kPiLow) / w, win = L.window(side);
-    const double t_win = L.time(win, side, win, "point_at"), t_mid = side > 0 ? th_mid / w : L.time(dm, -1, win, "point_at");
+    // The halves' times add up to T / 2 = pi / omega (to the quadratures' ~1e-14).
+    const double t_win = L.time(win, side, win, "point_at"), t_mid = (side > 0 ? th_mid : (kPi - th_mid) + kPiLow) / w;
     double d;
     if (!(t > 0)) {
         d = 0;

@@ -91,8 +91,28 @@ std::array<double, 4> section_point(const FlowSystem& s, double h, double theta,
     return z;
 }
 
+namespace {
+
+// section_coordinates of a state with H2 = e2 <= 0 (or NaN), out of line: the hot path stays as
+// small as it was.
+[[noreturn]] void negative_h2(const double* z, double e2) {
+    bad("section_coordinates: H2 = p2^2/2 + V2(q2) = " + fmt(e2) + " at (q2, p2) = (" + fmt(z[2]) + ", " + fmt(z[3]) +
+        ") must be >= 0 (V2 is a single well with minimum V2(0) = 0; allowed: finite states with V2(q2) >= 0)");
+}
+
+}  // namespace
+
 std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) {
     const double e2 = 0.5 * z[3] * z[3] + s.V2->V(z[2]);
+    if (!(e2 > 0)) {
+        // H2 = 0: oscillator 2 rests at the bottom of its well (q2 = p2 = 0), the centre of the
+        // polar-like (theta, I), where I = 0 and the angle is undefined: theta = 0 by convention.
+        // Not an error, because the callers meet it legitimately: the return map's images and the
+        // flow map's steps (an orbit can hand all its energy to oscillator 1, as the starts
+        // I -> 0 do), and Section.coordinates of any state of the phase space.
+        if (e2 == 0) return {0.0, 0.0};
+        negative_h2(z, e2);
+    }
     double th = s.V2->angle_on_level(z[2], z[3], e2);
     if (th >= kPi) th -= 2 * kPi;  // [-pi, pi)
     return {th, s.V2->action(e2)};

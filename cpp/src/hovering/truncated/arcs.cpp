@@ -164,6 +164,20 @@ void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
         if (K[i] <= 0.0) ++n_nonpos;
     }
     if (!has_zero) bad("the K grid must contain K = 0 exactly (the tangency circle)");
+    // Nearly coincident circles: a cubic spline's slopes are differences of values over the
+    // spacing, so it amplifies the values' rounding (or measurement error) by range / spacing,
+    // and its second derivatives by (range / spacing)^2; K = [..., 0, 1e-14, 0.05] gave
+    // Omega'(0) = -8e11 instead of 3. 1e-9 of the range keeps rounding of 1e-16 below 1e-7 in the
+    // slopes while admitting any grid a measurement would use (geometric grids toward K = 0
+    // included, down to spacings 1e-9 of their range). The same bound holds, halved, for the
+    // sqrt(-K) grid of |J_1|: its spacing ds = dK / (s_i + s_j) >= dK / (2 sqrt(-K_min)).
+    const double range = K.back() - K.front();
+    for (std::size_t i = 1; i < K.size(); ++i)
+        if (!(K[i] - K[i - 1] >= 1e-9 * range))
+            bad("the K grid's points must be at least 1e-9 of its range (" + fmt(range) + ") apart, but K[" +
+                std::to_string(i - 1) + "] = " + fmt(K[i - 1]) + " and K[" + std::to_string(i) + "] = " + fmt(K[i]) +
+                " are " + fmt(K[i] - K[i - 1]) + " apart (a cubic spline through nearly coincident points amplifies "
+                "their rounding by range / spacing)");
     if (n_nonpos < 3)
         bad("the K grid needs at least 3 points with K <= 0, got " + std::to_string(n_nonpos));
     if (!(K.back() > 0.0)) bad("the K grid must extend above K = 0, got max K = " + fmt(K.back()));
