@@ -165,8 +165,9 @@ class CustomPotential(_CallablePotential):
         ``float -> float``: the potential, with ``V(0) = 0`` and ``q V'(q) > 0`` for ``q != 0``,
         and its derivative. They may be called from the return map's worker threads (holding the
         GIL), so they must not rely on thread-local state. An exception they raise propagates to
-        the caller of the computation; a non-float result is a TypeError, a non-finite one a
-        ValueError (for ``|q| < q_limit``; outside the well the integrator rejects the trial step).
+        the caller of the computation; a non-float result is a ``Potential.ReturnError`` (both a
+        TypeError and a ValueError, naming the callable), a non-finite one a ValueError (for
+        ``|q| < q_limit``; outside the well the integrator rejects the trial step).
     q_limit : float, optional
         Largest ``|q|`` of the well (``math.inf``: unbounded). For a singular well such as
         ``tan^2``, the position of the singularity.
