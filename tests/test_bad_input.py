@@ -319,3 +319,14 @@ def test_output_path_refuses_what_savefig_would_fail_on(tmp_path):
     finally:
         ro.chmod(0o700)
     assert not list(tmp_path.rglob("*.png"))  # the check leaves no file behind
+
+
+@pytest.mark.parametrize("m,K_low", [(M, -1e-8), (M, -1e-12), (hv.TruncatedMap(eps=0.1, Omega0=1.0, theta_w=1e-10), None)],
+                         ids=["K_low=-1e-8", "K_low=-1e-12", "theta_w=1e-10 default box"])
+def test_hovering_area_draws_samples_whatever_the_box(m, K_low):
+    # A thin box used to get n_phi ~ sqrt(samples 2 pi / |K_low|) columns: 2.5 M points for
+    # samples = 10,000 at K_low = -1e-8, 12.9 TiB for the default box at theta_w = 1e-10. The
+    # stratified grid now has at most samples + n_phi <= 2 samples cells.
+    a = hv.hovering_area(m, n_steps=16, samples=1000, K_low=K_low)
+    assert 1000 <= a.n_samples <= 2000
+    assert 0 <= a.area <= 2 * math.pi * -a.box[2]
