@@ -4,16 +4,12 @@ The crash paths run in subprocesses (an abort must not take the test run with it
 
 from __future__ import annotations
 
-import math
 import os
 import subprocess
 import sys
 import textwrap
 
-import numpy as np
-import pytest
 
-import hovering as hv
 
 DAEMON_AT_EXIT = textwrap.dedent(
     """
