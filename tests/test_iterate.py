@@ -379,7 +379,7 @@ BAD_ITERATE = [
     (dict(phi0=[0.0, np.nan]), r"phi0\[1\] must be finite"),
     (dict(K0=[np.inf, 0.0]), r"K0\[0\] must be finite"),
     (dict(phi0=[np.inf, 0.0]), r"phi0\[0\] must be finite"),
-    (dict(phi0=np.zeros(3), K0=np.zeros(4)), r"iterate: phi and K must have broadcastable shapes"),
+    (dict(phi0=np.zeros(3), K0=np.zeros(4)), r"phi0 and K0 must have broadcastable shapes"),
 ]
 
 

@@ -451,20 +451,20 @@ _LO = -np.pi  # band floor of the paper's parameters: -2 (pi - theta_w) / tau1
 
 
 BAD_CALLS = [
-    ("step", (np.nan, -0.5), r"step: phi must be finite"),
-    ("step", (0.1, np.inf), r"step: K must be finite"),
-    ("step", (0.1, -np.inf), r"step: K must be finite"),
+    ("step", (np.nan, -0.5), r"step: phi(\[0\])? must be finite"),
+    ("step", (0.1, np.inf), r"step: K(\[0\])? must be finite"),
+    ("step", (0.1, -np.inf), r"step: K(\[0\])? must be finite"),
     ("step", (0.1, _LO - 0.1), r"step: K = -3\.24.* is outside the band \(-3\.14159265358979"),
     ("step", (0.1, _LO), r"step: K = -3\.14.* is outside the band"),  # the band is open
     ("step", (np.zeros(3), np.zeros(4)), r"step: phi and K must have broadcastable shapes"),
     ("step_inverse", (np.pi / 2, _LO + 0.1), r"step_inverse \(preimage\): K = .* is outside the band"),
-    ("step_inverse", (np.nan, 0.0), r"step_inverse: phi must be finite"),
+    ("step_inverse", (np.nan, 0.0), r"step_inverse: phi(\[0\])? must be finite"),
     ("step_inverse", (np.zeros(2), np.zeros(5)), r"step_inverse: phi and K must have broadcastable"),
-    ("region", (0.0, np.nan), r"region: K must be finite"),
+    ("region", (0.0, np.nan), r"region: K(\[0\])? must be finite"),
     ("region", (0.0, -4.0), r"region: K = -4 is outside the band"),
     # rotation() reports through region() (message prefix 'region:'); the parameter and band are named
     ("rotation", (0.0, -4.0), r"K = -4 is outside the band \(-3\.14159265358979"),
-    ("rotation", (np.inf, 0.0), r"phi must be finite"),
+    ("rotation", (np.inf, 0.0), r"phi(\[0\])? must be finite"),
 ]
 
 
@@ -503,7 +503,7 @@ def test_bad_region_names():
 def test_huge_angles_are_rejected_not_mis_wrapped():
     # Beyond |phi| ~ 1e16 wrapping is off by whole turns; the map refuses angles above 1e6.
     m = make_map(PARAM_SETS[next(iter(PARAM_SETS))])
-    with pytest.raises(ValueError, match=r"\|step: phi\| <= 1e6"):
+    with pytest.raises(ValueError, match=r"step: phi must be an angle in \[-1e6, 1e6\]"):
         m.step(-1e18, 0.1)
     with pytest.raises(ValueError, match=r"phi0\[1\] must be an angle in \[-1e6, 1e6\].*got 10000000.0"):
         m.iterate([0.0, 1e7], [0.1, 0.1], 3)

@@ -17,7 +17,7 @@ from ._core import FlowStatus, Geometry, Kernel, Region, Status
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
            "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
-           "check_memory", "thread_count", "is_choice", "status_code", "require_map", "flag", "require_type", "forcing_array", "MAX_MODES", "output_path", "MAX_ANGLE"]
+           "check_memory", "point_pair", "thread_count", "is_choice", "status_code", "require_map", "flag", "require_type", "forcing_array", "MAX_MODES", "output_path", "MAX_ANGLE"]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -210,6 +210,23 @@ def forcing_array(value) -> np.ndarray:
         raise ValueError(f"forcing must be a 1-D sequence of 1 to {MAX_MODES} sine coefficients, got shape {b.shape}")
     require_finite("forcing", b)
     return b
+
+
+def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
+    """Points (phi, K) of a map: real, finite, |phi| <= 1e6, broadcast together (C-ordered); and
+    whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0)."""
+    na, nb = (f"{who}: {n}" if who else n for n in names)
+    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
+    p, k = real_array(na, phi), real_array(nb, K)  # type errors first, named
+    require_angles(na, p)
+    require_finite(nb, k)
+    try:
+        p, k = np.broadcast_arrays(p, k)
+    except ValueError:
+        raise ValueError(f"{who + ': ' if who else ''}{names[0]} and {names[1]} must have broadcastable shapes, got "
+                         f"{np.shape(phi)} and {np.shape(K)}") from None
+    # np.ascontiguousarray would turn 0-d into 1-d; the bindings copy non-contiguous views themselves.
+    return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
 
 
 def real_array(name: str, value) -> np.ndarray:

@@ -150,8 +150,8 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         For counts that are not integers in range, or a K_low outside the band below 0.
     """
     require_map("m", m)
-    n_steps = _count("n_steps", n_steps, 4)
-    samples = _count("samples", samples, 1)
+    n_steps = integer("n_steps", n_steps, 4, 2**53)
+    samples = integer("samples", samples, 1, 2**53)
     keep_points = flag("keep_points", keep_points)
     seed = integer("seed", seed, 0, 2**63 - 1)
     n_threads = thread_count(n_threads)
@@ -212,11 +212,3 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         both_sides=hov_both if keep_points else None,
     )
 
-
-def _count(name: str, value, least: int) -> int:
-    """An integer count >= least, or a ValueError naming it."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} must be an integer >= {least}, got {value!r}")
-    if value < least:
-        raise ValueError(f"{name} must be >= {least}, got {value}")
-    return int(value)

@@ -15,8 +15,8 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import (MAX_MODES, Region, check_memory, flag, integer, is_choice, iterate_arguments, real_array,
-                       require_angles, require_finite, wrap)
+from .._common import (MAX_MODES, Region, check_memory, flag, integer, is_choice, iterate_arguments, point_pair,
+                       wrap)
 from .._protocols import MapAnalyses
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -62,18 +62,6 @@ class FlowSteps:
     energy_error: np.ndarray
     steps: np.ndarray
     z: np.ndarray
-
-
-def _pair(phi, K, who: str):
-    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
-    p, k = real_array(f"{who}: phi", phi), real_array(f"{who}: K", K)  # type errors first, named
-    require_angles(f"{who}: phi", p)
-    require_finite(f"{who}: K", k)
-    try:
-        p, k = np.broadcast_arrays(p, k)
-    except ValueError:
-        raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {np.shape(phi)} and {np.shape(K)}") from None
-    return p, k, scalar
 
 
 class FlowMap(MapAnalyses):
@@ -183,7 +171,7 @@ class FlowMap(MapAnalyses):
         KeyboardInterrupt
             On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
         """
-        p, k, _ = _pair(phi, K, "returns")
+        p, k, _ = point_pair(phi, K, "returns")
         d = self._core.steps(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel()), flag("inverse", inverse),
                              _threads(n_threads, self.sys.python_defined))
         res = FlowSteps(phi=d["x"], K=d["y"], status=d["status"], region=d["region"], itinerary=d["itinerary"],
@@ -207,7 +195,7 @@ class FlowMap(MapAnalyses):
         phi1, K1 : ndarray or float
             Images, ``phi1`` in ``[-pi, pi)``; floats when both inputs are scalars.
         """
-        p, k, scalar = _pair(phi, K, "step")
+        p, k, scalar = point_pair(phi, K, "step")
         r = self.returns(p, k)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
         return (float(a), float(b)) if scalar else (a, b)
@@ -225,7 +213,7 @@ class FlowMap(MapAnalyses):
         -------
         phi0, K0 : ndarray or float
         """
-        p, k, scalar = _pair(phi, K, "step_inverse")
+        p, k, scalar = point_pair(phi, K, "step_inverse")
         r = self.returns(p, k, inverse=True)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
         return (float(a), float(b)) if scalar else (a, b)
@@ -242,7 +230,7 @@ class FlowMap(MapAnalyses):
         -------
         Region or ndarray of int8
         """
-        p, k, scalar = _pair(phi, K, "region")
+        p, k, scalar = point_pair(phi, K, "region")
         r = self.returns(p, k).region.reshape(p.shape)
         return Region(int(r)) if scalar else r
 
@@ -286,9 +274,7 @@ class FlowMap(MapAnalyses):
             On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
         """
         record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
-        p, k, _ = _pair(phi0, K0, "iterate")
-        require_angles("phi0", p)
-        require_finite("K0", k)
+        p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         # The recorded orbit starts on [-pi, pi) like every later point.
         p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
         n_points = p.size * (n_steps + 1)

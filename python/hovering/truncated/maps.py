@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import _core
 from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
-                       require_angles, require_finite, status_code, thread_count, wrap, forcing_array)
+                       point_pair, require_angles, require_finite, status_code, thread_count, wrap, forcing_array)
 from .._protocols import MapAnalyses
 from . import theory as _geo
 
@@ -110,23 +110,6 @@ class IterateResult:
         return int(np.count_nonzero(self.status == status_code(Status, status)))
 
 
-def _finite_float(name: str, value) -> float:
-    return real_number(name, value)
-
-
-def _pair(phi, K, who: str):
-    """Broadcast (phi, K) to one shape of contiguous doubles; remember whether both were scalars."""
-    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
-    p = real_array(f"{who}: phi", phi)
-    k = real_array(f"{who}: K", K)
-    try:
-        p, k = np.broadcast_arrays(p, k)
-    except ValueError:
-        raise ValueError(f"{who}: phi and K must have broadcastable shapes, got {p.shape} and {k.shape}") from None
-    # np.ascontiguousarray would turn 0-d into 1-d; the binding copies non-contiguous views itself.
-    return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
-
-
 class _MapAPI(MapAnalyses):
     """Methods shared by every member of the truncated family (mixed into the compiled classes)."""
 
@@ -148,7 +131,7 @@ class _MapAPI(MapAnalyses):
         ValueError
             For a non-finite value or a K outside the band (the message names it and the band).
         """
-        p, k, scalar = _pair(phi, K, "step")
+        p, k, scalar = point_pair(phi, K, "step")
         a, b = self._step(p, k)
         return (float(a), float(b)) if scalar else (a, b)
 
@@ -170,7 +153,7 @@ class _MapAPI(MapAnalyses):
         ValueError
             For a non-finite value or a preimage outside the band.
         """
-        p, k, scalar = _pair(phi, K, "step_inverse")
+        p, k, scalar = point_pair(phi, K, "step_inverse")
         a, b = self._step_inverse(p, k)
         return (float(a), float(b)) if scalar else (a, b)
 
@@ -187,7 +170,7 @@ class _MapAPI(MapAnalyses):
         Region or ndarray of int8
             A :class:`Region` for scalar input, else an int8 array of region codes.
         """
-        p, k, scalar = _pair(phi, K, "region")
+        p, k, scalar = point_pair(phi, K, "region")
         r, _ = self._region_rotation(p, k, "region")
         return Region(int(r)) if scalar else r
 
@@ -203,7 +186,7 @@ class _MapAPI(MapAnalyses):
         -------
         ndarray or float
         """
-        p, k, scalar = _pair(phi, K, "rotation")
+        p, k, scalar = point_pair(phi, K, "rotation")
         _, w = self._region_rotation(p, k, "rotation")
         return float(w) if scalar else w
 
@@ -221,7 +204,7 @@ class _MapAPI(MapAnalyses):
         -------
         phi_r, K_r : ndarray or float
         """
-        p, k, scalar = _pair(phi, K, "reversal")
+        p, k, scalar = point_pair(phi, K, "reversal")
         require_angles("reversal: phi", p)
         require_finite("reversal: K", k)
         out = (_geo.wrap(-p), k - self.eps * self.forcing_at(p))
@@ -328,8 +311,7 @@ class _MapAPI(MapAnalyses):
         if isinstance(sin_ulp, (bool, np.bool_)) or not isinstance(sin_ulp, numbers.Real) or float(sin_ulp) not in (1.0, 3.5):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
         n_threads = thread_count(n_threads)
-        p, k, _ = _pair(phi0, K0, "iterate")
-        require_angles("phi0", p)
+        p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         p = np.asarray(wrap(p), dtype=float)  # the recorded orbit starts on [-pi, pi) like every later point
         n_points = p.size * (n_steps + 1)
         check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps",
@@ -402,7 +384,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
 
     def __init__(self, eps, Omega0, theta_w, tau0=1.0, tau1=0.5, lam=0.5, K_max=math.inf):
         vals = {"eps": eps, "Omega0": Omega0, "theta_w": theta_w, "tau0": tau0, "tau1": tau1, "lam": lam}
-        vals = {name: _finite_float(name, v) for name, v in vals.items()}
+        vals = {name: real_number(name, v) for name, v in vals.items()}
         try:
             K_max = float(K_max)
         except (TypeError, ValueError):
@@ -528,7 +510,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
     """
 
     def __init__(self, eps, K, Omega, JR, J1, forcing=(1.0,), K_max=math.inf):
-        eps = _finite_float("eps", eps)
+        eps = real_number("eps", eps)
         Kg = real_array("K", K)
         if Kg.ndim != 1:
             raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")

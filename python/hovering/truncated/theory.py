@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .._common import forcing_array, integer, real_array, real_number, require_finite, wrap
+from .._common import forcing_array, integer, real_array, real_number, require_angles, require_finite, wrap
 
 __all__ = [
     "OMEGA_G",
@@ -127,9 +127,8 @@ def _wall_angle(theta_w) -> np.ndarray:
 
 def _broadcast_angle(phi, a):
     """phi + a for angles phi (finite, |phi| <= 1e6) broadcast against the half rotations a(K0)."""
-    p = _finite("phi", phi)
-    if np.any(np.abs(p) > 1e6):
-        raise ValueError(f"phi must be angles in [-1e6, 1e6], got {np.ravel(p)[int(np.argmax(np.ravel(np.abs(p)) > 1e6))]}")
+    p = real_array("phi", phi)
+    require_angles("phi", p)
     try:
         return p + a
     except ValueError:
