@@ -274,7 +274,13 @@ def test_cli_demo_writes_png(tmp_path, capsys):
     data = out.read_bytes()
     assert len(data) > 1000 and data[:8] == b"\x89PNG\r\n\x1a\n"
     text = capsys.readouterr().out
-    assert "eps=+0.3" in text and "eps=-0.3" in text and "wrote" in text
+    assert "eps = 0.3" in text and "eps = -0.3" in text and "wrote" in text and "scene demo (portrait)" in text
+    # demo is the packaged scene: its result is saved like any scene's and redraws without computing
+    from hovering import scenes
+
+    res = scenes.load_result(out.with_suffix(".npz"))
+    assert res.scene.kind == "portrait" and res.scene.color_by == "region" and res.meta["n_steps"] == 200
+    assert [p.orbits.n_orbits for p in res.panels] == [5, 5]
     plt.close("all")
 
 

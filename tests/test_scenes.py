@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import Region, Status, figures, scenes
+from hovering import Region, Status, scenes
+from hovering.scenes.compute import zoom_window_critical, zoom_window_islands
 from hovering.scenes import load_scene, parse_scene, run_scene
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "examples" / "scenes"
@@ -229,9 +230,12 @@ def test_quick_run_writes_png_and_npz(runs, name):
     assert s["quick"] is True
     full = load_scene(SCENE_DIR / f"{name}.toml").n_steps
     assert s["n_steps"] == max(full // scenes.QUICK_FACTOR, 100)
-    with np.load(npz) as z:
-        stored = json.loads(str(z["summary_json"]))
-    assert stored["n_steps"] == s["n_steps"] and stored["scene"] == name
+    # the typed result on disk: NPZ (arrays + tree) and a sidecar JSON (scene, meta, summary)
+    res = scenes.load_result(npz)
+    assert res.meta["n_steps"] == s["n_steps"] and res.scene.name == name and res.meta["quick"] is True
+    side = json.loads(Path(s["json"]).read_text())
+    assert side["summary"]["n_steps"] == s["n_steps"] and side["summary"]["scene"] == name
+    assert side["meta"]["version"] == hovering.__version__ and side["meta"]["timings"]["total"] > 0
 
 
 def _orbit_colls(ax):
@@ -267,8 +271,7 @@ def test_smalleps_special_orbits_legends_and_curves(runs):
     s = runs["fig_smalleps"]
     fig = s["figure"]
     assert len(fig.axes) == 2
-    with np.load(s["npz"]) as z:
-        data = {k: z[k] for k in z.files}
+    result = s["result"]
     for ax, p in zip(fig.axes, s["panels"]):
         eps = p["params"]["eps"]
         m = hovering.TruncatedMap(**p["params"])
@@ -294,13 +297,14 @@ def test_smalleps_special_orbits_legends_and_curves(runs):
         for lab in ("blue", "orange", "green", "red"):
             assert any(f"{o[lab]['rho']:.3f}" in t and r"\rho" in t for t in texts), (lab, texts)
         # rho is <omega_a>; an orbit that never impacts has rho = Omega0 + tau0 <K> (paper, after
-        # fig:smalleps). The NPZ keeps float32 orbits: 1e-5 covers their rounding.
+        # fig:smalleps); 1e-12 covers the summation order of the two means.
         free = [x for x in p["orbits"] if x["impacts"] == 0 and x["status"] == "OK"]
         assert free  # green for eps > 0, red for eps < 0 (the curve k^{u0})
+        orbits = result.panel(p["id"]).orbits
         for x in free:
-            i = list(data[f"{p['id']}_labels"]).index(x["label"])
-            K = data[f"{p['id']}_K"][i].astype(float)
-            assert x["rho"] == pytest.approx(m.Omega0 + m.tau0 * K[:-1].mean(), abs=1e-5)
+            i = orbits.labels.index(x["label"])
+            K = orbits.K[i]
+            assert x["rho"] == pytest.approx(m.Omega0 + m.tau0 * K[:-1].mean(), abs=1e-12)
         # the leading-order curve: k_{eps,1}(phi; 0) for eps > 0, k_{eps,2}(phi; 0) for eps < 0
         (lead,) = [ln for ln in ax.lines if ln.get_gid() == "leading_curve"]
         x, y = lead.get_data()
@@ -364,9 +368,8 @@ def test_epsbig_panels_islands_zoom_and_flipped_eps(runs):
     # zoom (c): inside the circle, and it contains the impacting points of the island orbits
     w = by_id["c"]["window"]
     assert -np.pi <= w["xlim"][0] < w["xlim"][1] <= np.pi
-    with np.load(s["npz"]) as z:
-        lab = list(z["b_labels"])
-        phi, K, reg = z["b_phi"], z["b_K"], z["b_region"]
+    ob = s["result"].panel("b").orbits
+    lab, phi, K, reg = ob.labels, ob.phi, ob.K, ob.region
     for name in w["orbits"]:
         i = lab.index(name)
         sel = (reg[i] == int(Region.UPPER)) | (reg[i] == int(Region.RIGHT))
@@ -414,10 +417,10 @@ def test_zoom_window_rules_on_synthetic_orbits():
     # critical rule: the orbit K = -0.1 cos(phi - 1) dips below 0 on (1 - pi/2, 1 + pi/2)
     phi = np.linspace(-np.pi, np.pi, 20001)[:-1]
     K = -0.1 * np.cos(phi - 1.0)
-    res = SimpleNamespace(phi=phi[None, :], K=K[None, :], region=np.full((1, phi.size - 1), int(Region.ABOVE)),
-                          status=np.array([int(Status.OK)]), steps_done=np.array([phi.size - 1]))
-    pr = SimpleNamespace(res=res, labels=["x"], kinds=["extra"], map=None)
-    w = figures.zoom_window_critical(pr, pad=0.1)
+    orbits = SimpleNamespace(phi=phi[None, :], K=K[None, :], region=np.full((1, phi.size - 1), int(Region.ABOVE)),
+                             status=np.array([int(Status.OK)]), steps_done=np.array([phi.size - 1]), labels=["x"],
+                             kinds=["extra"])
+    w = zoom_window_critical(orbits, None, pad=0.1)
     np.testing.assert_allclose(w["xlim"], [1 - np.pi / 2 - 0.1 * np.pi, 1 + np.pi / 2 + 0.1 * np.pi], atol=1e-3)
     np.testing.assert_allclose(w["ylim"], [-0.11, 0.01], atol=1e-8)
     assert w["orbit"] == "x"
@@ -426,9 +429,9 @@ def test_zoom_window_rules_on_synthetic_orbits():
     reg[0, [2, 5]] = int(Region.RIGHT)
     p = np.array([[0.0, 0.5, 3.1, 1.0, 2.0, -3.1, 0.3, 0.2, 0.1, 0.0]])
     k = np.array([[-0.5, -0.4, -0.2, -0.9, -0.8, -0.1, -0.3, -0.3, -0.3, -0.3]])
-    res = SimpleNamespace(phi=p, K=k, region=reg, status=np.array([0]), steps_done=np.array([9]))
-    pr = SimpleNamespace(res=res, labels=["isl"], kinds=["extra"], map=None)
-    w = figures.zoom_window_islands(pr, ["isl"], pad=0.0)
+    orbits = SimpleNamespace(phi=p, K=k, region=reg, status=np.array([0]), steps_done=np.array([9]), labels=["isl"],
+                             kinds=["extra"])
+    w = zoom_window_islands(orbits, ["isl"], pad=0.0)
     np.testing.assert_allclose(w["ylim"], [-0.2, -0.1])
     assert w["xlim"] == [pytest.approx(3.1), np.pi]  # the box (3.1, 3.1 + 0.083) is clipped at pi
 
@@ -468,9 +471,8 @@ def test_portrait_coloured_by_region(tmp_path):
         # orbits from K0 = -1 to 0.5 visit every region: beside, above, upper wall, right wall
         assert labels == {"J_0u", "J_0", "J_1", "J_R"}
         assert [t.get_text() for t in ax.get_legend().get_texts()] == ["J_0u", "J_0", "J_1", "J_R"]
-        with np.load(s["npz"]) as z:
-            assert z["a_region"].shape == (6, 100)  # regions recorded only because they are drawn
+        assert s["result"].panel("a").orbits.region.shape == (6, 100)  # recorded because they are drawn
     finally:
         plt.close(s["figure"])
-    with np.load(tmp_path / "r.npz") as z:
-        assert "a_phi" in z.files and z["a_phi"].shape == (6, 101)
+    o = scenes.load_result(tmp_path / "r.npz").panel("a").orbits
+    assert o.phi.shape == (6, 101) and o.region.shape == (6, 100)

@@ -18,6 +18,7 @@ import importlib
 import json
 import math
 import os
+from pathlib import Path, PurePath
 from typing import Any
 
 import numpy as np
@@ -46,6 +47,8 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
     """JSON-able description of ``obj``; its arrays go into ``arrays`` under path-like keys."""
     if obj is None or isinstance(obj, (bool, str)):
         return obj
+    if isinstance(obj, PurePath):
+        return {"__path__": str(obj)}
     if isinstance(obj, enum.Enum):
         return {"__enum__": _type_name(type(obj)), "value": obj.value}
     if isinstance(obj, (int, np.integer)):
@@ -89,6 +92,8 @@ def from_tree(tree, arrays):
         raise ValueError("malformed result file: a bare list in the tree")
     if "__float__" in tree:
         return float(tree["__float__"])
+    if "__path__" in tree:
+        return Path(tree["__path__"])
     if "__enum__" in tree:
         return _resolve(tree["__enum__"])(tree["value"])
     if "__array__" in tree:

@@ -1,0 +1,172 @@
+"""Command line of ``python -m hovering``.
+
+``demo [--out PNG]``
+    The packaged demo scene (phase portraits of F_eps for +-eps, coloured by region).
+``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress]``
+    One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
+    and the PNG, prints the numbers shown.
+``redraw RESULT.npz [--out PNG]``
+    Redraws a saved result's figure without computing.
+``explore SCENE.toml [--n-steps N]``
+    A phase portrait where a click launches an orbit (needs an interactive matplotlib backend).
+
+Every bad input (file, key, value, output path, format, colour) is ``error: ...`` on stderr and
+exit status 2, before anything is computed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+
+def _checked(kind, lo, hi):
+    """An argparse type: a finite number of ``kind`` in [lo, hi], or a usage error naming the range."""
+
+    def parse(text):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'an integer' if kind is int else 'a number'}") from None
+        if not (lo <= v <= hi):  # also rejects nan
+            raise argparse.ArgumentTypeError(f"{text} is out of range; allowed: [{lo}, {hi}]")
+        return v
+
+    return parse
+
+
+def _error(e) -> int:
+    print(f"error: {e}", file=sys.stderr)
+    return 2
+
+
+def _progress(args) -> bool:
+    # Bars only for a person watching: on by default when stderr is a terminal, never in logs.
+    return sys.stderr.isatty() if args.progress is None else args.progress
+
+
+def _run(scene, out, quick: bool, progress: bool) -> int:
+    from .scenes import format_summary, run_scene
+
+    try:
+        summary = run_scene(scene, out=out, quick=quick, progress=progress)
+    except ValueError as e:  # a value only the computation can check (e.g. a K beyond the band's top)
+        return _error(e)
+    print(format_summary(summary))
+    return 0
+
+
+def _scene(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ._common import output_path
+    from .scenes import load_scene
+
+    try:
+        scene = load_scene(args.path)
+        out = output_path("--out", args.out) if args.out is not None else None
+    except (OSError, ValueError) as e:
+        return _error(e)
+    return _run(scene, out, args.quick, _progress(args))
+
+
+def _demo(args) -> int:
+    import tomllib
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ._common import output_path
+    from .scenes import packaged_scene, parse_scene
+
+    path = packaged_scene("demo")
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data.update(n_steps=args.steps, n_orbits=args.orbits, dpi=args.dpi)
+    for p, sign in zip(data["panels"], (1, -1)):
+        p["eps"] = sign * args.eps
+    try:
+        out = output_path("--out", args.out)
+        scene = parse_scene(data, path)
+    except ValueError as e:
+        return _error(e)
+    t0 = time.perf_counter()
+    rc = _run(scene, out, False, _progress(args))
+    if rc == 0:
+        print(f"demo done in {time.perf_counter() - t0:.2f} s")
+    return rc
+
+
+def _redraw(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ._common import output_path
+    from .scenes import redraw
+
+    try:
+        out = output_path("--out", args.out) if args.out is not None else None
+        png, result, _ = redraw(args.path, out=out)
+    except (OSError, ValueError) as e:
+        return _error(e)
+    print(f"redrew {result.scene.kind} scene {result.scene.name!r} (computed by hovering "
+          f"{result.meta.get('version')}) without computing: wrote {png}")
+    return 0
+
+
+def _explore(args) -> int:
+    try:
+        from .explore import main as explore_main
+    except ImportError as e:  # pragma: no cover - the explorer ships with the package
+        return _error(e)
+    argv = [args.path] + ([] if args.n_steps is None else ["--n-steps", str(args.n_steps)])
+    return explore_main(argv)
+
+
+def main(argv=None) -> int:
+    """Entry point of ``python -m hovering``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status (0 success, 2 bad input).
+    """
+    p = argparse.ArgumentParser(prog="python -m hovering", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="cmd", required=True)
+
+    def progress_flags(sp):
+        g = sp.add_mutually_exclusive_group()
+        g.add_argument("--progress", dest="progress", action="store_true", default=None,
+                       help="progress bars on stderr (default: when stderr is a terminal)")
+        g.add_argument("--no-progress", dest="progress", action="store_false")
+
+    d = sub.add_parser("demo", help="the packaged demo scene: phase portraits of F_eps for +eps and -eps")
+    d.add_argument("--out", default="hovering_demo.png", help="output PNG (default %(default)s)")
+    d.add_argument("--eps", type=_checked(float, 0.0, 10.0), default=0.3, help="|eps| in [0, 10] (default %(default)s)")
+    d.add_argument("--orbits", type=_checked(int, 1, 10_000), default=30,
+                   help="initial conditions on L1, 1..10000 (default %(default)s)")
+    d.add_argument("--steps", type=_checked(int, 1, 10_000_000), default=20000,
+                   help="iterates per orbit, 1..1e7 (default %(default)s)")
+    d.add_argument("--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)")
+    progress_flags(d)
+    sc = sub.add_parser("scene", help="make one figure from a scene file (examples/scenes/*.toml)")
+    sc.add_argument("path", help="scene file (TOML)")
+    sc.add_argument("--out", default=None,
+                    help="output PNG (default: the scene's 'output'); the result NPZ + JSON are written next to it")
+    sc.add_argument("--quick", action="store_true",
+                    help="divide the iterate counts by 50 (a fast check, not the paper's figure)")
+    progress_flags(sc)
+    rd = sub.add_parser("redraw", help="redraw a saved result (RESULT.npz) without computing")
+    rd.add_argument("path", help="result file written by 'scene' (NPZ)")
+    rd.add_argument("--out", default=None, help="output PNG (default: RESULT.png)")
+    ex = sub.add_parser("explore", help="click to launch orbits on a scene's map (interactive backend)")
+    ex.add_argument("path", help="scene file (TOML)")
+    ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")
+    args = p.parse_args(argv)
+    return {"demo": _demo, "scene": _scene, "redraw": _redraw, "explore": _explore}[args.cmd](args)

@@ -1,0 +1,12 @@
+"""Drawing only: figures and primitives that take results and never iterate a map.
+
+:mod:`.figures` (``render`` and one figure maker per scene kind), :mod:`.primitives`
+(``draw_geometry``, ``plot_orbits``) and :mod:`.style` (colours and labels shared with the
+computing side).
+"""
+
+from .figures import render
+from .primitives import draw_geometry, plot_orbits
+from .style import REGION_COLORS, SPECIAL_COLORS, SPECIAL_LABELS
+
+__all__ = ["render", "draw_geometry", "plot_orbits", "REGION_COLORS", "SPECIAL_COLORS", "SPECIAL_LABELS"]

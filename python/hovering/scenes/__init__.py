@@ -1,0 +1,155 @@
+"""Scenes: one TOML file per figure, validated, computed, saved and drawn, arrows forward only.
+
+::
+
+    TOML --load_scene--> spec (one frozen class per kind) --compute--> typed result
+         --save--> NPZ + JSON (scene, parameters, version, timings)
+         --render--> Figure (pure function of the result)  /  --summarize--> text report
+
+A scene names its effects; nothing else is simulated. The kinds:
+
+``portrait``, ``critical_orbits``, ``hovering_area``
+    The truncated map (sec:truncatedmapnum): orbits from L1, the paper's special orbits with
+    critical curves and zooms, |HOV| against eps.
+``flow_portrait``
+    The full return map and its truncated model side by side, same starts, coloured by region,
+    with the measured corner-singularity curves and K = 0.
+``flow_hovering_area``
+    |HOV| against eps for the flow, its truncated models (onset arcs; arcs measured on the flow)
+    and eq:hovsetsize, both signs of eps, with error bars.
+``tangent_tori``
+    fig:two-tang computed: the two tangent tori of the unperturbed system with trajectories.
+``sigma_structure``
+    fig:structure_Sigma computed from the flow: regions J_R, J_0, J_1 and their images.
+
+Flow scenes carry ``[system]`` (potentials ``harmonic`` / ``tan``, ``coupling`` = ``"bilinear"``,
+``"none"`` or terms ``[[c, i, j], ...]``, ``eps``, ``qw1``, ``qw2``, ``geometry`` none / wall /
+step), ``[section]`` (``h``), ``[integrator]`` (``stepper``, ``rtol``, ``atol``) and
+``[outputs]`` (``record``: what is recorded; ``trajectory_dt``). See ``examples/scenes``.
+"""
+
+from __future__ import annotations
+
+import os
+from importlib import resources
+from pathlib import Path
+from typing import Optional
+
+from .._common import output_path
+from .compute import compute
+from .report import format_summary, summarize
+from .results import SceneResult, load_result
+from .schema import MAX_PANELS, MAX_SCENE_BYTES, MAX_SERIES_POINTS, load_scene, parse_scene
+from .spec import (FLOW_KINDS, KINDS, QUICK_FACTOR, SPECIAL_ORBITS, TRUNCATED_KINDS, CriticalSpec, MapSpec, OrbitSpec,
+                   PanelSpec, Scene, SceneSpec, SeriesSpec, ZoomSpec)
+
+__all__ = [
+    "KINDS", "TRUNCATED_KINDS", "FLOW_KINDS", "SPECIAL_ORBITS", "QUICK_FACTOR", "MAX_PANELS", "MAX_SERIES_POINTS",
+    "MAX_SCENE_BYTES", "MapSpec", "OrbitSpec", "CriticalSpec", "ZoomSpec", "PanelSpec", "SeriesSpec", "Scene",
+    "SceneSpec", "SceneResult", "load_scene", "parse_scene", "compute", "run_scene", "redraw", "load_result",
+    "summarize", "format_summary", "packaged_scene",
+]
+
+
+def packaged_scene(name: str) -> Path:
+    """Path of a scene file shipped with the package (``"demo"``).
+
+    Parameters
+    ----------
+    name : str
+        The scene's name.
+
+    Returns
+    -------
+    Path
+    """
+    p = resources.files(__name__).joinpath("data", f"{name}.toml")
+    if not p.is_file():
+        raise ValueError(f"no packaged scene {name!r}; available: demo")
+    return Path(str(p))
+
+
+def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool = False, keep_figure: bool = False,
+              progress=False) -> dict:
+    """Compute a scene, save its result (NPZ + JSON), draw its figure and write the PNG.
+
+    Parameters
+    ----------
+    scene : SceneSpec
+        From :func:`load_scene`.
+    out : path-like, optional
+        PNG path (default ``scene.output``); the result is written next to it as ``.npz`` and
+        ``.json``.
+    quick : bool, optional
+        Divide iterate counts (and samples) by :data:`QUICK_FACTOR` for a fast check; titles say so.
+    keep_figure : bool, optional
+        Return the figure in the summary (key ``"figure"``) and the result (key ``"result"``)
+        instead of closing the figure.
+    progress : bool or callable, optional
+        Progress bars on stderr for the long computations.
+
+    Returns
+    -------
+    dict
+        :func:`summarize` of the result plus ``output`` (PNG), ``npz`` and ``json`` paths.
+    """
+    import time
+
+    t0 = time.perf_counter()
+    png = output_path("out", out) if out is not None else scene.output
+    png.parent.mkdir(parents=True, exist_ok=True)
+    npz = png.with_suffix(".npz")
+    result = compute(scene, quick=quick, progress=progress, checkpoint=png.with_suffix(".sweep.jsonl"))
+    result.meta["output"] = str(png)
+    t = time.perf_counter()
+    fig = _draw(result, png)
+    result.meta["timings"]["render"] = time.perf_counter() - t
+    npz_path, json_path = result.save(npz)
+    summary = result.summary()
+    summary["runtime_s"] = time.perf_counter() - t0
+    summary.update(output=str(png), npz=npz_path, json=json_path)
+    if keep_figure:
+        summary["figure"] = fig
+        summary["result"] = result
+    else:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    return summary
+
+
+def _draw(result: SceneResult, png: Path):
+    from ..plot.figures import render
+
+    fig = render(result)
+    fig.savefig(png, dpi=result.scene.dpi)
+    return fig
+
+
+def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bool = False):
+    """Redraw a saved scene result without computing anything.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``.npz`` written by :func:`run_scene`.
+    out : path-like, optional
+        PNG path (default: the NPZ's name with ``.png``).
+    keep_figure : bool, optional
+        Return the figure instead of closing it.
+
+    Returns
+    -------
+    tuple
+        ``(png_path, result, figure or None)``.
+    """
+    result = load_result(path)
+    png = output_path("--out", out) if out is not None else Path(os.fspath(path)).with_suffix(".png")
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig = _draw(result, png)
+    if not keep_figure:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        fig = None
+    return png, result, fig

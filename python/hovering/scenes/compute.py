@@ -1,0 +1,640 @@
+"""Scene spec -> typed result: the only place a scene simulates anything.
+
+Each kind computes exactly what its figure and report show: orbits with the records the figure
+colours by, the lines drawn under them (L1, L2, corner curves, the leading-order curve), zoom
+windows, theory curves. Drawing (:mod:`hovering.plot`) never computes. Flow scenes build their
+system from the scene's own ``[system]``, ``[section]``, ``[integrator]`` and ``[outputs]``
+tables, so what a scene does not name is not simulated: geometry "none" has no wall events,
+eps = 0 no coupling, no "regions" no crossing bookkeeping, no "trajectory" no dense output.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from typing import Optional
+
+import numpy as np
+
+from .._common import Region, Status, wrap
+from ..plot.style import SPECIAL_COLORS, orbit_color
+from ..sweeps import Checkpoint
+from ..truncated.theory import golden_family, hovering_area_theory
+from .results import (FlowHoveringResult, FlowPortraitResult, Geometry, HoveringAreaResult, OrbitPanelResult,
+                      OrbitSceneResult, OrbitSet, SceneResult, SeriesResult, SigmaStructureResult, TangentToriResult,
+                      TorusResult, ZoomPanelResult)
+from .spec import (QUICK_FACTOR, FlowHoveringScene, FlowPortraitScene, HoveringAreaScene, OrbitScene, PanelSpec,
+                   SceneSpec, SigmaStructureScene, TangentToriScene)
+
+__all__ = ["compute", "map_geometry", "flow_geometry", "zoom_window_critical", "zoom_window_islands",
+           "leading_curve", "special_starts", "hovering_orbits", "scaled"]
+
+
+def scaled(n: int, quick: bool, floor: int = 100) -> int:
+    """An iterate count divided by :data:`QUICK_FACTOR` in quick runs (at least ``floor``).
+
+    Parameters
+    ----------
+    n : int
+        The scene's count.
+    quick : bool
+        Quick run.
+    floor : int, optional
+        Smallest count of a quick run.
+
+    Returns
+    -------
+    int
+    """
+    return max(n // QUICK_FACTOR, min(floor, n)) if quick else n
+
+
+def _progress_kw(progress) -> dict:
+    # Only passed when asked, so a map without a progress argument still runs silently.
+    return {"progress": progress} if progress else {}
+
+
+# ------------------------------------------------------------------------------------------------
+# Lines drawn under orbits
+
+
+def map_geometry(m, K_range, n: int = 400, corner_curves: bool = True, lines: bool = True) -> Geometry:
+    """K = 0, L1, L2 and the corner curves of a truncated map (closed forms) over ``K_range``.
+
+    Parameters
+    ----------
+    m : TruncatedMap or TruncatedFamily
+        The map.
+    K_range : (float, float)
+        Heights drawn (clipped to the map's band).
+    n : int, optional
+        Samples per line.
+    corner_curves, lines : bool, optional
+        What is drawn.
+
+    Returns
+    -------
+    Geometry
+    """
+    lo = m.valid_band()[0]
+    K = np.linspace(max(K_range[0], lo * (1 - 1e-9)), K_range[1], n)
+    Kn = K[K < 0]
+    corners = {}
+    if corner_curves and Kn.size:
+        cc = m.corner_curves(Kn)
+        corners = {k: np.asarray(cc[k], dtype=float) for k in ("01", "1R", "R0")}
+    return Geometry(K=K, L1=np.asarray(m.L1(K), dtype=float) if lines else None,
+                    L2=np.asarray(m.L2(K), dtype=float) if lines else None, K_corner=Kn, corners=corners)
+
+
+def flow_geometry(fm, K_range, n_circles: int, rtol: float, n: int = 200) -> Geometry:
+    """K = 0, L1, L2 of a FlowMap and its corner curves measured on ``n_circles`` circles K < 0.
+
+    Parameters
+    ----------
+    fm : FlowMap
+        The flow's map (normal coordinates, geometry "step").
+    K_range : (float, float)
+        Heights drawn.
+    n_circles : int
+        Circles on which the corner curves are bisected (0: none).
+    rtol : float
+        Integration tolerance of the measurement.
+    n : int, optional
+        Samples of L1, L2.
+
+    Returns
+    -------
+    Geometry
+    """
+    from ..normal.corners import corner_curves
+
+    lo = fm.valid_band()[0]
+    K = np.linspace(max(K_range[0], 0.95 * lo), K_range[1], n)
+    corners, Kc = {}, np.zeros(0)
+    if n_circles > 0 and K_range[0] < 0:
+        top = min(K_range[1], 0.0)
+        Kc = np.linspace(max(K_range[0], 0.95 * lo), top, n_circles + 1)[:-1] if top > K_range[0] else Kc
+        if Kc.size:
+            cc = corner_curves(fm.section, Kc, fm.curve, n_phi=256, bisections=30, rtol=max(rtol, 1e-13))
+            corners = {"01": cc.phi_01, "1R": cc.phi_1R, "R0": cc.phi_R0}
+    return Geometry(K=K, L1=np.asarray(fm.L1(K), dtype=float), L2=np.asarray(fm.L2(K), dtype=float), K_corner=Kc,
+                    corners=corners, measured=True)
+
+
+def leading_curve(m, n: int = 721, window: Optional[tuple] = None) -> tuple:
+    """The leading-order upper critical curve: ``k_{eps,1}(phi; 0)`` (eps >= 0) or ``k_{eps,2}`` (eps < 0).
+
+    Parameters
+    ----------
+    m : TruncatedMap
+        The map.
+    n : int, optional
+        Samples.
+    window : (float, float), optional
+        Angles sampled (default the whole circle).
+
+    Returns
+    -------
+    tuple
+        ``(phi, k, label)``.
+    """
+    lo, hi = window if window is not None else (-np.pi, np.pi)
+    phi = np.linspace(lo, hi, n)
+    if m.eps >= 0:
+        return phi, np.asarray(m.k_eps1(phi, 0.0)), r"$k_{\varepsilon,1}(\phi;K_0=0)$ (leading order)"
+    return phi, np.asarray(m.k_eps2(phi, 0.0)), r"$k_{\varepsilon,2}(\phi;K_0=0)$ (leading order)"
+
+
+# ------------------------------------------------------------------------------------------------
+# Truncated-map orbit scenes
+
+
+def special_starts(m, names) -> list:
+    """Initial points of the paper's special orbits (sec:truncatedmapnumact).
+
+    Parameters
+    ----------
+    m : TruncatedMap
+        The map.
+    names : sequence of str
+        From :data:`~hovering.scenes.SPECIAL_ORBITS`.
+
+    Returns
+    -------
+    list of (float, float)
+    """
+    Kc = m.K_crit()
+    K = {"blue": Kc, "orange": Kc + 0.05 * abs(m.eps), "green": 0.0, "red": 0.0}
+    return [(m.L2(0.0) if n == "red" else m.L1(K[n]), K[n]) for n in names]
+
+
+def hovering_orbits(orbits: OrbitSet) -> np.ndarray:
+    """Per orbit: all steps taken, never in J_1, J_R (or 2+ impacts), and some point below K = 0.
+
+    Parameters
+    ----------
+    orbits : OrbitSet
+        Orbits recorded with regions.
+
+    Returns
+    -------
+    ndarray of bool
+    """
+    reg = orbits.region
+    imp = np.any((reg == int(Region.UPPER)) | (reg == int(Region.RIGHT)) | (reg == int(Region.MULTI)), axis=1)
+    return (orbits.status == int(Status.OK)) & ~imp & (np.nanmin(orbits.K, axis=1) < 0)
+
+
+def _auto_ylim(K, band_floor: float, pad: float = 0.05) -> tuple:
+    """Heights of all finite orbit points (and K = 0), widened by ``pad``, inside the band."""
+    K = np.asarray(K)
+    lo = min(float(np.nanmin(K)), 0.0)
+    hi = max(float(np.nanmax(K)), 0.0)
+    d = pad * (hi - lo) if hi > lo else 0.1
+    return (max(lo - d, band_floor), hi + d)
+
+
+def _clip_x(lo: float, hi: float) -> list:
+    return [max(lo, -np.pi), min(hi, np.pi)]
+
+
+def zoom_window_critical(orbits: OrbitSet, m, pad: float = 0.5) -> dict:
+    """Window around the dip of the critical curve below K = 0 (the hovering set).
+
+    The critical orbit is the panel's numerically found critical curve if it hovers, else the
+    hovering orbit with the lowest minimum. The window spans the angles where that orbit lies
+    below K = 0 and the heights ``[K_min, 0]``, each widened by ``pad`` times its size on both
+    sides; with no hovering orbit, the predicted dip at ``K~_c``, ``phi = L1(0) +- theta_w``.
+
+    Parameters
+    ----------
+    orbits : OrbitSet
+        The zoomed panel's orbits (recorded with regions).
+    m : TruncatedMap
+        Its map.
+    pad : float, optional
+        Margin on each side as a fraction of the dip's width and depth.
+
+    Returns
+    -------
+    dict
+        ``xlim``, ``ylim``, ``rule`` and ``orbit`` (the label used, or None).
+    """
+    hov = hovering_orbits(orbits)
+    kinds = np.array(orbits.kinds)
+    Kmin = np.nanmin(orbits.K, axis=1)
+    if np.any(hov & (kinds == "critical")):
+        i = int(np.flatnonzero(hov & (kinds == "critical"))[0])
+    elif hov.any():
+        i = int(np.flatnonzero(hov)[np.argmin(Kmin[hov])])
+    else:
+        c, Kc = m.L1(0.0), min(m.K_crit(), -0.05 * abs(m.eps))
+        w, h = 2 * m.theta_w, -Kc
+        return dict(xlim=_clip_x(c - m.theta_w - pad * w, c + m.theta_w + pad * w),
+                    ylim=[Kc - pad * h, pad * h], rule="predicted dip (no hovering orbit)", orbit=None)
+    phi, K = orbits.phi[i], orbits.K[i]
+    ok = np.isfinite(K)
+    phi, K = phi[ok], K[ok]
+    j = int(np.argmin(K))
+    d = wrap(phi - phi[j])
+    below = K < 0
+    a, b = float(d[below].min()), float(d[below].max())
+    w, h = b - a, -float(K[j])
+    x0 = float(phi[j])
+    return dict(xlim=_clip_x(x0 + a - pad * w, x0 + b + pad * w), ylim=[-h - pad * h, pad * h],
+                rule=f"dip of orbit '{orbits.labels[i]}' below K=0, pad {pad:g}", orbit=orbits.labels[i])
+
+
+def zoom_window_islands(orbits: OrbitSet, names, pad: float = 0.3) -> dict:
+    """Bounding box of the impacting points (J_1, J_R) of the named island orbits.
+
+    Parameters
+    ----------
+    orbits : OrbitSet
+        The zoomed panel's orbits (recorded with regions).
+    names : sequence of str
+        Labels of the island orbits.
+    pad : float, optional
+        Margin on each side as a fraction of the box size.
+
+    Returns
+    -------
+    dict
+        ``xlim``, ``ylim``, ``rule`` and ``orbits``.
+    """
+    idx = [orbits.labels.index(o) for o in names]
+    phis, Ks = [], []
+    for i in idx:
+        n = int(orbits.steps_done[i])
+        reg = orbits.region[i, :n]
+        sel = (reg == int(Region.UPPER)) | (reg == int(Region.RIGHT))
+        phis.append(orbits.phi[i, :n][sel])
+        Ks.append(orbits.K[i, :n][sel])
+    phi, K = np.concatenate(phis), np.concatenate(Ks)
+    rule = f"impacting points of {list(names)}, pad {pad:g}"
+    if phi.size == 0:
+        phi = np.concatenate([orbits.phi[i][np.isfinite(orbits.phi[i])] for i in idx])
+        K = np.concatenate([orbits.K[i][np.isfinite(orbits.K[i])] for i in idx])
+        rule = f"all points of {list(names)} (none impacts), pad {pad:g}"
+    c = float(np.angle(np.mean(np.exp(1j * phi))))
+    d = wrap(phi - c)
+    a, b = c + float(d.min()), c + float(d.max())
+    w, h = b - a, float(K.max() - K.min())
+    return dict(xlim=_clip_x(a - pad * w, b + pad * w), ylim=[float(K.min()) - pad * h, float(K.max()) + pad * h],
+                rule=rule, orbits=list(names))
+
+
+def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, progress) -> tuple:
+    from ..analysis import rotation_number
+
+    m = p.map.build()
+    critical = None
+    if scene.kind == "portrait":
+        K0 = np.linspace(p.K0_range[0], p.K0_range[1], p.n_orbits)
+        line = m.L1 if scene.line == "L1" else m.L2
+        record = ("orbit", "regions") if scene.color_by == "region" else ("orbit",)
+        res = m.iterate(line(K0), K0, n_steps, record=record, **_progress_kw(progress))
+        orbits = OrbitSet.of(res, [f"K0={k:.4g}" for k in K0], [orbit_color(i) for i in range(p.n_orbits)],
+                             ["fan"] * p.n_orbits)
+    else:
+        starts = special_starts(m, p.special)
+        labels, colors, kinds = list(p.special), [SPECIAL_COLORS[n] for n in p.special], list(p.special)
+        for j, o in enumerate(p.orbits):
+            phi0 = o.phi0 if o.phi0 is not None else (m.L1(o.K0) if o.line == "L1" else m.L2(o.K0))
+            starts.append((phi0, o.K0))
+            labels.append(o.label)
+            colors.append(o.color or orbit_color(j, 5))
+            kinds.append("extra")
+        if p.critical is not None:
+            kw = {"line": p.critical.line}
+            if p.critical.K_range is not None:
+                kw["K_range"] = p.critical.K_range
+            try:
+                c = m.critical_curve(n_steps=scaled(p.critical.n_steps, quick), **kw, **_progress_kw(progress))
+            except RuntimeError as e:
+                critical = dict(found=False, reason=str(e))
+            else:
+                critical = dict(found=True, K0=c.K0, K_min=c.K_min, rotation=c.rotation,
+                                rotation_mean=c.rotation_mean, K_pred=c.K_pred, rotation_pred=c.rotation_pred,
+                                digits=c.digits)
+                line = m.L1 if p.critical.line == "L1" else m.L2
+                starts.append((line(c.K0), c.K0))
+                labels.append("critical")
+                colors.append(p.critical.color)
+                kinds.append("critical")
+        phi0 = np.array([s[0] for s in starts], dtype=float)
+        K0 = np.array([s[1] for s in starts], dtype=float)
+        record = ("orbit", "regions", "rotation") if scene.rotation == "mean" else ("orbit", "regions")
+        res = m.iterate(phi0, K0, n_steps, record=record, **_progress_kw(progress))
+        rho = np.asarray(rotation_number(res, method=scene.rotation), dtype=float)
+        orbits = OrbitSet.of(res, labels, colors, kinds, rho)
+    band_floor = m.valid_band()[0]
+    ylim = tuple(p.ylim) if p.ylim else _auto_ylim(orbits.K, band_floor)
+    xlim = tuple(p.xlim) if p.xlim else (-np.pi, np.pi)
+    geom = map_geometry(m, ylim, corner_curves=scene.corner_curves)
+    lead = leading_curve(m) if scene.leading_curve else None
+    panel = OrbitPanelResult(id=p.id, params=p.map.as_dict(), orbits=orbits, geometry=geom, leading=lead,
+                             K_crit=float(m.K_crit()), rho_crit=float(m.rho_crit()), band_floor=float(band_floor),
+                             xlim=xlim, ylim=ylim, critical=critical)
+    return panel, m
+
+
+def _orbit_scene(scene: OrbitScene, quick: bool, progress, meta: dict) -> OrbitSceneResult:
+    n_steps = scaled(scene.n_steps, quick)
+    meta["n_steps"] = n_steps
+    done, maps = {}, {}
+    for p in scene.panels:
+        if p.zoom is None:
+            t = time.perf_counter()
+            done[p.id], maps[p.id] = _orbit_panel(scene, p, n_steps, quick, progress)
+            meta["timings"][f"panel {p.id}"] = time.perf_counter() - t
+    panels = []
+    for p in scene.panels:
+        if p.zoom is None:
+            panels.append(done[p.id])
+            continue
+        src, m, z = done[p.zoom.of], maps[p.zoom.of], p.zoom
+        if z.on == "critical":
+            w = zoom_window_critical(src.orbits, m, z.pad)
+        elif z.on == "islands":
+            w = zoom_window_islands(src.orbits, z.orbits, z.pad)
+        else:
+            w = dict(xlim=list(z.xlim), ylim=list(z.ylim), rule="fixed")
+        geom = map_geometry(m, tuple(w["ylim"]), n=1200, corner_curves=scene.corner_curves)
+        lead = leading_curve(m, n=2001) if scene.leading_curve else None
+        panels.append(ZoomPanelResult(id=p.id, of=z.of, on=z.on, window=w, geometry=geom, leading=lead))
+    return OrbitSceneResult(scene=scene, meta=meta, panels=panels)
+
+
+# ------------------------------------------------------------------------------------------------
+# Truncated-map |HOV| against eps
+
+
+def _theory_line(spec, eps_all: np.ndarray) -> tuple:
+    e_hi = max(float(eps_all.max()), 0.0)
+    e_lo = min(float(eps_all.min()), 0.0)
+    eg = np.linspace(0.0, e_hi, 200)[1:]
+    if spec.golden_c is not None:
+        tg = np.array([hovering_area_theory(x, golden_family(x, spec.golden_c, spec.tau0)[1],
+                                            golden_family(x, spec.golden_c, spec.tau0)[0]) for x in eg])
+    else:
+        tg = np.asarray(hovering_area_theory(eg, spec.theta_w, spec.Omega0), dtype=float)
+    return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
+
+
+def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint) -> HoveringAreaResult:
+    n_steps = scaled(scene.n_steps, quick)
+    samples = max(scene.samples // QUICK_FACTOR, 400) if quick else scene.samples
+    meta.update(n_steps=n_steps, samples=samples)
+    # Each measured point is on disk at once; a rerun resumes where an interrupted one stopped and
+    # recomputes nothing already measured (keys hold every parameter that changes a point).
+    ckpt = Checkpoint(checkpoint)
+    meta["checkpoint"] = str(ckpt.path)
+    eps_all = np.array(scene.eps)
+    drawn = set()
+    out = []
+    for k, s in enumerate(scene.series):
+        rows, reused = [], 0
+        for e in scene.eps:
+            ms = s.map_at(e)
+            kw = {} if s.K_low is None else {"K_low": s.K_low}
+            key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+            row = ckpt.get(key)
+            if row is None:
+                t = time.perf_counter()
+                h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw,
+                                             **_progress_kw(progress))
+                row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
+                           floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
+                           theta_w=ms.theta_w, seconds=time.perf_counter() - t)
+                ckpt.put(key, row)
+            else:
+                reused += 1
+            rows.append(row)
+        fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
+        te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
+        drawn.add(fam)
+        col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
+        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
+                                error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
+                                K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
+                                theory_curve=tc, golden_c=s.golden_c, reused=reused))
+    meta["points_reused"] = sum(s.reused for s in out)
+    return HoveringAreaResult(scene=scene, meta=meta, series=out)
+
+
+# ------------------------------------------------------------------------------------------------
+# The physical flow
+
+
+def _flowmap(scene, eps: Optional[float] = None, coordinates: str = "normal"):
+    from ..normal.flowmap import FlowMap
+
+    return FlowMap(scene.system.build(eps=eps), h=scene.h, coordinates=coordinates, **scene.integrator.options())
+
+
+def _work(res) -> dict:
+    w = getattr(res, "work", None)
+    return {} if w is None else {k: int(v) for k, v in dict(w).items()}
+
+
+def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) -> FlowPortraitResult:
+    n = scaled(scene.n_steps, quick, floor=50)
+    meta["n_steps"] = n
+    t = time.perf_counter()
+    fm = _flowmap(scene)
+    tm = fm.truncated(forcing=scene.model)
+    meta["timings"]["setup"] = time.perf_counter() - t
+    K0 = np.linspace(scene.K0_range[0], scene.K0_range[1], scene.n_orbits)
+    phi0 = np.asarray(fm.L1(K0), dtype=float)
+    regions = "regions" in scene.outputs.record
+    record = ("orbit", "regions") if regions else ("orbit",)
+    labels = [f"K0={k:.4g}" for k in K0]
+    colors = [orbit_color(i) for i in range(scene.n_orbits)]
+    t = time.perf_counter()
+    fres = fm.iterate(phi0, K0, n, record=record, **_progress_kw(progress))
+    meta["timings"]["flow"] = time.perf_counter() - t
+    t = time.perf_counter()
+    mres = tm.iterate(phi0, K0, n, record=record)
+    meta["timings"]["model"] = time.perf_counter() - t
+    flow = OrbitSet.of(fres, labels, colors, ["fan"] * len(labels))
+    model = OrbitSet.of(mres, labels, colors, ["fan"] * len(labels))
+    floor = max(fm.valid_band()[0], tm.valid_band()[0])
+    lo = min(_auto_ylim(flow.K, floor)[0], _auto_ylim(model.K, floor)[0])
+    hi = max(_auto_ylim(flow.K, floor)[1], _auto_ylim(model.K, floor)[1])
+    t = time.perf_counter()
+    fg = flow_geometry(fm, (lo, hi), scene.corner_K, scene.integrator.rtol)
+    meta["timings"]["corner curves"] = time.perf_counter() - t
+    mg = map_geometry(tm, (lo, hi), corner_curves=scene.corner_K > 0)
+    p = fm.onset
+    onset = dict(Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
+    return FlowPortraitResult(scene=scene, meta=meta, flow=flow, model=model, flow_geometry=fg, model_geometry=mg,
+                              onset=onset, forcing=np.asarray(fm.forcing_coefficients()), model_name=scene.model,
+                              work=_work(fres))
+
+
+def _measured_model(fm, K_low: float):
+    """The truncated family with arcs measured on the flow's corner curves (and measured forcing)."""
+    from ..normal.compare import truncated_from_flow
+    from ..normal.corners import corner_curves
+
+    s = np.linspace(math.sqrt(-1.05 * K_low), 0.0, 17)[:-1]
+    K = np.concatenate([-s**2, [0.01, 0.03, 0.05]])
+    cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=1e-12)
+    return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
+
+
+def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint) -> FlowHoveringResult:
+    n = scaled(scene.n_steps, quick, floor=50)
+    samples = max(scene.samples // QUICK_FACTOR, 100) if quick else scene.samples
+    meta.update(n_steps=n, samples=samples)
+    ckpt = Checkpoint(checkpoint)
+    meta["checkpoint"] = str(ckpt.path)
+    rows, reused = [], 0
+    for e in scene.eps:
+        sysd = _serial_dict(scene.system)
+        sysd["eps"] = e
+        key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
+                   seed=scene.seed, models=list(scene.models))
+        row = ckpt.get(key)
+        if row is not None:
+            reused += 1
+            rows.append(row)
+            continue
+        t = time.perf_counter()
+        fm = _flowmap(scene, eps=e)
+        flow = fm.hovering_area(n_steps=n, samples=samples, seed=scene.seed, keep_points=True,
+                                **_progress_kw(progress))
+        th = fm.theory()
+        row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
+                   theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
+                   seconds=time.perf_counter() - t, models={})
+        for name in scene.models:
+            tm = fm.truncated() if name == "onset" else _measured_model(fm, flow.box[2])
+            mh = tm.hovering_area(n_steps=n, samples=samples, K_low=flow.box[2], seed=scene.seed, keep_points=True)
+            row["models"][name] = dict(area=mh.area, error=mh.error,
+                                       agree=float(np.mean(mh.hovering == flow.hovering)))
+        ckpt.put(key, row)
+        rows.append(row)
+    col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
+    models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree")}
+              for name in scene.models}
+    meta["points_reused"] = reused
+    return FlowHoveringResult(scene=scene, meta=meta, eps=col("eps"), flow_area=col("flow"), flow_error=col("flow_err"),
+                              flow_both_sides=col("flow_both"), models=models, theory=col("theory"), K_low=col("K_low"),
+                              b1=col("b1"), seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
+
+
+def _serial_dict(spec) -> dict:
+    from dataclasses import asdict
+
+    return asdict(spec)
+
+
+def _circle(V, e: float, n: int) -> tuple:
+    """The level ``V(q) + p^2/2 = e`` as a closed curve, by the potential's own angle variable."""
+    th = np.linspace(-np.pi, np.pi, n)
+    qp = np.array([V.point_at(float(t), e) for t in th])
+    return qp[:, 0], qp[:, 1]
+
+
+def _tangent_tori(scene: TangentToriScene, quick: bool, progress, meta: dict) -> TangentToriResult:
+    sys = scene.system.build()
+    h = scene.h
+    h1w, h2w = float(sys.V1.V(sys.qw1)), float(sys.V2.V(sys.qw2))
+    fm = _flowmap(scene, coordinates="section")
+    tori = []
+    for name, h1, color in (("right", h1w, "C0"), ("upper", h - h2w, "C3")):
+        h2 = h - h1
+        q1, p1 = _circle(sys.V1, h1, scene.n_points)
+        q2, p2 = _circle(sys.V2, h2, scene.n_points)
+        # A point of Sigma_h on this torus: (theta, I) with H2(I) = h2; theta = 0 (p2 = 0, q2 at
+        # its maximum) starts the segment at a clean corner of the configuration-space box.
+        I = float(sys.V2.action(h2))
+        res = fm.iterate([0.0], [I], scene.n_returns, record=("trajectory",),
+                         trajectory_dt=scene.outputs.trajectory_dt, **_progress_kw(progress))
+        meta.setdefault("status", {})[name] = Status(int(res.status[0])).name
+        meta.setdefault("work", {})[name] = _work(res)
+        tori.append(TorusResult(name=name, h1=h1, h2=h2, q1=q1, p1=p1, q2=q2, p2=p2,
+                                trajectory=np.asarray(res.trajectory_of(0)), color=color))
+    return TangentToriResult(scene=scene, meta=meta, tori=tori, qw1=sys.qw1, qw2=sys.qw2)
+
+
+def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: dict) -> SigmaStructureResult:
+    fm = _flowmap(scene)
+    nphi, nK = scene.grid
+    if quick:
+        nphi, nK = max(nphi // 4, 16), max(nK // 4, 4)
+    meta["grid"] = [nphi, nK]
+    lo = max(scene.K_range[0], 0.95 * fm.valid_band()[0])
+    P, KK = np.meshgrid(-np.pi + 2 * np.pi * (np.arange(nphi) + 0.5) / nphi, np.linspace(lo, scene.K_range[1], nK))
+    t = time.perf_counter()
+    res = fm.iterate(P.ravel(), KK.ravel(), 1, record=("orbit", "regions", "section", "states"),
+                     **_progress_kw(progress))
+    meta["timings"]["returns"] = time.perf_counter() - t
+    ok = np.isfinite(res.theta[:, 0])  # points with a point of Sigma_h
+    z = res.z
+    # The tangency circle K = 0 and its image (K = eps f(phi) to leading order).
+    ph = np.linspace(-np.pi, np.pi, 721, endpoint=False)
+    tg = fm.iterate(ph, np.zeros_like(ph), 1, record=("orbit", "section", "states"))
+    tangency = dict(phi=ph, theta=tg.theta[:, 0], I=tg.I[:, 0], q2=tg.z[:, 0, 2], p2=tg.z[:, 0, 3],
+                    phi1=tg.phi[:, 1], K1=tg.K[:, 1], theta1=tg.theta[:, 1], I1=tg.I[:, 1], q21=tg.z[:, 1, 2],
+                    p21=tg.z[:, 1, 3])
+    t = time.perf_counter()
+    corners = flow_geometry(fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, scene.integrator.rtol)
+    meta["timings"]["corner curves"] = time.perf_counter() - t
+    return SigmaStructureResult(
+        scene=scene, meta=meta, phi=res.phi[ok, 0], K=res.K[ok, 0], region=res.region[ok, 0],
+        theta=res.theta[ok, 0], I=res.I[ok, 0], q2=z[ok, 0, 2], p2=z[ok, 0, 3], phi1=res.phi[ok, 1], K1=res.K[ok, 1],
+        theta1=res.theta[ok, 1], I1=res.I[ok, 1], q21=z[ok, 1, 2], p21=z[ok, 1, 3], tangency=tangency, corners=corners)
+
+
+# ------------------------------------------------------------------------------------------------
+
+
+def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: Optional[os.PathLike] = None
+            ) -> SceneResult:
+    """Run a scene's simulation and return its typed result (nothing is drawn or written).
+
+    Parameters
+    ----------
+    scene : SceneSpec
+        From :func:`hovering.scenes.load_scene`.
+    quick : bool, optional
+        Divide iterate counts (and samples) by :data:`QUICK_FACTOR` for a fast check.
+    progress : bool or callable, optional
+        Progress bars on stderr for the long computations (see :mod:`hovering._progress`).
+    checkpoint : path-like, optional
+        Sweep scenes (``hovering_area``, ``flow_hovering_area``): the JSON-lines file every
+        finished point is written to at once (default: next to the scene's output).
+
+    Returns
+    -------
+    SceneResult
+        The kind's result type, with ``meta`` (version, quick, timings).
+    """
+    from .. import __version__
+
+    if not isinstance(scene, SceneSpec):
+        raise ValueError(f"scene must be a scene spec from hovering.scenes.load_scene, got {type(scene).__name__}")
+    meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
+    t0 = time.perf_counter()
+    ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
+    if isinstance(scene, OrbitScene):
+        out = _orbit_scene(scene, quick, progress, meta)
+    elif isinstance(scene, HoveringAreaScene):
+        out = _hovering_scene(scene, quick, progress, meta, ck)
+    elif isinstance(scene, FlowPortraitScene):
+        out = _flow_portrait(scene, quick, progress, meta)
+    elif isinstance(scene, FlowHoveringScene):
+        out = _flow_hovering(scene, quick, progress, meta, ck)
+    elif isinstance(scene, TangentToriScene):
+        out = _tangent_tori(scene, quick, progress, meta)
+    elif isinstance(scene, SigmaStructureScene):
+        out = _sigma_structure(scene, quick, progress, meta)
+    else:
+        raise ValueError(f"no computation for scene kind {scene.kind!r}")
+    meta["timings"]["total"] = time.perf_counter() - t0
+    return out

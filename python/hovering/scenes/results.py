@@ -1,0 +1,504 @@
+"""Typed results of scenes: everything a figure or a report shows, and nothing else.
+
+Each result holds its scene spec, the computed arrays and numbers, and ``meta`` (version, quick
+run, timings). Results save to NPZ + JSON without pickle (:meth:`SceneResult.save`,
+:func:`load_result`) and a figure is a pure function of them (:mod:`hovering.plot.figures`), so
+``python -m hovering redraw RESULT.npz`` redraws any figure without computing.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from .. import _serial
+from .spec import SceneSpec
+
+__all__ = [
+    "Geometry", "OrbitSet", "OrbitPanelResult", "ZoomPanelResult", "SeriesResult", "TorusResult",
+    "SceneResult", "OrbitSceneResult", "HoveringAreaResult", "FlowPortraitResult", "FlowHoveringResult",
+    "TangentToriResult", "SigmaStructureResult", "load_result", "jsonable",
+]
+
+
+def jsonable(x):
+    """``x`` with numpy scalars as Python numbers and non-finite floats as None (JSON-safe).
+
+    Parameters
+    ----------
+    x : object
+        Nested dicts, lists, tuples and numbers.
+
+    Returns
+    -------
+    object
+    """
+    if isinstance(x, dict):
+        return {str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return jsonable(x.tolist())
+    if isinstance(x, (np.floating, float)):
+        return None if not math.isfinite(float(x)) else float(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, Path):
+        return str(x)
+    return x
+
+
+@dataclass
+class Geometry:
+    """The lines a phase portrait on (phi, K) draws: K = 0, L1, L2 and the corner curves.
+
+    Attributes
+    ----------
+    K : ndarray
+        Heights of the lines L1, L2.
+    L1, L2 : ndarray or None
+        Their angles at ``K`` (None: not drawn).
+    K_corner : ndarray
+        Heights (K < 0) of the corner-singularity curves.
+    corners : dict
+        ``"01"``, ``"1R"``, ``"R0"`` -> angles at ``K_corner`` (empty: not drawn; NaN where a curve
+        was not found).
+    measured : bool
+        Whether the corner curves were measured on the flow (else closed forms of the model).
+    """
+
+    K: np.ndarray
+    L1: Optional[np.ndarray]
+    L2: Optional[np.ndarray]
+    K_corner: np.ndarray
+    corners: dict
+    measured: bool = False
+
+
+@dataclass
+class OrbitSet:
+    """Orbits of one panel, with what each one is.
+
+    Attributes
+    ----------
+    phi, K : ndarray
+        Shape ``(n_orbits, n_steps + 1)``; NaN after an orbit stopped.
+    region : ndarray of int8 or None
+        Region of the point each step was taken from, ``(n_orbits, n_steps)``.
+    status : ndarray of int8
+        Per-orbit :class:`~hovering.Status`.
+    steps_done : ndarray of int64
+        Steps each orbit took.
+    labels, colors, kinds : list of str
+        Legend label, colour and kind (``"fan"``, a special orbit's name, ``"extra"``,
+        ``"critical"``) of each orbit.
+    rho : ndarray or None
+        Rotation numbers.
+    """
+
+    phi: np.ndarray
+    K: np.ndarray
+    region: Optional[np.ndarray]
+    status: np.ndarray
+    steps_done: np.ndarray
+    labels: list
+    colors: list
+    kinds: list
+    rho: Optional[np.ndarray] = None
+
+    @classmethod
+    def of(cls, res, labels, colors, kinds, rho=None) -> "OrbitSet":
+        """From an :class:`~hovering.IterateResult` (``"orbit"`` recorded).
+
+        Parameters
+        ----------
+        res : IterateResult
+            The orbits.
+        labels, colors, kinds : list of str
+            Per orbit.
+        rho : ndarray, optional
+            Rotation numbers.
+
+        Returns
+        -------
+        OrbitSet
+        """
+        return cls(np.asarray(res.phi), np.asarray(res.K), None if res.region is None else np.asarray(res.region),
+                   np.asarray(res.status), np.asarray(res.steps_done), list(labels), list(colors), list(kinds),
+                   None if rho is None else np.asarray(rho, dtype=float))
+
+    @property
+    def n_orbits(self) -> int:
+        """Number of orbits."""
+        return int(self.phi.shape[0])
+
+
+@dataclass
+class OrbitPanelResult:
+    """One computed orbit panel of a truncated-map scene.
+
+    Attributes
+    ----------
+    id : str
+        Panel tag.
+    params : dict
+        The map's parameters (and golden-family c, eps).
+    orbits : OrbitSet
+        The orbits.
+    geometry : Geometry
+        Lines drawn under them.
+    leading : tuple or None
+        ``(phi, k, label)`` of the leading-order curve k_{eps,1} / k_{eps,2}, when drawn.
+    K_crit, rho_crit, band_floor : float
+        Predictions eq:kcrit, eq:rhocrit and the valid band's floor.
+    xlim, ylim : tuple of float
+        Axes limits.
+    critical : dict or None
+        The critical curve found (``found``, ``K0``, ``K_min``, ...), when searched.
+    """
+
+    id: str
+    params: dict
+    orbits: OrbitSet
+    geometry: Geometry
+    leading: Optional[tuple]
+    K_crit: float
+    rho_crit: float
+    band_floor: float
+    xlim: tuple
+    ylim: tuple
+    critical: Optional[dict] = None
+
+
+@dataclass
+class ZoomPanelResult:
+    """A zoom into another panel: its window and the finer lines drawn in it.
+
+    Attributes
+    ----------
+    id, of, on : str
+        Panel tag, the panel zoomed into, how the window was chosen.
+    window : dict
+        ``xlim``, ``ylim``, ``rule`` (and the orbit(s) it was chosen from).
+    geometry : Geometry
+        Lines, sampled finely over the window.
+    leading : tuple or None
+        The leading-order curve, sampled finely.
+    """
+
+    id: str
+    of: str
+    on: str
+    window: dict
+    geometry: Geometry
+    leading: Optional[tuple] = None
+
+
+@dataclass
+class SeriesResult:
+    """One curve of |HOV| against eps.
+
+    Attributes
+    ----------
+    label, color : str
+        Legend label and colour.
+    eps, area, error, theory : ndarray
+        Measured points and eq:hovsetsize at them.
+    floor_touched : ndarray of bool
+        Hovering points reached the lowest tenth of the sampled box.
+    K_low, Omega0, theta_w : ndarray
+        The box floor and the map at each point.
+    theory_eps, theory_curve : ndarray
+        The theory drawn as a line (empty when another series with the same map family drew it).
+    golden_c : float or None
+        Golden-family parameter.
+    reused : int
+        Points read from the checkpoint instead of computed.
+    """
+
+    label: str
+    color: str
+    eps: np.ndarray
+    area: np.ndarray
+    error: np.ndarray
+    theory: np.ndarray
+    floor_touched: np.ndarray
+    K_low: np.ndarray
+    Omega0: np.ndarray
+    theta_w: np.ndarray
+    theory_eps: np.ndarray
+    theory_curve: np.ndarray
+    golden_c: Optional[float] = None
+    reused: int = 0
+
+
+@dataclass
+class TorusResult:
+    """One tangent torus of the unperturbed system (fig:two-tang) and a trajectory on it.
+
+    Attributes
+    ----------
+    name : str
+        ``"right"`` (tangent to q1 = qw1, the paper's blue torus) or ``"upper"`` (tangent to
+        q2 = qw2, red).
+    h1, h2 : float
+        Partial energies ``H1 = h1``, ``H2 = h2`` (``h1 + h2 = h``).
+    q1, p1, q2, p2 : ndarray
+        The two circles ``H1 = h1`` in (q1, p1) and ``H2 = h2`` in (q2, p2).
+    trajectory : ndarray
+        ``(m, 5)`` samples ``(t, q1, p1, q2, p2)`` of a trajectory on the torus.
+    color : str
+        Its colour.
+    """
+
+    name: str
+    h1: float
+    h2: float
+    q1: np.ndarray
+    p1: np.ndarray
+    q2: np.ndarray
+    p2: np.ndarray
+    trajectory: np.ndarray
+    color: str
+
+
+@dataclass
+class SceneResult:
+    """What every scene result has.
+
+    Attributes
+    ----------
+    scene : SceneSpec
+        The validated scene.
+    meta : dict
+        ``version``, ``quick``, ``timings`` (seconds per stage), what was recorded and run.
+    """
+
+    scene: SceneSpec
+    meta: dict
+
+    def summary(self) -> dict:
+        """The numbers shown, as a JSON-able dict (what the CLI prints and the sidecar JSON holds).
+
+        Returns
+        -------
+        dict
+        """
+        from .report import summarize
+
+        return summarize(self)
+
+    def save(self, path: os.PathLike) -> tuple:
+        """Write the result as NPZ (arrays + the typed tree) and a sidecar JSON (scene, meta, summary).
+
+        Parameters
+        ----------
+        path : path-like
+            The ``.npz`` file (the JSON gets the same name with ``.json``).
+
+        Returns
+        -------
+        tuple of str
+            The two paths written.
+        """
+        npz = _serial.save(self, path, meta=jsonable(self.meta))
+        side = str(Path(npz).with_suffix(".json"))
+        doc = dict(scene=jsonable(_serial.to_tree(self.scene, {})), meta=jsonable(self.meta),
+                   summary=jsonable(self.summary()))
+        with open(side, "w", encoding="utf-8") as fh:
+            json.dump(doc, fh, indent=1, allow_nan=False)
+        return npz, side
+
+
+@dataclass
+class OrbitSceneResult(SceneResult):
+    """Result of a ``portrait`` or ``critical_orbits`` scene.
+
+    Attributes
+    ----------
+    panels : list of OrbitPanelResult and ZoomPanelResult
+        In the scene's order.
+    """
+
+    panels: list = field(default_factory=list)
+
+    def panel(self, id: str):
+        """The panel with this id.
+
+        Parameters
+        ----------
+        id : str
+            Panel tag.
+
+        Returns
+        -------
+        OrbitPanelResult or ZoomPanelResult
+        """
+        for p in self.panels:
+            if p.id == id:
+                return p
+        raise KeyError(f"no panel {id!r}; panels: {[p.id for p in self.panels]}")
+
+
+@dataclass
+class HoveringAreaResult(SceneResult):
+    """Result of a ``hovering_area`` scene.
+
+    Attributes
+    ----------
+    series : list of SeriesResult
+        One per curve.
+    """
+
+    series: list = field(default_factory=list)
+
+
+@dataclass
+class FlowPortraitResult(SceneResult):
+    """Result of a ``flow_portrait`` scene: the same starts under the flow and its model.
+
+    Attributes
+    ----------
+    flow, model : OrbitSet
+        The flow's orbits (FlowMap) and the truncated model's.
+    flow_geometry, model_geometry : Geometry
+        Measured corner curves and lines of the flow; closed forms of the model.
+    onset : dict
+        The onset parameters (Omega0, theta_w, tau0, tau1, lam).
+    forcing : ndarray
+        Sine coefficients of the measured forcing f.
+    model_name : str
+        ``"measured"`` or ``"first_mode"``.
+    work : dict
+        The flow's work counters, when the core reports them.
+    """
+
+    flow: OrbitSet = None
+    model: OrbitSet = None
+    flow_geometry: Geometry = None
+    model_geometry: Geometry = None
+    onset: dict = field(default_factory=dict)
+    forcing: np.ndarray = None
+    model_name: str = "measured"
+    work: dict = field(default_factory=dict)
+
+
+@dataclass
+class FlowHoveringResult(SceneResult):
+    """Result of a ``flow_hovering_area`` scene (one row per eps).
+
+    Attributes
+    ----------
+    eps : ndarray
+        The eps values.
+    flow_area, flow_error, flow_both_sides : ndarray
+        |HOV| of the flow, its error bar, and the part whose orbits visit both J_0 and J_0u.
+    models : dict
+        Model name -> ``{"area": ndarray, "error": ndarray, "agree": ndarray}`` (agree: fraction
+        of the sample points with the flow's verdict).
+    theory : ndarray
+        eq:hovsetsize with the measured first forcing mode (0 on the sign that does not hover).
+    K_low, b1, seconds, unresolved : ndarray
+        Box floor, first forcing mode, the flow's seconds, its unresolved points.
+    """
+
+    eps: np.ndarray = None
+    flow_area: np.ndarray = None
+    flow_error: np.ndarray = None
+    flow_both_sides: np.ndarray = None
+    models: dict = field(default_factory=dict)
+    theory: np.ndarray = None
+    K_low: np.ndarray = None
+    b1: np.ndarray = None
+    seconds: np.ndarray = None
+    unresolved: np.ndarray = None
+    reused: int = 0
+
+
+@dataclass
+class TangentToriResult(SceneResult):
+    """Result of a ``tangent_tori`` scene (fig:two-tang).
+
+    Attributes
+    ----------
+    tori : list of TorusResult
+        The right-wall (blue) and upper-wall (red) tangent tori.
+    qw1, qw2 : float
+        The step's corner.
+    well1, well2 : tuple of float
+        Extent of each oscillator's motion at energy h (for the axes).
+    """
+
+    tori: list = field(default_factory=list)
+    qw1: float = 0.0
+    qw2: float = 0.0
+
+
+@dataclass
+class SigmaStructureResult(SceneResult):
+    """Result of a ``sigma_structure`` scene (fig:structure_Sigma), all from the flow.
+
+    Attributes
+    ----------
+    phi, K : ndarray
+        Grid points of the band (normal coordinates) that have a point of Sigma_h.
+    region : ndarray of int8
+        Region of each point's return (J_0u, J_0, J_1, J_R, ...).
+    theta, I, q2, p2 : ndarray
+        The same points in section coordinates and in the (q2, p2) plane.
+    phi1, K1, theta1, I1, q21, p21 : ndarray
+        Their images (NaN where the return failed).
+    tangency : dict
+        The tangential curve K = 0: ``theta``, ``I``, ``q2``, ``p2`` on a fine grid, and
+        ``phi1``, ``K1`` of its image (the curve ``K = eps f(phi)`` of thm:reversalinkphi).
+    corners : Geometry
+        Measured corner-singularity curves in (phi, K).
+    """
+
+    phi: np.ndarray = None
+    K: np.ndarray = None
+    region: np.ndarray = None
+    theta: np.ndarray = None
+    I: np.ndarray = None
+    q2: np.ndarray = None
+    p2: np.ndarray = None
+    phi1: np.ndarray = None
+    K1: np.ndarray = None
+    theta1: np.ndarray = None
+    I1: np.ndarray = None
+    q21: np.ndarray = None
+    p21: np.ndarray = None
+    tangency: dict = field(default_factory=dict)
+    corners: Geometry = None
+
+
+def load_result(path: os.PathLike) -> SceneResult:
+    """Read a scene result written by :meth:`SceneResult.save`.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``.npz`` file.
+
+    Returns
+    -------
+    SceneResult
+
+    Raises
+    ------
+    ValueError
+        If the file is not a scene result of this package.
+    """
+    obj = _serial.load(path)
+    if not isinstance(obj, SceneResult):
+        raise ValueError(f"{os.fspath(path)} holds a {type(obj).__name__}, not a scene result "
+                         "(written by `python -m hovering scene`)")
+    return obj
