@@ -77,6 +77,7 @@ from .truncated import (
     rho_crit,
 )
 from .truncated.theory import theory
+from .explore import explore
 from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one release)
 
 __version__ = "0.2.0"
@@ -146,4 +147,5 @@ __all__ = [
     "forcing_coefficients",
     "to_normal",
     "from_normal",
+    "explore",
 ]
