@@ -502,10 +502,8 @@ def _K_range(value) -> tuple:
 
 
 def _map_from_scene(path):
-    """The map of a scene file: its first panel's (or, for a ``hovering_area`` scene, its first
-    series' at its first eps).
-
-    A placeholder for the scene layer, which is being rebuilt and will replace this hook.
+    """The map of a scene file (:func:`hovering.scenes.compute.scene_map`): an orbit scene's first
+    panel's, a hovering-area scene's first series at its first eps, a flow scene's FlowMap.
 
     Parameters
     ----------
@@ -514,7 +512,7 @@ def _map_from_scene(path):
 
     Returns
     -------
-    TruncatedMap
+    TruncatedMap, TruncatedFamily or FlowMap
 
     Raises
     ------
@@ -524,14 +522,10 @@ def _map_from_scene(path):
         If the file does not exist.
     """
     from .scenes import load_scene
+    from .scenes.compute import scene_map
 
-    scene = load_scene(path)
-    for panel in scene.panels:
-        if panel.map is not None:  # zoom panels have none
-            return panel.map.build()
-    if scene.series:
-        return scene.series[0].map_at(scene.eps[0]).build()
-    raise ValueError(f"{path}: the scene defines no map to explore")
+    # Exploring writes nothing: the scene's output path is not checked.
+    return scene_map(load_scene(path, check_output=False))
 
 
 def explore(map_or_scene, n_steps: Optional[int] = None, K_range=None, *, ax=None, marker_size: float = 2.0,

@@ -28,7 +28,7 @@ from .spec import (QUICK_FACTOR, FlowHoveringScene, FlowPortraitScene, HoveringA
                    SceneSpec, SigmaStructureScene, TangentToriScene)
 
 __all__ = ["compute", "map_geometry", "flow_geometry", "zoom_window_critical", "zoom_window_islands",
-           "leading_curve", "special_starts", "hovering_orbits", "scaled"]
+           "leading_curve", "special_starts", "hovering_orbits", "scaled", "scene_map"]
 
 
 def scaled(n: int, quick: bool, floor: int = 100) -> int:
@@ -589,6 +589,35 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
         scene=scene, meta=meta, phi=res.phi[ok, 0], K=res.K[ok, 0], region=res.region[ok, 0],
         theta=res.theta[ok, 0], I=res.I[ok, 0], q2=z[ok, 0, 2], p2=z[ok, 0, 3], phi1=res.phi[ok, 1], K1=res.K[ok, 1],
         theta1=res.theta[ok, 1], I1=res.I[ok, 1], q21=z[ok, 1, 2], p21=z[ok, 1, 3], tangency=tangency, corners=corners)
+
+
+def scene_map(scene: SceneSpec):
+    """The map a scene is about: an orbit scene's first panel's, a hovering-area scene's first
+    series at its first eps, a flow scene's :class:`~hovering.FlowMap` (its system, section and
+    integrator; a ``tangent_tori`` scene's in section coordinates).
+
+    Parameters
+    ----------
+    scene : SceneSpec
+        A validated scene.
+
+    Returns
+    -------
+    TruncatedMap or FlowMap
+    """
+    if isinstance(scene, OrbitScene):
+        for p in scene.panels:
+            if p.map is not None:  # zoom panels have none
+                return p.map.build()
+    if isinstance(scene, HoveringAreaScene):
+        return scene.series[0].map_at(scene.eps[0]).build()
+    if isinstance(scene, FlowHoveringScene):
+        return _flowmap(scene, eps=scene.eps[0])
+    if isinstance(scene, TangentToriScene):
+        return _flowmap(scene, coordinates="section")
+    if isinstance(scene, (FlowPortraitScene, SigmaStructureScene)):
+        return _flowmap(scene)
+    raise ValueError(f"scene {scene.name!r} defines no map")
 
 
 # ------------------------------------------------------------------------------------------------

@@ -248,7 +248,7 @@ _OUTPUTS_KEYS = ("record", "trajectory_dt")
 _STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams")
 
 
-def parse_scene(data: dict, path: Optional[os.PathLike] = None) -> SceneSpec:
+def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bool = True) -> SceneSpec:
     """Validate a scene given as a dict (the parsed TOML) and build its spec.
 
     Parameters
@@ -257,6 +257,9 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None) -> SceneSpec:
         The parsed TOML document.
     path : path-like, optional
         Where it came from (used in messages and as the scene name).
+    check_output : bool, optional
+        Check that ``output`` can be written (format, writable directory); off for uses that
+        write nothing (the explorer).
 
     Returns
     -------
@@ -288,7 +291,8 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None) -> SceneSpec:
         name=name,
         kind=kind,
         title=_str(f"{where}.title", data["title"]) if "title" in data else name,
-        output=output_path(f"{where}.output", _str(f"{where}.output", data["output"])),
+        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"])) if check_output
+                else Path(_str(f"{where}.output", data["output"]))),
         dpi=_int(f"{where}.dpi", data["dpi"], 30, 1200) if "dpi" in data else 130,
         figsize=_size(f"{where}.figsize", data["figsize"]) if "figsize" in data else None,
     )
@@ -699,13 +703,15 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
         **common)
 
 
-def load_scene(path: os.PathLike) -> SceneSpec:
+def load_scene(path: os.PathLike, check_output: bool = True) -> SceneSpec:
     """Read and validate a scene file (TOML).
 
     Parameters
     ----------
     path : path-like
         The ``.toml`` file.
+    check_output : bool, optional
+        Check the scene's output path (see :func:`parse_scene`).
 
     Returns
     -------
@@ -732,7 +738,7 @@ def load_scene(path: os.PathLike) -> SceneSpec:
         raise ValueError(f"{p.name}: not UTF-8 text (TOML files are UTF-8): byte {e.start}") from None
     except tomllib.TOMLDecodeError as e:
         raise ValueError(f"{p.name}: not valid TOML: {e}") from None
-    return parse_scene(data, p)
+    return parse_scene(data, p, check_output=check_output)
 
 
 # ------------------------------------------------------------------------------------------------
