@@ -19,6 +19,7 @@ import numpy as np
 
 from .._common import Region, Status, wrap
 from ..plot.style import SPECIAL_COLORS, orbit_color
+from ..analysis.hovering import default_depth
 from ..sweeps import Checkpoint
 from ..truncated.theory import golden_family, hovering_area_theory
 from .results import (FlowHoveringResult, FlowPortraitResult, Geometry, HoveringAreaResult, OrbitPanelResult,
@@ -476,13 +477,29 @@ def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) 
 
 
 def _measured_model(fm, K_low: float):
-    """The truncated family with arcs measured on the flow's corner curves (and measured forcing)."""
+    """The truncated family with arcs measured on the flow's corner curves (and measured forcing).
+
+    Circles below the flow's impact zone (eps > 0: under the deformed torus tangent to the upper
+    wall, ``FlowMap.impact_zone_floor``) hold no J_1 / J_R arcs: the family then stops at the
+    lowest circle that has them, and its band is shallower than the box asked for.
+    """
     from ..normal.compare import truncated_from_flow
     from ..normal.corners import corner_curves
 
-    s = np.linspace(math.sqrt(-1.05 * K_low), 0.0, 17)[:-1]
+    depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
+    s = np.linspace(math.sqrt(depth), 0.0, 17)[:-1]
     K = np.concatenate([-s**2, [0.01, 0.03, 0.05]])
     cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=1e-12)
+    ok = (K > 0) | (np.isfinite(cc.JR) & np.isfinite(cc.J1) & np.isfinite(cc.Omega))
+    first = int(np.argmax(np.cumprod(ok[::-1])[::-1])) if not ok.all() else 0
+    keep = np.zeros(K.size, bool)
+    keep[first:] = True
+    keep &= ok
+    if not keep.all():
+        from dataclasses import replace
+
+        cc = replace(cc, **{f: getattr(cc, f)[keep] for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1",
+                                                              "Omega", "Omega_spread", "other")})
     return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
 
 
@@ -497,7 +514,7 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
         sysd = _serial_dict(scene.system)
         sysd["eps"] = e
         key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
-                   seed=scene.seed, models=list(scene.models))
+                   seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
         row = ckpt.get(key)
         if row is not None:
             reused += 1
@@ -505,21 +522,30 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
             continue
         t = time.perf_counter()
         fm = _flowmap(scene, eps=e)
-        flow = fm.hovering_area(n_steps=n, samples=samples, seed=scene.seed, keep_points=True,
+        # One box for flow and models, so the same points are classified by each: the default
+        # depth (the critical band of eq:hovsetsize), cut to the band every model is defined on.
+        depth = default_depth(fm) if e != 0 else 0.1
+        tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
+        K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
+        if "onset" in tms:
+            K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
+        flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True,
                                 **_progress_kw(progress))
         th = fm.theory()
         row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
                    theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
                    seconds=time.perf_counter() - t, models={})
-        for name in scene.models:
-            tm = fm.truncated() if name == "onset" else _measured_model(fm, flow.box[2])
-            mh = tm.hovering_area(n_steps=n, samples=samples, K_low=flow.box[2], seed=scene.seed, keep_points=True)
-            row["models"][name] = dict(area=mh.area, error=mh.error,
-                                       agree=float(np.mean(mh.hovering == flow.hovering)))
+        for name, tm in tms.items():
+            # A model whose band is shallower than the box (measured arcs stop at the impact zone's
+            # floor) samples its own box: its points are not the flow's, so no verdict agreement.
+            K_m = max(K_low, tm.valid_band()[0] * (1 - 1e-9))
+            mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True)
+            agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
+            row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
         ckpt.put(key, row)
         rows.append(row)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
-    models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree")}
+    models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")}
               for name in scene.models}
     meta["points_reused"] = reused
     return FlowHoveringResult(scene=scene, meta=meta, eps=col("eps"), flow_area=col("flow"), flow_error=col("flow_err"),

@@ -79,7 +79,7 @@ def summarize(result) -> dict:
             for e, a, er, t, f, kl, O, tw in zip(r.eps, r.area, r.error, r.theory, r.floor_touched, r.K_low, r.Omega0,
                                                  r.theta_w)]) for r in result.series]
     elif isinstance(result, FlowPortraitResult):
-        s.update(onset=result.onset, forcing=result.forcing[:3], model=result.model_name, work=result.work)
+        s.update(onset=result.onset, forcing=result.forcing[:3], model_name=result.model_name, work=result.work)
         for name, o in (("flow", result.flow), ("model", result.model)):
             s[name] = dict(orbits=_orbits(o), regions=_region_counts(o.region),
                            statuses={Status(int(v)).name: int(np.count_nonzero(o.status == v))
@@ -159,15 +159,16 @@ def format_summary(summary: dict) -> str:
     if "flow" in summary and "model" in summary:
         o = summary["onset"]
         lines.append(f"  onset: Omega0 = {o['Omega0']:.5f}, theta_w = {o['theta_w']:.5f}, tau0 = {o['tau0']:.4f}, "
-                     f"tau1 = {o['tau1']:.4f}, lam = {o['lam']:.4f}; model: {summary['model']}")
+                     f"tau1 = {o['tau1']:.4f}, lam = {o['lam']:.4f}; model: {summary['model_name']} forcing")
         for name in ("flow", "model"):
             d = summary[name]
             hov = sum(1 for x in d["orbits"] if x.get("hovering"))
             lines.append(f"  {name:>5}: {len(d['orbits'])} orbits, {hov} hovering, regions {d['regions']}, "
                          f"statuses {d['statuses']}")
     for r in summary.get("points", []) if isinstance(summary.get("points"), list) else []:
-        mod = ", ".join(f"{m} {v['area']:.4f} +- {v['error']:.4f} (agree {100 * v['agree']:.1f}%)"
-                        for m, v in r["models"].items())
+        mod = ", ".join(f"{m} {v['area']:.4f} +- {v['error']:.4f} " + (
+            f"(agree {100 * v['agree']:.1f}%)" if v["agree"] is not None else
+            f"(own box from K = {v['K_low']:.4f}: its band ends there)") for m, v in r["models"].items())
         lines.append(f"  eps = {r['eps']:+.3f}: flow |HOV| = {r['flow']:.4f} +- {r['flow_error']:.4f} "
                      f"[both sides {r['flow_both_sides']:.4f}], {mod}, eq:hovsetsize {r['theory']:.4f} "
                      f"({r['seconds']:.1f} s)")

@@ -609,7 +609,7 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
         _check_keys(f"{where}.section", st, _SECTION_KEYS, ("h",))
         h = _real(f"{where}.section.h", st["h"], lo=0.0, lo_open=True)
     sys = system.build()
-    hw = sys.step_energy()
+    hw = sys.step_energy
     # Normal coordinates (every flow figure but the tori) need the tangential band: h above the
     # step energy; the tori need both tangent tori, which exist for the same h.
     if not h > hw:

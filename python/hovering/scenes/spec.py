@@ -279,7 +279,7 @@ class PotentialSpec:
         -------
         hovering.Harmonic or hovering.Tan
         """
-        from ..flow.potentials import Harmonic, Tan
+        from ..flow import Harmonic, Tan
 
         return Harmonic(self.omega) if self.kind == "harmonic" else Tan(self.omega, self.alpha)
 
