@@ -653,6 +653,10 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
     if kind in ("flow_portrait", "flow_hovering_area", "sigma_structure") and system.geometry != "step":
         raise ValueError(f"{where}.system.geometry = {system.geometry!r}: a {kind} scene draws the regions of "
                          f"the step; allowed: 'step'")
+    if kind == "tangent_tori" and (system.eps != 0 or system.geometry != "none"):
+        raise ValueError(f"{where}.system: the tangent tori are those of the unperturbed smooth flow; allowed: "
+                         f"eps = 0 and geometry = 'none' (got eps = {system.eps!r}, geometry = {system.geometry!r}: "
+                         f"with walls, a tangent trajectory stops as GRAZING)")
     if kind == "flow_portrait":
         kr = _pair(f"{where}.K0_range", data["K0_range"]) if "K0_range" in data else (-0.1, 0.05)
         return FlowPortraitScene(

@@ -326,7 +326,9 @@ class SystemSpec:
         """
         from ..flow.system import Bilinear, Polynomial, StepSystem
 
-        if self.coupling == ((1.0, 1, 1),):
+        if not self.coupling:
+            c = None
+        elif self.coupling == ((1.0, 1, 1),):
             c = Bilinear()
         else:
             c = Polynomial({(int(i), int(j)): float(v) for v, i, j in self.coupling})
