@@ -80,7 +80,7 @@ def issue_system(eps=-0.05, V1=None, V2=None, geometry="step"):
                          qw1=-1.0, qw2=-0.5, geometry=geometry)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def maps() -> dict:
     """Every kind of map, with test points (phi, K) inside its band: name -> (map, phi, K)."""
     rng = np.random.default_rng(7)
@@ -103,7 +103,7 @@ def maps() -> dict:
     return out
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def results() -> dict:
     """One result of every type: name -> result."""
     m, phi, K = maps()["truncated"]

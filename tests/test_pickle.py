@@ -19,7 +19,18 @@ import pytest
 
 import hovering as hv
 from hovering import _core
-from pickle_helpers import Cosh, issue_system, maps, quartic, quartic_dV, quartic_V, results, same, same_steps, scaled
+from pickle_helpers import (
+    Cosh,
+    issue_system,
+    maps,
+    quartic,
+    quartic_dV,
+    quartic_V,
+    results,
+    same,
+    same_steps,
+    scaled,
+)
 
 PROTOCOLS = list(range(2, pickle.HIGHEST_PROTOCOL + 1))
 COPIES = {
@@ -144,7 +155,7 @@ def test_couplings_systems_and_sections_round_trip():
     sys = issue_system(0.1).replace(coupling=poly)
     sec = hv.Section(sys, 1.2)
     onset = hv.onset_parameters(sys, 1.2)
-    for how, f in COPIES.items():
+    for f in COPIES.values():
         assert f(hv.Bilinear()) == hv.Bilinear() and f(poly) == poly
         s2 = f(sys)
         assert s2 == sys and s2.core is not sys.core and s2.core.terms == sys.core.terms

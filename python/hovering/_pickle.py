@@ -13,7 +13,7 @@ from __future__ import annotations
 import pickle
 import sys
 
-__all__ = ["reduce_compiled", "restore_compiled", "pickler_stores_code"]
+__all__ = ["pickler_stores_code", "reduce_compiled", "restore_compiled"]
 
 
 def reduce_compiled(obj, base: type) -> tuple:

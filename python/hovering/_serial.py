@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["save", "load", "to_tree", "from_tree", "FORMAT", "Saveable"]
+__all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
 
 FORMAT = "hovering-npz-1"
 _META_KEY = "__meta__"
@@ -134,8 +134,11 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
                 raise TypeError(f"{key}: arrays of Python objects cannot be saved without pickle")
         return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
+        try:  # first: it may refuse with a message of its own (Python code)
+            record = obj._to_record()
+        except TypeError as e:
+            raise TypeError(f"{key}: {e}") from None
         name = _saveable_name(type(obj), "record", key)
-        record = obj._to_record()
         if not isinstance(record, dict):
             raise TypeError(f"{key}: {type(obj).__name__}._to_record() must return a dict, got {type(record).__name__}")
         return {"__record__": name, "data": to_tree(record, arrays, f"{key}@")}
