@@ -186,6 +186,14 @@ class CustomPotential(_CallablePotential):
         is not > 0 (e.g. a double well), a sampled value is not finite, or dV disagrees with the
         derivative of V; the message names the value and the allowed range.
 
+    Notes
+    -----
+    It pickles (multiprocessing, Dask) when V and dV do: module-level functions or picklable
+    callables for the standard pickler, also lambdas for cloudpickle; otherwise pickling raises
+    ``pickle.PicklingError`` naming the callable. It compares equal to a CustomPotential of the same
+    callables (``is``), q_limit and name. It cannot be saved to NPZ (:func:`hovering.save` writes no
+    code): a ``TypeError`` says so.
+
     Examples
     --------
     >>> import math, hovering

@@ -102,6 +102,12 @@ class FlowMap(MapAnalyses):
     ValueError
         For bad parameters (named, with the allowed range), or normal coordinates where the
         tangential curve is not a graph.
+
+    Notes
+    -----
+    A FlowMap pickles and saves (:func:`hovering.save`) as its constructor arguments and its
+    tangential curve's measured samples: it is rebuilt through the constructor with that curve (no
+    trace of the flow, no measurement) and steps bit for bit as the original.
     """
 
     #: Regularity threshold of the critical-curve search (digits of agreement of the two half-orbit
