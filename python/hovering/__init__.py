@@ -10,6 +10,9 @@ Rom-Kedar, "Hovering Sets in Near Pseudo-Integrable Hamiltonian Impact Systems",
   return map as a map you iterate;
 * :mod:`hovering.analysis`: rotation numbers, hovering sets and critical curves of any of them.
 
+Every map, system, potential and result pickles (multiprocessing, Dask); results, maps and
+systems also save to NPZ without pickle (``result.save(path)``, :func:`save`, :func:`load`).
+
 >>> import hovering
 >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * 3.141592653589793 / 4)
 >>> res = m.iterate([m.L1(0.0)], [0.0], 1000, record=("rotation",))
@@ -20,6 +23,7 @@ from __future__ import annotations
 from . import _core, analysis, flow, normal, truncated
 from ._common import FlowStatus, Geometry, Region, Status, region_mask, wrap
 from ._protocols import ReturnMap
+from ._serial import load, save
 from .analysis import (
     CriticalCurve,
     HoveringArea,
@@ -148,4 +152,6 @@ __all__ = [
     "to_normal",
     "from_normal",
     "explore",
+    "save",
+    "load",
 ]

@@ -3,11 +3,16 @@
 An object is written as arrays (each under a path-like key) plus one JSON document that records
 the tree's shape and every non-array value. Reading rebuilds the same types. Only types of this
 package are rebuilt (a file names the classes it holds, so reading an untrusted file must not
-import arbitrary modules), and arrays are loaded with ``allow_pickle=False``.
+import or call anything else: a name must resolve to a class defined in a ``hovering`` module, of
+the kind the file says it is), and arrays are loaded with ``allow_pickle=False``.
 
-Types take part by being dataclasses, enums, or by defining ``_to_record(self) -> dict`` and a
-classmethod ``_from_record(cls, record)`` (maps, systems and potentials: their constructor
-arguments).
+Types take part by defining ``_to_record(self) -> dict`` and a classmethod
+``_from_record(cls, record)`` (maps, systems and potentials: their constructor arguments, so that
+reading runs the constructor's checks again), by being dataclasses (results: their fields), or
+enums. A type with a record is written by its record even when it is a dataclass.
+
+The public entry points are :func:`hovering.save`, :func:`hovering.load` and the ``save`` method
+that :class:`Saveable` gives the result types.
 """
 
 from __future__ import annotations
@@ -18,12 +23,13 @@ import importlib
 import json
 import math
 import os
+import zipfile
 from pathlib import Path, PurePath
 from typing import Any
 
 import numpy as np
 
-__all__ = ["save", "load", "to_tree", "from_tree", "FORMAT"]
+__all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
 
 FORMAT = "hovering-npz-1"
 _META_KEY = "__meta__"
@@ -33,24 +39,89 @@ def _type_name(cls) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
-def _resolve(name: str):
+def _resolve(name, kind: str = "any"):
+    """The class a file names, refused (ValueError) unless it is one of hovering's own of that kind.
+
+    ``kind``: ``"enum"``, ``"dataclass"``, ``"record"`` (has ``_from_record``) or ``"any"``.
+    """
+    if not isinstance(name, str) or name.count(":") != 1:
+        raise ValueError(f"malformed result file: a type name must be 'module:QualName', got {name!r}")
     module, _, qual = name.partition(":")
     if not (module == "hovering" or module.startswith("hovering.")):
         raise ValueError(f"refusing to rebuild type {name!r}: only hovering's own types are read from a file")
-    obj = importlib.import_module(module)
-    for part in qual.split("."):
-        obj = getattr(obj, part)
+    parts = module.split(".") + qual.split(".")
+    if not all(p.isidentifier() and not p.startswith("__") for p in parts):
+        raise ValueError(f"refusing to rebuild type {name!r}: not the name of a hovering class")
+    try:
+        obj = importlib.import_module(module)
+        for part in qual.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        raise ValueError(f"cannot rebuild type {name!r}: this version of hovering has no such class") from None
+    # The name must lead to a class defined where the name says (not, e.g., to a function that a
+    # hovering module imported from elsewhere).
+    if not (isinstance(obj, type) and obj.__module__ == module and obj.__qualname__ == qual):
+        raise ValueError(f"refusing to rebuild type {name!r}: it does not name a class defined in hovering")
+    ok = {"enum": lambda c: issubclass(c, enum.Enum), "dataclass": dataclasses.is_dataclass,
+          "record": lambda c: callable(getattr(c, "_from_record", None)), "any": lambda c: True}[kind]
+    if not ok(obj):
+        raise ValueError(f"refusing to rebuild type {name!r} as a {kind}: it is not one")
     return obj
 
 
+def _saveable_name(cls, kind: str, key: str) -> str:
+    """The name under which ``cls`` is written; a TypeError unless reading it back gives ``cls``."""
+    name = _type_name(cls)
+    try:
+        back = _resolve(name, kind)
+    except ValueError:
+        back = None
+    if back is not cls:
+        raise TypeError(f"{key}: cannot save a {cls.__module__}.{cls.__qualname__} to NPZ: only hovering's own classes "
+                        "(importable by name) are written, so that reading a file never imports anything else")
+    return name
+
+
+def _put(arrays: dict, key: str, a: np.ndarray) -> str:
+    """Store ``a`` under ``key`` (made unique: dict keys may contain the separators of another path)."""
+    k, i = key, 1
+    while k in arrays or k == _META_KEY:
+        k, i = f"{key}~{i}", i + 1
+    arrays[k] = a
+    return k
+
+
 def to_tree(obj: Any, arrays: dict, key: str = "root"):
-    """JSON-able description of ``obj``; its arrays go into ``arrays`` under path-like keys."""
+    """JSON-able description of ``obj``; its arrays go into ``arrays`` under path-like keys.
+
+    Parameters
+    ----------
+    obj : object
+        None, bool, str, int, float (NumPy scalars included), an enum, an ndarray, a dataclass, an
+        object with ``_to_record``, or a dict, list or tuple of these.
+    arrays : dict
+        Receives the arrays (key -> ndarray).
+    key : str, optional
+        Path of ``obj`` in the tree (array keys and messages).
+
+    Returns
+    -------
+    object
+        A JSON-able tree.
+
+    Raises
+    ------
+    TypeError
+        For anything else, naming its path and type.
+    """
     if obj is None or isinstance(obj, (bool, str)):
         return obj
     if isinstance(obj, PurePath):
         return {"__path__": str(obj)}
+    if isinstance(obj, np.bool_):
+        return bool(obj)
     if isinstance(obj, enum.Enum):
-        return {"__enum__": _type_name(type(obj)), "value": obj.value}
+        return {"__enum__": _saveable_name(type(obj), "enum", key), "value": obj.value}
     if isinstance(obj, (int, np.integer)):
         return int(obj)
     if isinstance(obj, (float, np.floating)):
@@ -64,13 +135,20 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
                 a = a.astype(str)
             else:
                 raise TypeError(f"{key}: arrays of Python objects cannot be saved without pickle")
-        arrays[key] = a
-        return {"__array__": key, "object": obj.dtype == object}
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        fields = {f.name: to_tree(getattr(obj, f.name), arrays, f"{key}.{f.name}") for f in dataclasses.fields(obj)}
-        return {"__dataclass__": _type_name(type(obj)), "fields": fields}
+        return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
-        return {"__record__": _type_name(type(obj)), "data": to_tree(obj._to_record(), arrays, f"{key}@")}
+        try:  # first: it may refuse with a message of its own (Python code)
+            record = obj._to_record()
+        except TypeError as e:
+            raise TypeError(f"{key}: {e}") from None
+        name = _saveable_name(type(obj), "record", key)
+        if not isinstance(record, dict):
+            raise TypeError(f"{key}: {type(obj).__name__}._to_record() must return a dict, got {type(record).__name__}")
+        return {"__record__": name, "data": to_tree(record, arrays, f"{key}@")}
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        name = _saveable_name(type(obj), "dataclass", key)
+        fields = {f.name: to_tree(getattr(obj, f.name), arrays, f"{key}.{f.name}") for f in dataclasses.fields(obj)}
+        return {"__dataclass__": name, "fields": fields}
     if isinstance(obj, dict):
         if all(isinstance(k, str) for k in obj):
             return {"__dict__": {k: to_tree(v, arrays, f"{key}.{k}") for k, v in obj.items()}}
@@ -84,29 +162,79 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
                     "dataclass or hovering object)")
 
 
+def _dataclass_from_fields(cls, fields: dict):
+    """A dataclass instance from its saved fields, without running ``__init__``/``__post_init__``
+    (the values were valid when saved). A field missing from the file takes its default; a field
+    without default missing, or a name that is not a field, is a ValueError."""
+    if not isinstance(fields, dict):
+        raise ValueError(f"malformed result file: the fields of {cls.__qualname__} are not a mapping")
+    known = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(fields) - set(known))
+    if unknown:
+        raise ValueError(f"the file's {cls.__qualname__} has fields {unknown} this version does not know (written by "
+                         "another version of hovering?)")
+    obj = object.__new__(cls)
+    for name, f in known.items():
+        if name in fields:
+            value = fields[name]
+        elif f.default is not dataclasses.MISSING:
+            value = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            value = f.default_factory()
+        else:
+            raise ValueError(f"the file's {cls.__qualname__} lacks the field {name!r} (written by another version of "
+                             "hovering?)")
+        object.__setattr__(obj, name, value)
+    return obj
+
+
 def from_tree(tree, arrays):
-    """Inverse of :func:`to_tree`."""
+    """Inverse of :func:`to_tree`.
+
+    Parameters
+    ----------
+    tree : object
+        What :func:`to_tree` returned (after a JSON round trip).
+    arrays : mapping
+        The arrays it refers to.
+
+    Returns
+    -------
+    object
+
+    Raises
+    ------
+    ValueError
+        For a malformed tree, a type that is not hovering's, or a missing array.
+    """
     if tree is None or isinstance(tree, (bool, str, int, float)):
         return tree
-    if isinstance(tree, list):
-        raise ValueError("malformed result file: a bare list in the tree")
+    if not isinstance(tree, dict):
+        raise ValueError(f"malformed result file: a bare {type(tree).__name__} in the tree")
     if "__float__" in tree:
         return float(tree["__float__"])
     if "__path__" in tree:
         return Path(tree["__path__"])
     if "__enum__" in tree:
-        return _resolve(tree["__enum__"])(tree["value"])
+        return _resolve(tree["__enum__"], "enum")(tree["value"])
     if "__array__" in tree:
-        a = arrays[tree["__array__"]]
+        k = tree["__array__"]
+        if not isinstance(k, str) or k not in arrays:
+            raise ValueError(f"malformed result file: the array {k!r} is missing")
+        a = arrays[k]
         return a.astype(object) if tree.get("object") else a
     if "__dataclass__" in tree:
-        cls = _resolve(tree["__dataclass__"])
-        obj = object.__new__(cls)  # bypasses __post_init__ checks: the values were valid when saved
-        for name, sub in tree["fields"].items():
-            object.__setattr__(obj, name, from_tree(sub, arrays))
-        return obj
+        cls = _resolve(tree["__dataclass__"], "dataclass")
+        fields = tree["fields"]
+        if not isinstance(fields, dict):
+            raise ValueError(f"malformed result file: the fields of {tree['__dataclass__']} are not a mapping")
+        return _dataclass_from_fields(cls, {name: from_tree(sub, arrays) for name, sub in fields.items()})
     if "__record__" in tree:
-        return _resolve(tree["__record__"])._from_record(from_tree(tree["data"], arrays))
+        cls = _resolve(tree["__record__"], "record")
+        data = from_tree(tree["data"], arrays)
+        if not isinstance(data, dict):
+            raise ValueError(f"malformed result file: the record of {tree['__record__']} is not a mapping")
+        return cls._from_record(data)
     if "__dict__" in tree:
         return {k: from_tree(v, arrays) for k, v in tree["__dict__"].items()}
     if "__items__" in tree:
@@ -118,37 +246,162 @@ def from_tree(tree, arrays):
     raise ValueError(f"malformed result file: unknown node {sorted(tree)}")
 
 
-def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
-    """Write ``obj`` to ``path`` (``.npz`` appended if missing); returns the path written.
+def _path(path, what: str) -> str:
+    if not isinstance(path, (str, os.PathLike)):
+        raise ValueError(f"{what} must be a file path (str or os.PathLike), got {path!r}")
+    p = os.fspath(path)
+    if isinstance(p, bytes):
+        p = os.fsdecode(p)
+    if not p.strip() or "\0" in p:
+        raise ValueError(f"{what} must be a file path (non-empty, no NUL byte), got {path!r}")
+    return p
 
-    ``meta`` (JSON-able) is stored beside the tree and returned by :func:`load` with ``meta=True``.
+
+def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
+    """Write ``obj`` (a result, map, system, ... or a dict/list/tuple of them) to an NPZ file.
+
+    The file holds the arrays and one JSON document for everything else; nothing is pickled, so
+    reading it (:func:`load`) never runs code from the file. The object is converted before the file
+    is touched, and written to a temporary file that then replaces ``path``: an object that cannot be
+    saved, or a failed write, leaves an existing file as it was.
+
+    Parameters
+    ----------
+    obj : object
+        What to save: hovering's results, maps (TruncatedMap, TruncatedFamily, FlowMap), systems,
+        sections, tangential curves, potentials (not those defined in Python), arrays, numbers,
+        strings, and dicts, lists and tuples of these.
+    path : str or os.PathLike
+        The file; ``.npz`` is appended if missing.
+    meta : dict, optional
+        JSON-able metadata stored beside the object (returned by ``load(path, meta=True)``).
+
+    Returns
+    -------
+    str
+        The path written.
+
+    Raises
+    ------
+    TypeError
+        For an object that cannot be saved (e.g. a CustomPotential: Python code), naming where it is.
+    ValueError
+        For a path that is not a writable file path, or metadata that is not JSON-able.
     """
     from . import __version__
 
-    path = os.fspath(path)
+    path = _path(path, "path")
     if not path.endswith(".npz"):
         path += ".npz"
+    if os.path.isdir(path):
+        raise ValueError(f"path = {path!r} is a directory, not a file")
+    if meta is not None and not isinstance(meta, dict):
+        raise ValueError(f"meta must be a dict of JSON-able values, got {meta!r}")
     arrays: dict = {}
     tree = to_tree(obj, arrays)
     doc = {"format": FORMAT, "version": __version__, "meta": meta or {}, "tree": tree}
-    text = json.dumps(doc, allow_nan=False)
-    with open(path, "wb") as fh:
-        np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
+    try:
+        text = json.dumps(doc, allow_nan=False)
+    except (TypeError, ValueError) as e:  # only the metadata can hold something else
+        raise ValueError(f"meta must be JSON-able (str, finite numbers, bool, None, lists and dicts): {e}") from None
+    tmp = f"{path}.tmp-{os.getpid()}"
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
+        os.replace(tmp, path)
+    except OSError as e:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise ValueError(f"cannot write {path!r}: {e.strerror or e}") from None
     return path
 
 
 def load(path: os.PathLike, meta: bool = False):
-    """Read an object written by :func:`save` (``meta=True``: also return its metadata dict)."""
-    path = os.fspath(path)
+    """Read an object written by :func:`save` (or a result's ``save`` method).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    meta : bool, optional
+        Also return the metadata dict stored with it.
+
+    Returns
+    -------
+    object or (object, dict)
+        The object, rebuilt with its own types (maps and systems through their constructors, so
+        they compute bit for bit what the saved ones did).
+
+    Raises
+    ------
+    ValueError
+        For a file that does not exist, is not a hovering result file, is malformed, or names a
+        type that is not hovering's (e.g. ``os:system``), or values the constructors refuse.
+    """
+    path = _path(path, "path")
+    not_ours = f"{path} is not a hovering result file"
     try:
-        with np.load(path, allow_pickle=False) as z:
-            if _META_KEY not in z.files:
-                raise ValueError(f"{path} is not a hovering result file (no {_META_KEY} entry)")
-            doc = json.loads(str(z[_META_KEY]))
+        z = np.load(path, allow_pickle=False)
+    except (OSError, EOFError) as e:
+        raise ValueError(f"cannot read {path}: {e}") from None
+    except (ValueError, zipfile.BadZipFile) as e:  # pickled data refused, a bad .npy header or archive
+        raise ValueError(f"{not_ours}: {e}") from None
+    if not isinstance(z, np.lib.npyio.NpzFile):
+        raise ValueError(f"{not_ours} (a single .npy array, not an NPZ archive)")
+    with z:
+        if _META_KEY not in z.files:
+            raise ValueError(f"{not_ours} (no {_META_KEY} entry)")
+        try:
+            text = z[_META_KEY]
+            if text.dtype.kind != "U" or text.ndim != 0:
+                raise ValueError(f"its {_META_KEY} entry is not a string")
+            doc = json.loads(str(text))
             arrays = {k: z[k] for k in z.files if k != _META_KEY}
-    except (OSError, EOFError) as exc:
-        raise ValueError(f"cannot read {path}: {exc}") from None
-    if doc.get("format") != FORMAT:
-        raise ValueError(f"{path}: unknown result format {doc.get('format')!r} (this version reads {FORMAT})")
-    obj = from_tree(doc["tree"], arrays)
-    return (obj, doc.get("meta", {})) if meta else obj
+        except (OSError, EOFError, zipfile.BadZipFile, ValueError, RecursionError) as e:
+            raise ValueError(f"{not_ours}: {e}") from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else None
+        raise ValueError(f"{path}: unknown result format {found!r} (this version reads {FORMAT})")
+    if "tree" not in doc:
+        raise ValueError(f"{path}: malformed result file (no tree)")
+    try:
+        obj = from_tree(doc["tree"], arrays)
+    except (KeyError, TypeError, AttributeError, IndexError, RecursionError) as e:
+        raise ValueError(f"{path}: malformed result file ({type(e).__name__}: {e})") from None
+    except ValueError as e:
+        raise ValueError(f"{path}: {e}") from None
+    extra = doc.get("meta", {})
+    return (obj, extra if isinstance(extra, dict) else {}) if meta else obj
+
+
+class Saveable:
+    """Mixin of the result types: ``result.save(path)`` writes it to NPZ (read back by :func:`hovering.load`)."""
+
+    __slots__ = ()
+
+    def save(self, path: os.PathLike, meta: dict | None = None) -> str:
+        """Write this result to an NPZ file (arrays + JSON, no pickle); see :func:`hovering.save`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file; ``.npz`` is appended if missing.
+        meta : dict, optional
+            JSON-able metadata stored beside it.
+
+        Returns
+        -------
+        str
+            The path written.
+
+        Raises
+        ------
+        TypeError
+            If part of the result cannot be saved (e.g. a map on a CustomPotential, whose V and V'
+            are Python code), naming it.
+        ValueError
+            For a bad path or metadata.
+        """
+        return save(self, path, meta)

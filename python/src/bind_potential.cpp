@@ -238,6 +238,73 @@ std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
     return std::shared_ptr<const Potential>(owner, cpp);
 }
 
+/// The tuple a __setstate__ received, checked to have n entries (a ValueError naming the class
+/// otherwise: a corrupted or foreign pickle, not a crash).
+py::tuple state_tuple(const py::handle& state, std::size_t n, const char* cls, const char* fields) {
+    if (!py::isinstance<py::tuple>(state) || py::len(state) != n)
+        throw py::value_error(std::string(cls) + ".__setstate__: expected the tuple " + fields + ", got " + short_repr(state));
+    return py::reinterpret_borrow<py::tuple>(state);
+}
+
+/// Pickling of the potentials and the onset parameters (protocol 2+, copy, deepcopy): the state is
+/// what the constructor takes, and unpickling runs the constructor's checks again. A Python subclass
+/// of Potential keeps its instance dict (its class must be importable, as for any pickled class);
+/// hovering.CustomPotential adds its own __reduce_ex__, which names a callable that cannot be pickled.
+void register_potential_pickles(py::module_& m) {
+    py::class_<Potential, PyPotential, std::shared_ptr<Potential>> pot(m.attr("Potential"));
+    pot.def(py::pickle([](const py::object& self) { return py::object(py::getattr(self, "__dict__", py::dict())); },
+                       [](const py::object& state) {
+                           if (!py::isinstance<py::dict>(state))
+                               throw py::value_error("Potential.__setstate__: expected the instance dict, got " +
+                                                     short_repr(state));
+                           return std::make_pair(new PyPotential(), py::reinterpret_borrow<py::dict>(state));
+                       }));
+    py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>> harmonic(m.attr("Harmonic"));
+    harmonic.def(py::pickle([](const Harmonic& p) { return py::object(py::make_tuple(p.omega())); },
+                            [](const py::object& state) {
+                                const py::tuple t = state_tuple(state, 1, "Harmonic", "(omega,)");
+                                return std::make_shared<Harmonic>(real_arg(t[0], "Harmonic", "omega"));
+                            }));
+    py::class_<Tan, Potential, std::shared_ptr<Tan>> tan(m.attr("Tan"));
+    tan.def(py::pickle([](const Tan& p) { return py::object(py::make_tuple(p.omega(), p.alpha())); },
+                       [](const py::object& state) {
+                           const py::tuple t = state_tuple(state, 2, "Tan", "(omega, alpha)");
+                           return std::make_shared<Tan>(real_arg(t[0], "Tan", "omega"), real_arg(t[1], "Tan", "alpha"));
+                       }));
+    py::class_<Numerical, Potential, std::shared_ptr<Numerical>> numerical(m.attr("Numerical"));
+    numerical.def(py::pickle(
+        [](const Numerical& p) { return py::object(py::make_tuple(std::const_pointer_cast<Potential>(p.base()))); },
+        [](const py::object& state) {
+            const py::tuple t = state_tuple(state, 1, "Numerical", "(base,)");
+            return std::make_shared<Numerical>(keep_python_alive(t[0]));
+        }));
+    numerical.def_property_readonly(
+        "base", [](const Numerical& p) { return std::const_pointer_cast<Potential>(p.base()); },
+        "The wrapped potential (whose V and V' this one uses).");
+    py::class_<CallablePotential, Potential, std::shared_ptr<CallablePotential>> callable(m.attr("_CallablePotential"));
+    callable.def(py::pickle(
+        [](const CallablePotential& p) {
+            return py::object(py::make_tuple(p.V_callable(), p.dV_callable(), p.q_limit(), p.name()));
+        },
+        [](const py::object& state) {
+            const py::tuple t = state_tuple(state, 4, "_CallablePotential", "(V, dV, q_limit, name)");
+            if (!py::isinstance<py::str>(t[3]))
+                throw py::value_error("_CallablePotential.__setstate__: name must be a str, got " + short_repr(t[3]));
+            return std::make_shared<CallablePotential>(t[0], t[1], real_arg(t[2], "_CallablePotential", "q_limit"),
+                                                       t[3].cast<std::string>());
+        }));
+    py::class_<OnsetParameters> onset(m.attr("OnsetParameters"));
+    onset.def(py::pickle(
+        [](const OnsetParameters& p) { return py::object(py::make_tuple(p.Omega0, p.tau0, p.tau1, p.lam, p.theta_w, p.I_tan)); },
+        [](const py::object& state) {
+            const py::tuple t = state_tuple(state, 6, "OnsetParameters", "(Omega0, tau0, tau1, lam, theta_w, I_tan)");
+            const char* names[6] = {"Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan"};
+            double v[6];
+            for (std::size_t i = 0; i < 6; ++i) v[i] = real_arg(t[i], "OnsetParameters", names[i]);
+            return OnsetParameters{v[0], v[1], v[2], v[3], v[4], v[5]};
+        }));
+}
+
 }  // namespace
 
 void register_potential(py::module_& m) {
@@ -330,6 +397,7 @@ void register_potential(py::module_& m) {
             return "OnsetParameters(Omega0=" + g(p.Omega0) + ", tau0=" + g(p.tau0) + ", tau1=" + g(p.tau1) +
                    ", lam=" + g(p.lam) + ", theta_w=" + g(p.theta_w) + ", I_tan=" + g(p.I_tan) + ")";
         });
+    register_potential_pickles(m);
     m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"));
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),
           py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"));

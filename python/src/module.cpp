@@ -12,6 +12,7 @@ PYBIND11_MODULE(_core, m) {
     register_flow(flow);
     auto normal = m.def_submodule("normal", "The tangential curve (normal coordinates) and the flow map.");
     register_normal(normal);
+    register_pickles(m);  // after every class it adds pickling to
     // `from hovering._core.flow import X` needs the submodules in sys.modules (def_submodule only
     // sets them as attributes).
     auto modules = py::module_::import("sys").attr("modules");

@@ -12,6 +12,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask, require_map
+from .._serial import Saveable
 from .rotation import regularity, rotation_number
 
 __all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
@@ -37,7 +38,7 @@ def max_angular_gap(phi) -> float:
 
 
 @dataclass(frozen=True)
-class CriticalCurve:
+class CriticalCurve(Saveable):
     """The lowest invariant curve inside a set of no-impact regions (see :func:`critical_curve`).
 
     Attributes

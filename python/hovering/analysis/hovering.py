@@ -16,12 +16,13 @@ from typing import Optional
 import numpy as np
 
 from .._common import Region, Status, check_memory, flag, integer, real_number, require_map, thread_count
+from .._serial import Saveable
 
 __all__ = ["HoveringArea", "hovering_area"]
 
 
 @dataclass(frozen=True)
-class HoveringArea:
+class HoveringArea(Saveable):
     """Measured area of the hovering set HOV(eps) (see :func:`hovering_area`).
 
     Attributes

@@ -22,12 +22,15 @@ a return of the flow costs ~13x the compiled one, a section point (a root search
 
 from __future__ import annotations
 
+import copy
 import math
+import pickle
 from typing import Callable, Optional
 
 import numpy as np
 
 from .._core.flow import Potential, _CallablePotential
+from .._pickle import pickler_stores_code
 
 __all__ = ["CustomPotential", "check_potential"]
 
@@ -183,6 +186,14 @@ class CustomPotential(_CallablePotential):
         is not > 0 (e.g. a double well), a sampled value is not finite, or dV disagrees with the
         derivative of V; the message names the value and the allowed range.
 
+    Notes
+    -----
+    It pickles (multiprocessing, Dask) when V and dV do: module-level functions or picklable
+    callables for the standard pickler, also lambdas for cloudpickle; otherwise pickling raises
+    ``pickle.PicklingError`` naming the callable. It compares equal to a CustomPotential of the same
+    callables (``is``), q_limit and name. It cannot be saved to NPZ (:func:`hovering.save` writes no
+    code): a ``TypeError`` says so.
+
     Examples
     --------
     >>> import math, hovering
@@ -203,3 +214,86 @@ class CustomPotential(_CallablePotential):
         lim = _q_limit(q_limit, name)
         _check(V, dV, lim, name, _extent(check_extent))
         super().__init__(V, dV, lim, name)
+
+    # ------------------------------------------------------------------ equality, copying, saving
+
+    def __eq__(self, other):
+        """Equal to a CustomPotential of the same class with the same callables (``is``), q_limit and name."""
+        if not isinstance(other, Potential):
+            return NotImplemented
+        return (type(self) is type(other) and self.V_callable is other.V_callable
+                and self.dV_callable is other.dV_callable and self.q_limit == other.q_limit and self.name == other.name)
+
+    def __hash__(self) -> int:
+        """Hash of the callables' identities, q_limit and name (consistent with ``==``)."""
+        return hash((type(self), id(self.V_callable), id(self.dV_callable), self.q_limit, self.name))
+
+    def __reduce_ex__(self, protocol):
+        """Pickle as the callables, q_limit and name (unpickling does not run the checks again).
+
+        The callables are pickled by the pickler in use: the standard one (``pickle``,
+        ``multiprocessing``) stores functions by their importable name, so V and dV must be
+        module-level functions or picklable callable objects; cloudpickle and dill (Dask) also
+        store lambdas and local functions.
+
+        Raises
+        ------
+        pickle.PicklingError
+            Naming this potential and the callable that the standard pickler cannot store.
+        """
+        V, dV = self.V_callable, self.dV_callable
+        if not pickler_stores_code():
+            for what, f in (("V", V), ("dV", dV)):
+                try:
+                    pickle.dumps(f, protocol)
+                except Exception as e:
+                    raise pickle.PicklingError(
+                        f"cannot pickle {self.name}: its {what} = {f!r} cannot be pickled ({type(e).__name__}: {e}); "
+                        "pickle stores functions by their importable name: define V and dV at module level (not as "
+                        "lambdas or local functions), or pass picklable callables (e.g. functools.partial of "
+                        "module-level functions); cloudpickle (Dask's pickler) also stores lambdas") from e
+        return _restore_custom, (type(self), V, dV, self.q_limit, self.name, dict(self.__dict__))
+
+    def __copy__(self) -> "CustomPotential":
+        """A new potential with the same callables (no checks run; any callable can be copied)."""
+        return _restore_custom(type(self), self.V_callable, self.dV_callable, self.q_limit, self.name, dict(self.__dict__))
+
+    def __deepcopy__(self, memo) -> "CustomPotential":
+        """A new potential with deep copies of the callables (functions are their own deep copies)."""
+        V, dV, attrs = copy.deepcopy((self.V_callable, self.dV_callable, dict(self.__dict__)), memo)
+        return _restore_custom(type(self), V, dV, self.q_limit, self.name, attrs)
+
+    def _to_record(self) -> dict:
+        """Refused: V and dV are Python code, which an NPZ file (written without pickle) cannot hold.
+
+        Raises
+        ------
+        TypeError
+            Always, naming the potential and what to do instead.
+        """
+        raise TypeError(_NOT_SAVEABLE.format(what=f"{self.name} (a CustomPotential)"))
+
+
+_NOT_SAVEABLE = ("cannot save {what} to NPZ: its V and V' are Python code, which the NPZ format (written without "
+                 "pickle, so that reading a file never runs code) cannot hold; pickle the object instead (with "
+                 "module-level V and dV), or save a result without its map, e.g. "
+                 "dataclasses.replace(result, map=None).save(path)")
+
+
+def _restore_custom(cls, V, dV, q_limit, name, attrs):
+    """A ``cls`` (CustomPotential or a subclass) from checked callables, without checking them again."""
+    obj = cls.__new__(cls)
+    _CallablePotential.__init__(obj, V, dV, q_limit, name)
+    obj.__dict__.update(attrs)
+    return obj
+
+
+def _python_potential_record(self) -> dict:
+    """Refused: a Potential subclass defined in Python is Python code (see :data:`_NOT_SAVEABLE`)."""
+    raise TypeError(_NOT_SAVEABLE.format(what=f"{self!r} (a {type(self).__name__}, a Potential defined in Python)"))
+
+
+# The base class answers for Python subclasses; the compiled potentials define their own records
+# (hovering.flow.system).
+Potential._to_record = _python_potential_record
+

@@ -9,6 +9,7 @@ import numpy as np
 
 from .. import _core
 from .._common import FlowStatus, integer, is_choice, status_code, real_array, real_number, thread_count
+from .._serial import Saveable
 from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
@@ -48,7 +49,7 @@ def _threads(n_threads, python_defined: bool) -> int:
 
 
 @dataclass(frozen=True)
-class ReturnMapResult:
+class ReturnMapResult(Saveable):
     """Images of points of Sigma_h under the return map, one entry per initial condition.
 
     Attributes
@@ -115,6 +116,25 @@ class Section:
 
     def __repr__(self) -> str:
         return f"Section({self.sys!r}, h={self.h!r})"
+
+    def __eq__(self, other):
+        """Equal to a section of an equal system at the same energy."""
+        if not isinstance(other, Section):
+            return NotImplemented
+        return type(self) is type(other) and self.sys == other.sys and self.h == other.h
+
+    def __hash__(self) -> int:
+        """Hash of the system and the energy (consistent with ``==``)."""
+        return hash((self.sys, self.h))
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the system and the energy."""
+        return {"sys": self.sys, "h": self.h}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "Section":
+        """Inverse of :meth:`_to_record` (validated again)."""
+        return cls(record["sys"], record["h"])
 
     def point(self, theta, I) -> np.ndarray:
         """States (q1, 0, q2, p2) of Sigma_h at section coordinates (theta, I).

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 
@@ -28,6 +29,64 @@ __all__ = [
 _GEOMETRIES = ("none", "wall", "step")
 
 
+# ---------------------------------------------------------------- the compiled potentials' values
+# Pickling is the compiled classes' own (bind_potential.cpp: their constructor arguments); these
+# add equality by value and the records :func:`hovering.save` writes (no pickle in the file).
+
+def _potential_eq(self, other):
+    """Equal to a potential of the same class with the same parameters (for Numerical: an equal base)."""
+    if not isinstance(other, Potential):
+        return NotImplemented
+    return type(self) is type(other) and self.__getstate__() == other.__getstate__()
+
+
+def _potential_hash(self) -> int:
+    """Hash of the class and the parameters (consistent with ``==``)."""
+    return hash((type(self), self.__getstate__()))
+
+
+def _record_fields(*names):
+    def to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the constructor arguments."""
+        return {name: getattr(self, name) for name in names}
+
+    def from_record(cls, record: dict):
+        """Inverse of ``_to_record`` (the constructor's checks run again)."""
+        return cls(*(record[name] for name in names))
+
+    return to_record, classmethod(from_record)
+
+
+for _cls, _names in ((Harmonic, ("omega",)), (Tan, ("omega", "alpha")), (Numerical, ("base",))):
+    _cls.__eq__, _cls.__hash__ = _potential_eq, _potential_hash
+    _cls._to_record, _cls._from_record = _record_fields(*_names)
+
+_ONSET_FIELDS = ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
+
+
+def _onset_to_record(self) -> dict:
+    """What :func:`hovering.save` writes: the six parameters."""
+    return {name: getattr(self, name) for name in _ONSET_FIELDS}
+
+
+def _onset_from_record(cls, record: dict) -> OnsetParameters:
+    """Inverse of ``_to_record``."""
+    obj = cls.__new__(cls)
+    obj.__setstate__(tuple(record[name] for name in _ONSET_FIELDS))
+    return obj
+
+
+def _onset_eq(self, other):
+    """Equal to onset parameters with the same six values."""
+    if not isinstance(other, OnsetParameters):
+        return NotImplemented
+    return self.__getstate__() == other.__getstate__()
+
+
+OnsetParameters._to_record, OnsetParameters._from_record = _onset_to_record, classmethod(_onset_from_record)
+OnsetParameters.__eq__, OnsetParameters.__hash__ = _onset_eq, _potential_hash
+
+
 @dataclass(frozen=True)
 class Bilinear:
     """The coupling ``Vc(q1, q2) = q1 q2``."""
@@ -45,6 +104,15 @@ class Bilinear:
         float or ndarray
         """
         return q1 * q2
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: nothing (the coupling has no parameter)."""
+        return {}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "Bilinear":
+        """Inverse of :meth:`_to_record`."""
+        return cls()
 
 
 @dataclass(frozen=True)
@@ -84,6 +152,15 @@ class Polynomial:
         float or ndarray
         """
         return sum(c * q1**i * q2**j for (i, j), c in self.coefficients.items())
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the terms ``[i, j, c_ij]`` in order."""
+        return {"terms": [[int(i), int(j), float(c)] for (i, j), c in self.coefficients.items()]}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "Polynomial":
+        """Inverse of :meth:`_to_record` (validated again)."""
+        return cls({(i, j): c for i, j, c in record["terms"]})
 
 
 def _terms(coupling) -> list:
@@ -196,6 +273,19 @@ class StepSystem:
             raise ValueError(f"unknown StepSystem field(s) {sorted(unknown)}; allowed: {sorted(fields)}")
         fields.update(changes)
         return StepSystem(**fields)
+
+    def __reduce__(self):
+        """Pickle as the constructor arguments (the core's copy is rebuilt, and validated, on unpickling)."""
+        return type(self), tuple(getattr(self, f.name) for f in dataclasses.fields(self) if f.init)
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the fields (potentials and coupling as their own records)."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "StepSystem":
+        """Inverse of :meth:`_to_record` (validated again)."""
+        return cls(**record)
 
 
 def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> OnsetParameters:

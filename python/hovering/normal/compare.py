@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._common import Region, forcing_array, real_number, require_type, wrap
+from .._serial import Saveable
 from ..flow.section import Section
 from ..truncated.maps import TruncatedFamily, TruncatedMap
 from .coordinates import TangentialCurve, _curve_of, _finite_pair, _section
@@ -65,7 +66,7 @@ def truncated_from_flow(cc: CornerCurves, eps: float, forcing=(1.0,)) -> Truncat
 
 
 @dataclass
-class MapComparison:
+class MapComparison(Saveable):
     """Full return map vs a truncated map on the same points (see :func:`compare_maps`).
 
     Attributes

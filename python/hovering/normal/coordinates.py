@@ -18,6 +18,7 @@ import numpy as np
 
 from .. import _core
 from .._common import MAX_MODES, integer, real_array, require_angles, require_finite, require_type, wrap
+from .._serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 
 __all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_coefficients", "to_normal", "from_normal"]
@@ -25,8 +26,15 @@ __all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_c
 _TWO_PI = 2 * np.pi
 
 
-class TangentialCurve:
+#: The compiled curve's state (its ``__getstate__``): what a saved or pickled curve is rebuilt from.
+_CURVE_STATE = ("h", "eps", "I_tan0", "theta", "I", "err_theta", "err_I")
+
+
+class TangentialCurve(Saveable):
     """``I_tan^eps(theta)`` (Def:sing_curve) measured on the flow; see the module docstring.
+
+    A curve pickles, copies and saves (:meth:`save`, :func:`hovering.save`) as its section and
+    measured samples: the interpolants are rebuilt from them bit for bit, without tracing the flow.
 
     Parameters
     ----------
@@ -77,19 +85,54 @@ class TangentialCurve:
         if not 0 <= n_check <= n:
             raise ValueError(f"n_check must be in [0, n], got {n_check!r}")
         opts = flow_options(rtol=rtol, atol=rtol * 1e-2)
-        self.sec = sec
-        self._c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
-        while auto and n_check and n < 1024 and not self._c.interpolation_error[1] < 1e-12:
+        c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
+        while auto and n_check and n < 1024 and not c.interpolation_error[1] < 1e-12:
             n *= 2
-            self._c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
-        self.s = self._c.s
-        self.theta = self._c.theta
-        self.values = self._c.I
-        et, eI = self._c.interpolation_error
-        self.interpolation_error = float(eI) if n_check else float("nan")
-        self.interpolation_error_theta = float(et) if n_check else float("nan")
-        self.is_graph = bool(self._c.is_graph)
-        self.min_slope = float(self._c.min_slope)
+            c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
+        self._adopt(sec, c, checked=bool(n_check))
+
+    def _adopt(self, sec: Section, c, checked: bool) -> None:
+        """Take the compiled curve ``c`` of ``sec`` (``checked``: its interpolation error was measured)."""
+        self.sec = sec
+        self._c = c
+        self.s = c.s
+        self.theta = c.theta
+        self.values = c.I
+        et, eI = c.interpolation_error
+        self.interpolation_error = float(eI) if checked else float("nan")
+        self.interpolation_error_theta = float(et) if checked else float("nan")
+        self.is_graph = bool(c.is_graph)
+        self.min_slope = float(c.min_slope)
+
+    def _samples(self) -> dict:
+        """The compiled curve's state by name (see :data:`_CURVE_STATE`), and whether its error was measured."""
+        return dict(zip(_CURVE_STATE, self._c.__getstate__()), checked=not np.isnan(self.interpolation_error))
+
+    @classmethod
+    def _from_samples(cls, sec: Section, samples: dict) -> "TangentialCurve":
+        """The curve of ``sec`` with the samples of :meth:`_samples` (no trace of the flow; validated)."""
+        sec = _section("sec", sec)
+        try:
+            state = tuple(samples[k] for k in _CURVE_STATE)
+        except (KeyError, TypeError):
+            raise ValueError(f"a tangential curve's samples need the entries {_CURVE_STATE}, got {samples!r}") from None
+        if state[0] != sec.h:
+            raise ValueError(f"the tangential curve's samples were measured at h = {state[0]}, not at the section's "
+                             f"h = {sec.h}")
+        c = _core.normal.TangentialCurve.__new__(_core.normal.TangentialCurve)
+        c.__setstate__(state)
+        obj = cls.__new__(cls)
+        obj._adopt(sec, c, checked=bool(samples.get("checked", True)))
+        return obj
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the section and the measured samples."""
+        return {"sec": self.sec, "samples": self._samples()}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "TangentialCurve":
+        """Inverse of :meth:`_to_record` (the interpolants are rebuilt bit for bit, the flow is not traced)."""
+        return cls._from_samples(record["sec"], record["samples"])
 
     def __repr__(self) -> str:
         return (f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "

@@ -11,6 +11,7 @@ from typing import Optional
 import numpy as np
 
 from .._common import integer, real_array, require_finite, wrap
+from .._serial import Saveable
 from ..flow.section import FlowStatus, Section
 from ..flow.system import onset_parameters
 from .coordinates import TangentialCurve, _curve_of, _section
@@ -29,7 +30,7 @@ def _labels(sec, curve, phi, K, rtol):
 
 
 @dataclass
-class CornerCurves:
+class CornerCurves(Saveable):
     """Corner-singularity curves and arcs of the full return map on circles ``K = const``.
 
     Attributes

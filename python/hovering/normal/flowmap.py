@@ -18,6 +18,7 @@ from .. import _core
 from .._common import (MAX_MODES, Region, check_memory, flag, integer, is_choice, iterate_arguments, point_pair,
                        wrap)
 from .._protocols import MapAnalyses
+from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
 from ..truncated import theory as _theory  # the module (hovering.truncated does not export the function)
@@ -32,7 +33,7 @@ FLOW_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "section", "state
 
 
 @dataclass(frozen=True)
-class FlowSteps:
+class FlowSteps(Saveable):
     """One return of many points (:meth:`FlowMap.returns`), with what the flow reported.
 
     Attributes
@@ -101,6 +102,12 @@ class FlowMap(MapAnalyses):
     ValueError
         For bad parameters (named, with the allowed range), or normal coordinates where the
         tangential curve is not a graph.
+
+    Notes
+    -----
+    A FlowMap pickles and saves (:func:`hovering.save`) as its constructor arguments and its
+    tangential curve's measured samples: it is rebuilt through the constructor with that curve (no
+    trace of the flow, no measurement) and steps bit for bit as the original.
     """
 
     #: Regularity threshold of the critical-curve search (digits of agreement of the two half-orbit
@@ -141,6 +148,40 @@ class FlowMap(MapAnalyses):
 
     def __repr__(self) -> str:
         return f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
+
+    # ---------------------------------------------------------------- pickling and saving
+    # A FlowMap is rebuilt from its constructor arguments, with its tangential curve passed in: the
+    # curve pickles (and saves) as its measured samples, so unpickling neither traces the flow nor
+    # measures anything; the onset parameters (closed forms or a few quadratures) are recomputed by
+    # the constructor. The same doubles go through the same construction: the rebuilt map steps bit
+    # for bit as the original. Other instance attributes (the forcing cache, a subclass's own) are
+    # restored as they were.
+
+    _OWN = frozenset({"section", "sys", "h", "coordinates", "_options", "integrator_options", "onset", "curve", "_core"})
+
+    def __reduce__(self):
+        """Pickle as the constructor arguments, the measured curve and the other instance attributes."""
+        extra = {k: v for k, v in self.__dict__.items() if k not in self._OWN}
+        return _restore_flowmap, (type(self), self.sys, self.h, self.coordinates, dict(self.integrator_options),
+                                  self.curve, extra)
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: system, h, coordinates, integrator options, the curve's samples
+        (not its system again: it is this map's) and the forcing cache."""
+        return {"sys": self.sys, "h": self.h, "coordinates": self.coordinates, "options": dict(self.integrator_options),
+                "curve": None if self.curve is None else self.curve._samples(), "forcing": self._forcing}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "FlowMap":
+        """Inverse of :meth:`_to_record` (validated again; no flow is traced)."""
+        sys, h = record["sys"], record["h"]
+        curve = None
+        if record["curve"] is not None:
+            curve = TangentialCurve._from_samples(Section(sys, h), record["curve"])
+        options = record["options"]
+        if not isinstance(options, dict):
+            raise ValueError(f"the FlowMap's options must be a dict, got {options!r}")
+        return _restore_flowmap(cls, sys, h, record["coordinates"], options, curve, {"_forcing": record["forcing"]})
 
     # ---------------------------------------------------------------- the map interface
 
@@ -475,3 +516,10 @@ class FlowMap(MapAnalyses):
         ref = np.where(reg == int(Region.RIGHT), ref - 2 * p.lam * s, ref)
         return ref + wrap(np.diff(ph) - ref)
 
+
+def _restore_flowmap(cls, sys, h, coordinates, options, curve, extra):
+    """A ``cls`` (FlowMap or a subclass) built by ``FlowMap.__init__`` with the given curve, plus ``extra`` attributes."""
+    obj = cls.__new__(cls)
+    FlowMap.__init__(obj, sys, h, coordinates=coordinates, curve=curve, **options)
+    obj.__dict__.update(extra)
+    return obj

@@ -17,7 +17,9 @@ import numpy as np
 from .. import _core
 from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
                        point_pair, require_angles, require_finite, status_code, thread_count, wrap, forcing_array)
+from .._pickle import reduce_compiled
 from .._protocols import MapAnalyses
+from .._serial import Saveable
 from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
@@ -26,7 +28,7 @@ _RECORD_KEYS = ("orbit", "regions", "rotation", "visited")
 
 
 @dataclass(frozen=True)
-class IterateResult:
+class IterateResult(Saveable):
     """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
 
     Attributes
@@ -464,6 +466,19 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         p["eps"] = eps
         return TruncatedMap(**p, K_max=self.valid_band()[1])
 
+    def __reduce__(self):
+        """Pickle as the compiled map's parameters (K_max: the band's upper end) and the instance dict."""
+        return reduce_compiled(self, _core.truncated.TruncatedMap)
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the six parameters and ``K_max`` (the band's upper end)."""
+        return dict(self.params, K_max=self.valid_band()[1])
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "TruncatedMap":
+        """Inverse of :meth:`_to_record` (validated again; the same doubles give the same map bit for bit)."""
+        return cls(**record)
+
 
 def _angles(name: str, phi):
     """Finite angles with |phi| <= 1e6 (beyond, sin(k phi) is rounding noise), as an array or float."""
@@ -574,6 +589,23 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         """
         K, Om, JR, J1 = self._tables
         return TruncatedFamily(eps, K, Om, JR, J1, forcing=tuple(self.forcing), K_max=self._K_max)
+
+    def __reduce__(self):
+        """Pickle as the compiled family's tables, forcing and band, and the instance dict (the tables as given)."""
+        return reduce_compiled(self, _core.truncated.TruncatedFamily)
+
+    def _to_record(self) -> dict:
+        """What :func:`hovering.save` writes: eps, the tables as given, the forcing and K_max."""
+        K, Om, JR, J1 = self._tables
+        return {"eps": self.eps, "K": K, "Omega": Om, "JR": JR, "J1": J1, "forcing": np.array(self.forcing, dtype=float),
+                "K_max": self._K_max}
+
+    @classmethod
+    def _from_record(cls, record: dict) -> "TruncatedFamily":
+        """Inverse of :meth:`_to_record` (validated again; the same tables give the same map bit for bit)."""
+        r = dict(record)
+        return cls(r.pop("eps"), r.pop("K"), r.pop("Omega"), r.pop("JR"), r.pop("J1"), forcing=tuple(r.pop("forcing")),
+                   **r)
 
     @classmethod
     def from_map(cls, m: TruncatedMap, K, forcing=(1.0,)) -> "TruncatedFamily":

@@ -18,6 +18,7 @@ from typing import Sequence
 import numpy as np
 
 from .._common import forcing_array, integer, real_array, real_number, require_angles, require_finite, wrap
+from .._serial import Saveable
 
 __all__ = [
     "OMEGA_G",
@@ -342,7 +343,7 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
 
 
 @dataclass(frozen=True)
-class Theory:
+class Theory(Saveable):
     """Leading-order predictions of sec:truncinvcurves for one set of map parameters.
 
     At first order in eps, the invariant curves of ``K' = K + eps f(phi')``, ``phi' = phi + Omega0

@@ -114,6 +114,8 @@ public:
     double dV(double q) const override { return base_->dV(q); }
     std::string name() const override { return "Numerical(" + base_->name() + ")"; }
     double q_limit() const override { return base_->q_limit(); }
+    /// The wrapped potential.
+    const std::shared_ptr<const Potential>& base() const { return base_; }
 
 private:
     std::shared_ptr<const Potential> base_;

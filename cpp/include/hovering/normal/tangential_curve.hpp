@@ -47,6 +47,11 @@ public:
     /// interpolation error. Throws std::invalid_argument, saying why, when the wall tangency curve
     /// does not exist or is not a graph over the wall angle (eps too large), or a trace fails.
     static TangentialCurve measure(const FlowSystem& s, double h, int n, const FlowOptions& opt, int n_check = 4);
+    /// The curve of measure() from its samples (theta_k, I_k at s_k = -pi + 2 pi k / n), its
+    /// energy h, the system's eps, I_tan0 and the measured interpolation errors: bit for bit the
+    /// curve measure() built from them (what a saved or pickled curve is rebuilt from).
+    static TangentialCurve from_samples(double h, double eps, double I_tan0, const std::vector<double>& theta,
+                                        const std::vector<double>& I, double err_theta, double err_I);
 
     /// (theta(s), I(s)) at the wall angle s (theta in [-pi, pi)).
     std::pair<double, double> at(double s) const;
@@ -71,10 +76,14 @@ public:
     double I_tan0() const { return I0_; }
     /// Energy of the section.
     double h() const { return h_; }
+    /// The coupling strength eps of the system the curve was measured on.
+    double eps() const { return eps_; }
     /// A one-line explanation of why the curve is not a graph (empty if it is).
     std::string not_graph_reason() const;
 
 private:
+    /// Build the interpolants, min_slope and I_tan(theta) from s_, theta_, I_ (throws if theta(s) winds).
+    void interpolate();
     std::vector<double> s_, theta_, I_;
     TrigInterpolant u_, Ifun_;  // theta(s) = s + u(s), I(s)
     TrigInterpolant Itheta_;    // I_tan(theta) itself, from the inverted curve at n equispaced theta

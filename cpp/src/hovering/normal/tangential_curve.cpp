@@ -154,15 +154,29 @@ TangentialCurve TangentialCurve::measure(const FlowSystem& s, double h, int n, c
     c.s_.resize(std::size_t(n));
     c.theta_.resize(std::size_t(n));
     c.I_.resize(std::size_t(n));
-    std::vector<double> u(static_cast<std::size_t>(n));
     for (int k = 0; k < n; ++k) {
         const double sk = -kPi + kTwoPi * k / n;
         const auto [th, I] = trace_back(tr, h, sk, c.I0_);
         c.s_[std::size_t(k)] = sk;
         c.theta_[std::size_t(k)] = th;
         c.I_[std::size_t(k)] = I;
-        u[std::size_t(k)] = wrap(th - sk);
     }
+    c.interpolate();
+    for (int k = 0; k < n_check; ++k) {
+        const double sk = -kPi + kTwoPi * (double(k) * n / n_check + 0.5) / n;  // midway between samples
+        const auto [th, I] = trace_back(tr, h, sk, c.I0_);
+        const auto [thi, Ii] = c.at(sk);
+        c.err_theta_ = std::max(c.err_theta_, std::fabs(wrap(th - thi)));
+        c.err_I_ = std::max(c.err_I_, std::fabs(I - Ii));
+        if (c.is_graph()) c.err_I_ = std::max(c.err_I_, std::fabs(I - c.I_tan(th)));  // the theta-interpolant too
+    }
+    return c;
+}
+
+void TangentialCurve::interpolate() {
+    const int n = int(s_.size());
+    std::vector<double> u(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) u[std::size_t(k)] = wrap(theta_[std::size_t(k)] - s_[std::size_t(k)]);
     // theta(s) - s must be continuous and periodic: unwrap it; a winding left over means theta(s)
     // is not a degree-one circle map, so no interpolant (and no graph) exists.
     double wind = 0;
@@ -172,34 +186,55 @@ TangentialCurve TangentialCurve::measure(const FlowSystem& s, double h, int n, c
         else wind = u[std::size_t(n - 1)] + d - u[0];
     }
     if (std::fabs(wind) > 1e-6)
-        bad("the tangential curve winds " + fmt(wind / kTwoPi) + " extra times around the cylinder (eps = " + fmt(s.eps) +
+        bad("the tangential curve winds " + fmt(wind / kTwoPi) + " extra times around the cylinder (eps = " + fmt(eps_) +
             "): it is not a graph over theta and normal coordinates do not exist");
-    c.u_ = TrigInterpolant(u);
-    c.Ifun_ = TrigInterpolant(c.I_);
-    c.min_slope_ = 1e300;
+    u_ = TrigInterpolant(u);
+    Ifun_ = TrigInterpolant(I_);
+    min_slope_ = 1e300;
     for (int k = 0; k < 8 * n; ++k) {
         const double sk = -kPi + kTwoPi * k / (8 * n);
-        const double slope = 1 + c.u_.with_derivative(sk).second;
-        if (slope < c.min_slope_) {
-            c.min_slope_ = slope;
-            c.min_slope_s_ = sk;
+        const double slope = 1 + u_.with_derivative(sk).second;
+        if (slope < min_slope_) {
+            min_slope_ = slope;
+            min_slope_s_ = sk;
         }
     }
-    if (c.is_graph()) {
+    if (is_graph()) {
         // I_tan(theta) is smooth and periodic in theta too: interpolate it directly, so normal
         // coordinates cost one interpolant evaluation instead of a Newton inversion of theta(s).
         std::vector<double> Ith(static_cast<std::size_t>(n));
-        for (int k = 0; k < n; ++k) Ith[std::size_t(k)] = c.Ifun_(c.parameter_of(-kPi + kTwoPi * k / n));
-        c.Itheta_ = TrigInterpolant(Ith);
+        for (int k = 0; k < n; ++k) Ith[std::size_t(k)] = Ifun_(parameter_of(-kPi + kTwoPi * k / n));
+        Itheta_ = TrigInterpolant(Ith);
     }
-    for (int k = 0; k < n_check; ++k) {
-        const double sk = -kPi + kTwoPi * (double(k) * n / n_check + 0.5) / n;  // midway between samples
-        const auto [th, I] = trace_back(tr, h, sk, c.I0_);
-        const auto [thi, Ii] = c.at(sk);
-        c.err_theta_ = std::max(c.err_theta_, std::fabs(wrap(th - thi)));
-        c.err_I_ = std::max(c.err_I_, std::fabs(I - Ii));
-        if (c.is_graph()) c.err_I_ = std::max(c.err_I_, std::fabs(I - c.I_tan(th)));  // the theta-interpolant too
+}
+
+TangentialCurve TangentialCurve::from_samples(double h, double eps, double I_tan0, const std::vector<double>& theta,
+                                              const std::vector<double>& I, double err_theta, double err_I) {
+    const std::size_t n = theta.size();
+    if (n < 8 || n % 2 || n > 4096)
+        bad("a tangential curve needs an even number in [8, 4096] of samples, got " + std::to_string(n));
+    if (I.size() != n)
+        bad("theta and I of a tangential curve must have the same length, got " + std::to_string(n) + " and " +
+            std::to_string(I.size()));
+    for (std::size_t k = 0; k < n; ++k) {
+        if (!std::isfinite(theta[k])) bad("theta[" + std::to_string(k) + "] must be finite, got " + fmt(theta[k]));
+        if (!std::isfinite(I[k])) bad("I[" + std::to_string(k) + "] must be finite, got " + fmt(I[k]));
     }
+    for (const auto& [name, v] : {std::pair<const char*, double>{"h", h}, {"eps", eps}, {"I_tan0", I_tan0}})
+        if (!std::isfinite(v)) bad(std::string(name) + " must be finite, got " + fmt(v));
+    for (const auto& [name, v] : {std::pair<const char*, double>{"err_theta", err_theta}, {"err_I", err_I}})
+        if (!(v >= 0)) bad(std::string(name) + " must be >= 0, got " + fmt(v));
+    TangentialCurve c;
+    c.h_ = h;
+    c.eps_ = eps;
+    c.I0_ = I_tan0;
+    c.theta_ = theta;
+    c.I_ = I;
+    c.s_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) c.s_[k] = -kPi + kTwoPi * int(k) / int(n);  // measure()'s grid, same rounding
+    c.interpolate();
+    c.err_theta_ = err_theta;
+    c.err_I_ = err_I;
     return c;
 }
 
