@@ -41,6 +41,7 @@ from .flow import (
     Section,
     StepSystem,
     Tan,
+    TrajectoryPoint,
     check_potential,
     onset_parameters,
 )
