@@ -77,7 +77,8 @@ class Progress:
         return self._sink is not None
 
     def __call__(self, done, total=None) -> None:
-        """Report ``done`` units of the whole (absolute; a smaller value than before is ignored).
+        """Report ``done`` units of the whole (absolute; a smaller value than before is ignored, a
+        larger one than the total raises the total).
 
         Parameters
         ----------
@@ -94,6 +95,7 @@ class Progress:
         if done < self.done:
             return
         self.done = done
+        self.total = max(self.total, done)  # work beyond the announced total raises it
         self._sink(done, self.total)
 
     def advance(self, delta: int) -> None:
