@@ -48,7 +48,7 @@ struct FlowIterateOutput {
     double* orbit_x = nullptr;        ///< points: phi (normal) or theta (section)
     double* orbit_y = nullptr;        ///< K or I
     double* orbit_theta = nullptr;    ///< section coordinates of the points
-    double* orbit_I = nullptr;
+    double* orbit_I = nullptr;        ///< I of the points (section coordinates)
     double* states = nullptr;         ///< (n, n_steps + 1, 4) points of Sigma_h (q1, p1, q2, p2)
     std::int8_t* regions = nullptr;   ///< Region of each return
     double* times = nullptr;          ///< return times
