@@ -87,7 +87,7 @@ Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s,
 
 FlowWork Tracer::work() const {
     FlowWork w = work_;
-    w.field_evaluations = in_.field().evaluations;
+    w.field_evaluations = in_.field().evaluations();
     w.coupling_evaluations = in_.field().coupling_evaluations;
     return w;
 }
