@@ -169,7 +169,7 @@ def test_max_trajectory_points_truncates_per_orbit_and_is_checked_first():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(record=("trajectory",)), "needs trajectory_dt"),
+    (dict(record=("trajectory",)), r"trajectory_dt \(the sample spacing\) must be a number in \(0, inf\) .*got None"),
     (dict(record=("orbit",), trajectory_dt=0.1), "only used with record 'trajectory'"),
     (dict(record=("trajectory",), trajectory_dt=0.0), r"trajectory_dt must lie in \(0.0, inf\), got 0.0"),
     (dict(record=("trajectory",), trajectory_dt=float("nan")), "trajectory_dt must be finite"),

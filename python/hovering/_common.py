@@ -420,6 +420,15 @@ MAX_TRAJECTORY_POINTS = 10_000_000
 def trajectory_arguments(trajectory_dt, max_trajectory_points, n_orbits: int) -> tuple:
     """Check the arguments of a trajectory recording before anything is computed.
 
+    Parameters
+    ----------
+    trajectory_dt : float
+        Sample spacing, > 0.
+    max_trajectory_points : int
+        Bound of the points of all orbits together.
+    n_orbits : int
+        Number of orbits of the call.
+
     Returns
     -------
     (float, int)
@@ -445,7 +454,25 @@ def trajectory_arguments(trajectory_dt, max_trajectory_points, n_orbits: int) ->
 
 
 def trajectory_rows(res, i) -> np.ndarray:
-    """Rows ``(t, q1, p1, q2, p2)`` of orbit i of a result with a recorded trajectory (a view)."""
+    """Rows ``(t, q1, p1, q2, p2)`` of orbit i of a result with a recorded trajectory.
+
+    Parameters
+    ----------
+    res : IterateResult or ReturnMapResult
+        A result with ``trajectory`` and ``trajectory_index``.
+    i : int
+        Orbit index (negative counts from the end).
+
+    Returns
+    -------
+    ndarray
+        Shape ``(m_i, 5)``, a view into ``res.trajectory``.
+
+    Raises
+    ------
+    ValueError
+        If no trajectory was recorded or i is out of range.
+    """
     if res.trajectory is None:
         raise ValueError("no trajectory was recorded: pass record=('trajectory',) (FlowMap.iterate) or "
                          "trajectory_dt (Section.return_map)")

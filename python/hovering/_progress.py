@@ -39,6 +39,18 @@ ProgressArg = Union[bool, Callable[[int, int], object]]
 def check_progress(value, name: str = "progress"):
     """The ``progress`` argument, validated: ``True``, ``False`` or a callable ``(done, total)``.
 
+    Parameters
+    ----------
+    value : object
+        What was passed.
+    name : str, optional
+        The parameter's name (for the message).
+
+    Returns
+    -------
+    bool or callable
+        ``value`` (a NumPy bool as a bool).
+
     Raises
     ------
     ValueError
@@ -99,17 +111,34 @@ class Progress:
         self._sink(done, self.total)
 
     def advance(self, delta: int) -> None:
-        """Report ``delta`` more units done."""
+        """Report ``delta`` more units done.
+
+        Parameters
+        ----------
+        delta : int
+            Units of work finished since the last report.
+        """
         self(self.done + int(delta))
 
     def set_total(self, total: int) -> None:
-        """Change the total (when the work turns out larger or smaller than announced)."""
+        """Change the total (when the work turns out larger or smaller than announced).
+
+        Parameters
+        ----------
+        total : int
+            The new total; the sink is told at once (with the work done so far).
+        """
         self.total = int(total)
         if self._sink is not None:
             self._sink(min(self.done, self.total), self.total)
 
     def part(self, offset: int):
         """The ``progress`` argument for a sub-call whose work counts from ``offset`` in the whole.
+
+        Parameters
+        ----------
+        offset : int
+            Units of the whole done before the sub-call starts.
 
         Returns
         -------

@@ -315,7 +315,8 @@ class FlowMap(MapAnalyses):
         dt, per_orbit = 0.0, 0
         if "trajectory" in record:
             if trajectory_dt is None:
-                raise ValueError("record 'trajectory' needs trajectory_dt (the sample spacing, > 0)")
+                raise ValueError("trajectory_dt (the sample spacing) must be a number in (0, inf) with record 'trajectory', "
+                                 "got None")
             dt, per_orbit = trajectory_arguments(trajectory_dt, max_trajectory_points, p.size)
         elif trajectory_dt is not None:
             raise ValueError(f"trajectory_dt = {trajectory_dt!r} is only used with record 'trajectory'; add it to record "
@@ -477,7 +478,7 @@ class FlowMap(MapAnalyses):
             Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, inside the band
             and below 0).
         **kwargs
-            ``grid``, ``digits``, ``tol``, ``n_threads`` of :func:`hovering.critical_curve`.
+            ``grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
 
         Returns
         -------
