@@ -203,9 +203,8 @@ def test_progress_module_parts_totals_and_the_disabled_reporter():
 def test_progress_bar_closes_on_keyboard_interrupt(capsys):
     from tqdm import tqdm
 
-    with pytest.raises(KeyboardInterrupt):
-        with progress_bar(True, 10, desc="closing", unit="step") as bar:
-            bar(3)
-            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt), progress_bar(True, 10, desc="closing", unit="step") as bar:
+        bar(3)
+        raise KeyboardInterrupt
     assert len(tqdm._instances) == 0
     assert "closing" in capsys.readouterr().err

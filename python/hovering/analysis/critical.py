@@ -202,23 +202,22 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     # Work of the whole search: the grid, the bisection from one grid spacing down to tol, the final orbit.
     spacing = (K_b - K_a) / (grid - 1)
     n_bisect = max(0, math.ceil(math.log2(spacing / tol))) if spacing > tol else 0
-    bar = None
-    done = 0
-
-    def test(K0s):
-        nonlocal done
-        K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
-        res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
-                        n_threads=n_threads, progress=bar.part(done))
-        done += K0s.size * n_steps
-        stayed = res.status == Status.OK
-        dig = np.where(stayed, regularity(res), 0.0)
-        circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
-                           for i in range(res.n_orbits)])
-        return stayed & (dig >= digits) & circle, res, dig
-
     with progress_bar(progress, (grid + n_bisect + 1) * n_steps, desc="critical_curve",
                       unit=getattr(m, "_progress_unit", "step")) as bar:
+        done = 0
+
+        def test(K0s):
+            nonlocal done
+            K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
+            res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
+                            n_threads=n_threads, progress=bar.part(done))
+            done += K0s.size * n_steps
+            stayed = res.status == Status.OK
+            dig = np.where(stayed, regularity(res), 0.0)
+            circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
+                               for i in range(res.n_orbits)])
+            return stayed & (dig >= digits) & circle, res, dig
+
         K_pass, K_fail, res, dig = _search(test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits,
                                            hover_search, th)
         bar.set_total(done)  # the bisection may have been shorter than its bound
