@@ -95,6 +95,7 @@ __all__ = [
     "Status",
     "FlowStatus",
     "Geometry",
+    "TrajectoryPoint",
     "region_mask",
     "truncated",
     "flow",
