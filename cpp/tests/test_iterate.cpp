@@ -1,6 +1,7 @@
 // Batch iteration: SIMD kernel vs scalar kernel, thread-count invariance, statuses and recording.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -140,4 +141,38 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
     std::vector<double> big = {1e18};
     CHECK_INVALID(m.iterate(big.data(), k0.data(), 1, o, out), "<= 1e6");
     CHECK_INVALID(m.step(-1e18, 0.1), "<= 1e6");
+}
+
+TEST_CASE("batch iteration: the progress counter ends at n * n_steps, early exits credited", "[truncated][iterate]") {
+    const double OmegaG = kPi * (std::sqrt(5.0) - 1.0);
+    TruncatedMap m = make_truncated_map(0.3, OmegaG, 3 * kPi / 4, 1.0, 0.5, 0.5, 1.0);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> U(-kPi, kPi), V(-0.4, 0.4);
+    std::vector<double> p0(3000), k0(3000);
+    for (std::size_t i = 0; i < p0.size(); ++i) {
+        p0[i] = U(rng);
+        k0[i] = V(rng);
+    }
+    k0[5] = 2.0;  // outside the band (K_max = 1): escaped at once, its steps credited
+    const unsigned no_impact = (1u << int(Region::Beside)) | (1u << int(Region::Above));
+    for (Kernel kern : {Kernel::Simd, Kernel::Scalar}) {
+        for (int threads : {1, 2}) {
+            std::atomic<std::int64_t> progress{0};
+            std::vector<std::int8_t> st(p0.size());
+            IterateOptions o;
+            o.n_steps = 700;
+            o.kernel = kern;
+            o.n_threads = threads;
+            o.exit_mask = no_impact;
+            o.stop_on_exit = true;
+            o.progress = &progress;
+            IterateOutput out;
+            out.status = st.data();
+            m.iterate(p0.data(), k0.data(), std::int64_t(p0.size()), o, out);
+            CHECKF(progress.load() == std::int64_t(p0.size()) * 700, "kernel %d, %d threads: %lld", int(kern), threads,
+                   (long long)progress.load());
+            CHECK(std::count(st.begin(), st.end(), static_cast<std::int8_t>(Status::Exited)) > 0);
+            CHECK(st[5] == static_cast<std::int8_t>(Status::Escaped));
+        }
+    }
 }

@@ -182,3 +182,105 @@ TEST_CASE("batch return map: one status per orbit, cancellation marks the rest",
     for (auto v : st) CHECK(v == static_cast<std::int8_t>(FlowStatus::Interrupted));
     CHECK_INVALID(return_maps(s, z0.data(), 3, tight(), -1, nullptr, out), "n_threads must be in");
 }
+
+TEST_CASE("flow map iteration: labels only when read, dense output, work counters, progress", "[normal]") {
+    const FlowSystem s = issue_system(-0.05);
+    FlowOptions o = tight();
+    o.rtol = o.atol = 1e-10;
+    const FlowMap fm(s, 1.0, o, nullptr);  // section coordinates (theta, I)
+    std::vector<double> x = {0.3, -1.0, 2.0, -2.5, 1.1}, y = {0.30, 0.33, 0.31, 0.29, 50.0};  // the last: OffSection
+    const std::int64_t n = std::int64_t(x.size()), ns = 5;
+    struct R {
+        std::vector<double> xf, yf;
+        std::vector<std::int8_t> reg, trunc;
+        std::vector<std::vector<double>> pts;
+        std::vector<std::vector<std::int8_t>> kinds;
+        FlowWork work;
+        std::int64_t progress = 0;
+    };
+    auto run = [&](bool labels, double dt, std::int64_t max_points = 1000000) {
+        R r;
+        r.xf.resize(x.size()); r.yf.resize(x.size()); r.reg.resize(x.size() * ns); r.trunc.resize(x.size());
+        r.pts.resize(x.size()); r.kinds.resize(x.size());
+        std::atomic<std::int64_t> progress{0};
+        FlowIterateOptions opt;
+        opt.n_steps = ns; opt.labels = labels; opt.progress = &progress; opt.n_threads = 2;
+        FlowIterateOutput out;
+        out.x_final = r.xf.data(); out.y_final = r.yf.data(); out.work = &r.work;
+        if (labels) out.regions = r.reg.data();
+        if (dt > 0) {
+            out.trajectory.dt = dt;
+            out.trajectory.max_points_per_orbit = max_points;
+            out.trajectory.points = r.pts.data();
+            out.trajectory.kinds = r.kinds.data();
+            out.trajectory.truncated = r.trunc.data();
+        }
+        fm.iterate(x.data(), y.data(), n, opt, out);
+        r.progress = progress.load();
+        return r;
+    };
+    const R plain = run(false, 0), labelled = run(true, 0), dense = run(false, 0.05), cut = run(false, 0.05, 7);
+    for (std::size_t i = 0; i < x.size(); ++i) {  // the same orbit whatever is recorded, bit for bit
+        CHECK(std::memcmp(&plain.xf[i], &labelled.xf[i], sizeof(double)) == 0);
+        CHECK(std::memcmp(&plain.yf[i], &dense.yf[i], sizeof(double)) == 0);
+        CHECK(std::memcmp(&plain.yf[i], &cut.yf[i], sizeof(double)) == 0);
+    }
+    CHECK(plain.work.label_operations == 0);
+    CHECK(labelled.work.label_operations >= 4 * ns);  // at least one label per return
+    CHECK(plain.work.dense_samples == 0);
+    CHECK(dense.work.dense_samples > 0);
+    CHECK(cut.work.dense_samples < dense.work.dense_samples);
+    CHECK(plain.work.steps == labelled.work.steps);
+    CHECK(plain.work.field_evaluations == labelled.work.field_evaluations);
+    CHECK(plain.work.coupling_evaluations == plain.work.field_evaluations);
+    CHECK(plain.work.section_searches == 4 * ns);
+    for (const R* r : {&plain, &labelled, &dense, &cut}) CHECK(r->progress == n * ns);  // the OffSection orbit credited
+    std::int64_t samples = 0;
+    for (std::size_t i = 0; i < 4; ++i) {
+        const auto& p = dense.pts[i];
+        const auto& k = dense.kinds[i];
+        REQUIRE(p.size() == 5 * k.size());
+        CHECK(dense.trunc[i] == 0);
+        CHECK(cut.trunc[i] == 1);
+        CHECK(cut.kinds[i].size() == 7);
+        CHECK(std::memcmp(cut.pts[i].data(), p.data(), 35 * sizeof(double)) == 0);
+        CHECK(std::count(k.begin(), k.end(), static_cast<std::int8_t>(TrajectoryPoint::Return)) == ns);
+        std::int64_t next = 0;
+        for (std::size_t j = 0; j < k.size(); ++j) {
+            if (j > 0) CHECK(p[5 * j] >= p[5 * (j - 1)]);  // in time order
+            if (k[j] != static_cast<std::int8_t>(TrajectoryPoint::Sample)) continue;
+            CHECKF(p[5 * j] == double(next) * 0.05, "orbit %zu sample %lld", i, (long long)next);  // t = k dt exactly
+            ++next;
+            ++samples;
+        }
+        // the energy along the trajectory is h to the integrator's accuracy
+        for (std::size_t j = 0; j < k.size(); ++j) CHECK(std::fabs(s.energy(&p[5 * j + 1]) - 1.0) < 2e-9);
+    }
+    CHECK(dense.pts[4].empty());  // no point of Sigma_h: nothing to record
+    CHECK(samples == dense.work.dense_samples);
+    FlowIterateOptions bad;
+    bad.n_steps = 1;
+    bad.labels = false;
+    std::vector<std::int8_t> reg(x.size());
+    FlowIterateOutput with_regions;
+    with_regions.regions = reg.data();
+    CHECK_INVALID(fm.iterate(x.data(), y.data(), n, bad, with_regions), "labels = false");
+    FlowIterateOutput bad_dt;
+    std::vector<std::vector<double>> pts(x.size());
+    std::vector<std::vector<std::int8_t>> kinds(x.size());
+    bad_dt.trajectory.points = pts.data();
+    bad_dt.trajectory.kinds = kinds.data();
+    bad_dt.trajectory.max_points_per_orbit = 10;
+    CHECK_INVALID(fm.iterate(x.data(), y.data(), n, FlowIterateOptions{}, bad_dt), "trajectory dt must be finite and > 0");
+    // No walls: no wall search at all.
+    const FlowMap smooth(issue_system(-0.05, Geometry::None), 1.0, o, nullptr);
+    FlowWork w;
+    FlowIterateOutput wo;
+    wo.work = &w;
+    FlowIterateOptions one;
+    one.n_steps = 3;
+    smooth.iterate(x.data(), y.data(), 4, one, wo);
+    CHECK(w.wall_searches == 0);
+    CHECK(w.label_operations == 0);  // labels on, but the smooth flow labels nothing
+    CHECK(w.section_searches == 12);
+}

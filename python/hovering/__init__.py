@@ -45,6 +45,7 @@ from .flow import (
     Section,
     StepSystem,
     Tan,
+    TrajectoryPoint,
     check_potential,
     onset_parameters,
 )
@@ -99,6 +100,7 @@ __all__ = [
     "Status",
     "FlowStatus",
     "Geometry",
+    "TrajectoryPoint",
     "region_mask",
     "truncated",
     "flow",

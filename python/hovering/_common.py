@@ -13,11 +13,12 @@ import os
 
 import numpy as np
 
-from ._core import FlowStatus, Geometry, Kernel, Region, Status
+from ._core import FlowStatus, Geometry, Kernel, Region, Status, TrajectoryPoint
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "region_mask", "wrap", "REGION_LABELS",
            "iterate_arguments", "real_number", "integer", "real_array", "require_finite", "require_angles",
-           "check_memory", "point_pair", "thread_count", "is_choice", "status_code", "require_map", "flag", "require_type", "forcing_array", "MAX_MODES", "output_path", "MAX_ANGLE"]
+           "check_memory", "point_pair", "thread_count", "is_choice", "status_code", "require_map", "flag", "require_type", "forcing_array", "MAX_MODES", "output_path", "MAX_ANGLE",
+           "TrajectoryPoint", "MAX_TRAJECTORY_POINTS", "trajectory_arguments", "trajectory_rows"]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -409,3 +410,72 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
     if stop_on_exit and mask == 0:
         raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
     return record, n_steps, mask
+
+
+#: Default bound of the points a trajectory recording keeps in total (all orbits of one call):
+#: 10 million points are ~410 MB (five float64 and one int8 each).
+MAX_TRAJECTORY_POINTS = 10_000_000
+
+
+def trajectory_arguments(trajectory_dt, max_trajectory_points, n_orbits: int) -> tuple:
+    """Check the arguments of a trajectory recording before anything is computed.
+
+    Parameters
+    ----------
+    trajectory_dt : float
+        Sample spacing, > 0.
+    max_trajectory_points : int
+        Bound of the points of all orbits together.
+    n_orbits : int
+        Number of orbits of the call.
+
+    Returns
+    -------
+    (float, int)
+        The sample spacing and the points each orbit may keep (``max_trajectory_points //
+        n_orbits``: an orbit that would record more stops recording and is flagged in
+        ``trajectory_truncated``).
+
+    Raises
+    ------
+    ValueError
+        For a spacing that is not a finite number > 0, a bound below two points per orbit (the
+        start and one more), or a bound whose worst case would not fit in memory.
+    """
+    dt = real_number("trajectory_dt", trajectory_dt, 0.0)
+    least = 2 * max(n_orbits, 1)
+    cap = integer(f"max_trajectory_points (at least 2 per orbit: {n_orbits} orbits)", max_trajectory_points, least,
+                  2**62)
+    per_orbit = cap // max(n_orbits, 1)
+    # Per-orbit vectors (growing by doubling) and the flat arrays they are copied into: ~3x the
+    # 41 bytes of a point in the worst case.
+    check_memory(f"a trajectory of up to {cap} points (max_trajectory_points)", 3 * 41 * per_orbit * n_orbits)
+    return dt, per_orbit
+
+
+def trajectory_rows(res, i) -> np.ndarray:
+    """Rows ``(t, q1, p1, q2, p2)`` of orbit i of a result with a recorded trajectory.
+
+    Parameters
+    ----------
+    res : IterateResult or ReturnMapResult
+        A result with ``trajectory`` and ``trajectory_index``.
+    i : int
+        Orbit index (negative counts from the end).
+
+    Returns
+    -------
+    ndarray
+        Shape ``(m_i, 5)``, a view into ``res.trajectory``.
+
+    Raises
+    ------
+    ValueError
+        If no trajectory was recorded or i is out of range.
+    """
+    if res.trajectory is None:
+        raise ValueError("no trajectory was recorded: pass record=('trajectory',) (FlowMap.iterate) or "
+                         "trajectory_dt (Section.return_map)")
+    n = res.trajectory_index.size - 1
+    i = integer("i (orbit index)", i, -n, n - 1) % n
+    return res.trajectory[res.trajectory_index[i] : res.trajectory_index[i + 1]]

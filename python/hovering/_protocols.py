@@ -25,8 +25,8 @@ class ReturnMap(Protocol):
         """Region of the return from each point."""
 
     def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ..., exit_regions: Optional[Iterable] = None,
-                stop_on_exit: bool = False, n_threads: int = 0):
-        """Many orbits at once -> IterateResult."""
+                stop_on_exit: bool = False, n_threads: int = 0, progress=False):
+        """Many orbits at once -> IterateResult (progress: see hovering._progress)."""
 
     def with_eps(self, eps: float) -> "ReturnMap":
         """The same map at another eps (F_0 for the hovering set's definition)."""
@@ -57,7 +57,8 @@ class MapAnalyses:
         samples : int, optional
             Sample points (stratified over the box below K = 0).
         **kwargs
-            ``K_low``, ``seed``, ``n_threads``, ``keep_points``.
+            ``K_low``, ``seed``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
+            stderr; a callable ``progress(done, total)``).
 
         Returns
         -------
@@ -76,7 +77,8 @@ class MapAnalyses:
         n_steps : int, optional
             Iterates per tested orbit.
         **kwargs
-            ``K_range``, ``regions``, ``line``, ``grid``, ``digits``, ``tol``, ``n_threads``.
+            ``K_range``, ``regions``, ``line``, ``grid``, ``digits``, ``tol``, ``n_threads``,
+            ``search``, ``progress`` (True: a tqdm bar on stderr; a callable ``progress(done, total)``).
 
         Returns
         -------

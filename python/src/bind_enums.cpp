@@ -40,6 +40,13 @@ void register_enums(py::module_& m) {
         .value("OFF_SECTION", FlowStatus::OffSection, "the starting point is not on Sigma_h at this energy")
         .value("INTERRUPTED", FlowStatus::Interrupted, "the batch was interrupted before this return ended")
         .finalize();
+    py::native_enum<TrajectoryPoint>(m, "TrajectoryPoint", "enum.IntEnum", "What a recorded trajectory point is.")
+        .value("SAMPLE", TrajectoryPoint::Sample, "uniform sample at t = k dt of the orbit's clock")
+        .value("IMPACT_IN", TrajectoryPoint::ImpactIn, "state at an impact before the reflection (on the wall)")
+        .value("IMPACT_OUT", TrajectoryPoint::ImpactOut, "state at an impact after the reflection")
+        .value("RETURN", TrajectoryPoint::Return, "the return to Sigma_h that ends a return")
+        .value("END", TrajectoryPoint::End, "where a return stopped otherwise (corner, grazing, limits, interrupt)")
+        .finalize();
     py::native_enum<Geometry>(m, "Geometry", "enum.IntEnum", "Which walls the flow sees.")
         .value("NONE", Geometry::None, "the smooth flow, no impact events")
         .value("WALL", Geometry::Wall, "the infinite wall q1 = qw1")

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hovering/flow/return_map.hpp"
+#include "flow_results.hpp"
 #include "pybind.hpp"
 #include "signals.hpp"
 
@@ -113,14 +114,20 @@ void register_flow(py::module_& m) {
           },
           py::arg("system"), py::arg("z"), "Section coordinates (theta, I) of states z (NaN rows stay NaN).");
     m.def("return_maps",
-          [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads) {
+          [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads, double trajectory_dt,
+             std::int64_t max_points_per_orbit, py::object progress) {
               o.validate();
               if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
+              if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
+                  throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
+                                        std::to_string(trajectory_dt));
               const py::ssize_t n = z0.shape(0);
               darray z({n, py::ssize_t(4)}), time(n), err(n);
               py::array_t<std::int8_t> status(n), region(n);
               py::array_t<std::int64_t> steps(n);
               std::vector<std::string> itin{static_cast<std::size_t>(n)};
+              hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
+              FlowWork work;
               ReturnMapsOutput out;
               out.z = z.mutable_data();
               out.time = time.mutable_data();
@@ -129,10 +136,15 @@ void register_flow(py::module_& m) {
               out.region = region.mutable_data();
               out.steps = steps.mutable_data();
               out.itinerary = itin.data();
+              out.work = &work;
+              out.trajectory = traj.output();
               std::atomic<bool> cancel{false};
+              std::atomic<std::int64_t> done{0};
+              const hovering_py::ProgressReport report{&done, std::int64_t(n), std::move(progress)};
               // Orbits are independent and write disjoint slots of freshly allocated arrays.
-              const bool interrupted =
-                  hovering_py::run_watched([&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out); }, cancel, n >= 64);
+              const bool interrupted = hovering_py::run_watched(
+                  [&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out, report.active() ? &done : nullptr); },
+                  cancel, n >= 64, &report);
               py::dict d;
               d["z"] = z;
               d["time"] = time;
@@ -141,9 +153,13 @@ void register_flow(py::module_& m) {
               d["region"] = region;
               d["steps"] = steps;
               d["itinerary"] = itin;
+              d["work"] = hovering_py::work_dict(work);
+              traj.put(d);
               d["interrupted"] = interrupted;
               return d;
           },
-          py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"),
-          "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit.");
+          py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
+          py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(),
+          "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit; with trajectory_dt > 0 "
+          "each return's trajectory too; progress(done, total) is called every ~0.1 s and at the end.");
 }

@@ -9,6 +9,7 @@
 
 #include "hovering/normal/flow_map.hpp"
 #include "hovering/normal/tangential_curve.hpp"
+#include "flow_results.hpp"
 #include "pybind.hpp"
 #include "signals.hpp"
 
@@ -75,7 +76,8 @@ py::dict steps(const FlowMap& fm, const darray& x, const darray& y, bool inverse
 }
 
 py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int64_t n_steps, const py::set& record,
-                 unsigned exit_mask, bool stop_on_exit, int n_threads) {
+                 unsigned exit_mask, bool stop_on_exit, int n_threads, double trajectory_dt,
+                 std::int64_t max_points_per_orbit, py::object progress) {
     same_size(x0, y0, "x0", "y0");
     if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
     const py::ssize_t n = x0.size();
@@ -86,6 +88,13 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
     opt.exit_mask = exit_mask;
     opt.stop_on_exit = stop_on_exit;
     opt.n_threads = n_threads;
+    // Labels only where something reads them: otherwise no crossing of q1 = qw1 is tracked and no
+    // itinerary built (the orbit is the same bit for bit).
+    opt.labels = exit_mask != 0 || has("regions") || has("visited") || has("itinerary") || has("rotation");
+    if (has("trajectory") != (trajectory_dt > 0))
+        throw py::value_error("record 'trajectory' and trajectory_dt > 0 go together");
+    if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
+        throw py::value_error("trajectory_dt must be finite and >= 0, got " + std::to_string(trajectory_dt));
     FlowIterateOutput out;
     py::dict d;
     darray xf(n), yf(n);
@@ -154,10 +163,19 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
         out.visited = a.mutable_data();
         d["visited"] = a;
     }
+    hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
+    out.trajectory = traj.output();
+    FlowWork work;
+    out.work = &work;
     std::atomic<bool> cancel{false};
+    std::atomic<std::int64_t> returns_done{0};
     opt.cancel = &cancel;
-    const bool interrupted =
-        hovering_py::run_watched([&] { fm.iterate(x0.data(), y0.data(), n, opt, out); }, cancel, n * ns >= 16);
+    const hovering_py::ProgressReport report{&returns_done, std::int64_t(n) * n_steps, std::move(progress)};
+    if (report.active()) opt.progress = &returns_done;  // no counting at all otherwise
+    const bool interrupted = hovering_py::run_watched([&] { fm.iterate(x0.data(), y0.data(), n, opt, out); }, cancel,
+                                                      n * ns >= 16, &report);
+    d["work"] = hovering_py::work_dict(work);
+    traj.put(d);
     if (has("itinerary")) {
         py::list rows;
         for (py::ssize_t i = 0; i < n; ++i) {
@@ -216,7 +234,8 @@ void register_normal(py::module_& m) {
              py::arg("system"), py::arg("h"), py::arg("options"), py::arg("curve"), py::arg("lift"))
         .def("steps", &steps, py::arg("x"), py::arg("y"), py::arg("inverse"), py::arg("n_threads"))
         .def("iterate", &iterate, py::arg("x0"), py::arg("y0"), py::arg("n_steps"), py::arg("record"),
-             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"))
+             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
+             py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none())
         .def("to_section",
              [](const FlowMap& fm, const darray& x, const darray& y) {
                  same_size(x, y, "x", "y");

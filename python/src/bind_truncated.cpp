@@ -45,7 +45,8 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
 template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
                  bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
-                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp, bool record_visited) {
+                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp, bool record_visited,
+                 py::object progress) {
     if (phi0.ndim() != 1 || K0.ndim() != 1)
         throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
@@ -110,10 +111,14 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
     }
 
     std::atomic<bool> cancel{false};
+    std::atomic<std::int64_t> done{0};
     opt.cancel = &cancel;
-    // Short runs (< 2e6 orbit-steps, ~5 ms) get no watcher thread: its ~50 us would dominate.
+    const hovering_py::ProgressReport report{&done, std::int64_t(n) * n_steps, std::move(progress)};
+    if (report.active()) opt.progress = &done;  // no counting at all otherwise
+    // Short runs (< 2e6 orbit-steps, ~5 ms) get no watcher thread unless progress is reported: its
+    // ~50 us would dominate.
     const bool interrupted = hovering_py::run_watched([&] { m.iterate(phi0.data(), K0.data(), n, opt, out); }, cancel,
-                                                      double(n) * double(n_steps) >= 2e6);
+                                                      double(n) * double(n_steps) >= 2e6, &report);
     res["interrupted"] = interrupted;
     return res;
 }
@@ -168,7 +173,7 @@ void bind_common(Cls& cls) {
         .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
              py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
              py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"),
-             py::arg("record_visited") = false)
+             py::arg("record_visited") = false, py::arg("progress") = py::none())
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def("valid_band",
              [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },

@@ -4,11 +4,13 @@
 // run on), polls PyErr_CheckSignals every 100 ms. On KeyboardInterrupt the core's cancel flag is
 // set; the core then ends every orbit promptly with an Interrupted status and keeps what it
 // computed, and the Python wrapper raises KeyboardInterrupt with that partial result attached.
+// The same waiting thread reports progress to a Python callable (ProgressReport) when asked to.
 
 #include <Python.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <condition_variable>
 #include <exception>
 #include <memory>
@@ -54,18 +56,47 @@ inline bool on_main_thread() {
     return threading.attr("current_thread")().is(threading.attr("main_thread")());
 }
 
+/// Progress of a core computation as run_watched reports it: the core's counter (relaxed
+/// increments), the value it ends at, and a Python callable progress(done, total).
+struct ProgressReport {
+    const std::atomic<std::int64_t>* done = nullptr;  ///< the core's counter
+    std::int64_t total = 0;                           ///< where the counter ends when nothing is cancelled
+    py::object callback;                              ///< progress(done, total); None or null: no report
+    /// Whether there is anything to report to.
+    bool active() const { return done != nullptr && callback && !callback.is_none(); }
+};
+
 /// Run work() with the GIL released. watch: poll for signals (pass false for short work, where a
 /// watcher thread would cost more than the work). Returns true if Ctrl-C interrupted it (cancel
 /// is then set); an exception raised by another signal handler (e.g. SIGALRM's) is rethrown
 /// unchanged once the work has stopped, as is any exception of the work itself.
+///
+/// With an active progress report the waiting thread also calls progress(done, total) (GIL held)
+/// every ~100 ms and once at the end, whatever the size of the work and on any thread (signals
+/// are only polled on the main thread). An exception the callable raises stops the work like a
+/// signal handler's: KeyboardInterrupt (Ctrl-C landing inside the callable) counts as Ctrl-C,
+/// anything else is rethrown once the work has stopped.
 template <class Work>
-bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch) {
-    watch = watch && on_main_thread();
+bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const ProgressReport* progress = nullptr) {
+    const bool signals = watch && on_main_thread();
+    const bool report = progress != nullptr && progress->active();
     bool interrupted = false;
     std::unique_ptr<py::error_already_set> handler_error;
+    // progress(done, total), GIL held; what it raises stops the work (see above).
+    auto call_progress = [&] {
+        try {
+            progress->callback(progress->done->load(std::memory_order_relaxed), progress->total);
+        } catch (py::error_already_set& e) {
+            cancel.store(true);
+            if (e.matches(PyExc_KeyboardInterrupt))
+                interrupted = true;  // re-raised by the Python wrapper, with the partial result
+            else if (!handler_error)
+                handler_error = std::make_unique<py::error_already_set>(std::move(e));
+        }
+    };
     {
         GilRelease release;
-        if (!watch) {
+        if (!signals && !report) {
             work();
         } else {
             std::exception_ptr err;
@@ -73,6 +104,7 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch) {
             std::condition_variable cv;
             bool done = false;
             std::thread runner;
+            bool threaded = true;
             try {
                 runner = std::thread([&] {
                     try {
@@ -86,32 +118,37 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch) {
                 });
             } catch (const std::system_error&) {
                 // No thread to spare (ulimit -u, a container's pids limit): compute here; only
-                // Ctrl-C's promptness is lost, not the result.
+                // Ctrl-C's promptness and the intermediate progress reports are lost, not the result.
+                threaded = false;
+            }
+            if (!threaded) {
                 work();
-                return false;
-            }
-            std::unique_lock<std::mutex> lock(mu);
-            while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
-                lock.unlock();
-                if (!cancel.load()) {
-                    py::gil_scoped_acquire acquire;
-                    if (PyErr_CheckSignals() != 0) {
-                        cancel.store(true);
-                        if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
-                            PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
-                            interrupted = true;
-                        } else {
-                            handler_error = std::make_unique<py::error_already_set>();
+            } else {
+                std::unique_lock<std::mutex> lock(mu);
+                while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
+                    lock.unlock();
+                    if (!cancel.load()) {
+                        py::gil_scoped_acquire acquire;
+                        if (signals && PyErr_CheckSignals() != 0) {
+                            cancel.store(true);
+                            if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+                                PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
+                                interrupted = true;
+                            } else {
+                                handler_error = std::make_unique<py::error_already_set>();
+                            }
                         }
+                        if (report && !cancel.load()) call_progress();
                     }
+                    lock.lock();
                 }
-                lock.lock();
+                lock.unlock();
+                runner.join();
+                if (err) std::rethrow_exception(err);
             }
-            lock.unlock();
-            runner.join();
-            if (err) std::rethrow_exception(err);
         }
     }
+    if (report && !handler_error) call_progress();  // once at the end (GIL held again)
     if (handler_error) throw std::move(*handler_error);  // what a signal handler raised, unchanged
     return interrupted;
 }

@@ -36,6 +36,13 @@ class FlowStatus(enum.IntEnum):
     OFF_SECTION = 6
     INTERRUPTED = 7
 
+class TrajectoryPoint(enum.IntEnum):
+    SAMPLE = 0
+    IMPACT_IN = 1
+    IMPACT_OUT = 2
+    RETURN = 3
+    END = 4
+
 class Geometry(enum.IntEnum):
     NONE = 0
     WALL = 1

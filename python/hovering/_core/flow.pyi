@@ -1,6 +1,6 @@
 """Type stubs of hovering._core.flow (use hovering.StepSystem, Section and the potentials)."""
 
-from typing import Callable
+from typing import Callable, Optional
 
 import numpy as np
 import numpy.typing as npt
@@ -97,4 +97,6 @@ class FlowOptions:
 def section_points(system: FlowSystem, h: float, theta: npt.NDArray[np.float64],
                    I: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray, list[str]]: ...
 def section_coordinates(system: FlowSystem, z: npt.NDArray[np.float64]) -> np.ndarray: ...
-def return_maps(system: FlowSystem, z0: npt.NDArray[np.float64], options: FlowOptions, n_threads: int) -> dict[str, object]: ...
+def return_maps(system: FlowSystem, z0: npt.NDArray[np.float64], options: FlowOptions, n_threads: int,
+                trajectory_dt: float = ..., max_points_per_orbit: int = ...,
+                progress: Optional[Callable[[int, int], object]] = ...) -> dict[str, object]: ...

@@ -1,5 +1,7 @@
 """Type stubs of hovering._core.truncated (use hovering.TruncatedMap / TruncatedFamily)."""
 
+from typing import Callable, Optional
+
 import numpy as np
 import numpy.typing as npt
 
@@ -25,6 +27,7 @@ class _MapCore:
         kernel: str,
         sin_ulp: float,
         record_visited: bool = ...,
+        progress: Optional[Callable[[int, int], object]] = ...,
     ) -> dict[str, object]: ...
 
 class TruncatedMap(_MapCore):

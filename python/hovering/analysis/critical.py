@@ -13,6 +13,7 @@ import numpy as np
 
 from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask, require_map
 from .._serial import Saveable
+from .._progress import check_progress, progress_bar
 from .rotation import regularity, rotation_number
 
 __all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
@@ -88,7 +89,7 @@ class CriticalCurve(Saveable):
 
 def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] = None,
                    regions=("0u", "0"), line=None, grid: int = 64, digits: Optional[float] = None,
-                   tol: float = 1e-6, n_threads: int = 0, search: str = "lowest") -> CriticalCurve:
+                   tol: float = 1e-6, n_threads: int = 0, search: str = "lowest", progress=False) -> CriticalCurve:
     """Search the lowest invariant curve that stays in ``regions``, along the line L1 (or L2).
 
     A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps``, its
@@ -133,6 +134,11 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         ``"lowest"``: the lowest passing start (the floor of a no-impact region above the impacts,
         as the hovering critical curve). ``"highest"``: the highest passing start (the roof of a
         no-impact region under the impacts, as the flow's lower boundary of the impact zone).
+    progress : bool or callable, optional
+        One report for the whole search (grid scan, bisection, final orbit; its total, fixed up
+        front from the grid spacing and ``tol``, is corrected at the end if the bisection was
+        shorter): ``True`` a tqdm bar on stderr, a callable ``progress(done, total)``, ``False``
+        (default) none.
 
     Returns
     -------
@@ -146,6 +152,7 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         If no start in ``K_range`` passes (no invariant curve found: widen the range); the message
         says when the sign of eps does not hover.
     """
+    progress = check_progress(progress)
     th = require_map("m", m).theory()
     try:
         mask = region_mask(regions)
@@ -193,40 +200,28 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
                          f"got {tol!r}")
     flow = hasattr(m, "step_rotations")
     record = ("orbit", "regions") if flow else ("orbit",)
+    # Work of the whole search: the grid, the bisection from one grid spacing down to tol, the final orbit.
+    spacing = (K_b - K_a) / (grid - 1)
+    n_bisect = max(0, math.ceil(math.log2(spacing / tol))) if spacing > tol else 0
+    with progress_bar(progress, (grid + n_bisect + 1) * n_steps, desc="critical_curve",
+                      unit=getattr(m, "_progress_unit", "step")) as bar:
+        done = 0
 
-    def test(K0s):
-        K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
-        res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
-                        n_threads=n_threads)
-        stayed = res.status == Status.OK
-        dig = np.where(stayed, regularity(res), 0.0)
-        circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
-                           for i in range(res.n_orbits)])
-        return stayed & (dig >= digits) & circle, res, dig
+        def test(K0s):
+            nonlocal done
+            K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
+            res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
+                            n_threads=n_threads, progress=bar.part(done))
+            done += K0s.size * n_steps
+            stayed = res.status == Status.OK
+            dig = np.where(stayed, regularity(res), 0.0)
+            circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
+                               for i in range(res.n_orbits)])
+            return stayed & (dig >= digits) & circle, res, dig
 
-    K_grid = np.linspace(K_a, K_b, grid)
-    ok, _, _ = test(K_grid)
-    if not ok.any():
-        why = f"; {th.note}" if hover_search and not th.hovers else "; widen K_range"
-        raise RuntimeError(
-            f"no invariant curve in regions {tuple(regions)} found on {line} for K0 in [{K_a}, {K_b}] "
-            f"with {n_steps} steps and {digits} digits{why}")
-    if search == "lowest":
-        j = int(np.argmax(ok))
-        K_pass = K_grid[j]
-        K_fail = K_grid[j - 1] if j > 0 else K_a
-    else:  # the highest passing start: an invariant curve, so nothing below it gets out
-        j = int(np.flatnonzero(ok)[-1])
-        K_pass = K_grid[j]
-        K_fail = K_grid[j + 1] if j + 1 < grid else K_b
-    if K_fail != K_pass:
-        while abs(K_pass - K_fail) > tol:
-            mid = 0.5 * (K_pass + K_fail)
-            if test([mid])[0][0]:
-                K_pass = mid
-            else:
-                K_fail = mid
-    _, res, dig = test([K_pass])
+        K_pass, K_fail, res, dig = _search(test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits,
+                                           hover_search, th)
+        bar.set_total(done)  # the bisection may have been shorter than its bound
     rho_w = rotation_number(res, "birkhoff")[0]
     rho_m = rotation_number(res, "mean")[0]
     if th.hovers or not hover_search:
@@ -250,3 +245,32 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         hovers=bool(th.hovers),
         note=th.note,
     )
+
+
+def _search(test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits, hover_search, th):
+    """The grid scan and the bisection of :func:`critical_curve`: ``(K_pass, K_fail, res, digits)``
+    of the passing start found (``res``: its orbit's IterateResult)."""
+    K_grid = np.linspace(K_a, K_b, grid)
+    ok, _, _ = test(K_grid)
+    if not ok.any():
+        why = f"; {th.note}" if hover_search and not th.hovers else "; widen K_range"
+        raise RuntimeError(
+            f"no invariant curve in regions {tuple(regions)} found on {line} for K0 in [{K_a}, {K_b}] "
+            f"with {n_steps} steps and {digits} digits{why}")
+    if search == "lowest":
+        j = int(np.argmax(ok))
+        K_pass = K_grid[j]
+        K_fail = K_grid[j - 1] if j > 0 else K_a
+    else:  # the highest passing start: an invariant curve, so nothing below it gets out
+        j = int(np.flatnonzero(ok)[-1])
+        K_pass = K_grid[j]
+        K_fail = K_grid[j + 1] if j + 1 < grid else K_b
+    if K_fail != K_pass:
+        while abs(K_pass - K_fail) > tol:
+            mid = 0.5 * (K_pass + K_fail)
+            if test([mid])[0][0]:
+                K_pass = mid
+            else:
+                K_fail = mid
+    _, res, dig = test([K_pass])
+    return K_pass, K_fail, res, dig

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._common import Region, Status, check_memory, flag, integer, real_number, require_map, thread_count
 from .._serial import Saveable
+from .._progress import check_progress, progress_bar
 
 __all__ = ["HoveringArea", "hovering_area"]
 
@@ -112,7 +113,7 @@ def default_depth(m) -> float:
 
 
 def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optional[float] = None, seed: int = 0,
-                  n_threads: int = 0, keep_points: bool = False) -> HoveringArea:
+                  n_threads: int = 0, keep_points: bool = False, progress=False) -> HoveringArea:
     """Area of the hovering set HOV(eps) of a map, by its definition.
 
     HOV(eps) is the set of points that impact under F_0 (some iterate leaves J_0 u J_0u) and never
@@ -140,6 +141,10 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         Worker threads (0 = all cores).
     keep_points : bool, optional
         Keep the sample points and their membership in the result (for plotting).
+    progress : bool or callable, optional
+        One report for the whole call (both iterations, ``2 * n_samples * n_steps`` steps or
+        returns): ``True`` a tqdm bar on stderr, a callable ``progress(done, total)``, ``False``
+        (default) none. See :mod:`hovering._progress`.
 
     Returns
     -------
@@ -156,6 +161,7 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     keep_points = flag("keep_points", keep_points)
     seed = integer("seed", seed, 0, 2**63 - 1)
     n_threads = thread_count(n_threads)
+    progress = check_progress(progress)
     check_memory(f"hovering_area with {samples} samples", 64 * samples)
     lo = m.valid_band()[0]
     if not lo < 0:
@@ -172,12 +178,16 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     n = phi.size
     no_impact = ("0u", "0")
 
-    # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
-    r0 = m.with_eps(0.0).iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
-                                 n_threads=n_threads)
+    m0 = m.with_eps(0.0)
+    unit = getattr(m, "_progress_unit", "step")
+    with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
+        # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
+        r0 = m0.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads,
+                        progress=bar.part(0))
+        # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
+        r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True,
+                      n_threads=n_threads, progress=bar.part(n * n_steps))
     impacts0 = np.isin(r0.status, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
-    # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
-    r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
     stayed = r.status == Status.OK
     box_area = 2 * math.pi * (-K_low)
     areas = {}

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
 
 from .. import _core
-from .._common import FlowStatus, integer, is_choice, status_code, real_array, real_number, thread_count
+from .._common import (MAX_TRAJECTORY_POINTS, FlowStatus, integer, is_choice, real_array, real_number, status_code,
+                       thread_count, trajectory_arguments, trajectory_rows)
+from .._progress import check_progress, progress_bar
 from .._serial import Saveable
 from .system import StepSystem
 
@@ -74,6 +76,11 @@ class ReturnMapResult(Saveable):
         ``|H(image) - H(start)|``.
     steps : ndarray of int64
         Accepted integrator steps.
+    work : dict or None
+        What the integration did, summed over the call (see :attr:`hovering.IterateResult.work`).
+    trajectory, trajectory_index, trajectory_kind, trajectory_truncated : ndarray or None
+        With ``trajectory_dt``: each return's flow, rows ``(t, q1, p1, q2, p2)`` (its clock
+        starts at 0), as in :class:`hovering.IterateResult`; see :meth:`trajectory_of`.
     """
 
     theta: np.ndarray
@@ -85,6 +92,21 @@ class ReturnMapResult(Saveable):
     energy_error: np.ndarray
     steps: np.ndarray
     region: Optional[np.ndarray] = None
+    work: Optional[dict] = None
+    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
+
+    def trajectory_of(self, i: int) -> np.ndarray:
+        """The recorded flow of return i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
+
+        Raises
+        ------
+        ValueError
+            If no trajectory was recorded (no ``trajectory_dt``) or i is out of range.
+        """
+        return trajectory_rows(self, i)
 
     def count(self, status) -> int:
         """Number of orbits with the given :class:`FlowStatus` (or its name, or the Status of that name)."""
@@ -189,7 +211,9 @@ class Section:
 
     def return_map(self, theta, I, rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd",
                    event_tol: float = 1e-15, max_steps: int = 1_000_000, max_impacts: int = 100,
-                   grazing_tol: float = 1e-12, corner_tol: float = 1e-10, n_threads: int = 0) -> ReturnMapResult:
+                   grazing_tol: float = 1e-12, corner_tol: float = 1e-10, n_threads: int = 0,
+                   trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
+                   progress=False) -> ReturnMapResult:
         """Return map of many points of Sigma_h (multi-threaded, GIL released).
 
         Parameters
@@ -219,6 +243,16 @@ class Section:
         n_threads : int, optional
             Worker threads (0 = all cores, or 1 when a potential is defined in Python: its calls
             serialise on the GIL).
+        trajectory_dt : float, optional
+            Record each return's flow, sampled at ``t = k * trajectory_dt`` (> 0) plus every
+            impact (before and after) and the return point (see :meth:`hovering.FlowMap.iterate`).
+        max_trajectory_points : int, optional
+            Bound of the recorded points of all returns together (default 10 million); each keeps
+            at most ``max_trajectory_points // n`` and is flagged in ``trajectory_truncated``
+            beyond.
+        progress : bool or callable, optional
+            ``True``: a tqdm bar on stderr (unit: return); a callable ``progress(done, total)``
+            is called every ~0.1 s and at the end; ``False`` (default): none.
 
         Returns
         -------
@@ -229,18 +263,26 @@ class Section:
         Raises
         ------
         ValueError
-            For bad options (named, with the allowed range) or non-finite / out-of-range angles.
+            For bad options (named, with the allowed range), non-finite / out-of-range angles,
+            bad trajectory bounds or a bad ``progress``.
         KeyboardInterrupt
             On Ctrl-C: its ``partial`` attribute holds the ReturnMapResult with every finished
             return and status INTERRUPTED for the rest.
         """
         opts = flow_options(rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)
         threads = _threads(n_threads, self.sys.python_defined)
+        progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
-        d = _core.flow.return_maps(self.sys.core, z0, opts, threads)
+        dt, per_orbit = (0.0, 0) if trajectory_dt is None else trajectory_arguments(trajectory_dt, max_trajectory_points,
+                                                                                      z0.shape[0])
+        with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
+            d = _core.flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
         c = self.coordinates(d["z"])
         res = ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
-                              status=d["status"], energy_error=d["energy_error"], steps=d["steps"], region=d["region"])
+                              status=d["status"], energy_error=d["energy_error"], steps=d["steps"], region=d["region"],
+                              work=d["work"], trajectory=d.get("trajectory"), trajectory_index=d.get("trajectory_index"),
+                              trajectory_kind=d.get("trajectory_kind"),
+                              trajectory_truncated=d.get("trajectory_truncated"))
         if d["interrupted"]:
             exc = KeyboardInterrupt("return map interrupted; the finished returns are in .partial")
             exc.partial = res

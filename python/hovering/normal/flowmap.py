@@ -15,8 +15,9 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import (MAX_MODES, Region, check_memory, flag, integer, is_choice, iterate_arguments, point_pair,
-                       wrap)
+from .._common import (MAX_MODES, MAX_TRAJECTORY_POINTS, Region, check_memory, flag, integer, is_choice,
+                       iterate_arguments, point_pair, trajectory_arguments, wrap)
+from .._progress import check_progress, progress_bar
 from .._protocols import MapAnalyses
 from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
@@ -29,7 +30,7 @@ __all__ = ["FlowMap", "FlowSteps", "FLOW_RECORD_KEYS"]
 
 #: What :meth:`FlowMap.iterate` can record (nothing else is computed or stored).
 FLOW_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "section", "states", "times", "energy_error", "steps",
-                    "itinerary")
+                    "itinerary", "trajectory")
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,9 @@ class FlowMap(MapAnalyses):
     tangential curve's measured samples: it is rebuilt through the constructor with that curve (no
     trace of the flow, no measurement) and steps bit for bit as the original.
     """
+
+    #: Unit of work of this map's progress reports (one return of the flow).
+    _progress_unit = "return"
 
     #: Regularity threshold of the critical-curve search (digits of agreement of the two half-orbit
     #: rotation averages): the integration error of each return caps invariant curves at 7-9.
@@ -276,7 +280,9 @@ class FlowMap(MapAnalyses):
         return Region(int(r)) if scalar else r
 
     def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ("orbit", "regions", "rotation"),
-                exit_regions: Optional[Iterable] = None, stop_on_exit: bool = False, n_threads: int = 0) -> IterateResult:
+                exit_regions: Optional[Iterable] = None, stop_on_exit: bool = False, n_threads: int = 0,
+                trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
+                progress=False) -> IterateResult:
         """Iterate many orbits in C++ (the core's thread pool, GIL released, no Python between returns).
 
         Parameters
@@ -291,7 +297,11 @@ class FlowMap(MapAnalyses):
             ``"orbit"`` (phi, K), ``"regions"``, ``"rotation"`` (mean lifted angle advance, see
             :meth:`step_rotations`), ``"visited"`` (regions each orbit went through), ``"section"``
             (theta, I), ``"states"`` (points of Sigma_h),
-            ``"times"``, ``"energy_error"``, ``"steps"`` (integrator steps), ``"itinerary"``.
+            ``"times"``, ``"energy_error"``, ``"steps"`` (integrator steps), ``"itinerary"``,
+            ``"trajectory"`` (the flow between the returns, sampled every ``trajectory_dt``: see
+            :class:`IterateResult`). Returns are labelled (crossings of q1 = qw1 tracked,
+            itineraries built) only when ``"regions"``, ``"visited"``, ``"itinerary"``,
+            ``"rotation"`` or ``exit_regions`` need it; the orbit is the same either way.
         exit_regions : iterable of Region or str, optional
             Regions to watch (e.g. ``{"0u", "0"}``): ``exit_step`` is the first return from a point
             outside them.
@@ -299,22 +309,41 @@ class FlowMap(MapAnalyses):
             Stop an orbit (status EXITED) when it first leaves ``exit_regions``.
         n_threads : int, optional
             Worker threads (0 = all cores; 1 when a potential is defined in Python).
+        trajectory_dt : float, optional
+            With record ``"trajectory"`` (and only then): the spacing of the uniform samples, > 0.
+            Each sample is one exact step of the integrator from the start of the accepted step it
+            falls in, so it carries the integrator's accuracy (not an interpolant's), at the cost
+            of one stepper step per sample; without a trajectory no such work is done.
+        max_trajectory_points : int, optional
+            Bound of the recorded points of all orbits together (default 10 million, ~410 MB):
+            each orbit keeps at most ``max_trajectory_points // n_orbits`` (at least 2) and stops
+            recording beyond, flagged in ``trajectory_truncated`` (its orbit goes on). Checked
+            before computing: below 2 points per orbit, or a worst case that would not fit in
+            memory, is a ValueError.
+        progress : bool or callable, optional
+            ``True``: a tqdm bar on stderr (unit: return, total ``n_orbits * n_steps``; an orbit
+            that stops early counts its remaining returns). A callable ``progress(done, total)``
+            is called every ~0.1 s and at the end. ``False`` (default): none.
 
         Returns
         -------
         IterateResult
             The same result type as the truncated map's. Per-orbit statuses: OK, EXITED,
             INTERRUPTED, and the flow's CORNER, GRAZING, STEP_LIMIT, NON_FINITE, IMPACT_LIMIT,
-            OFF_SECTION (the orbit stops there, NaN after; the others go on).
+            OFF_SECTION (the orbit stops there, NaN after; the others go on). ``work`` counts what
+            the integration did.
 
         Raises
         ------
         ValueError
-            For non-finite initial points, a negative ``n_steps``, unknown record keys or regions.
+            For non-finite initial points, a negative ``n_steps``, unknown record keys or regions,
+            a ``trajectory_dt`` without record ``"trajectory"`` (or the reverse), bad trajectory
+            bounds or a bad ``progress``.
         KeyboardInterrupt
             On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
         """
         record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
+        progress = check_progress(progress)
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         # The recorded orbit starts on [-pi, pi) like every later point.
         p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
@@ -324,14 +353,27 @@ class FlowMap(MapAnalyses):
             64 * ("itinerary" in record)
         check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns",
                      8 * per_point * n_points + per_return * p.size * n_steps)
-        d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit),
-                               _threads(n_threads, self.sys.python_defined))
+        dt, per_orbit = 0.0, 0
+        if "trajectory" in record:
+            if trajectory_dt is None:
+                raise ValueError("trajectory_dt (the sample spacing) must be a number in (0, inf) with record 'trajectory', "
+                                 "got None")
+            dt, per_orbit = trajectory_arguments(trajectory_dt, max_trajectory_points, p.size)
+        elif trajectory_dt is not None:
+            raise ValueError(f"trajectory_dt = {trajectory_dt!r} is only used with record 'trajectory'; add it to record "
+                             "or leave trajectory_dt out")
+        threads = _threads(n_threads, self.sys.python_defined)
+        with progress_bar(progress, p.size * n_steps, desc="FlowMap.iterate", unit="return") as bar:
+            d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit), threads, dt, per_orbit,
+                                   bar.part(0) or None)
         res = IterateResult(phi=d.get("x"), K=d.get("y"), region=d.get("region"), rotation=d.get("rotation"),
                             phi_final=d["x_final"], K_final=d["y_final"], status=d["status"], steps_done=d["steps_done"],
                             exit_step=d.get("exit_step"), n_steps=n_steps, map=self, theta=d.get("theta"), I=d.get("I"),
                             z=d.get("z"), time=d.get("time"), energy_error=d.get("energy_error"),
                             integrator_steps=d.get("integrator_steps"), itinerary=d.get("itinerary"),
-                            visited=d.get("visited"))
+                            visited=d.get("visited"), trajectory=d.get("trajectory"),
+                            trajectory_index=d.get("trajectory_index"), trajectory_kind=d.get("trajectory_kind"),
+                            trajectory_truncated=d.get("trajectory_truncated"), work=d["work"])
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
             exc.partial = res
@@ -477,7 +519,7 @@ class FlowMap(MapAnalyses):
             Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, inside the band
             and below 0).
         **kwargs
-            ``grid``, ``digits``, ``tol``, ``n_threads`` of :func:`hovering.critical_curve`.
+            ``grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
 
         Returns
         -------

@@ -16,7 +16,9 @@ import numpy as np
 
 from .. import _core
 from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
-                       point_pair, require_angles, require_finite, status_code, thread_count, wrap, forcing_array)
+                       point_pair, require_angles, require_finite, status_code, thread_count, trajectory_rows, wrap,
+                       forcing_array)
+from .._progress import check_progress, progress_bar
 from .._pickle import reduce_compiled
 from .._protocols import MapAnalyses
 from .._serial import Saveable
@@ -70,6 +72,28 @@ class IterateResult(Saveable):
         Record ``"visited"``: per orbit, bit r set when it took a step from a point of Region r
         (including the point where it left ``exit_regions``); e.g. a hovering orbit has the bits of
         both J_0 (ABOVE) and J_0u (BESIDE).
+    trajectory : ndarray or None
+        Flow only, record ``"trajectory"``: the flow between the returns, rows ``(t, q1, p1, q2,
+        p2)`` of all orbits one after the other, shape ``(N_total, 5)`` (orbit i is
+        ``trajectory[trajectory_index[i]:trajectory_index[i + 1]]``, see :meth:`trajectory_of`).
+        Per orbit, in time order: the states at the uniform times ``t = k * trajectory_dt`` of the
+        orbit's clock (it starts at 0 and runs on across returns), plus the exact states just
+        before and after every impact (on the wall), each return point on Sigma_h and where the
+        orbit stopped (``trajectory_kind`` tells which).
+    trajectory_index : ndarray of int64 or None
+        Offsets of each orbit's rows, shape ``(n_orbits + 1,)``.
+    trajectory_kind : ndarray of int8 or None
+        :class:`hovering.TrajectoryPoint` of each row: SAMPLE, IMPACT_IN, IMPACT_OUT, RETURN, END.
+    trajectory_truncated : ndarray of bool or None
+        Per orbit: it reached its share of ``max_trajectory_points`` and recorded no further point
+        (the orbit itself was followed to the end).
+    work : dict or None
+        Flow only: what the integration did, summed over the call (ints): ``field_evaluations``,
+        ``coupling_evaluations``, ``wall_searches``, ``section_searches``, ``label_operations``
+        (crossings of q1 = qw1 and itinerary bookkeeping), ``dense_samples`` (trajectory samples),
+        ``steps`` (accepted integrator steps). Effects nobody asked for cost nothing: no walls, no
+        wall search; eps = 0, no coupling evaluation; no labels, no label operation; no trajectory,
+        no dense sample.
     """
 
     phi: Optional[np.ndarray]
@@ -91,6 +115,31 @@ class IterateResult(Saveable):
     integrator_steps: Optional[np.ndarray] = None
     itinerary: Optional[list] = None
     visited: Optional[np.ndarray] = None
+    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
+    work: Optional[dict] = None
+
+    def trajectory_of(self, i: int) -> np.ndarray:
+        """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
+
+        Parameters
+        ----------
+        i : int
+            Orbit index (negative counts from the end).
+
+        Returns
+        -------
+        ndarray
+            Its kinds are ``trajectory_kind[trajectory_index[i]:trajectory_index[i + 1]]``.
+
+        Raises
+        ------
+        ValueError
+            If no trajectory was recorded or i is out of range.
+        """
+        return trajectory_rows(self, i)
 
     @property
     def n_orbits(self) -> int:
@@ -260,6 +309,7 @@ class _MapAPI(MapAnalyses):
         n_threads: int = 0,
         kernel: str = "simd",
         sin_ulp: float = 1.0,
+        progress=False,
     ) -> IterateResult:
         """Iterate many orbits at once in C++ (multi-threaded, GIL released).
 
@@ -288,6 +338,11 @@ class _MapAPI(MapAnalyses):
             Maximum error of the SIMD kernel's sin (SLEEF): 1.0 ulp (default) or 3.5 ulp, about
             20% faster per step. Either error (<4e-16 in K per step) is far below what the chaotic
             dynamics amplifies from any other rounding; the scalar kernel always uses libm.
+        progress : bool or callable, optional
+            ``True``: a tqdm bar on stderr (unit: step, total ``n_orbits * n_steps``; an orbit
+            that stops early counts its remaining steps). A callable ``progress(done, total)`` is
+            called every ~0.1 s and at the end. ``False`` (default): none, at no cost. See
+            :mod:`hovering._progress`.
 
         Returns
         -------
@@ -308,6 +363,7 @@ class _MapAPI(MapAnalyses):
         as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps.
         """
         record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
+        progress = check_progress(progress)
         if not is_choice(kernel, ("simd", "scalar")):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
         if isinstance(sin_ulp, (bool, np.bool_)) or not isinstance(sin_ulp, numbers.Real) or float(sin_ulp) not in (1.0, 3.5):
@@ -318,20 +374,22 @@ class _MapAPI(MapAnalyses):
         n_points = p.size * (n_steps + 1)
         check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps",
                      16 * n_points * ("orbit" in record) + p.size * n_steps * ("regions" in record))
-        d = self._iterate(
-            np.ascontiguousarray(p.ravel()),
-            np.ascontiguousarray(k.ravel()),
-            n_steps,
-            "orbit" in record,
-            "regions" in record,
-            "rotation" in record,
-            mask,
-            bool(stop_on_exit),
-            int(n_threads),
-            kernel,
-            float(sin_ulp),
-            "visited" in record,
-        )
+        with progress_bar(progress, p.size * n_steps, desc=f"{type(self).__name__}.iterate", unit="step") as bar:
+            d = self._iterate(
+                np.ascontiguousarray(p.ravel()),
+                np.ascontiguousarray(k.ravel()),
+                n_steps,
+                "orbit" in record,
+                "regions" in record,
+                "rotation" in record,
+                mask,
+                bool(stop_on_exit),
+                int(n_threads),
+                kernel,
+                float(sin_ulp),
+                "visited" in record,
+                bar.part(0) or None,
+            )
         res = IterateResult(
             phi=d.get("phi"),
             K=d.get("K"),

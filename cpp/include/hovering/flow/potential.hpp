@@ -16,6 +16,7 @@ namespace hovering {
 /// A single-well potential and its energy-dependent quantities.
 class Potential {
 public:
+    /// Potentials are used through shared pointers to the base.
     virtual ~Potential() = default;
     /// V(q).
     virtual double V(double q) const = 0;
@@ -53,6 +54,7 @@ public:
     virtual double angle_on_level(double q, double p, double h) const;
 
 protected:
+    /// Throw std::invalid_argument (naming the potential and who) unless h is finite and > 0.
     void check_energy(double h, const char* who) const;
 };
 
@@ -61,15 +63,25 @@ class Harmonic final : public Potential {
 public:
     /// Throws std::invalid_argument unless omega lies in [1e-100, 1e100] (omega^2 stays a normal double).
     explicit Harmonic(double omega);
+    /// V(q) in closed form.
     double V(double q) const override;
+    /// V'(q) in closed form.
     double dV(double q) const override;
+    /// Short description with the parameters.
     std::string name() const override;
+    /// Turning points in closed form.
     std::pair<double, double> turning_points(double h) const override;
+    /// T(h) in closed form.
     double period(double h) const override;
+    /// I(h) in closed form.
     double action(double h) const override;
+    /// H(I) in closed form.
     double energy(double I) const override;
+    /// Angle of (q, p < 0) in closed form.
     double angle_of(double q, double h) const override;
+    /// (q, p) at angle theta in closed form.
     std::pair<double, double> point_at(double theta, double h) const override;
+    /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
@@ -84,16 +96,27 @@ class Tan final : public Potential {
 public:
     /// Throws std::invalid_argument unless omega and alpha lie in [1e-100, 1e100].
     Tan(double omega, double alpha);
+    /// V(q) in closed form.
     double V(double q) const override;
+    /// V'(q) in closed form.
     double dV(double q) const override;
+    /// Short description with the parameters.
     std::string name() const override;
+    /// pi / (2 alpha): the wall of the well.
     double q_limit() const override;
+    /// Turning points in closed form.
     std::pair<double, double> turning_points(double h) const override;
+    /// T(h) in closed form.
     double period(double h) const override;
+    /// I(h) in closed form.
     double action(double h) const override;
+    /// H(I) in closed form.
     double energy(double I) const override;
+    /// Angle of (q, p < 0) in closed form.
     double angle_of(double q, double h) const override;
+    /// (q, p) at angle theta in closed form.
     std::pair<double, double> point_at(double theta, double h) const override;
+    /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
@@ -110,9 +133,13 @@ class Numerical final : public Potential {
 public:
     /// Use base.V and base.dV only.
     explicit Numerical(std::shared_ptr<const Potential> base);
+    /// The base's V.
     double V(double q) const override { return base_->V(q); }
+    /// The base's V'.
     double dV(double q) const override { return base_->dV(q); }
+    /// "Numerical(<base>)".
     std::string name() const override { return "Numerical(" + base_->name() + ")"; }
+    /// The base's q_limit.
     double q_limit() const override { return base_->q_limit(); }
     /// The wrapped potential.
     const std::shared_ptr<const Potential>& base() const { return base_; }

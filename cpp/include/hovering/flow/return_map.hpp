@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hovering/flow/system.hpp"
 #include "hovering/types.hpp"
@@ -61,13 +62,56 @@ std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z);
 struct ReturnResult {
     std::array<double, 4> z{};  ///< state at the return (or where the orbit stopped)
     double time = 0;            ///< return time (up to the stop for a non-Ok status)
-    FlowStatus status = FlowStatus::Ok;
+    FlowStatus status = FlowStatus::Ok;  ///< how the return ended
     /// Impacts in order ('R' right wall, '1' upper wall: "R", "1", "11", "R1", ...); without
     /// impact "0" if the segment crossed q1 = qw1 above the step, "u" if it never crossed it;
-    /// "" for the smooth flow (geometry None) and for a return that did not end Ok without impact.
+    /// "" for the smooth flow (geometry None), for a return that did not end Ok without impact,
+    /// and when labels are off (FlowIterateOptions::labels = false).
     std::string itinerary;
     double energy_error = 0;    ///< |H(z) - H(z0)|
     std::int64_t steps = 0;     ///< accepted integrator steps
+};
+
+/// What the tracer did, counted per worker and summed at the end of a batch (no atomics in the
+/// loop): shows that a computation simulates only the effects it needs (no walls: no wall-event
+/// search; eps = 0: no coupling term; no labels: no crossing bookkeeping; no trajectory: no dense
+/// sample).
+struct FlowWork {
+    std::int64_t field_evaluations = 0;     ///< evaluations of the vector field (steps, events, samples)
+    std::int64_t coupling_evaluations = 0;  ///< of those, evaluations of the coupling term eps grad Vc
+    std::int64_t wall_searches = 0;         ///< event searches (locate) for wall crossings and grazing minima
+    std::int64_t section_searches = 0;      ///< event searches for the crossing of Sigma_h
+    std::int64_t label_operations = 0;      ///< crossing-of-q1 = qw1 and itinerary bookkeeping operations
+    std::int64_t dense_samples = 0;         ///< uniform trajectory samples computed (one stepper step each)
+    std::int64_t steps = 0;                 ///< accepted integrator steps
+    /// Add another worker's counts.
+    FlowWork& operator+=(const FlowWork& o);
+};
+
+/// What a recorded trajectory point is.
+enum class TrajectoryPoint : std::int8_t {
+    Sample = 0,     ///< uniform sample at t = k dt of the orbit's clock
+    ImpactIn = 1,   ///< state at an impact, before the reflection (on the wall)
+    ImpactOut = 2,  ///< state at an impact, after the reflection
+    Return = 3,     ///< the return to Sigma_h that ends a return
+    End = 4,        ///< where a return stopped otherwise (corner, grazing, step or impact limit, ...)
+};
+
+/// Dense output of a batch ("trajectory"): per orbit, the states (t, q1, p1, q2, p2) at the
+/// uniform times t = k dt of the orbit's clock (it runs on across returns; samples come from one
+/// exact stepper step from the start of the accepted step, so they carry the stepper's accuracy),
+/// plus the exact pre- and post-impact states of every reflection, each return point and where an
+/// orbit stopped. Nothing is computed when points is null.
+struct TrajectoryOutput {
+    double dt = 0;                               ///< sample spacing (> 0 when points is set)
+    std::int64_t max_points_per_orbit = 0;       ///< points kept per orbit (>= 1); beyond, recording stops
+    std::vector<double>* points = nullptr;       ///< (n) per orbit, 5 doubles per point: t, q1, p1, q2, p2
+    std::vector<std::int8_t>* kinds = nullptr;   ///< (n) per orbit, the TrajectoryPoint of each point
+    std::int8_t* truncated = nullptr;            ///< (n) 1 where the orbit reached max_points_per_orbit
+    /// Whether a trajectory is recorded.
+    bool active() const { return points != nullptr; }
+    /// Throw std::invalid_argument for a bad dt or limit (when active).
+    void validate() const;
 };
 
 /// Region of Sigma_h a return's itinerary labels: "u" Beside (J_0u), "0" Above (J_0), "1" Upper
@@ -86,14 +130,18 @@ struct ReturnMapsOutput {
     std::int8_t* region = nullptr;   ///< Region of the return (region_of(itinerary))
     double* energy_error = nullptr;  ///< |H(image) - H(start)|
     std::int64_t* steps = nullptr;   ///< accepted integrator steps
-    std::string* itinerary = nullptr;
+    std::string* itinerary = nullptr;  ///< itinerary of each return
+    FlowWork* work = nullptr;        ///< the batch's work counters (summed over workers)
+    TrajectoryOutput trajectory;     ///< dense output of each return (its clock starts at 0)
 };
 
 /// Returns of n states z0 (row-major (n, 4)) on the core's thread pool (n_threads, 0 = all
 /// cores). A state with a non-finite entry is OffSection (a failed section point); every orbit
 /// gets its own status, none stops the batch. Setting *cancel ends the batch promptly: returns not
 /// finished are Interrupted. Bad options throw std::invalid_argument before anything runs.
+/// progress (optional) is increased by one per finished return (relaxed), for a progress bar.
 void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
-                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out);
+                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out,
+                 std::atomic<std::int64_t>* progress = nullptr);
 
 }  // namespace hovering

@@ -30,6 +30,13 @@ struct FlowIterateOptions {
     bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
     int n_threads = 0;                ///< worker threads; 0 = all hardware threads
     const std::atomic<bool>* cancel = nullptr;  ///< polled between and inside returns
+    /// Label returns (itinerary, region; needs the crossings of q1 = qw1 tracked). false: no
+    /// label work at all, every region None (then regions, visited, itinerary, rotation and an
+    /// exit_mask are refused); the orbit is the same bit for bit.
+    bool labels = true;
+    /// Returns accounted for (relaxed increments, one per return; an orbit that stops early adds
+    /// its remaining returns), so it ends at n * n_steps unless cancelled. Null: not counted.
+    std::atomic<std::int64_t>* progress = nullptr;
 };
 
 /// Where a flow-map iteration writes; a null pointer means "not recorded". Per-point arrays are
@@ -41,7 +48,7 @@ struct FlowIterateOutput {
     double* orbit_x = nullptr;        ///< points: phi (normal) or theta (section)
     double* orbit_y = nullptr;        ///< K or I
     double* orbit_theta = nullptr;    ///< section coordinates of the points
-    double* orbit_I = nullptr;
+    double* orbit_I = nullptr;        ///< I of the points (section coordinates)
     double* states = nullptr;         ///< (n, n_steps + 1, 4) points of Sigma_h (q1, p1, q2, p2)
     std::int8_t* regions = nullptr;   ///< Region of each return
     double* times = nullptr;          ///< return times
@@ -53,12 +60,16 @@ struct FlowIterateOutput {
     std::int64_t* steps_done = nullptr;  ///< (n) returns taken
     std::int64_t* exit_step = nullptr;   ///< (n) first return outside the watched set, else -1
     std::int8_t* visited = nullptr;      ///< (n) bit r: a return of Region r was taken (as IterateOutput)
+    FlowWork* work = nullptr;            ///< the iteration's work counters (summed over workers)
+    /// Dense output of each orbit across its returns (the clock runs on from return to return;
+    /// each return's point is the image before the next start is put back on Sigma_h).
+    TrajectoryOutput trajectory;
 };
 
 /// One return of the map: the image, its region and what the flow reported.
 struct FlowStep {
     double x = 0, y = 0;  ///< image in map coordinates (NaN unless status is Ok)
-    Region region = Region::None;
+    Region region = Region::None;  ///< region of the return (None unless Ok with labels)
     ReturnResult ret;     ///< the flow's return (state, time, itinerary, energy error, steps)
 };
 

@@ -25,6 +25,7 @@ namespace hovering {
 /// trigonometric interpolant.
 class TrigInterpolant {
 public:
+    /// An empty interpolant (assign a real one before use).
     TrigInterpolant() = default;
     /// Interpolant of values[k] at s_k = -pi + 2 pi k / n.
     explicit TrigInterpolant(const std::vector<double>& values);

@@ -21,7 +21,7 @@ struct Band {
 
 /// Arcs of the paper's F_eps: Omega = Omega0 + tau0 K, |J_R| = 2(pi - theta_w) + tau1 K, |J_1| = 2 lam sqrt(-K).
 struct AnalyticArcs {
-    double Omega0, theta_w, tau0, tau1, lam;
+    double Omega0, theta_w, tau0, tau1, lam;  ///< the paper's parameters (eq:truncatedmap)
 
     /// Validate the parameters; throws std::invalid_argument naming the bad one and its range.
     void validate() const;
@@ -36,8 +36,11 @@ class Spline {
 public:
     /// Build from x (strictly increasing, >= 3 points) and y (same size, finite).
     Spline(std::vector<double> x, std::vector<double> y, const char* name);
+    /// Frees the GSL spline.
     ~Spline();
+    /// A copy with its own GSL spline.
     Spline(const Spline&);
+    /// Not assignable (const tables).
     Spline& operator=(const Spline&) = delete;
     /// Value at x (x inside [x.front(), x.back()]); thread-safe (no shared accelerator).
     double operator()(double x) const;

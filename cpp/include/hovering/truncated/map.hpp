@@ -49,6 +49,9 @@ struct IterateOptions {
     /// SIMD kernel only: SLEEF's 3.5-ulp sin instead of the 1-ulp one (about 20% faster per step).
     bool fast_sin = false;
     const std::atomic<bool>* cancel = nullptr;  ///< polled every few steps; set it to stop early
+    /// Orbit-steps accounted for (relaxed increments in chunks; an orbit that stops early adds the
+    /// steps it will not take), so it ends at n * n_steps unless cancelled. Null: not counted.
+    std::atomic<std::int64_t>* progress = nullptr;
 };
 
 /// One member of the truncated family; see the file comment.

@@ -48,6 +48,34 @@ struct WorkCursor {
     }
 };
 
+/// One worker's share of a progress counter: units (steps, returns) gather locally and are added
+/// to the shared counter (relaxed, so the hot loop has no atomic) once `chunk` of them have
+/// gathered, and when the worker ends. A null target makes every call a no-op.
+class ProgressShare {
+public:
+    /// Report into target (may be null) in chunks of at least `chunk` units.
+    ProgressShare(std::atomic<std::int64_t>* target, std::int64_t chunk) : target_(target), chunk_(chunk) {}
+    ~ProgressShare() { flush(); }
+    ProgressShare(const ProgressShare&) = delete;
+    ProgressShare& operator=(const ProgressShare&) = delete;
+    /// Count k more units done.
+    void add(std::int64_t k) {
+        if (!target_) return;
+        pending_ += k;
+        if (pending_ >= chunk_) flush();
+    }
+    /// Hand the units gathered so far to the shared counter.
+    void flush() {
+        if (target_ && pending_ != 0) target_->fetch_add(pending_, std::memory_order_relaxed);
+        pending_ = 0;
+    }
+
+private:
+    std::atomic<std::int64_t>* target_;
+    std::int64_t chunk_;
+    std::int64_t pending_ = 0;
+};
+
 /// Worker threads for a batch: `requested` (0 = all hardware threads), at least 1, at most `useful`.
 inline int worker_count(int requested, std::int64_t useful) {
     std::int64_t t = requested > 0 ? requested : std::int64_t(std::thread::hardware_concurrency());

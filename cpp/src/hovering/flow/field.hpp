@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include "hovering/flow/system.hpp"
 
@@ -68,6 +69,13 @@ struct Field {
     int dim = 4;
     /// dz/dt in GSL's calling convention (params = this Field), handed to GSL directly.
     int (*fn)(double, const double*, double*, void*) = nullptr;
+    /// Evaluations of the field without and with its coupling term so far (FlowWork): plain
+    /// counters, one Field per integrator and worker, so no atomics; each evaluation increments
+    /// exactly one of them (the second inside the coupling branch), so counting costs one
+    /// increment per evaluation. All evaluations: evaluations() below.
+    mutable std::int64_t uncoupled_evaluations = 0, coupling_evaluations = 0;
+    /// Every evaluation so far.
+    std::int64_t evaluations() const { return uncoupled_evaluations + coupling_evaluations; }
 
     explicit Field(const FlowSystem& s);
     void operator()(const double* z, double* dz) const { fn(0.0, z, dz, const_cast<Field*>(this)); }
@@ -82,14 +90,17 @@ struct Field {
         // The auxiliary variables follow (q1, p1, q2, p2) in the order V1, V2: compile-time indices.
         constexpr int A1 = 4, A2 = K1 == Kind::Tan ? 5 : 4;
         const Field& F = *static_cast<const Field*>(params);
+        if constexpr (C == CKind::None) ++F.uncoupled_evaluations;
         dz[0] = z[1];
         dz[1] = -F.f1.eval<K1, 0, A1>(z);
         dz[2] = z[3];
         dz[3] = -F.f2.eval<K2, 2, A2>(z);
         if constexpr (C == CKind::Bilinear) {
+            ++F.coupling_evaluations;
             dz[1] -= F.eps * (F.bilinear_c * z[2]);
             dz[3] -= F.eps * (F.bilinear_c * z[0]);
         } else if constexpr (C == CKind::General) {
+            ++F.coupling_evaluations;
             const auto g = F.coupling->gradient(z[0], z[2]);
             dz[1] -= F.eps * g[0];
             dz[3] -= F.eps * g[1];

@@ -56,8 +56,15 @@ Integrator::~Integrator() {
 }
 
 void Integrator::restart() {
-    if (driver_) gsl_odeiv2_driver_reset(driver_);
-    else gsl_odeiv2_step_reset(step_);
+    if (driver_) {
+        gsl_odeiv2_driver_reset(driver_);
+        // msadams' clock restarts too: step lengths are differences t_ms_ - t0, whose rounding
+        // depends on |t_ms_|, so a clock running on from earlier returns made a return depend on
+        // what the worker had traced before (orbits differed with the thread count).
+        t_ms_ = 0;
+    } else {
+        gsl_odeiv2_step_reset(step_);
+    }
 }
 
 bool Integrator::advance(double* y, double* d, double* h, double hmax, double* h_done) {

@@ -3,6 +3,7 @@
 #include "hovering/flow/return_map.hpp"
 
 #include <cmath>
+#include <mutex>
 #include <string>
 
 #include "hovering/detail/common.hpp"
@@ -28,6 +29,25 @@ Status orbit_status(FlowStatus s) {
     return Status::NonFinite;
 }
 
+FlowWork& FlowWork::operator+=(const FlowWork& o) {
+    field_evaluations += o.field_evaluations;
+    coupling_evaluations += o.coupling_evaluations;
+    wall_searches += o.wall_searches;
+    section_searches += o.section_searches;
+    label_operations += o.label_operations;
+    dense_samples += o.dense_samples;
+    steps += o.steps;
+    return *this;
+}
+
+void TrajectoryOutput::validate() const {
+    if (!active()) return;
+    if (!(dt > 0 && std::isfinite(dt))) bad("trajectory dt must be finite and > 0, got " + detail::fmt(dt));
+    if (max_points_per_orbit < 1)
+        bad("trajectory max_points_per_orbit must be >= 1, got " + std::to_string(max_points_per_orbit));
+    if (!kinds) bad("trajectory kinds must be given with trajectory points");
+}
+
 Region region_of(const std::string& itinerary) {
     if (itinerary.size() > 1) return Region::Multi;
     if (itinerary == "u") return Region::Beside;
@@ -46,7 +66,7 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
 }
 
 void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
-                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out) {
+                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress) {
     detail::gsl_quiet();
     opt.validate();
     s.validate();
@@ -54,6 +74,7 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     if (n_threads < 0 || n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
             std::to_string(n_threads));
+    out.trajectory.validate();
     if (n == 0) return;
     auto write = [&](std::int64_t i, const ReturnResult& r) {
         for (int k = 0; k < 4; ++k)
@@ -67,11 +88,15 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     };
     const int threads = detail::worker_count(n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
+    const TrajectoryOutput& traj = out.trajectory;
+    std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
         detail::Tracer tracer(s, opt);
+        detail::DenseRecorder rec;
         for (std::int64_t i; cur.pop(i);) {
             const std::array<double, 4> a{z0[4 * i], z0[4 * i + 1], z0[4 * i + 2], z0[4 * i + 3]};
             ReturnResult r;
+            if (traj.truncated) traj.truncated[i] = 0;
             if (cancel && cancel->load(std::memory_order_relaxed)) {
                 r.z = a;
                 r.status = FlowStatus::Interrupted;
@@ -79,9 +104,20 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
                 r.z = a;
                 r.status = FlowStatus::OffSection;
             } else {
+                if (traj.active()) {
+                    rec.start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
+                    tracer.set_dense(&rec);
+                }
                 r = tracer.trace(a, false, cancel);
+                if (traj.truncated) traj.truncated[i] = rec.truncated ? 1 : 0;
             }
             write(i, r);
+            if (progress) progress->fetch_add(1, std::memory_order_relaxed);
+        }
+        if (out.work) {
+            const FlowWork w = tracer.work();
+            std::lock_guard<std::mutex> lock(mu);
+            *out.work += w;
         }
     });
 }

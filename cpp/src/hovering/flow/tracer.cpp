@@ -8,6 +8,10 @@
 // accelerations at both ends, all known) bounds a coordinate over the step, with the distance to
 // the cubic one as its error estimate; a minimum that stays clear of a wall, a crossing of the
 // line q2 = qw2 beside the step, or a crossing of q1 = qw1 well above it costs nothing.
+//
+// Only the effects a computation asks for are simulated: walls only for geometries that have
+// them, labels (itinerary, crossings of q1 = qw1) only when set_labels(true), dense output only
+// with a DenseRecorder; FlowWork counts what was done. None of them changes the orbit.
 
 #include "hovering/flow/tracer.hpp"
 
@@ -81,11 +85,48 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
 
 Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) { cands_.reserve(8); }
 
+FlowWork Tracer::work() const {
+    FlowWork w = work_;
+    w.field_evaluations = in_.field().evaluations();
+    w.coupling_evaluations = in_.field().coupling_evaluations;
+    return w;
+}
+
+void Tracer::sample(const double* y0, const double* d0, double t0, double t_end) {
+    DenseRecorder& D = *dense_;
+    const double a = D.offset + t0, b = D.offset + t_end, len = t_end - t0;
+    bool prepared = false;
+    for (;;) {
+        const double tk = double(D.next) * D.dt;
+        if (!(tk < b)) return;
+        if (D.room <= 0) {  // full: no more dense work for this orbit
+            D.truncated = true;
+            return;
+        }
+        double ys[kMaxDim];
+        const double tau = std::min(std::max(tk - a, 0.0), len);
+        if (tau == 0) {
+            for (int i = 0; i < 4; ++i) ys[i] = y0[i];
+        } else {
+            if (!prepared) {
+                in_.prepare_extension(y0, d0, len);  // msadams: size the rk8pd extension once per step
+                prepared = true;
+            }
+            in_.exact(y0, d0, tau, ys);
+        }
+        ++work_.dense_samples;
+        D.push(tk, ys, TrajectoryPoint::Sample);
+        ++D.next;
+    }
+}
+
 ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
     const FlowSystem& s = s_;
     const FlowOptions& opt = o_;
     const int n = in_.dim();
     const Field& field = in_.field();
+    const bool labels = labels_;
+    DenseRecorder* const dense = dense_;
     ReturnResult r;
     const double H0 = s.energy(z0.data());
     double y[kMaxDim] = {z0[0], z0[1], z0[2], z0[3]}, t = 0;
@@ -104,6 +145,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
     double dy[kMaxDim];
     field(y, dy);
     bool seen_negative = false, armed = first_crossing, crossed = false;
+    int impacts = 0;
     const bool right = s.geometry != Geometry::None, upper = s.geometry == Geometry::Step;
     const bool is_step = s.geometry == Geometry::Step;
     bool done = false;
@@ -153,6 +195,12 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
             if (!is_step) return false;
             return gi == 2 ? stays_above(0, s.qw1 + opt.corner_tol) : stays_above(2, s.qw2 + opt.corner_tol);
         };
+        // A crossing of q1 = qw1 above the step (a label: the return is J_0, not J_0u).
+        auto note_crossing = [&] {
+            if (!labels) return;
+            crossed = true;
+            ++work_.label_operations;
+        };
 
         // Candidate events of this step, each located on exact steps from y0.
         cands_.clear();
@@ -161,11 +209,12 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
             const double g0 = y0[gi] - off, g1 = y[gi] - off;
             if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
                 if (wall_absent(gi)) {
-                    crossed = crossed || gi == 0;  // q1 = qw1 crossed above the step
+                    if (gi == 0) note_crossing();  // q1 = qw1 crossed above the step
                     return;
                 }
                 Candidate c;
                 c.kind = cross;
+                ++work_.wall_searches;
                 c.tau = locate(in_, y0, d0, y, d1, gi, off, h, opt.event_tol, c.y);
                 cands_.push_back(c);
             } else if (g0 > 0 && g1 > 0 && y0[pi] < 0 && y[pi] > 0) {
@@ -173,12 +222,14 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
                 // though g > 0 at both ends (a near-grazing impact a sign test would miss).
                 if (stays_above(gi, off + opt.grazing_tol) || (gi == 2 && wall_absent(2))) return;
                 double ym[kMaxDim], dm[kMaxDim];
+                ++work_.wall_searches;
                 const double tm = locate(in_, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
                 const double gm = ym[gi] - off;
                 Candidate c;
                 if (gm < -opt.grazing_tol) {
                     c.kind = cross;
                     field(ym, dm);
+                    ++work_.wall_searches;
                     c.tau = locate(in_, y0, d0, ym, dm, gi, off, tm, opt.event_tol, c.y);
                     cands_.push_back(c);
                 } else if (gm <= opt.grazing_tol) {
@@ -194,17 +245,24 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         if (armed && y0[1] > 0 && y[1] <= 0) {
             Candidate c{};
             c.kind = Ev::Section;
+            ++work_.section_searches;
             c.tau = locate(in_, y0, d0, y, d1, 1, 0.0, h, opt.event_tol, c.y);
             cands_.push_back(c);
         }
         std::sort(cands_.begin(), cands_.end(), [](const Candidate& a, const Candidate& b) { return a.tau < b.tau; });
 
+        bool reflected = false;
         for (const Candidate& c : cands_) {
             auto stop = [&](FlowStatus status) {
                 for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = c.y[i];
                 r.time = t0 + c.tau;
                 r.status = status;
                 done = true;
+                if (dense) {
+                    sample(y0, d0, t0, r.time);
+                    dense->push(dense->offset + r.time, c.y,
+                                status == FlowStatus::Ok ? TrajectoryPoint::Return : TrajectoryPoint::End);
+                }
             };
             if (c.kind == Ev::Section) {
                 stop(FlowStatus::Ok);
@@ -220,47 +278,62 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
                 break;
             }
             if (!has_wall) {  // crossed the wall's line beside / above the step
-                crossed = crossed || (is_right && c.kind == Ev::Right);
+                if (is_right && c.kind == Ev::Right) note_crossing();
                 continue;
             }
             if (c.kind == Ev::GrazeRight || c.kind == Ev::GrazeUpper) {
                 stop(FlowStatus::Grazing);
                 break;
             }
-            if (r.itinerary.size() >= std::size_t(opt.max_impacts)) {
+            if (impacts >= opt.max_impacts) {
                 stop(FlowStatus::ImpactLimit);
                 break;
             }
             // Elastic reflection (eq:R1, eq:R2), placed exactly on the wall so that the restart
             // (g = 0, moving away) cannot find the same impact again.
             for (int i = 0; i < n; ++i) y[i] = c.y[i];
+            ++impacts;
             if (is_right) {
                 y[0] = s.qw1;
                 y[1] = -y[1];
-                r.itinerary += 'R';
             } else {
                 y[2] = s.qw2;
                 y[3] = -y[3];
-                r.itinerary += '1';
+            }
+            if (labels) {
+                r.itinerary += is_right ? 'R' : '1';
+                ++work_.label_operations;
             }
             field.sync_aux(y);
             t = t0 + c.tau;
+            if (dense) {
+                sample(y0, d0, t0, t);
+                dense->push(dense->offset + t, c.y, TrajectoryPoint::ImpactIn);
+                dense->push(dense->offset + t, y, TrajectoryPoint::ImpactOut);
+            }
             field(y, dy);
             in_.restart();
+            reflected = true;
             break;
         }
         if (done) break;
+        if (dense && !reflected) sample(y0, d0, t0, t);
         // A return passes q1's minimum (p1 from - to +, or a right-wall reflection) and then its
         // maximum (p1 from + to -). Arming the section only after the minimum makes a start with
         // p1 = +-1e-14 (a point computed on Sigma_h) safe from being taken for its own return.
         seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
         armed = armed || (seen_negative && y[1] > 0);
     }
-    if (!done)
+    if (!done) {
         for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
-    if (r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None)
+        if (dense) dense->push(dense->offset + t, y, TrajectoryPoint::End);
+    }
+    if (labels && r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None) {
         r.itinerary = crossed ? "0" : "u";
+        ++work_.label_operations;
+    }
     r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
+    work_.steps += r.steps;
     return r;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // One worker's engine for returns to Sigma_h (internal): the adaptive loop, event search on every
-// accepted step, reflections, and the bookkeeping of impacts and crossings of q1 = qw1.
+// accepted step, reflections, the bookkeeping of impacts and crossings of q1 = qw1 (labels, only
+// when asked for), dense output (only when asked for) and the work counters.
 
 #include <array>
 #include <atomic>
@@ -11,16 +12,60 @@
 
 namespace hovering::detail {
 
+/// One orbit's trajectory while it is recorded: where the points go, the orbit's clock and the
+/// room left. The tracer samples t = k dt of the clock offset + (time within the return).
+struct DenseRecorder {
+    double dt = 0;                        ///< sample spacing
+    double offset = 0;                    ///< the orbit's clock at the start of the current return
+    std::int64_t next = 0;                ///< index k of the next uniform sample
+    std::int64_t room = 0;                ///< points that may still be recorded
+    bool truncated = false;               ///< a point was dropped for want of room
+    std::vector<double>* points = nullptr;      ///< 5 doubles per point: t, q1, p1, q2, p2
+    std::vector<std::int8_t>* kinds = nullptr;  ///< TrajectoryPoint of each point
+
+    /// Start an orbit at clock 0 (clears the vectors).
+    void start(std::vector<double>* pts, std::vector<std::int8_t>* kds, double spacing, std::int64_t limit) {
+        points = pts;
+        kinds = kds;
+        dt = spacing;
+        offset = 0;
+        next = 0;
+        room = limit;
+        truncated = false;
+        points->clear();
+        kinds->clear();
+    }
+    /// Append (t, y[0..4)) of this kind; false (and truncated set) when there is no room left.
+    bool push(double t, const double* y, TrajectoryPoint kind) {
+        if (room <= 0) {
+            truncated = true;
+            return false;
+        }
+        --room;
+        points->insert(points->end(), {t, y[0], y[1], y[2], y[3]});
+        kinds->push_back(static_cast<std::int8_t>(kind));
+        return true;
+    }
+};
+
 /// Follows orbits of one system from a point of Sigma_h to its next crossing of Sigma_h. Holds
 /// the GSL objects, so a worker builds one and traces many returns with it.
 class Tracer {
 public:
+    /// A tracer of system s with integrator options o (s must outlive it).
     Tracer(const FlowSystem& s, const FlowOptions& o);
     /// One return from z0 (on Sigma_h): the first crossing of Sigma_h after q1 has passed its
     /// minimum. With first_crossing, the first crossing of Sigma_h at all (z0 need not lie on it:
     /// the tangential curve starts at q1's minimum). cancel is polled every 256 steps.
     ReturnResult trace(const std::array<double, 4>& z0, bool first_crossing = false,
                        const std::atomic<bool>* cancel = nullptr);
+    /// Whether returns are labelled (itinerary, crossings of q1 = qw1 above the step; default on).
+    /// Off, the itinerary stays "" and no crossing is tracked; the orbit is the same bit for bit.
+    void set_labels(bool on) { labels_ = on; }
+    /// Record the following returns into this trajectory (null: no dense output, no dense work).
+    void set_dense(DenseRecorder* d) { dense_ = d; }
+    /// Everything counted since construction (FlowWork), field evaluations included.
+    FlowWork work() const;
     /// The system traced.
     const FlowSystem& system() const { return s_; }
 
@@ -31,10 +76,16 @@ private:
         Ev kind;
         double y[kMaxDim];
     };
+    // Uniform samples of the clock in [t0, t_end) (times within the return) of the step from
+    // (y0, d0) at t0, each one exact stepper step from y0.
+    void sample(const double* y0, const double* d0, double t0, double t_end);
     const FlowSystem& s_;
     FlowOptions o_;
     Integrator in_;
     std::vector<Candidate> cands_;
+    FlowWork work_;
+    bool labels_ = true;
+    DenseRecorder* dense_ = nullptr;
 };
 
 }  // namespace hovering::detail

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <string>
 
 #include "hovering/detail/common.hpp"
@@ -150,12 +151,16 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
     if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
             std::to_string(opt.n_threads));
+    if (!opt.labels && (out.regions || out.visited || out.itinerary || out.rotation || opt.exit_mask))
+        bad("labels = false, but regions, visited, itinerary, rotation or an exit_mask need the returns labelled");
+    out.trajectory.validate();
     for (std::int64_t i = 0; i < n; ++i) {
         detail::require_angle(x0[i], "x0[" + std::to_string(i) + "]");
         detail::require_finite(y0[i], "y0[" + std::to_string(i) + "]");
     }
     if (n == 0) return;
     const std::int64_t ns = opt.n_steps;
+    const TrajectoryOutput& traj = out.trajectory;
     const std::int64_t np = ns + 1;  // points per orbit
 
     auto record_point = [&](std::int64_t i, std::int64_t k, double x, double y, const std::array<double, 4>* z) {
@@ -204,16 +209,26 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
 
     const int threads = detail::worker_count(opt.n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 4));
+    std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
         detail::Tracer tr(s_, opt_);
+        tr.set_labels(opt.labels);
+        detail::DenseRecorder rec;
+        detail::ProgressShare progress(opt.progress, 1);
         for (std::int64_t i; cur.pop(i);) {
             double x = x0[i], y = y0[i], rot = 0;
             if (out.exit_step) out.exit_step[i] = -1;
+            if (traj.truncated) traj.truncated[i] = 0;
             std::array<double, 4> z{};
             if (!state(x, y, z)) {
                 record_point(i, 0, x, y, nullptr);
                 finish(i, x, y, 0.0, 0, Status::OffSection, 0);
+                progress.add(ns);
                 continue;
+            }
+            if (traj.active()) {
+                rec.start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
+                tr.set_dense(&rec);
             }
             record_point(i, 0, x, y, &z);
             Status status = Status::Ok;
@@ -230,6 +245,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                     status = orbit_status(st.ret.status);
                     break;
                 }
+                rec.offset += st.ret.time;  // the orbit's clock runs on into the next return
                 const int r = int(st.region);
                 if (r >= 0) visited |= 1 << r;
                 if (opt.exit_mask && !reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
@@ -250,8 +266,18 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 x = st.x;
                 y = st.y;
                 record_point(i, k + 1, x, y, nullptr);
+                progress.add(1);
             }
             finish(i, x, y, rot, k, status, visited);
+            if (traj.truncated) traj.truncated[i] = rec.truncated ? 1 : 0;
+            // The returns an orbit that stopped early will not take are accounted for (not when
+            // cancelled: the count then shows how far the run got).
+            if (status != Status::Interrupted) progress.add(ns - k);
+        }
+        if (out.work) {
+            const FlowWork w = tr.work();
+            std::lock_guard<std::mutex> lock(mu);
+            *out.work += w;
         }
     });
 }

@@ -75,6 +75,7 @@ inline Packet force_packet(const FourierForcing& f, const Packet& p) {
 struct Finisher {
     const IterateOptions& opt;
     const IterateOutput& out;
+    detail::ProgressShare& progress;  // credits the steps an orbit that stops early will not take
     void start(std::int64_t i, double phi, double K) const {
         if (out.orbit_phi) out.orbit_phi[i * (opt.n_steps + 1)] = phi;
         if (out.orbit_K) out.orbit_K[i * (opt.n_steps + 1)] = K;
@@ -89,6 +90,7 @@ struct Finisher {
         if (out.rotation) out.rotation[i] = steps > 0 ? rotsum / double(steps) : kNaN;
         if (out.status) out.status[i] = static_cast<std::int8_t>(st);
         if (out.steps_done) out.steps_done[i] = steps;
+        if (st != Status::Interrupted) progress.add(ns - steps);
         if (out.orbit_phi)
             std::fill(out.orbit_phi + i * (ns + 1) + steps + 1, out.orbit_phi + (i + 1) * (ns + 1), kNaN);
         if (out.orbit_K)
@@ -110,12 +112,12 @@ constexpr int kLanes = kP * kW;
 
 template <bool Fast, class A, class F>
 void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
-              const IterateOptions& opt, const IterateOutput& out) {
+              const IterateOptions& opt, const IterateOutput& out, detail::ProgressShare& progress) {
     // Lane kernel on Eigen packets: kLanes orbits are stepped together; an orbit that stops frees
     // its lane, which is refilled from the source at once, so the vectors stay full even when
     // orbits stop at very different times (early exit). Per-lane bookkeeping happens on a rare
     // path that unpacks the packets into lane arrays and packs them back.
-    const Finisher finish{opt, out};
+    const Finisher finish{opt, out, progress};
     const std::int64_t ns = opt.n_steps;
     const double lo = m.band().lo, hi = m.band().hi;
     const bool watch = opt.exit_mask != 0;
@@ -286,6 +288,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         }
         ++it;
         --countdown;
+        progress.add(nlive);  // every live lane took one step
         if (out.orbit_phi || out.orbit_K) {
             unpack();
             for (int j = 0; j < kLanes; ++j) {
@@ -315,8 +318,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
 
 template <class A, class F>
 void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
-                const IterateOptions& opt, const IterateOutput& out) {
-    const Finisher finish{opt, out};
+                const IterateOptions& opt, const IterateOutput& out, detail::ProgressShare& progress) {
+    const Finisher finish{opt, out, progress};
     const std::int64_t ns = opt.n_steps;
     for (std::int64_t i; src.pop(i);) {
         double phi = phi0[i], K = K0[i], rot = 0.0;
@@ -350,6 +353,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
             K += m.eps() * m.forcing().at(phi);
             if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
             if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
+            progress.add(1);
             if (!(K > m.band().lo && K < m.band().hi)) {
                 st = Status::Escaped;
                 ++n;
@@ -393,12 +397,14 @@ void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n
     const int threads = detail::worker_count(opt.n_threads, (n + kLanes - 1) / kLanes);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 256));
     detail::run_workers(threads, queue, [&](WorkCursor& src) {
+        // Steps are ~1 ns: a worker hands its count over every 2^14 of them (~20 us).
+        detail::ProgressShare progress(opt.progress, std::int64_t(1) << 14);
         if (opt.kernel == Kernel::Simd && opt.fast_sin)
-            run_simd<true>(*this, phi0, K0, src, opt, out);
+            run_simd<true>(*this, phi0, K0, src, opt, out, progress);
         else if (opt.kernel == Kernel::Simd)
-            run_simd<false>(*this, phi0, K0, src, opt, out);
+            run_simd<false>(*this, phi0, K0, src, opt, out, progress);
         else
-            run_scalar(*this, phi0, K0, src, opt, out);
+            run_scalar(*this, phi0, K0, src, opt, out, progress);
     });
 }
 
