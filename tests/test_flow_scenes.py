@@ -248,7 +248,11 @@ def test_tangent_tori_figure(runs):
     gids = {ln.get_gid() for ax in fig.axes for ln in ax.lines}
     assert {"trajectory:right", "trajectory:upper", "torus:right", "torus:upper"} <= gids
     assert [ax.get_xlabel() for ax in fig.axes] == [r"$q_1$", r"$q_1$", r"$q_1$", r"$q_2$"]
-    assert s["work"]["right"].get("wall_event_searches", 0) == 0  # geometry none: no wall events
+    # the effects the scene names and no others: no walls (geometry none) -> no wall-event search, no
+    # coupling (eps = 0) -> none evaluated, a trajectory asked -> dense samples; no labels asked
+    for w in s["work"].values():
+        assert w["wall_searches"] == 0 and w["coupling_evaluations"] == 0 and w["label_operations"] == 0
+        assert w["dense_samples"] > 100 and w["field_evaluations"] > 0
 
 
 # ------------------------------------------------------------------------------------------------
