@@ -351,3 +351,20 @@ def test_cli_redraw(tmp_path, runs, capsys):
     assert main(["redraw", str(tmp_path / "plain.npz")]) == 2
     err = capsys.readouterr().err
     assert "error: " in err and "not a hovering result file" in err and "Traceback" not in err
+
+
+def test_scene_progress_reaches_its_total(tmp_path):
+    # a sweep scene reports its points; an orbit scene the iterations of its core calls
+    calls = []
+    d = _small("flow_hov_vs_eps")
+    d.update(eps=[-0.1, 0.05], samples=100, n_steps=100, models=["onset"])
+    scenes.compute(parse_scene(d, "h.toml"), quick=True, progress=lambda done, total: calls.append((done, total)),
+                   checkpoint=tmp_path / "h.jsonl")
+    assert calls and calls[-1] == (2, 2) and all(a <= b for (a, _), (b, _) in zip(calls, calls[1:]))
+    calls.clear()
+    d = _small("flow_portrait")
+    d.update(n_orbits=2, n_steps=100, corner_K=0)
+    scenes.compute(parse_scene(d, "p.toml"), quick=True, progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1][0] == calls[-1][1] == 2 * 50  # 2 orbits x 50 returns (quick: 100 / 50, floor 50)
+    with pytest.raises(ValueError, match="progress"):
+        scenes.compute(parse_scene(d, "p.toml"), progress="yes")

@@ -19,6 +19,7 @@ import numpy as np
 
 from .._common import Region, Status, wrap
 from ..plot.style import SPECIAL_COLORS, orbit_color
+from .._progress import check_progress, progress_bar
 from ..analysis.hovering import default_depth
 from ..sweeps import Checkpoint
 from ..truncated.theory import golden_family, hovering_area_theory
@@ -396,6 +397,8 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
     eps_all = np.array(scene.eps)
     drawn = set()
     out = []
+    bar_cm = progress_bar(progress, total=len(scene.series) * len(scene.eps), desc=scene.name, unit="point")
+    bar = bar_cm.__enter__()
     for k, s in enumerate(scene.series):
         rows, reused = [], 0
         for e in scene.eps:
@@ -405,8 +408,7 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
             row = ckpt.get(key)
             if row is None:
                 t = time.perf_counter()
-                h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw,
-                                             **_progress_kw(progress))
+                h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
                 row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
                            floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
                            theta_w=ms.theta_w, seconds=time.perf_counter() - t)
@@ -414,6 +416,7 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
             else:
                 reused += 1
             rows.append(row)
+            bar.advance(1)
         fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
         te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
         drawn.add(fam)
@@ -422,6 +425,7 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
                                 error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
                                 K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
                                 theory_curve=tc, golden_c=s.golden_c, reused=reused))
+    bar_cm.__exit__(None, None, None)
     meta["points_reused"] = sum(s.reused for s in out)
     return HoveringAreaResult(scene=scene, meta=meta, series=out)
 
@@ -510,40 +514,10 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
     rows, reused = [], 0
-    for e in scene.eps:
-        sysd = _serial_dict(scene.system)
-        sysd["eps"] = e
-        key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
-                   seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
-        row = ckpt.get(key)
-        if row is not None:
-            reused += 1
-            rows.append(row)
-            continue
-        t = time.perf_counter()
-        fm = _flowmap(scene, eps=e)
-        # One box for flow and models, so the same points are classified by each: the default
-        # depth (the critical band of eq:hovsetsize), cut to the band every model is defined on.
-        depth = default_depth(fm) if e != 0 else 0.1
-        tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
-        K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
-        if "onset" in tms:
-            K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
-        flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True,
-                                **_progress_kw(progress))
-        th = fm.theory()
-        row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
-                   theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
-                   seconds=time.perf_counter() - t, models={})
-        for name, tm in tms.items():
-            # A model whose band is shallower than the box (measured arcs stop at the impact zone's
-            # floor) samples its own box: its points are not the flow's, so no verdict agreement.
-            K_m = max(K_low, tm.valid_band()[0] * (1 - 1e-9))
-            mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True)
-            agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
-            row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
-        ckpt.put(key, row)
-        rows.append(row)
+    with progress_bar(progress, total=len(scene.eps), desc=scene.name, unit="eps") as bar:
+        for e in scene.eps:
+            _flow_point(scene, e, n, samples, ckpt, rows, bar)
+            reused += rows[-1].pop("_reused", 0)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
     models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")}
               for name in scene.models}
@@ -551,6 +525,43 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
     return FlowHoveringResult(scene=scene, meta=meta, eps=col("eps"), flow_area=col("flow"), flow_error=col("flow_err"),
                               flow_both_sides=col("flow_both"), models=models, theory=col("theory"), K_low=col("K_low"),
                               b1=col("b1"), seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
+
+
+def _flow_point(scene, e, n, samples, ckpt, rows, bar) -> None:
+    """One eps of a flow |HOV| sweep: from the checkpoint, or computed and checkpointed at once."""
+    sysd = _serial_dict(scene.system)
+    sysd["eps"] = e
+    key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
+               seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
+    row = ckpt.get(key)
+    if row is not None:
+        rows.append(dict(row, _reused=1))
+        bar.advance(1)
+        return
+    t = time.perf_counter()
+    fm = _flowmap(scene, eps=e)
+    # One box for flow and models, so the same points are classified by each: the default
+    # depth (the critical band of eq:hovsetsize), cut to the band every model is defined on.
+    depth = default_depth(fm) if e != 0 else 0.1
+    tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
+    K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
+    if "onset" in tms:
+        K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
+    flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True)
+    th = fm.theory()
+    row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
+               theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
+               seconds=time.perf_counter() - t, models={})
+    for name, tm in tms.items():
+        # A model whose band is shallower than the box (measured arcs stop at the impact zone's
+        # floor) samples its own box: its points are not the flow's, so no verdict agreement.
+        K_m = max(K_low, tm.valid_band()[0] * (1 - 1e-9))
+        mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True)
+        agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
+        row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
+    ckpt.put(key, row)
+    rows.append(row)
+    bar.advance(1)
 
 
 def _serial_dict(spec) -> dict:
@@ -674,6 +685,7 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
 
     if not isinstance(scene, SceneSpec):
         raise ValueError(f"scene must be a scene spec from hovering.scenes.load_scene, got {type(scene).__name__}")
+    progress = check_progress(progress)
     meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
     t0 = time.perf_counter()
     ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
