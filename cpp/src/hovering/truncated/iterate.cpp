@@ -332,10 +332,15 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
             finish(i, phi, K, 0.0, 0, Status::Escaped);
             continue;
         }
+        std::int64_t counted = 0;  // steps of this orbit handed to progress so far
         for (; n < ns; ++n) {
-            if ((n & 63) == 0 && cancelled(opt)) {
-                st = Status::Interrupted;
-                break;
+            if ((n & 63) == 0) {
+                progress.add(n - counted);  // every 64 steps, off the per-step path
+                counted = n;
+                if (cancelled(opt)) {
+                    st = Status::Interrupted;
+                    break;
+                }
             }
             const Classified c = classify(phi, K, m.arcs().at(K));
             vis |= 1 << int(c.region);
@@ -353,13 +358,13 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
             K += m.eps() * m.forcing().at(phi);
             if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
             if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
-            progress.add(1);
             if (!(K > m.band().lo && K < m.band().hi)) {
                 st = Status::Escaped;
                 ++n;
                 break;
             }
         }
+        progress.add(n - counted);
         finish(i, phi, K, rot, n, st, vis);
     }
 }
