@@ -147,6 +147,27 @@ def _table(where: str, value) -> dict:
     return value
 
 
+def _tables(where: str, value, what: str) -> list:
+    """A non-empty array of tables ([[what]]) of at most MAX_PANELS entries (one figure)."""
+    if not isinstance(value, list) or not value:
+        raise ValueError(f"{where} must be a non-empty array of tables ([[{what}]]), got {value!r}")
+    if len(value) > MAX_PANELS:
+        raise ValueError(f"{where}: {len(value)} {what}; allowed: at most {MAX_PANELS} (one figure)")
+    return value
+
+
+def _eps_list(where: str, value, **bounds) -> tuple:
+    """A non-empty list of distinct eps values, at most MAX_SERIES_POINTS of them."""
+    if not isinstance(value, list) or not value:
+        raise ValueError(f"{where} must be a non-empty list of numbers, got {value!r}")
+    if len(value) > MAX_SERIES_POINTS:
+        raise ValueError(f"{where}: {len(value)} values; allowed: at most {MAX_SERIES_POINTS} (use a sweep for more)")
+    eps = tuple(_real(f"{where}[{i}]", e, **bounds) for i, e in enumerate(value))
+    if len(set(eps)) != len(eps):
+        raise ValueError(f"{where} = {value!r} lists a value twice")
+    return eps
+
+
 def _check_keys(where: str, table: dict, allowed, required=()) -> None:
     unknown = [k for k in table if k not in allowed]
     if unknown:
@@ -336,11 +357,7 @@ def _parse_orbit_scene(where: str, kind: str, data: dict, scene_map: dict, commo
         if "leading_curve" in data:
             opts["leading_curve"] = _bool(f"{where}.leading_curve", data["leading_curve"])
 
-    raw = data["panels"]
-    if not isinstance(raw, list) or not raw:
-        raise ValueError(f"{where}.panels must be a non-empty array of tables ([[panels]]), got {raw!r}")
-    if len(raw) > MAX_PANELS:
-        raise ValueError(f"{where}.panels: {len(raw)} panels; allowed: at most {MAX_PANELS} (one figure)")
+    raw = _tables(f"{where}.panels", data["panels"], "panels")
     panels = []
     for i, pt in enumerate(raw):
         pw = f"{where}.panels[{i}]"
@@ -493,19 +510,8 @@ def _layout(where: str, value, n: int) -> tuple:
 
 
 def _parse_hovering_area(where: str, data: dict, scene_map: dict, common: dict) -> SceneSpec:
-    ev = data["eps"]
-    if not isinstance(ev, list) or not ev:
-        raise ValueError(f"{where}.eps must be a non-empty list of numbers, got {ev!r}")
-    if len(ev) > MAX_SERIES_POINTS:
-        raise ValueError(f"{where}.eps: {len(ev)} values; allowed: at most {MAX_SERIES_POINTS} (use a sweep for more)")
-    eps = tuple(_real(f"{where}.eps[{i}]", e) for i, e in enumerate(ev))
-    if len(set(eps)) != len(eps):
-        raise ValueError(f"{where}.eps = {ev!r} lists a value twice")
-    sv = data["series"]
-    if not isinstance(sv, list) or not sv:
-        raise ValueError(f"{where}.series must be a non-empty array of tables ([[series]]), got {sv!r}")
-    if len(sv) > MAX_PANELS:
-        raise ValueError(f"{where}.series: {len(sv)} series; allowed: at most {MAX_PANELS}")
+    eps = _eps_list(f"{where}.eps", data["eps"])
+    sv = _tables(f"{where}.series", data["series"], "series")
     series = []
     for i, st in enumerate(sv):
         sw = f"{where}.series[{i}]"
@@ -669,14 +675,7 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
                          if "marker_size" in data else 0.5),
             **common)
     if kind == "flow_hovering_area":
-        ev = data["eps"]
-        if not isinstance(ev, list) or not ev:
-            raise ValueError(f"{where}.eps must be a non-empty list of numbers, got {ev!r}")
-        if len(ev) > MAX_SERIES_POINTS:
-            raise ValueError(f"{where}.eps: {len(ev)} values; allowed: at most {MAX_SERIES_POINTS}")
-        eps = tuple(_real(f"{where}.eps[{i}]", e, lo=-1.0, hi=1.0) for i, e in enumerate(ev))
-        if len(set(eps)) != len(eps):
-            raise ValueError(f"{where}.eps = {ev!r} lists a value twice")
+        eps = _eps_list(f"{where}.eps", data["eps"], lo=-1.0, hi=1.0)
         models = ("onset", "measured")
         if "models" in data:
             mv = data["models"]
