@@ -368,3 +368,13 @@ def test_scene_progress_reaches_its_total(tmp_path):
     assert calls and calls[-1][0] == calls[-1][1] == 2 * 50  # 2 orbits x 50 returns (quick: 100 / 50, floor 50)
     with pytest.raises(ValueError, match="progress"):
         scenes.compute(parse_scene(d, "p.toml"), progress="yes")
+
+
+def test_cli_explore_is_wired(capsys):
+    from hovering.cli import main
+
+    # on Agg there is no window: the scene and its map are checked and built, nothing is shown
+    assert main(["explore", str(SCENE_DIR / "flow_portrait.toml"), "--n-steps", "10"]) == 0
+    assert "cannot open a window" in capsys.readouterr().err
+    assert main(["explore", str(SCENE_DIR / "absent.toml")]) == 2
+    assert "error:" in capsys.readouterr().err
