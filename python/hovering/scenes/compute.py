@@ -379,8 +379,8 @@ def _theory_line(spec, eps_all: np.ndarray) -> tuple:
     e_lo = min(float(eps_all.min()), 0.0)
     eg = np.linspace(0.0, e_hi, 200)[1:]
     if spec.golden_c is not None:
-        tg = np.array([hovering_area_theory(x, golden_family(x, spec.golden_c, spec.tau0)[1],
-                                            golden_family(x, spec.golden_c, spec.tau0)[0]) for x in eg])
+        tg = np.array([hovering_area_theory(x, tw, O) for x in eg
+                       for O, tw in [golden_family(x, spec.golden_c, spec.tau0)]])
     else:
         tg = np.asarray(hovering_area_theory(eg, spec.theta_w, spec.Omega0), dtype=float)
     return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
@@ -397,35 +397,33 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
     eps_all = np.array(scene.eps)
     drawn = set()
     out = []
-    bar_cm = progress_bar(progress, total=len(scene.series) * len(scene.eps), desc=scene.name, unit="point")
-    bar = bar_cm.__enter__()
-    for k, s in enumerate(scene.series):
-        rows, reused = [], 0
-        for e in scene.eps:
-            ms = s.map_at(e)
-            kw = {} if s.K_low is None else {"K_low": s.K_low}
-            key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-            row = ckpt.get(key)
-            if row is None:
-                t = time.perf_counter()
-                h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-                row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
-                           floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
-                           theta_w=ms.theta_w, seconds=time.perf_counter() - t)
-                ckpt.put(key, row)
-            else:
-                reused += 1
-            rows.append(row)
-            bar.advance(1)
-        fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
-        te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
-        drawn.add(fam)
-        col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
-        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
-                                error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
-                                K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
-                                theory_curve=tc, golden_c=s.golden_c, reused=reused))
-    bar_cm.__exit__(None, None, None)
+    with progress_bar(progress, total=len(scene.series) * len(scene.eps), desc=scene.name, unit="point") as bar:
+        for k, s in enumerate(scene.series):
+            rows, reused = [], 0
+            for e in scene.eps:
+                ms = s.map_at(e)
+                kw = {} if s.K_low is None else {"K_low": s.K_low}
+                key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+                row = ckpt.get(key)
+                if row is None:
+                    t = time.perf_counter()
+                    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+                    row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
+                               floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
+                               theta_w=ms.theta_w, seconds=time.perf_counter() - t)
+                    ckpt.put(key, row)
+                else:
+                    reused += 1
+                rows.append(row)
+                bar.advance(1)
+            fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
+            te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
+            drawn.add(fam)
+            col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
+            out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
+                                    error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
+                                    K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
+                                    theory_curve=tc, golden_c=s.golden_c, reused=reused))
     meta["points_reused"] = sum(s.reused for s in out)
     return HoveringAreaResult(scene=scene, meta=meta, series=out)
 
