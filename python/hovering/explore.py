@@ -66,6 +66,7 @@ _WHY = {
     Status.NON_FINITE: "the state became non-finite",
     Status.IMPACT_LIMIT: "too many impacts in one return",
     Status.OFF_SECTION: "left Sigma_h",
+    Status.OUTSIDE_WELL: "reached the edge of a bounded well",
 }
 _WHY_AT_START = {
     Status.ESCAPED: "the point lies outside the band where the map is defined",

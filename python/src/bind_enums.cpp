@@ -29,6 +29,7 @@ void register_enums(py::module_& m) {
         .value("NON_FINITE", Status::NonFinite, "flow: the state became non-finite (a runaway orbit)")
         .value("IMPACT_LIMIT", Status::ImpactLimit, "flow: more impacts in one return than max_impacts")
         .value("OFF_SECTION", Status::OffSection, "flow: the point is not on Sigma_h at this energy")
+        .value("OUTSIDE_WELL", Status::OutsideWell, "flow: no accepted step keeps the state inside a bounded well")
         .finalize();
     py::native_enum<FlowStatus>(m, "FlowStatus", "enum.IntEnum", "Outcome of one return of the flow.")
         .value("OK", FlowStatus::Ok, "returned to Sigma_h")
@@ -39,6 +40,7 @@ void register_enums(py::module_& m) {
         .value("IMPACT_LIMIT", FlowStatus::ImpactLimit, "more impacts than max_impacts in one return (chattering)")
         .value("OFF_SECTION", FlowStatus::OffSection, "the starting point is not on Sigma_h at this energy")
         .value("INTERRUPTED", FlowStatus::Interrupted, "the batch was interrupted before this return ended")
+        .value("OUTSIDE_WELL", FlowStatus::OutsideWell, "no accepted step keeps the state inside a bounded well")
         .finalize();
     py::native_enum<TrajectoryPoint>(m, "TrajectoryPoint", "enum.IntEnum", "What a recorded trajectory point is.")
         .value("SAMPLE", TrajectoryPoint::Sample, "uniform sample at t = k dt of the orbit's clock")

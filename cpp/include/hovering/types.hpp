@@ -31,6 +31,7 @@ enum class Status : std::int8_t {
     NonFinite = 7,     ///< flow: the state became non-finite (a runaway orbit)
     ImpactLimit = 8,   ///< flow: more impacts in one return than allowed (chattering)
     OffSection = 9,    ///< flow: the point is not on Sigma_h at this energy
+    OutsideWell = 10,  ///< flow: no accepted step keeps the state inside a bounded well (e.g. Tan)
 };
 
 /// Which implementation of one map step a batch iteration uses.

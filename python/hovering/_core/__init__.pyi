@@ -25,6 +25,7 @@ class Status(enum.IntEnum):
     NON_FINITE = 7
     IMPACT_LIMIT = 8
     OFF_SECTION = 9
+    OUTSIDE_WELL = 10
 
 class FlowStatus(enum.IntEnum):
     OK = 0
@@ -35,6 +36,7 @@ class FlowStatus(enum.IntEnum):
     IMPACT_LIMIT = 5
     OFF_SECTION = 6
     INTERRUPTED = 7
+    OUTSIDE_WELL = 8
 
 class TrajectoryPoint(enum.IntEnum):
     SAMPLE = 0

@@ -71,7 +71,9 @@ class ReturnMapResult(Saveable):
     status : ndarray of int8
         Per-orbit :class:`FlowStatus`: OK, or why this orbit alone stopped (CORNER, GRAZING,
         STEP_LIMIT, NON_FINITE, IMPACT_LIMIT, OFF_SECTION for a start with no point of Sigma_h,
-        INTERRUPTED); the others are computed regardless.
+        INTERRUPTED, OUTSIDE_WELL where no accepted step keeps the state inside a bounded well such
+        as Tan's); the others are computed regardless. ``z`` and ``time`` of a stopped orbit are
+        the last state reached (always inside the wells) and its time.
     energy_error : ndarray
         ``|H(image) - H(start)|``.
     steps : ndarray of int64

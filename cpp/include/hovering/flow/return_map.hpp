@@ -26,6 +26,7 @@ enum class FlowStatus : std::int8_t {
     ImpactLimit = 5,  ///< more impacts than max_impacts in one return (chattering)
     OffSection = 6,   ///< the starting point is not on Sigma_h at this energy (nothing integrated)
     Interrupted = 7,  ///< the caller cancelled the batch before or during this return
+    OutsideWell = 8,  ///< no step that the tolerances accept keeps the state inside a bounded well
 };
 
 /// The orbit outcome (Status) of a return that ended with this FlowStatus.
@@ -61,7 +62,7 @@ std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z);
 /// Result of one return.
 struct ReturnResult {
     std::array<double, 4> z{};  ///< state at the return (or where the orbit stopped)
-    double time = 0;            ///< return time (up to the stop for a non-Ok status)
+    double time = 0;            ///< return time, or the time of z where the orbit stopped (every status)
     FlowStatus status = FlowStatus::Ok;  ///< how the return ended
     /// Impacts in order ('R' right wall, '1' upper wall: "R", "1", "11", "R1", ...); without
     /// impact "0" if the segment crossed q1 = qw1 above the step, "u" if it never crossed it;

@@ -24,7 +24,8 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
         "provide; got '" + name + "'");
 }
 
-Integrator::Integrator(const FlowSystem& s, const FlowOptions& o) : field_(s), atol_(o.atol), rtol_(o.rtol) {
+Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
+    : field_(s), atol_(o.atol), rtol_(o.rtol), qlim1_(s.V1->q_limit()), qlim2_(s.V2->q_limit()) {
     gsl_quiet();
     sys_ = gsl_odeiv2_system{field_.fn, nullptr, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
@@ -67,37 +68,67 @@ void Integrator::restart() {
     }
 }
 
-bool Integrator::advance(double* y, double* d, double* h, double hmax, double* h_done) {
+Integrator::Advance Integrator::advance(double* y, double* d, double* h, double hmax, double* h_done) {
     const int n = field_.dim;
-    if (driver_) {
-        const double t0 = t_ms_;
-        *h = std::min(*h, hmax);
-        const int st = gsl_odeiv2_evolve_apply(driver_->e, driver_->c, driver_->s, &sys_, &t_ms_, t0 + hmax, h, y);
-        bool finite = st == GSL_SUCCESS;
-        for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y[i]);
-        *h_done = t_ms_ - t0;
-        if (!finite || !(*h_done > 0)) return false;
-        field_(y, d);
-        return true;
+    double y0[kMaxDim], d0[kMaxDim], err[kMaxDim], dout[kMaxDim];
+    for (int i = 0; i < n; ++i) {
+        y0[i] = y[i];
+        d0[i] = d[i];
     }
-    double y0[kMaxDim], err[kMaxDim], dout[kMaxDim];
-    for (int i = 0; i < n; ++i) y0[i] = y[i];
+    auto restore = [&] {
+        for (int i = 0; i < n; ++i) {
+            y[i] = y0[i];
+            d[i] = d0[i];
+        }
+    };
+    // A loose tolerance lets a large step jump across the edge of a bounded well (Tan: the force is
+    // a polynomial in u = tan(alpha q), so nothing stops the stepper at |alpha q| = pi / 2 and it
+    // carries on in the next branch of tan). The exact flow never gets there at finite energy, so
+    // such a step is rejected like one with too large an error, and halved.
+    bool left_well = false;
+    if (driver_) {
+        for (;;) {
+            const double t0 = t_ms_;
+            *h = std::min(*h, hmax);
+            const int st = gsl_odeiv2_evolve_apply(driver_->e, driver_->c, driver_->s, &sys_, &t_ms_, t0 + hmax, h, y);
+            bool finite = st == GSL_SUCCESS;
+            for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y[i]);
+            *h_done = t_ms_ - t0;
+            if (finite && *h_done > 0 && inside(y)) {
+                field_(y, d);
+                return Advance::Ok;
+            }
+            const double tried = *h_done;
+            restore();
+            if (!finite || !(tried > 0)) return left_well ? Advance::OutsideWell : Advance::Failed;
+            // Outside a well: forget the multistep history (it holds the bad step) and retry shorter.
+            left_well = true;
+            gsl_odeiv2_driver_reset(driver_);
+            t_ms_ = t0;
+            *h = 0.5 * tried;
+            if (!(*h >= 1e-14 * hmax)) return Advance::OutsideWell;
+        }
+    }
     for (;;) {
         const double h0 = std::min(*h, hmax);
         const int st = gsl_odeiv2_step_apply(step_, 0.0, h0, y, err, d, dout, &sys_);
         bool finite = st == GSL_SUCCESS;
         for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y[i]) && std::isfinite(err[i]);
+        const bool in = finite && inside(y);
+        left_well = left_well || (finite && !in);
         double hn = h0;
-        const int adj = finite ? hadjust(y, err, &hn) : GSL_ODEIV_HADJ_DEC;
+        const int adj = in ? hadjust(y, err, &hn) : GSL_ODEIV_HADJ_DEC;
         if (adj != GSL_ODEIV_HADJ_DEC) {
             for (int i = 0; i < n; ++i) d[i] = dout[i];
             *h_done = h0;
             *h = hn;
-            return true;
+            return Advance::Ok;
         }
-        for (int i = 0; i < n; ++i) y[i] = y0[i];
-        *h = finite ? hn : 0.5 * h0;
-        if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) return false;  // the tolerance cannot be met
+        restore();
+        *h = in ? hn : 0.5 * h0;
+        if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) {  // the tolerance cannot be met
+            return left_well ? Advance::OutsideWell : Advance::Failed;
+        }
     }
 }
 

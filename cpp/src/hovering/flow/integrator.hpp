@@ -4,6 +4,7 @@
 
 #include <gsl/gsl_odeiv2.h>
 
+#include <cmath>
 #include <string>
 
 #include "hovering/flow/field.hpp"
@@ -41,11 +42,17 @@ public:
     int hadjust(const double* y, const double* err, double* h) const;
     /// Forget the step history (a new orbit, or a restart after an impact).
     void restart();
-    /// One error-controlled step (GSL step, GSL's standard step-size rule) from (y, d = field(y)) with trial length *h (<= hmax): on return
-    /// y, d hold the new state and its derivative, *h_done the length taken, *h the proposal for
-    /// the next step. Rejected trials shrink *h and retry from the same state. false: the step
-    /// size underflowed or the stepper failed (non-finite state); y is then unspecified.
-    bool advance(double* y, double* d, double* h, double hmax, double* h_done);
+    /// Outcome of advance().
+    enum class Advance { Ok, Failed, OutsideWell };
+    /// One error-controlled step (GSL step, GSL's standard step-size rule) from (y, d = field(y)) with
+    /// trial length *h (<= hmax): on Ok y, d hold the new state and its derivative, *h_done the
+    /// length taken, *h the proposal for the next step. Rejected trials (error too large, or an end
+    /// state outside a bounded well) shrink *h and retry from the same state. Failed: the step size
+    /// underflowed or the stepper failed (non-finite state); OutsideWell: every step down to 1e-14
+    /// hmax left a well. In both y, d are the unchanged start state.
+    Advance advance(double* y, double* d, double* h, double hmax, double* h_done);
+    /// Whether (q1, q2) of y lie strictly inside both wells (|q| < q_limit).
+    bool inside(const double* y) const { return std::fabs(y[0]) < qlim1_ && std::fabs(y[2]) < qlim2_; }
     /// Before an event search on [0, h] from y0 (msadams only: sizes the rk8pd extension).
     void prepare_extension(const double* y0, const double* d0, double h);
     /// The continuous extension of the current step at length dt from y0 (derivative d0).
@@ -61,6 +68,7 @@ private:
     int ext_sub_ = 1;                      // substeps of the extension
     double t_ms_ = 0;                      // msadams: running time (its history is in time)
     double atol_, rtol_;
+    double qlim1_, qlim2_;      // the wells' edges (infinite for unbounded potentials)
     int order_ = 8;             // one-step methods: the stepper's order, for the step-size rule
     double grow_below_ = 0.43;  // 0.9^order: below this scaled error the step grows
 };

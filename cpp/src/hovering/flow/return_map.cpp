@@ -25,6 +25,7 @@ Status orbit_status(FlowStatus s) {
         case FlowStatus::ImpactLimit: return Status::ImpactLimit;
         case FlowStatus::OffSection: return Status::OffSection;
         case FlowStatus::Interrupted: return Status::Interrupted;
+        case FlowStatus::OutsideWell: return Status::OutsideWell;
     }
     return Status::NonFinite;
 }

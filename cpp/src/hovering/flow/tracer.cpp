@@ -165,11 +165,10 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         }
         const double t0 = t;
         double h = 0;
-        const bool ok = in_.advance(y, dy, &dt, hmax, &h);
+        const Integrator::Advance adv = in_.advance(y, dy, &dt, hmax, &h);
         ++r.steps;
-        if (!ok) {
-            for (int i = 0; i < n; ++i) y[i] = y0[i];
-            r.status = FlowStatus::NonFinite;
+        if (adv != Integrator::Advance::Ok) {  // y is the last good state, at time t
+            r.status = adv == Integrator::Advance::OutsideWell ? FlowStatus::OutsideWell : FlowStatus::NonFinite;
             break;
         }
         t = t0 + h;
@@ -324,8 +323,9 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
         armed = armed || (seen_negative && y[1] > 0);
     }
-    if (!done) {
+    if (!done) {  // stopped between events (step limit, non-finite, outside a well, interrupted)
         for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
+        r.time = t;
         if (dense) dense->push(dense->offset + t, y, TrajectoryPoint::End);
     }
     if (labels && r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None) {
