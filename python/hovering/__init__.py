@@ -83,6 +83,7 @@ from .truncated import (
 )
 from .truncated.theory import theory
 from .explore import explore
+from .accuracy import WorkPrecision, work_precision
 from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one release)
 
 __version__ = "0.2.0"
@@ -90,6 +91,8 @@ __version__ = "0.2.0"
 simd_is_avx2 = _core.truncated.simd_is_avx2
 
 __all__ = [
+    "WorkPrecision",
+    "work_precision",
     "TruncatedMap",
     "TruncatedFamily",
     "IterateResult",

@@ -7,6 +7,10 @@
     and the PNG, prints the numbers shown.
 ``redraw RESULT.npz [--out PNG]``
     Redraws a saved result's figure without computing.
+``accuracy SCENE.toml [--quick] [--out PNG]``
+    The work-precision diagram of the scene's own system (flow scenes: error of one return and of
+    long orbits vs time per return, one curve per stepper; truncated-map scenes: rotation-number
+    error vs time), its table on stdout and as JSON next to the PNG.
 ``explore SCENE.toml [--n-steps N]``
     A phase portrait where a click launches an orbit (needs an interactive matplotlib backend).
 
@@ -115,6 +119,40 @@ def _redraw(args) -> int:
     return 0
 
 
+def _accuracy(args) -> int:
+    import json
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ._common import output_path
+    from .accuracy import work_precision
+    from .flow.section import Section
+    from .scenes import load_scene
+    from .scenes.compute import scene_map
+    from .scenes.spec import FlowScene
+
+    try:
+        scene = load_scene(args.path, check_output=False)
+        out = output_path("--out", args.out if args.out is not None else f"accuracy_{Path(args.path).stem}.png")
+    except (OSError, ValueError) as e:
+        return _error(e)
+    t0 = time.perf_counter()
+    try:
+        target = Section(scene.system.build(), scene.h) if isinstance(scene, FlowScene) else scene_map(scene)
+        wp = work_precision(target, quick=args.quick)
+    except ValueError as e:
+        return _error(e)
+    fig = wp.plot()
+    fig.savefig(out, dpi=110)
+    side = Path(out).with_suffix(".json")
+    side.write_text(json.dumps(wp.to_dict(), indent=1), encoding="utf-8")
+    print(wp.format())
+    print(f"wrote {out} and {side} in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
 def _explore(args) -> int:
     try:
         from .explore import main as explore_main
@@ -165,8 +203,13 @@ def main(argv=None) -> int:
     rd = sub.add_parser("redraw", help="redraw a saved result (RESULT.npz) without computing")
     rd.add_argument("path", help="result file written by 'scene' (NPZ)")
     rd.add_argument("--out", default=None, help="output PNG (default: RESULT.png)")
+    ac = sub.add_parser("accuracy", help="work-precision diagram of a scene's system (error vs time per setting)")
+    ac.add_argument("path", help="scene file (TOML)")
+    ac.add_argument("--quick", action="store_true", help="fewer settings, points and returns (seconds, not minutes)")
+    ac.add_argument("--out", default=None, help="output PNG (default accuracy_<scene>.png); the table goes next to it as JSON")
     ex = sub.add_parser("explore", help="click to launch orbits on a scene's map (interactive backend)")
     ex.add_argument("path", help="scene file (TOML)")
     ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")
     args = p.parse_args(argv)
-    return {"demo": _demo, "scene": _scene, "redraw": _redraw, "explore": _explore}[args.cmd](args)
+    return {"demo": _demo, "scene": _scene, "redraw": _redraw, "accuracy": _accuracy,
+            "explore": _explore}[args.cmd](args)

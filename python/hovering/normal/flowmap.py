@@ -94,6 +94,15 @@ class FlowMap(MapAnalyses):
     curve : TangentialCurve, optional
         The tangential curve of this section (measured at rtol 1e-13 if not given, with as many
         wall points as its interpolation error below 1e-12 needs).
+    accuracy : float, optional
+        An accuracy target instead of ``stepper``/``rtol``/``atol``: the fastest setting measured
+        (here, on this system and energy: :func:`hovering.accuracy.choose_setting`) to keep the
+        section-coordinate error of one return (of ``accuracy_returns`` returns) within it. What
+        was chosen is in :attr:`integrator_options` and :attr:`accuracy_choice` (with its measured
+        error and cost per return). A ValueError names the best reachable error if none reaches it.
+    accuracy_returns : int, optional
+        Number of returns the ``accuracy`` target is for (default 1; errors grow as m^2 with the
+        number m of returns, so a 1e4-return portrait needs a much tighter setting).
     **options
         ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol`` (see
         :meth:`hovering.Section.return_map`).
@@ -120,18 +129,26 @@ class FlowMap(MapAnalyses):
 
     def __init__(self, sys: StepSystem, h: float = 1.0, coordinates: str = "normal", rtol: float = 1e-10,
                  atol: Optional[float] = None, stepper: str = "rk8pd", curve: Optional[TangentialCurve] = None,
-                 **options):
+                 accuracy: Optional[float] = None, accuracy_returns: int = 1, **options):
         if not isinstance(sys, StepSystem):
             raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
         if not is_choice(coordinates, ("normal", "section")):
             raise ValueError(f"coordinates must be 'normal' or 'section', got {coordinates!r}")
         self.section = Section(sys, h)
         self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
-        atol = rtol if atol is None else atol
         unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
         if unknown:
             raise ValueError(f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
                              "grazing_tol, corner_tol")
+        #: What an ``accuracy`` target chose (None without one): the row of the measurement.
+        self.accuracy_choice = None
+        if accuracy is not None:
+            from ..accuracy import choose_setting
+
+            self.accuracy_choice = choose_setting(self.section, accuracy, accuracy_returns)
+            stepper, rtol = self.accuracy_choice["method"], self.accuracy_choice["tolerance"]
+            atol = rtol
+        atol = rtol if atol is None else atol
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
         self.integrator_options = dict(rtol=float(rtol), atol=float(atol), stepper=stepper, **options)
         try:

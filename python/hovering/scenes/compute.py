@@ -468,7 +468,7 @@ def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) 
     lo = min(_auto_ylim(flow.K, floor)[0], _auto_ylim(model.K, floor)[0])
     hi = max(_auto_ylim(flow.K, floor)[1], _auto_ylim(model.K, floor)[1])
     t = time.perf_counter()
-    fg = flow_geometry(fm, (lo, hi), scene.corner_K, scene.integrator.rtol)
+    fg = flow_geometry(fm, (lo, hi), scene.corner_K, fm.integrator_options.get("rtol", 1e-10))
     meta["timings"]["corner curves"] = time.perf_counter() - t
     mg = map_geometry(tm, (lo, hi), corner_curves=scene.corner_K > 0)
     p = fm.onset
@@ -618,7 +618,7 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
                     phi1=tg.phi[:, 1], K1=tg.K[:, 1], theta1=tg.theta[:, 1], I1=tg.I[:, 1], q21=tg.z[:, 1, 2],
                     p21=tg.z[:, 1, 3])
     t = time.perf_counter()
-    corners = flow_geometry(fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, scene.integrator.rtol)
+    corners = flow_geometry(fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10))
     meta["timings"]["corner curves"] = time.perf_counter() - t
     return SigmaStructureResult(
         scene=scene, meta=meta, phi=res.phi[ok, 0], K=res.K[ok, 0], region=res.region[ok, 0],

@@ -264,7 +264,7 @@ _FLOW_RECORDS = {
 _SYSTEM_KEYS = ("V1", "V2", "coupling", "eps", "qw1", "qw2", "geometry")
 _POTENTIAL_KEYS = ("kind", "omega", "alpha")
 _SECTION_KEYS = ("h",)
-_INTEGRATOR_KEYS = ("stepper", "rtol", "atol")
+_INTEGRATOR_KEYS = ("stepper", "rtol", "atol", "accuracy")
 _OUTPUTS_KEYS = ("record", "trajectory_dt")
 _STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams")
 
@@ -628,7 +628,14 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
         rtol = _real(f"{where}.integrator.rtol", it["rtol"], lo=1e-15, hi=1e-2) if "rtol" in it else 1e-10
         atol = _real(f"{where}.integrator.atol", it["atol"], lo=1e-15, hi=1e-2) if "atol" in it else rtol
         stepper = _str(f"{where}.integrator.stepper", it["stepper"], _STEPPERS) if "stepper" in it else "rk8pd"
-        integ = IntegratorSpec(stepper, rtol, atol)
+        accuracy = None
+        if "accuracy" in it:
+            both = sorted({"stepper", "rtol", "atol"} & set(it))
+            if both:
+                raise ValueError(f"{where}.integrator: 'accuracy' picks the stepper and tolerances itself; "
+                                 f"remove {both} or 'accuracy'")
+            accuracy = _real(f"{where}.integrator.accuracy", it["accuracy"], lo=1e-13, hi=1e-2)
+        integ = IntegratorSpec(stepper, rtol, atol, accuracy)
     allowed, required = _FLOW_RECORDS[kind]
     record = tuple(sorted(set(required) | ({"regions"} & set(allowed))))
     dt = 0.02

@@ -347,11 +347,15 @@ class IntegratorSpec:
         ``rk8pd`` (default), ``rkck``, ``rkf45``, ``rk4``, ``rk2`` or ``msadams``.
     rtol, atol : float
         Tolerances of the step control (atol defaults to rtol).
+    accuracy : float or None
+        An accuracy target instead (``accuracy = 1e-9`` in [integrator]): the map picks the
+        fastest setting measured to reach it (:class:`~hovering.FlowMap` ``accuracy``).
     """
 
     stepper: str = "rk8pd"
     rtol: float = 1e-10
     atol: float = 1e-10
+    accuracy: Optional[float] = None
 
     def options(self) -> dict:
         """Keyword arguments of :class:`~hovering.FlowMap`.
@@ -360,6 +364,8 @@ class IntegratorSpec:
         -------
         dict
         """
+        if self.accuracy is not None:
+            return dict(accuracy=self.accuracy)
         return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol)
 
 
