@@ -460,6 +460,9 @@ def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) 
     fres = fm.iterate(phi0, K0, n, record=record, **_progress_kw(progress))
     meta["timings"]["flow"] = time.perf_counter() - t
     t = time.perf_counter()
+    meta["accuracy"] = _reversal_check(fm, fres, min(n, 1000))
+    meta["timings"]["reversal check"] = time.perf_counter() - t
+    t = time.perf_counter()
     mres = tm.iterate(phi0, K0, n, record=record)
     meta["timings"]["model"] = time.perf_counter() - t
     flow = OrbitSet.of(fres, labels, colors, ["fan"] * len(labels))
@@ -476,6 +479,25 @@ def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) 
     return FlowPortraitResult(scene=scene, meta=meta, flow=flow, model=model, flow_geometry=fg, model_geometry=mg,
                               onset=onset, forcing=np.asarray(fm.forcing_coefficients()), model_name=scene.model,
                               work=_work(fres))
+
+
+def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
+    """How far the integration carried the portrait's orbits: the first ``n_orbits`` that ran m
+    returns are run m returns back by time reversal from their m-th point; the distance to their
+    start (phi, K) is the reversal error. It needs no reference, and like the error it grows as
+    m^2 with the number of returns (``hovering.work_precision``)."""
+    from ..accuracy import _reverse
+
+    ok = np.flatnonzero(res.steps_done >= m)[:n_orbits]
+    out = {"integrator": {k: v for k, v in fm.integrator_options.items()}, "reversal_returns": int(m),
+           "reversal_orbits": int(ok.size), "reversal_error": float("nan")}
+    if ok.size and m > 0:
+        bt, bk, alive = _reverse(fm, res.phi[ok, m], res.K[ok, m], m, 0)
+        d = np.maximum(np.abs((bt - res.phi[ok, 0] + np.pi) % (2 * np.pi) - np.pi), np.abs(bk - res.K[ok, 0]))
+        out["reversal_error"] = float(np.max(d[alive])) if alive.any() else float("nan")
+    if fm.accuracy_choice is not None:
+        out["accuracy_target"] = {k: fm.accuracy_choice[k] for k in ("error", "seconds", "returns")}
+    return out
 
 
 def _measured_model(fm, K_low: float):

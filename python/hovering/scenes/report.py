@@ -56,7 +56,7 @@ def summarize(result) -> dict:
     sc, meta = result.scene, result.meta
     s = dict(scene=sc.name, kind=sc.kind, title=sc.title, quick=bool(meta.get("quick")),
              runtime_s=float(meta.get("timings", {}).get("total", float("nan"))))
-    for k in ("n_steps", "samples", "points_reused", "checkpoint", "grid"):
+    for k in ("n_steps", "samples", "points_reused", "checkpoint", "grid", "accuracy"):
         if k in meta:
             s[k] = meta[k]
     if isinstance(result, OrbitSceneResult):
@@ -122,6 +122,12 @@ def format_summary(summary: dict) -> str:
     if "n_steps" in summary:
         head += f", {summary['n_steps']} iterates"
     lines = [head + (" [quick]" if summary["quick"] else "")]
+    acc = summary.get("accuracy")
+    if acc:
+        it = ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in acc["integrator"].items()
+                       if k in ("stepper", "rtol", "atol"))
+        lines.append(f"  integrator: {it}; reversal error after {acc['reversal_returns']} returns "
+                     f"({acc['reversal_orbits']} orbits): {acc['reversal_error']:.2g} (grows as m^2)")
     for p in summary.get("panels", []):
         if "zoom_of" in p:
             w = p.get("window")

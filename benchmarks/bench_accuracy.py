@@ -1,0 +1,95 @@
+"""Work-precision diagrams of the README: the flow (Harmonic(1) + Tan(1.4, 0.7), qw = (-1, -0.5), h = 1;
+wall and step geometries; eps = 0 and 0.05) and the truncated map, measured in one run.
+
+Prints each table (hovering.work_precision), the ratios that matter (time per return at matched
+error between steppers, the exact flow against rk8pd at rtol 1e-13, the long-orbit growth
+error(1e4) / error(1)), and writes the diagrams to docs/accuracy_*.png.
+
+Run: python benchmarks/bench_accuracy.py [--quick]   (about 5 minutes; --quick: 30 s)
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import numpy as np  # noqa: E402
+
+import hovering  # noqa: E402
+from hovering.accuracy import exact_available  # noqa: E402
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+
+
+def system(eps, geometry):
+    return hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
+                               eps=eps, qw1=-1.0, qw2=-0.5, geometry=geometry)
+
+
+def matched(wp, a, b, error):
+    """seconds(b) / seconds(a) of the fastest settings of methods a and b that reach error."""
+    ra = [r for r in wp.table if r["method"] == a and r["error"] <= error]
+    rb = [r for r in wp.table if r["method"] == b and r["error"] <= error]
+    if not ra or not rb:
+        return None
+    return min(r["seconds"] for r in rb) / min(r["seconds"] for r in ra)
+
+
+def exact_speed(sec, n=2000):
+    """(seconds per return of exact, of rk8pd at rtol = atol = 1e-13, max distance between them)."""
+    rng = np.random.default_rng(5)
+    th, I = rng.uniform(-np.pi, np.pi, n), rng.uniform(0.05, 0.4, n)
+    out = {}
+    for name, kw in (("exact", {"stepper": "exact"}), ("rk8pd", {"rtol": 1e-13, "atol": 1e-13})):
+        best = np.inf
+        for _ in range(3):
+            t0 = time.perf_counter()
+            r = sec.return_map(th, I, n_threads=1, **kw)
+            best = min(best, time.perf_counter() - t0)
+        out[name] = (best / n, r)
+    a, b = out["exact"][1], out["rk8pd"][1]
+    ok = (a.status == 0) & (b.status == 0)
+    d = np.maximum(np.abs(hovering.wrap(a.theta - b.theta)), np.abs(a.I - b.I))[ok]
+    return out["exact"][0], out["rk8pd"][0], float(d.max())
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    DOCS.mkdir(exist_ok=True)
+    returns = (1, 100) if args.quick else (1, 100, 10_000)
+    for eps, geometry in ((0.0, "wall"), (0.0, "step"), (0.05, "wall"), (0.05, "step")):
+        sec = hovering.Section(system(eps, geometry), 1.0)
+        t0 = time.perf_counter()
+        wp = hovering.work_precision(sec, quick=args.quick, returns=returns)
+        print(f"\n## {geometry}, eps = {eps}  ({time.perf_counter() - t0:.0f} s)\n")
+        print(wp.format())
+        for err in (1e-6, 1e-9, 1e-12):
+            for other in ("rkck", "rkf45", "msadams"):
+                r = matched(wp, "rk8pd", other, err)
+                if r is not None:
+                    print(f"  error <= {err:g}: {other} / rk8pd time per return = {r:.2f}")
+        for row in wp.table:
+            ea = row.get("error_after", {})
+            if returns[-1] in ea and ea[1] > 0:
+                print(f"  {row['method']} {row['tolerance']:.0e}: error({returns[-1]}) / error(1) = "
+                      f"{ea[returns[-1]] / ea[1]:.3g}  (m^2 = {returns[-1] ** 2:.0e})")
+        if exact_available(sec):
+            te, tr, d = exact_speed(sec)
+            print(f"  exact: {1e6 * te:.2f} us per return; rk8pd at rtol 1e-13: {1e6 * tr:.2f} us; "
+                  f"ratio {tr / te:.0f}x; max distance {d:.2g}")
+        wp.plot().savefig(DOCS / f"accuracy_{geometry}_eps{eps:g}.png", dpi=90)
+    m = hovering.TruncatedMap(eps=0.05, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    wp = hovering.work_precision(m, quick=args.quick)
+    print("\n## truncated map (rotation number)\n")
+    print(wp.format())
+    wp.plot().savefig(DOCS / "accuracy_truncated.png", dpi=90)
+
+
+if __name__ == "__main__":
+    main()
