@@ -87,16 +87,23 @@ double LinearFlow::fastest_rate() const { return std::max(rate_[0], rate_[1]); }
 void LinearFlow::propagate(const double* y0, double t, double* y1) const {
     const double q[2] = {y0[0], y0[2]}, p[2] = {y0[1], y0[3]};
     double x[2], v[2];
+    if (!(t == t_last_)) {
+        for (int k = 0; k < 2; ++k) {
+            const double lam = lam_[std::size_t(k)], a = rate_[std::size_t(k)] * t;
+            c_last_[k] = lam > 0 ? std::cos(a) : lam < 0 ? std::cosh(a) : 1.0;
+            s_last_[k] = lam > 0 ? std::sin(a) : lam < 0 ? std::sinh(a) : 0.0;
+        }
+        t_last_ = t;
+    }
     for (int k = 0; k < 2; ++k) {
         // Mode k: x'' = -lam x, x = Q^T q.
         const double x0 = Q_[0][k] * q[0] + Q_[1][k] * q[1], v0 = Q_[0][k] * p[0] + Q_[1][k] * p[1];
         const double lam = lam_[std::size_t(k)], s = rate_[std::size_t(k)];
+        const double c = c_last_[k], sn = s_last_[k];
         if (lam > 0) {
-            const double c = std::cos(s * t), sn = std::sin(s * t);
             x[k] = c * x0 + sn / s * v0;
             v[k] = -s * sn * x0 + c * v0;
         } else if (lam < 0) {
-            const double c = std::cosh(s * t), sn = std::sinh(s * t);
             x[k] = c * x0 + sn / s * v0;
             v[k] = s * sn * x0 + c * v0;
         } else {

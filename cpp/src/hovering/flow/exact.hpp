@@ -13,6 +13,7 @@
 //    GSL's steppers, with the closed form as its continuous extension.
 
 #include <array>
+#include <limits>
 #include <string>
 
 #include "hovering/flow/return_map.hpp"
@@ -41,6 +42,9 @@ public:
 private:
     std::array<double, 2> lam_{}, rate_{};  // eigenvalues, sqrt(|eigenvalue|)
     double Q_[2][2]{};                      // columns: unit eigenvectors
+    // The modes' (cos, sin) or (cosh, sinh) at the last t: every full step has the same length
+    // (one LinearFlow per integrator, i.e. per worker: no sharing).
+    mutable double t_last_ = std::numeric_limits<double>::quiet_NaN(), c_last_[2]{}, s_last_[2]{};
 };
 
 /// One oscillator's closed-form angle flow: (q, p) <-> (h, theta) and theta(t) = theta + omega t.
