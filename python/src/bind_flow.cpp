@@ -77,7 +77,9 @@ void register_flow(py::module_& m) {
         .def_readonly("max_steps", &FlowOptions::max_steps)
         .def_readonly("max_impacts", &FlowOptions::max_impacts)
         .def_readonly("grazing_tol", &FlowOptions::grazing_tol)
-        .def_readonly("corner_tol", &FlowOptions::corner_tol);
+        .def_readonly("corner_tol", &FlowOptions::corner_tol)
+        .def("validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
+             "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");
 
     m.def("section_points",
           [](const FlowSystem& s, double h, const darray& theta, const darray& I) {

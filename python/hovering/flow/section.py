@@ -16,8 +16,9 @@ from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
 
-#: GSL steppers the flow offers: explicit Runge-Kutta methods and the Adams multistep method.
-STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams")
+#: Steppers the flow offers: GSL's explicit Runge-Kutta methods and Adams multistep method, and
+#: ``"exact"``, the flow in closed form where the system has one (see :meth:`Section.return_map`).
+STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "exact")
 
 
 def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd", event_tol: float = 1e-15,
@@ -28,7 +29,8 @@ def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd
     Parameters
     ----------
     rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol
-        See :meth:`Section.return_map`.
+        See :meth:`Section.return_map` (``"exact"`` ignores rtol and atol; whether it applies
+        depends on the system: ``FlowOptions.validate_for(system)``).
 
     Returns
     -------
@@ -36,7 +38,7 @@ def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd
     """
     if not is_choice(stepper, STEPPERS):
         raise ValueError(f"stepper must be one of {STEPPERS} (the implicit GSL steppers need a Jacobian the flow does "
-                         f"not provide), got {stepper!r}")
+                         f"not provide; 'exact' is the closed-form flow), got {stepper!r}")
     return _core.flow.FlowOptions(
         stepper=stepper, rtol=real_number("rtol", rtol, 1e-16, False, 1, True), atol=real_number("atol", atol, 0),
         event_tol=real_number("event_tol", event_tol, 0), max_steps=integer("max_steps", max_steps, 1, 2**62),
@@ -223,11 +225,17 @@ class Section:
         theta, I : array_like
             Section coordinates of the starting points.
         rtol, atol : float, optional
-            Tolerances of GSL's step-size control.
-        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams"}, optional
+            Tolerances of GSL's step-size control (not read by ``"exact"``).
+        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "exact"}, optional
             GSL stepper: an explicit Runge-Kutta method, or the variable-order Adams multistep
             method (its events are located on an rk8pd extension of each step; on this smooth,
-            oscillatory flow it is ~7x slower than rk8pd at matched accuracy).
+            oscillatory flow it is ~7x slower than rk8pd at matched accuracy). ``"exact"``: the
+            flow in closed form, for eps = 0 (or no coupling) with V1, V2 each Harmonic or Tan
+            (each oscillator turns on its own action-angle circle, an impact is an angle jump
+            theta -> -theta_w: returns are computed event to event, to rounding, ~1e-15) and for
+            Harmonic V1, V2 with a quadratic coupling at any eps (a linear flow, stepped through
+            its normal modes; events located as for the GSL steppers). Other systems raise
+            ValueError. ``steps`` then counts events passed (or closed-form steps).
         event_tol : float, optional
             Time accuracy of located events (impacts, section crossing, a wall distance's
             minimum): Newton's method on exact stepper steps runs until its correction is below
@@ -265,13 +273,15 @@ class Section:
         Raises
         ------
         ValueError
-            For bad options (named, with the allowed range), non-finite / out-of-range angles,
+            For bad options (named, with the allowed range), a stepper the system does not
+            admit ("exact" without a closed-form flow), non-finite / out-of-range angles,
             bad trajectory bounds or a bad ``progress``.
         KeyboardInterrupt
             On Ctrl-C: its ``partial`` attribute holds the ReturnMapResult with every finished
             return and status INTERRUPTED for the rest.
         """
         opts = flow_options(rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)
+        opts.validate_for(self.sys.core)
         threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)

@@ -90,7 +90,8 @@ class FlowMap(MapAnalyses):
         below rtol only tightens the steps where a momentum crosses zero: at rtol 1e-10,
         atol 1e-12 costs 17% more steps for a 2.5x smaller error per return).
     stepper : str, optional
-        GSL stepper (see :data:`hovering.flow.STEPPERS`).
+        GSL stepper, or ``"exact"`` for the closed-form flow (see :data:`hovering.flow.STEPPERS`
+        and :meth:`hovering.Section.return_map`; it ignores rtol and atol).
     curve : TangentialCurve, optional
         The tangential curve of this section (measured at rtol 1e-13 if not given, with as many
         wall points as its interpolation error below 1e-12 needs).
@@ -150,6 +151,7 @@ class FlowMap(MapAnalyses):
             atol = rtol
         atol = rtol if atol is None else atol
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
+        self._options.validate_for(sys.core)  # before the tangential curve is measured
         self.integrator_options = dict(rtol=float(rtol), atol=float(atol), stepper=stepper, **options)
         try:
             self.onset = onset_parameters(sys, self.h)

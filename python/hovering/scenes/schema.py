@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Optional
 
 from .._common import output_path
+from ..flow.section import STEPPERS
 from ..truncated.theory import OMEGA_G, golden_family
 from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHoveringScene, FlowPortraitScene,
                    HoveringAreaScene, IntegratorSpec, MapSpec, OrbitScene, OrbitSpec, OutputsSpec, PanelSpec,
@@ -266,7 +267,7 @@ _POTENTIAL_KEYS = ("kind", "omega", "alpha")
 _SECTION_KEYS = ("h",)
 _INTEGRATOR_KEYS = ("stepper", "rtol", "atol", "accuracy")
 _OUTPUTS_KEYS = ("record", "trajectory_dt")
-_STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams")
+_STEPPERS = STEPPERS
 
 
 def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bool = True) -> SceneSpec:

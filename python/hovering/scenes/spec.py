@@ -344,7 +344,9 @@ class IntegratorSpec:
     Attributes
     ----------
     stepper : str
-        ``rk8pd`` (default), ``rkck``, ``rkf45``, ``rk4``, ``rk2`` or ``msadams``.
+        ``rk8pd`` (default), ``rkck``, ``rkf45``, ``rk4``, ``rk2``, ``msadams`` or ``exact`` (the
+        closed-form flow: eps = 0 with Harmonic/Tan potentials, or Harmonic ones with a bilinear
+        coupling; it ignores the tolerances).
     rtol, atol : float
         Tolerances of the step control (atol defaults to rtol).
     accuracy : float or None

@@ -33,10 +33,14 @@ enum class FlowStatus : std::int8_t {
 Status orbit_status(FlowStatus s);
 
 /// Integrator settings.
+/// Stepper "exact" is the flow in closed form where the system has one (eps = 0 with Harmonic or
+/// Tan potentials: event to event on the action-angle variables; Harmonic + Harmonic with a
+/// quadratic coupling: the normal modes of the linear flow); it ignores rtol and atol, and its
+/// "steps" are events passed (uncoupled) or closed-form steps of 1/8 period (linear).
 struct FlowOptions {
-    std::string stepper = "rk8pd";  ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd) or msadams
-    double rtol = 1e-10;            ///< relative tolerance of the step control
-    double atol = 1e-12;            ///< absolute tolerance of the step control
+    std::string stepper = "rk8pd";  ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd), msadams, or exact
+    double rtol = 1e-10;            ///< relative tolerance of the step control (not read by "exact")
+    double atol = 1e-12;            ///< absolute tolerance of the step control (not read by "exact")
     double event_tol = 1e-15;       ///< time accuracy of located events (Newton on exact steps)
     std::int64_t max_steps = 1000000;  ///< per return
     int max_impacts = 100;          ///< per return; more ends the orbit with ImpactLimit
@@ -44,6 +48,9 @@ struct FlowOptions {
     double corner_tol = 1e-10;      ///< distance to the corner below which an impact is a corner hit
     /// Validate (throws std::invalid_argument naming the bad value and the allowed range).
     void validate() const;
+    /// validate(), and that the stepper applies to s ("exact" needs a closed-form flow; the message
+    /// names what s has and what "exact" needs).
+    void validate(const FlowSystem& s) const;
 };
 
 /// Point of Sigma_h from section coordinates (theta, I) of the unperturbed H2 at energy h:

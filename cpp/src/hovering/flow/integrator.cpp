@@ -19,8 +19,9 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "rkck") return gsl_odeiv2_step_rkck;
     if (name == "rk8pd") return gsl_odeiv2_step_rk8pd;
     if (name == "msadams") return gsl_odeiv2_step_msadams;
-    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods) or msadams "
-        "(variable-order Adams multistep); the implicit steppers need a Jacobian the flow does not "
+    if (name == "exact") return nullptr;
+    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods), msadams "
+        "(variable-order Adams multistep) or exact (closed-form flow, where the system has one); the implicit steppers need a Jacobian the flow does not "
         "provide; got '" + name + "'");
 }
 
@@ -29,7 +30,12 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
     gsl_quiet();
     sys_ = gsl_odeiv2_system{field_.fn, nullptr, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
-    if (T == gsl_odeiv2_step_msadams) {
+    kind_ = detail::exact_kind(s, o);
+    if (kind_ != ExactKind::None) {
+        if (kind_ == ExactKind::Linear) linear_ = std::make_unique<LinearFlow>(s);
+        osc_[0].V = s.V1.get();
+        osc_[1].V = s.V2.get();
+    } else if (T == gsl_odeiv2_step_msadams) {
         driver_ = gsl_odeiv2_driver_alloc_standard_new(&sys_, T, 1e-3, o.atol, o.rtol, 1.0, 0.0);
         if (!driver_) throw std::bad_alloc();
         step_ = driver_->s;
@@ -51,9 +57,16 @@ Integrator::~Integrator() {
     if (driver_) {
         gsl_odeiv2_driver_free(driver_);
         gsl_odeiv2_step_free(ext_);
-    } else {
+    } else if (step_) {
         gsl_odeiv2_step_free(step_);
     }
+}
+
+double Integrator::max_step() const {
+    if (!linear_ || !(linear_->fastest_rate() > 0)) return kInf;
+    // As the oscillators' T/8: one step never holds both extrema of a mode (a cosh mode has none,
+    // and 1/8 of 2 pi over its rate keeps the growth per step below e^0.8).
+    return 0.125 * kTwoPi / linear_->fastest_rate();
 }
 
 void Integrator::restart() {
@@ -63,13 +76,24 @@ void Integrator::restart() {
         // depends on |t_ms_|, so a clock running on from earlier returns made a return depend on
         // what the worker had traced before (orbits differed with the thread count).
         t_ms_ = 0;
-    } else {
+    } else if (step_) {
         gsl_odeiv2_step_reset(step_);
     }
 }
 
 Integrator::Advance Integrator::advance(double* y, double* d, double* h, double hmax, double* h_done) {
     const int n = field_.dim;
+    if (kind_ != ExactKind::None) {  // no error to control: every step is hmax long
+        double y1[kMaxDim];
+        exact(y, d, hmax, y1);
+        bool finite = true;
+        for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y1[i]);
+        if (!finite) return Advance::Failed;
+        for (int i = 0; i < n; ++i) y[i] = y1[i];
+        field_(y, d);
+        *h = *h_done = hmax;
+        return Advance::Ok;
+    }
     double y0[kMaxDim], d0[kMaxDim], err[kMaxDim], dout[kMaxDim];
     for (int i = 0; i < n; ++i) {
         y0[i] = y[i];
@@ -172,6 +196,24 @@ void Integrator::prepare_extension(const double* y0, const double* d0, double h)
 
 void Integrator::exact(const double* y0, const double* d0, double dt, double* y1) {
     const int n = field_.dim;
+    if (kind_ == ExactKind::Linear) {
+        linear_->propagate(y0, dt, y1);
+        return;
+    }
+    if (kind_ == ExactKind::Angles) {
+        for (int i = 0; i < 2; ++i) {
+            AngleOscillator& a = osc_[i];
+            if (!a.set(y0[2 * i], y0[2 * i + 1])) {
+                y1[2 * i] = y1[2 * i + 1] = kNaN;
+                continue;
+            }
+            const auto [q, p] = a.at(a.theta + a.omega * dt);
+            y1[2 * i] = q;
+            y1[2 * i + 1] = p;
+        }
+        field_.sync_aux(y1);
+        return;
+    }
     double err[kMaxDim], din[kMaxDim];
     for (int i = 0; i < n; ++i) {
         y1[i] = y0[i];

@@ -5,14 +5,17 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
+#include "hovering/flow/exact.hpp"
 #include "hovering/flow/field.hpp"
 #include "hovering/flow/return_map.hpp"
 
 namespace hovering::detail {
 
-/// The GSL stepper type of a name; throws std::invalid_argument naming the allowed ones.
+/// The GSL stepper type of a name (null for "exact": no GSL stepper); throws std::invalid_argument
+/// naming the allowed ones.
 const gsl_odeiv2_step_type* stepper_type(const std::string& name);
 
 /// Owns the GSL objects of one integration, reused from return to return by one worker.
@@ -23,7 +26,8 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name);
 /// 14 evaluations per rk8pd step), and the event search needs exactly those two. The multistep
 /// msadams needs GSL's driver (it reads the control through it) and its history cannot restart
 /// inside a step, so its events are located on an rk8pd extension of the step, subdivided until
-/// rk8pd's own error estimate meets the tolerances.
+/// rk8pd's own error estimate meets the tolerances. Stepper "exact" holds no GSL object: a step is
+/// the closed-form flow over hmax, the extension the closed form itself (exact.hpp).
 class Integrator {
 public:
     Integrator(const FlowSystem& s, const FlowOptions& o);
@@ -35,8 +39,12 @@ public:
     const Field& field() const { return field_; }
     /// State dimension (4 plus one per Tan potential).
     int dim() const { return field_.dim; }
-    /// Order of the stepper (8 for rk8pd).
-    int order() const { return int(gsl_odeiv2_step_order(step_)); }
+    /// Order of the stepper (8 for rk8pd; "exact": 8, only the first trial step reads it, and exact steps ignore it).
+    int order() const { return step_ ? int(gsl_odeiv2_step_order(step_)) : 8; }
+    /// The closed form of stepper "exact" (None for the GSL steppers).
+    ExactKind exact_kind() const { return kind_; }
+    /// Longest step the stepper allows (infinite but for the linear flow: 1/8 of its fastest mode's period).
+    double max_step() const;
     /// The step-size rule of GSL's standard control for the step just taken (y its end, err its
     /// error estimate): scales *h and returns GSL_ODEIV_HADJ_DEC (reject), _INC or _NIL.
     int hadjust(const double* y, const double* err, double* h) const;
@@ -69,6 +77,9 @@ private:
     double t_ms_ = 0;                      // msadams: running time (its history is in time)
     double atol_, rtol_;
     double qlim1_, qlim2_;      // the wells' edges (infinite for unbounded potentials)
+    ExactKind kind_ = ExactKind::None;
+    std::unique_ptr<LinearFlow> linear_;   // stepper "exact", linear flow
+    AngleOscillator osc_[2];               // stepper "exact", uncoupled flow (step loop only)
     int order_ = 8;             // one-step methods: the stepper's order, for the step-size rule
     double grow_below_ = 0.43;  // 0.9^order: below this scaled error the step grows
 };

@@ -60,7 +60,7 @@ Region region_of(const std::string& itinerary) {
 
 ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, const FlowOptions& opt) {
     detail::gsl_quiet();
-    opt.validate();
+    opt.validate(s);
     s.validate();
     detail::Tracer tracer(s, opt);
     return tracer.trace(z0);
@@ -69,7 +69,7 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
 void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
                  const std::atomic<bool>* cancel, const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress) {
     detail::gsl_quiet();
-    opt.validate();
+    opt.validate(s);
     s.validate();
     if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
     if (n_threads < 0 || n_threads > detail::kMaxThreads)

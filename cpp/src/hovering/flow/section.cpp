@@ -4,6 +4,7 @@
 #include <string>
 
 #include "hovering/detail/common.hpp"
+#include "hovering/flow/exact.hpp"
 #include "hovering/flow/integrator.hpp"
 #include "hovering/flow/return_map.hpp"
 
@@ -22,6 +23,11 @@ void FlowOptions::validate() const {
     if (max_impacts < 1 || max_impacts > 1000000) bad("max_impacts must be in [1, 1000000], got " + std::to_string(max_impacts));
     if (!(grazing_tol >= 0 && std::isfinite(grazing_tol))) bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
     if (!(corner_tol >= 0 && std::isfinite(corner_tol))) bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
+}
+
+void FlowOptions::validate(const FlowSystem& s) const {
+    validate();
+    detail::exact_kind(s, *this);
 }
 
 bool try_section_point(const FlowSystem& s, double h, double theta, double I, std::array<double, 4>& z,

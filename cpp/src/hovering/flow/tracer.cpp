@@ -121,6 +121,7 @@ void Tracer::sample(const double* y0, const double* d0, double t0, double t_end)
 }
 
 ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
+    if (in_.exact_kind() == ExactKind::Angles && event_driven_) return trace_angles(z0, first_crossing, cancel);
     const FlowSystem& s = s_;
     const FlowOptions& opt = o_;
     const int n = in_.dim();
@@ -137,7 +138,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
     // for the O(eps) period shifts of the coupled flow.
     const double T1 = s.V1->period(std::max(1e-12, 0.5 * y[1] * y[1] + s.V1->V(y[0])));
     const double T2 = s.V2->period(std::max(1e-12, 0.5 * y[3] * y[3] + s.V2->V(y[2])));
-    const double hmax = 0.125 * std::min(T1, T2);
+    const double hmax = std::min(0.125 * std::min(T1, T2), in_.max_step());
     // First trial step hmax rtol^(1/order): about the step the tolerance allows on these
     // oscillations (0.06 hmax for rk8pd at 1e-10), so a return does not spend 4-5 steps ramping up
     // from a tiny one; it depends on the options only, so every return is reproducible alone.

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <vector>
 
+#include "hovering/flow/exact.hpp"
 #include "hovering/flow/integrator.hpp"
 #include "hovering/flow/return_map.hpp"
 
@@ -62,6 +63,9 @@ public:
     /// Whether returns are labelled (itinerary, crossings of q1 = qw1 above the step; default on).
     /// Off, the itinerary stays "" and no crossing is tracked; the orbit is the same bit for bit.
     void set_labels(bool on) { labels_ = on; }
+    /// Stepper "exact" on an uncoupled system: event to event in closed form (default), or off:
+    /// trace()'s step loop on closed-form steps (the same flow by another route, for tests).
+    void set_event_driven(bool on) { event_driven_ = on; }
     /// Record the following returns into this trajectory (null: no dense output, no dense work).
     void set_dense(DenseRecorder* d) { dense_ = d; }
     /// Everything counted since construction (FlowWork), field evaluations included.
@@ -79,12 +83,17 @@ private:
     // Uniform samples of the clock in [t0, t_end) (times within the return) of the step from
     // (y0, d0) at t0, each one exact stepper step from y0.
     void sample(const double* y0, const double* d0, double t0, double t_end);
+    // Stepper "exact", uncoupled system: the return event to event (exact.cpp).
+    ReturnResult trace_angles(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel);
+    // Uniform samples in [t0, t_end) of the angle flow from the angles of o at t0.
+    void sample_angles(const AngleOscillator* o, double t0, double t_end);
     const FlowSystem& s_;
     FlowOptions o_;
     Integrator in_;
     std::vector<Candidate> cands_;
     FlowWork work_;
     bool labels_ = true;
+    bool event_driven_ = true;
     DenseRecorder* dense_ = nullptr;
 };
 

@@ -33,8 +33,8 @@ FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const 
                  std::shared_ptr<const AnalyticArcs> lift)
     : s_(std::move(s)), h_(h), opt_(std::move(opt)), curve_(std::move(curve)), lift_(std::move(lift)) {
     detail::gsl_quiet();
+    opt_.validate(s_);
     s_.validate();
-    opt_.validate();
     if (!std::isfinite(h_)) bad("h must be finite, got " + fmt(h_));
     if (curve_) {
         if (!curve_->is_graph()) bad(curve_->not_graph_reason());

@@ -1,0 +1,64 @@
+#pragma once
+// The flow in closed form (internal): stepper "exact".
+//
+// Two families of systems have an exact flow between impacts:
+//  - Angles: eps = 0 (or no coupling term) with V1, V2 each Harmonic or Tan. Each oscillator keeps
+//    its energy h_i (a reflection only flips its momentum) and turns on its own angle,
+//    theta_i(t) = theta_i(0) + omega_i(h_i) t, through the potentials' closed action-angle forms.
+//    Every event is an angle reaching a known value, so the Tracer runs event to event
+//    (Tracer::trace_angles) instead of step by step.
+//  - Linear: V1, V2 both Harmonic and a coupling that is a quadratic form (terms q1 q2, q1^2, q2^2;
+//    constants do not move the flow), any eps: q'' = -K q, solved through the normal modes of K
+//    (cos/sin, linear or cosh/sinh for eigenvalues > 0, = 0, < 0). The Tracer steps it as it steps
+//    GSL's steppers, with the closed form as its continuous extension.
+
+#include <array>
+#include <limits>
+#include <string>
+
+#include "hovering/flow/return_map.hpp"
+
+namespace hovering::detail {
+
+/// Which closed form a system's flow has under stepper "exact".
+enum class ExactKind { None, Angles, Linear };
+
+/// The closed form of stepper "exact" for this system: None for the GSL steppers; for "exact",
+/// Angles or Linear, or std::invalid_argument naming what the system has and what "exact" needs.
+ExactKind exact_kind(const FlowSystem& s, const FlowOptions& o);
+
+/// q'' = -K q in closed form through the normal modes of the symmetric K.
+class LinearFlow {
+public:
+    /// The flow of a Linear system (exact_kind == Linear).
+    explicit LinearFlow(const FlowSystem& s);
+    /// y1 = exp(A t) y0 for y = (q1, p1, q2, p2).
+    void propagate(const double* y0, double t, double* y1) const;
+    /// The largest |eigenvalue|^(1/2) of K: the fastest rate of the flow.
+    double fastest_rate() const;
+    /// The eigenvalues of K (ascending).
+    const std::array<double, 2>& eigenvalues() const { return lam_; }
+
+private:
+    std::array<double, 2> lam_{}, rate_{};  // eigenvalues, sqrt(|eigenvalue|)
+    double Q_[2][2]{};                      // columns: unit eigenvectors
+    // The modes' (cos, sin) or (cosh, sinh) at the last t: every full step has the same length
+    // (one LinearFlow per integrator, i.e. per worker: no sharing).
+    mutable double t_last_ = std::numeric_limits<double>::quiet_NaN(), c_last_[2]{}, s_last_[2]{};
+};
+
+/// One oscillator's closed-form angle flow: (q, p) <-> (h, theta) and theta(t) = theta + omega t.
+struct AngleOscillator {
+    const Potential* V = nullptr;
+    double h = 0, omega = 0, theta = 0;  // energy, frequency (0 at rest, h = 0), angle in [-pi, pi)
+    double q_rest = 0, p_rest = 0;       // the state when it rests (h = 0)
+    /// Set (h, omega, theta) from (q, p); false if the level is not finite.
+    bool set(double q, double p);
+    /// (q, p) at angle th (any real: wrapped to [-pi, pi)).
+    std::pair<double, double> at(double th) const;
+};
+
+/// th wrapped to [-pi, pi).
+double wrap_angle(double th);
+
+}  // namespace hovering::detail
