@@ -265,6 +265,8 @@ TEST_CASE("onset: energy slopes and error estimates, near the step energy and fa
     // The wall 1e-8 of q_limit from the Tan singularity: finite, or an error; never NaN.
     const double qw2 = -(1 - 1e-8) * T.q_limit();
     const OnsetEstimate w = onset_estimate(H, T, -1.0, qw2, 1.5 * (0.5 + T.V(qw2)));
-    CHECK(std::isfinite(w.value.tau0) && std::isfinite(w.value.tau1) && w.value.tau1 > 0);
-    CHECK(w.error.theta_w <= 1e-6 * w.value.theta_w && w.value.theta_w < kPi);
+    CHECKF(std::isfinite(w.value.tau0) && std::isfinite(w.value.tau1) && w.value.tau1 > 0, "wall: tau0 %g tau1 %g", w.value.tau0,
+           w.value.tau1);
+    CHECKF(w.error.theta_w <= 1e-6 * w.value.theta_w && w.value.theta_w < kPi, "wall: theta_w %.17g +- %g", w.value.theta_w,
+           w.error.theta_w);
 }
