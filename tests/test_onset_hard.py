@@ -305,7 +305,7 @@ def test_corner_energies():
             lo = mid
     p, e = onset_parameters(SYS, HW + hi, errors=True)
     check_against_reference(p, e, ref_sys(HW + hi), ("boundary", hi))
-    assert 1e-10 < hi < 1e-8  # tau1's relative error ~ 1e-15 / (2 (h - h_w)) reaches 1e-6 near 1e-9
+    assert 1e-10 < hi < 1e-8  # README: 7.3e-10 (tau1: ~1.1e-15 / (2 (h - h_w)) plus its own error reaches 1e-6)
     # The other singular action, I(h) (H1 = 0 on the torus): I_tan approaches it as qw1 -> 0.
     # V1(qw1) = 5e-201 still works (tau0, T1 are smooth at H1 = 0 for Harmonic/Tan) ...
     for V1, a1 in ((Harmonic(1.0), 0.0), (Tan(1.0, 0.6), 0.6)):
