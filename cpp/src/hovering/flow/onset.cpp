@@ -105,7 +105,7 @@ bool is_angle(const Part& p) { return std::string(p.name) == "tau1" || std::stri
               "); allowed: h - V1(qw1) well above that (or a larger rtol)";
     } else {
         why = std::string("the computation of ") + p.name + " itself has error " + fmt(p.own) + " (" + how +
-              "); allowed: a larger rtol" + (p.scale > 0 ? " or a closed-form potential" : "");
+              "); allowed: a larger rtol" + (how.find("quadrature") != std::string::npos ? " or a closed-form potential" : "");
     }
     bad("onset_parameters: " + std::string(p.name) + " = " + fmt(p.value) + " at h = " + fmt(in.h) + " (h - h_w = " +
         fmt(in.delta) + ") has estimated error " + fmt(E) + ", relative " + fmt(E / std::fabs(p.value)) +
