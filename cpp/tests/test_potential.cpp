@@ -217,3 +217,56 @@ TEST_CASE("generic angles next to the turning points", "[flow][potential]") {
         }
     }
 }
+
+TEST_CASE("onset: energy slopes and error estimates, near the step energy and far above it", "[flow][potential][onset]") {
+    // Closed-form slopes (Tan, Harmonic) against the generic path (Ridders differences of the
+    // quadratures) on the same V: the two share nothing but V, so their difference must lie within
+    // the sum of the two error estimates, and that sum must be small (the estimates are useful).
+    for (auto base : {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
+                      std::shared_ptr<const Potential>(std::make_shared<Tan>(1.4, 0.7))}) {
+        Numerical num(base);
+        for (double h : {1e-3, 0.7, 50.0}) {
+            const Estimate a = base->period_slope(h), b = num.period_slope(h);
+            CHECKF(std::fabs(a.value - b.value) <= a.error + b.error && a.error + b.error < 1e-8 * base->period(h) / h,
+                   "%s period_slope(%g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), h, a.value, a.error, b.value, b.error);
+            const double qmax = base->turning_points(h).second;
+            for (double f : {-0.999, -0.5, 0.3}) {
+                const Estimate c = base->angle_slope(f * qmax, h), d = num.angle_slope(f * qmax, h);
+                CHECKF(std::fabs(c.value - d.value) <= c.error + d.error && c.error + d.error < 1e-6 * std::fabs(c.value),
+                       "%s angle_slope(%g, %g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), f * qmax, h, c.value, c.error,
+                       d.value, d.error);
+            }
+        }
+        CHECK_INVALID(base->angle_slope(2 * base->turning_points(1.0).second, 1.0), "must lie strictly inside the level");
+    }
+
+    // The system of the README: the old single Richardson step gave tau0 = 5.736 (closed form
+    // 3.0788) at h_w + 1e-12, tau1 = -0.0 at 1e8, NaN with a wall 1e-8 from the Tan singularity.
+    Harmonic H(1.0);
+    Tan T(1.4, 0.7);
+    const double hw = H.V(-1.0) + T.V(-0.5);
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, hw + 1e-12), "below the resolution of the step energy");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, std::nextafter(hw, 1.0)), "below the resolution of the step energy");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, hw, 1e-6), "h must exceed the step energy");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, 1.0, 0.0), "rtol must lie in [1e-15, 1]");
+    for (double h : {hw + 1e-6, 1.0, 1e8, 1e100}) {
+        const OnsetEstimate d = onset_estimate(H, T, -1.0, -0.5, h), c = onset_estimate_closed_form(1.0, 0.0, 1.4, 0.7, -1.0, -0.5, h);
+        const double dv[] = {d.value.Omega0, d.value.tau0, d.value.tau1, d.value.lam, d.value.theta_w, d.value.I_tan};
+        const double de[] = {d.error.Omega0, d.error.tau0, d.error.tau1, d.error.lam, d.error.theta_w, d.error.I_tan};
+        const double cv[] = {c.value.Omega0, c.value.tau0, c.value.tau1, c.value.lam, c.value.theta_w, c.value.I_tan};
+        const double ce[] = {c.error.Omega0, c.error.tau0, c.error.tau1, c.error.lam, c.error.theta_w, c.error.I_tan};
+        for (int k = 0; k < 6; ++k)
+            CHECKF(std::fabs(dv[k] - cv[k]) <= de[k] + ce[k] && de[k] <= 1e-6 * std::fabs(dv[k]),
+                   "h = %.17g field %d: definitions %.17g +- %.3g vs closed form %.17g +- %.3g", h, k, dv[k], de[k], cv[k], ce[k]);
+        // Appendix: tau0 = 2 pi alpha2^2 / W1 with a harmonic V1, for every h; sign tau1 = -sign qw2.
+        CHECKF(std::fabs(d.value.tau0 - 2 * kPi * 0.49) <= 1e-13 * 2 * kPi * 0.49, "tau0 at h = %g: %.17g", h, d.value.tau0);
+        CHECKF(d.value.tau1 > 0, "tau1 at h = %g: %.17g", h, d.value.tau1);
+    }
+    // The wall 1e-8 of q_limit from the Tan singularity: finite, or an error; never NaN.
+    const double qw2 = -(1 - 1e-8) * T.q_limit();
+    const OnsetEstimate w = onset_estimate(H, T, -1.0, qw2, 1.5 * (0.5 + T.V(qw2)));
+    CHECKF(std::isfinite(w.value.tau0) && std::isfinite(w.value.tau1) && w.value.tau1 > 0, "wall: tau0 %g tau1 %g", w.value.tau0,
+           w.value.tau1);
+    CHECKF(w.error.theta_w <= 1e-6 * w.value.theta_w && w.value.theta_w < kPi, "wall: theta_w %.17g +- %g", w.value.theta_w,
+           w.error.theta_w);
+}

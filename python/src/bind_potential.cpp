@@ -398,7 +398,19 @@ void register_potential(py::module_& m) {
                    ", lam=" + g(p.lam) + ", theta_w=" + g(p.theta_w) + ", I_tan=" + g(p.I_tan) + ")";
         });
     register_potential_pickles(m);
-    m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"));
+    m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"),
+          py::arg("rtol") = 1e-6);
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),
-          py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"));
+          py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"), py::arg("rtol") = 1e-6);
+    // (values, errors) as two OnsetParameters.
+    m.def("_onset_estimate", [](const Potential& V1, const Potential& V2, double qw1, double qw2, double h, double rtol) {
+        const OnsetEstimate e = onset_estimate(V1, V2, qw1, qw2, h, rtol);
+        return std::make_pair(e.value, e.error);
+    }, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"), py::arg("rtol") = 1e-6);
+    m.def("_onset_estimate_closed_form", [](double w1, double a1, double w2, double a2, double qw1, double qw2, double h,
+                                            double rtol) {
+        const OnsetEstimate e = onset_estimate_closed_form(w1, a1, w2, a2, qw1, qw2, h, rtol);
+        return std::make_pair(e.value, e.error);
+    }, py::arg("omega1"), py::arg("alpha1"), py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"),
+          py::arg("h"), py::arg("rtol") = 1e-6);
 }

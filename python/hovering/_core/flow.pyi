@@ -61,10 +61,16 @@ class OnsetParameters:
     theta_w: float
     I_tan: float
 
-def _onset_parameters(V1: Potential, V2: Potential, qw1: float, qw2: float, h: float) -> OnsetParameters: ...
+def _onset_parameters(V1: Potential, V2: Potential, qw1: float, qw2: float, h: float, rtol: float = 1e-6) -> OnsetParameters: ...
 def _onset_parameters_closed_form(
-    omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float
+    omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float, rtol: float = 1e-6
 ) -> OnsetParameters: ...
+def _onset_estimate(
+    V1: Potential, V2: Potential, qw1: float, qw2: float, h: float, rtol: float = 1e-6
+) -> tuple[OnsetParameters, OnsetParameters]: ...
+def _onset_estimate_closed_form(
+    omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float, rtol: float = 1e-6
+) -> tuple[OnsetParameters, OnsetParameters]: ...
 
 
 class FlowSystem:

@@ -288,41 +288,65 @@ class StepSystem:
         return cls(**record)
 
 
-def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> OnsetParameters:
+def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rtol: float = 1e-6,
+                     errors: bool = False):
     """Onset parameters Omega0, tau0, tau1, lam, theta_w (sec:parametersdef) at energy h.
+
+    Every parameter comes with an estimate of its absolute error: the potentials' own error
+    (closed forms: a few ulps; quadrature: its 1e-12 tolerance; derivatives: their extrapolation
+    table) plus the rounding of h, V1(qw1) and V2(qw2) carried through. The step energy h_w is
+    known only to a few ulps, so h - h_w is too: theta_w and tau1, which have a square-root
+    singularity at h = h_w, cannot be had arbitrarily close to it.
 
     Parameters
     ----------
     sys : StepSystem
         The system (only V1, V2, qw1, qw2 enter: the parameters are defined at eps = 0).
     h : float
-        Energy, above the step energy ``sys.step_energy``.
+        Energy, above the step energy ``sys.step_energy``, at most 1e100.
     method : {"definitions", "quadrature", "closed_form"}, optional
-        ``"definitions"``: eq:omega0ofI .. eq:deftau1 with the potentials' own action-angle
-        variables (closed forms for Harmonic/Tan) and Richardson central differences for tau0,
-        tau1. ``"quadrature"``: the same with every period, action and angle by GSL quadrature
-        (any potential). ``"closed_form"``: the appendix formulas (Harmonic/Tan only), corrected
-        where they disagree with the definitions (tau0's last term over W1^3, not W1^4;
-        theta_w = arccos(+...), not arccos(-...)).
+        ``"definitions"``: eq:omega0ofI .. eq:deftau1 by the chain rule, Omega0 = omega2(h2) T1(h1w),
+        tau0 = omega2 (omega2'(h2) T1(h1w) - omega2 T1'(h1w)), tau1 = -2 omega2 dtheta_w/dh2
+        (h1w = V1(qw1), h2 = h - h1w), with the potentials' own action-angle variables and their
+        energy slopes (closed forms for Harmonic/Tan; Ridders-extrapolated differences of the
+        quadratures otherwise). ``"quadrature"``: the same with every period, action, angle and
+        slope by GSL quadrature (any potential). ``"closed_form"``: the appendix formulas
+        (Harmonic/Tan only), corrected where they disagree with the definitions (tau0's last term
+        over W1^3, not W1^4; theta_w = arccos(+...), not arccos(-...)) and evaluated without their
+        cancellations near the step energy.
+    rtol : float, optional
+        Largest accepted estimated relative error of each parameter, in [1e-15, 1].
+    errors : bool, optional
+        Also return the error estimates.
 
     Returns
     -------
     OnsetParameters
-        ``.Omega0, .tau0, .tau1, .lam, .theta_w, .I_tan``.
+        ``.Omega0, .tau0, .tau1, .lam, .theta_w, .I_tan``. A tau0 or tau1 smaller than its own error,
+        when that error is below ``rtol`` times the parameter's scale (Omega0 / I_tan for tau0,
+        1 / I_tan for tau1), is returned as 0 (zero within its error).
+    OnsetParameters, optional
+        With ``errors=True``: the estimated absolute error of each parameter (same fields).
 
     Raises
     ------
     ValueError
-        If h is not above the step energy, or for an unknown method.
+        If h is not above the step energy or above 1e100, for an unknown method, or if a parameter's
+        estimated relative error exceeds ``rtol`` (the message names the parameter, the energy,
+        h - h_w and why: e.g. h - h_w below the resolution of the step energy, or a derivative of
+        quadratures too noisy for a quantity that tends to 0).
     """
     if not isinstance(sys, StepSystem):
         raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
-    h = real_number("h", h, hi=1e100, hi_open=False)
+    h = float(real_number("h", h, hi=1e100, hi_open=False))
+    rtol = float(real_number("rtol", rtol, lo=1e-15, lo_open=False, hi=1.0, hi_open=False))
+    if not isinstance(errors, bool):
+        raise ValueError(f"errors must be True or False, got {errors!r}")
     if method == "definitions":
-        return _core.flow._onset_parameters(sys.V1, sys.V2, sys.qw1, sys.qw2, float(h))
-    if method == "quadrature":
-        return _core.flow._onset_parameters(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, float(h))
-    if method == "closed_form":
+        r = _core.flow._onset_estimate(sys.V1, sys.V2, sys.qw1, sys.qw2, h, rtol)
+    elif method == "quadrature":
+        r = _core.flow._onset_estimate(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, h, rtol)
+    elif method == "closed_form":
         def wa(p):
             if isinstance(p, Tan):
                 return p.omega, p.alpha
@@ -331,5 +355,7 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions") -> 
             raise ValueError(f"closed_form needs Harmonic or Tan potentials, got {p!r}")
 
         (w1, a1), (w2, a2) = wa(sys.V1), wa(sys.V2)
-        return _core.flow._onset_parameters_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, float(h))
-    raise ValueError(f"method must be 'definitions', 'quadrature' or 'closed_form', got {method!r}")
+        r = _core.flow._onset_estimate_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, h, rtol)
+    else:
+        raise ValueError(f"method must be 'definitions', 'quadrature' or 'closed_form', got {method!r}")
+    return r if errors else r[0]

@@ -13,6 +13,12 @@
 
 namespace hovering {
 
+/// A computed value and an estimate of its absolute error.
+struct Estimate {
+    double value;  ///< the value
+    double error;  ///< estimated absolute error (0: exact)
+};
+
 /// A single-well potential and its energy-dependent quantities.
 class Potential {
 public:
@@ -52,6 +58,18 @@ public:
     double angle_of_point(double q, double p, double h) const;
     /// angle_of_point without the level check, for callers that computed h from (q, p) themselves.
     virtual double angle_on_level(double q, double p, double h) const;
+    /// Relative accuracy of period, action, frequency (and, times pi, the absolute accuracy of
+    /// angle_of) at exact arguments: the quadrature tolerance on the generic path, a few ulps for
+    /// closed forms.
+    virtual double relative_accuracy() const;
+    /// dT/dh with its error estimate. Generic path: Ridders-extrapolated central differences of
+    /// period() (steps from h / 4 down), error from the extrapolation table plus the quadratures'
+    /// noise divided by the step.
+    virtual Estimate period_slope(double h) const;
+    /// d angle_of(q, h) / dh at fixed q, for q strictly inside the level (V(q) < h), with its error
+    /// estimate. Generic path: as period_slope, steps from min(h, h - V(q)) / 4 down (the angle has
+    /// a square-root branch point at h = V(q)).
+    virtual Estimate angle_slope(double q, double h) const;
 
 protected:
     /// Throw std::invalid_argument (naming the potential and who) unless h is finite and > 0.
@@ -83,6 +101,12 @@ public:
     std::pair<double, double> point_at(double theta, double h) const override;
     /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
+    /// Closed forms: a few ulps.
+    double relative_accuracy() const override;
+    /// dT/dh = 0 (isochronous).
+    Estimate period_slope(double h) const override;
+    /// d angle / dh = q omega / (2 sqrt(2) h sqrt(h - V(q))) in closed form.
+    Estimate angle_slope(double q, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
 
@@ -118,6 +142,12 @@ public:
     std::pair<double, double> point_at(double theta, double h) const override;
     /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
+    /// Closed forms: a few ulps.
+    double relative_accuracy() const override;
+    /// dT/dh = -2 pi alpha^2 / W^3, W = sqrt(omega^2 + 2 alpha^2 h), in closed form.
+    Estimate period_slope(double h) const override;
+    /// d angle / dh = sin(alpha q) omega^2 / (2 sqrt(2) alpha h W cos(alpha q) sqrt(h - V(q))) in closed form.
+    Estimate angle_slope(double q, double h) const override;
     /// The frequency parameter omega.
     double omega() const { return omega_; }
     /// The nonlinearity alpha.

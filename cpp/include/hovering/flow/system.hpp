@@ -54,16 +54,39 @@ struct OnsetParameters {
     double I_tan;    ///< action of the tangent circle, H_2(I_tan) = h - V_1(qw1) (eq:Itan)
 };
 
-/// Onset parameters from the definitions: derivatives of Omega0(I) and theta_w(I) by central
-/// differences (step chosen for the ~1e-12 accuracy of the underlying quantities).
-/// Throws std::invalid_argument if h is not above the step energy V1(qw1) + V2(qw2) or a wall lies
-/// outside its potential's well.
-OnsetParameters onset_parameters(const Potential& V1, const Potential& V2, double qw1, double qw2, double h);
+/// Onset parameters with the estimated absolute error of each one (same fields).
+struct OnsetEstimate {
+    OnsetParameters value;  ///< the parameters
+    OnsetParameters error;  ///< estimated absolute error of each parameter
+};
+
+/// Onset parameters from the definitions with error estimates: Omega0 = omega2(h2) T1(h1w),
+/// tau0 = omega2 (omega2'(h2) T1(h1w) - omega2 T1'(h1w)), tau1 = -2 omega2 d angle_of(qw2, h2) / dh
+/// (h1w = V1(qw1), h2 = h - h1w), the slopes from the potentials (closed forms for Harmonic/Tan,
+/// Ridders differences otherwise). Each error adds the potentials' own error to the propagated
+/// rounding of h, V1(qw1) and V2(qw2) (the step energy is known only to a few ulps, so
+/// h - h_w is too). Throws std::invalid_argument for walls outside the wells, h not above the step
+/// energy, or a parameter whose estimated relative error exceeds rtol (naming it, the energy and
+/// why); tau0 or tau1 smaller than its error, which is below rtol times its scale (Omega0 / I_tan,
+/// 1 / I_tan), is reported as 0.
+OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw1, double qw2, double h,
+                             double rtol = 1e-6);
+
+/// The values of onset_estimate (same checks, same errors).
+OnsetParameters onset_parameters(const Potential& V1, const Potential& V2, double qw1, double qw2, double h,
+                                 double rtol = 1e-6);
 
 /// The closed forms of the appendix (sec:calculationofparam) for Tan/harmonic pairs, with the two
 /// corrections the definitions require (see the README): tau0's last term over W1^3 (printed W1^4),
-/// and theta_w = arccos(+sqrt(alpha^2 + omega^2 / (2 h2)) sin(alpha qw2) / alpha) (printed with a minus).
+/// and theta_w = arccos(+sqrt(alpha^2 + omega^2 / (2 h2)) sin(alpha qw2) / alpha) (printed with a minus);
+/// evaluated without their cancellations (theta_w by atan2 with sin theta_w = cos(alpha2 qw2)
+/// sqrt((h - h_w) / h2), tau1's root as sqrt(2 cos^2(alpha2 qw2) (h - h_w))), with error
+/// estimates and the checks of onset_estimate.
+OnsetEstimate onset_estimate_closed_form(double omega1, double alpha1, double omega2, double alpha2, double qw1,
+                                         double qw2, double h, double rtol = 1e-6);
+
+/// The values of onset_estimate_closed_form.
 OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2,
-                                             double qw1, double qw2, double h);
+                                             double qw1, double qw2, double h, double rtol = 1e-6);
 
 }  // namespace hovering

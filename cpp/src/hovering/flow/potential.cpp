@@ -10,6 +10,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -140,6 +141,42 @@ double brent(const std::function<double(double)>& f, double lo, double hi) {
 // V underflows to 0 or the period to 0 and every answer would be silently wrong.
 void require_scale(double v, const char* name) {
     if (!(v >= 1e-100 && v <= 1e100)) bad(std::string(name) + " must lie in [1e-100, 1e100], got " + fmt(v));
+}
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// Ridders' extrapolation (Numerical Recipes' dfridr) of central differences of f at x, from the
+// step d0 down by 1.4 per level. An entry's error is the table's own estimate (its change from
+// its neighbours) plus the evaluation noise of f (`noise`, absolute) carried through the
+// differences and the extrapolation weights: with quadratures good to ~1e-13 the noise, not the
+// truncation, limits the smallest steps, and the table alone can miss it. The entry with the
+// smallest total is returned; the table stops once the diagonal grows (noise took over).
+Estimate ridders(const std::function<double(double)>& f, double x, double d0, double noise) {
+    constexpr int kN = 12;
+    constexpr double kCon = 1.4, kCon2 = kCon * kCon;
+    double a[kN][kN], n[kN][kN];
+    auto diff = [&](double d, int i) {
+        const double xp = x + d, xm = x - d;  // the steps the doubles really have
+        a[0][i] = (f(xp) - f(xm)) / (xp - xm);
+        n[0][i] = 2 * noise / (xp - xm);
+    };
+    double d = d0;
+    diff(d, 0);
+    Estimate best{a[0][0], kInf};
+    for (int i = 1; i < kN; ++i) {
+        d /= kCon;
+        diff(d, i);
+        double fac = kCon2;
+        for (int j = 1; j <= i; ++j) {
+            a[j][i] = (a[j - 1][i] * fac - a[j - 1][i - 1]) / (fac - 1);
+            n[j][i] = (n[j - 1][i] * fac + n[j - 1][i - 1]) / (fac - 1);
+            fac *= kCon2;
+            const double e = std::max(std::fabs(a[j][i] - a[j - 1][i]), std::fabs(a[j][i] - a[j - 1][i - 1])) + n[j][i];
+            if (e <= best.error) best = {a[j][i], e};
+        }
+        if (std::fabs(a[i][i] - a[i - 1][i - 1]) >= 2 * best.error) break;
+    }
+    return best;
 }
 
 }  // namespace
@@ -333,6 +370,33 @@ double Potential::angle_on_level(double q, double p, double h) const {
     return p > 0 ? -th : th;
 }
 
+// 1e-12: the tolerance every generic quadrature asks of QAWS (measured: ~3e-15 on Harmonic and
+// Tan levels 1e-10 .. 1e20; the tolerance is what is promised for any V).
+double Potential::relative_accuracy() const { return 1e-12; }
+
+Estimate Potential::period_slope(double h) const {
+    check_energy(h, "period_slope");
+    // T(h) of a single well is smooth on the scale h (power-law wells: T ~ h^k): steps from h / 4
+    // keep h - d > 0 and cover the scale.
+    const double T = period(h);
+    return ridders([&](double e) { return period(e); }, h, 0.25 * h, relative_accuracy() * T);
+}
+
+Estimate Potential::angle_slope(double q, double h) const {
+    check_energy(h, "angle_slope");
+    const double D = h - V(q);
+    if (!std::isfinite(q) || !(D > 0))
+        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) +
+            " (V(q) < h), got V(q) = " + fmt(V(q)));
+    // The angle at fixed q is sqrt(h - V(q)) near the turning point: smooth on the scale min(h, D).
+    // Its noise: the quadratures' plus the turning point's rounding (~4 ulps) times
+    // d theta / dq = omega / |p|, |p| at least sqrt(2 * 3D / 4) over the steps.
+    const auto tp = turning_points(h);
+    const double w = frequency(h);
+    const double noise = relative_accuracy() * kPi + 4 * kEps * std::max(-tp.first, tp.second) * w / std::sqrt(1.5 * D);
+    return ridders([&](double e) { return angle_of(q, e); }, h, 0.25 * std::min(h, D), noise);
+}
+
 // ------------------------------------------------------------------------------- closed forms
 
 Harmonic::Harmonic(double omega) : omega_(omega) { require_scale(omega, "Harmonic: omega"); }
@@ -370,6 +434,24 @@ std::pair<double, double> Harmonic::point_at(double theta, double h) const {
 
 double Harmonic::angle_on_level(double q, double p, double) const {
     return std::atan2(-p / omega_, q);  // (q, p) = A (cos theta, -omega sin theta): no arccos near +-1
+}
+
+double Harmonic::relative_accuracy() const { return 4 * kEps; }
+
+Estimate Harmonic::period_slope(double h) const {
+    check_energy(h, "period_slope");
+    return {0.0, 0.0};
+}
+
+Estimate Harmonic::angle_slope(double q, double h) const {
+    check_energy(h, "angle_slope");
+    const double v = V(q), D = h - v;
+    if (!std::isfinite(q) || !(D > 0))
+        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) + " (V(q) < h)");
+    // theta = acos(q / A), A = sqrt(2 h) / omega, sin(theta) = sqrt(D / h). The deficit D = h - V
+    // carries the rounding of V (4 ulps) relative to D: the slope's sqrt halves it.
+    const double s = q * omega_ / (2 * std::sqrt(2.0) * h * std::sqrt(D));
+    return {s, std::fabs(s) * (8 * kEps + kEps * (D + 4 * v) / (2 * D))};
 }
 
 Tan::Tan(double omega, double alpha) : omega_(omega), alpha_(alpha) {
@@ -433,6 +515,31 @@ double Tan::angle_on_level(double q, double p, double h) const {
     // cos theta = sin(alpha q) / k and sin theta = -p alpha cos(alpha q) / (omega(h) k), k > 0.
     const double w = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
     return std::atan2(-p * alpha_ * std::cos(alpha_ * q) / w, std::sin(alpha_ * q));
+}
+
+double Tan::relative_accuracy() const { return 8 * kEps; }
+
+Estimate Tan::period_slope(double h) const {
+    check_energy(h, "period_slope");
+    const double W = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+    const double s = -2 * kPi * alpha_ * alpha_ / (W * W * W);
+    return {s, 8 * kEps * std::fabs(s)};
+}
+
+Estimate Tan::angle_slope(double q, double h) const {
+    check_energy(h, "angle_slope");
+    const double v = V(q), D = h - v;
+    if (!std::isfinite(q) || !(D > 0))
+        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) + " (V(q) < h)");
+    // cos(theta) = k sin(alpha q) / alpha, k = W / sqrt(2 h): d theta / dh = -(d cos / dh) / sin(theta)
+    // with sin(theta) = cos(alpha q) sqrt(D / h) (no cancellation: 1 - k^2 s^2 written out).
+    const double x = alpha_ * q, c = std::cos(x);
+    const double W = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+    const double s = std::sin(x) / alpha_ * omega_ * omega_ / (2 * std::sqrt(2.0) * h * W * c * std::sqrt(D));
+    // Rounding: x = alpha q (1 ulp) moves cos(x) by |x tan x| ulps near the wall, V(q) by
+    // |q V'/V| of its ulps; V's error is D's, halved by the sqrt.
+    const double eV = kEps * (4 * v + std::fabs(q * dV(q)));
+    return {s, std::fabs(s) * (16 * kEps + kEps * std::fabs(x * std::tan(x)) + (kEps * D + eV) / (2 * D))};
 }
 
 Numerical::Numerical(std::shared_ptr<const Potential> base) : base_(std::move(base)) {
