@@ -153,10 +153,13 @@ class FlowMap(MapAnalyses):
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
         self._options.validate_for(sys.core)  # before the tangential curve is measured
         self.integrator_options = dict(rtol=float(rtol), atol=float(atol), stepper=stepper, **options)
+        #: Why there are no onset parameters (None when there are): below the step energy, or
+        #: too close to it for them to be accurate (onset_parameters raises rather than guess).
+        self.onset_error = None
         try:
             self.onset = onset_parameters(sys, self.h)
-        except ValueError:
-            self.onset = None  # below the step energy: no tangential band, no lift model
+        except ValueError as e:
+            self.onset, self.onset_error = None, str(e)  # no tangential band or no accurate one: no lift model
         self.curve = None
         if coordinates == "normal":
             self.curve = curve if curve is not None else TangentialCurve(self.section, rtol=1e-13)
@@ -180,7 +183,8 @@ class FlowMap(MapAnalyses):
     # for bit as the original. Other instance attributes (the forcing cache, a subclass's own) are
     # restored as they were.
 
-    _OWN = frozenset({"section", "sys", "h", "coordinates", "_options", "integrator_options", "onset", "curve", "_core"})
+    _OWN = frozenset({"section", "sys", "h", "coordinates", "_options", "integrator_options", "onset", "onset_error",
+                      "curve", "_core"})
 
     def __reduce__(self):
         """Pickle as the constructor arguments, the measured curve and the other instance attributes."""
@@ -428,8 +432,8 @@ class FlowMap(MapAnalyses):
 
     def _require_onset(self):
         if self.onset is None:
-            raise ValueError(f"h = {self.h} is not above the step energy {self.sys.step_energy}: no tangential band, "
-                             "no onset parameters")
+            raise ValueError(f"no onset parameters at h = {self.h} (step energy {self.sys.step_energy}): "
+                             f"{self.onset_error}")
         if self.coordinates != "normal":
             raise ValueError("the theory and the model live in normal coordinates: use coordinates='normal'")
 
