@@ -180,8 +180,34 @@ def test_cli_accuracy_writes_the_diagram_and_table(tmp_path):
     assert p.returncode == 0, p.stderr
     assert out.stat().st_size > 10_000
     table = json.loads(out.with_suffix(".json").read_text())
-    assert table["kind"] == "flow" and len(table["rows"]) == 6
+    assert table["kind"] == "flow"
+    assert len([r for r in table["rows"] if r["method"] in ("rk8pd", "rkck")]) == 6
+    assert len([r for r in table["rows"] if r["method"] == "scipy DOP853"]) == 3  # scipy is in the test extras
     assert "| rk8pd |" in p.stdout
     bad = subprocess.run([sys.executable, "-m", "hovering", "accuracy", str(tmp_path / "missing.toml")],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stderr.startswith("error:")
+
+
+def test_scipy_curve_is_an_independent_implementation_that_agrees():
+    # scipy's solve_ivp (DOP853 + events, the field in Python) on the step system at eps = 0: on
+    # orbits whose impacts are not near-grazing it must agree with the exact flow to its tolerance
+    # (1e-10 asked; 1e-7 allows DOP853's global error over a return and its event location)
+    from hovering.accuracy import scipy_return_map
+
+    sec = Section(system(0.0, "step"), 1.0)
+    th, I = np.linspace(-3.0, 3.0, 12), np.full(12, 0.2)
+    ex = sec.return_map(th, I, stepper="exact")
+    z0 = sec.point(th, I)
+    out = [scipy_return_map(sec.sys, z, 1e-10) for z in z0]
+    c = sec.coordinates(np.array([np.full(4, np.nan) if o is None else o for o in out]))
+    ok = ex.status == 0
+    assert all(out[i] is not None for i in np.flatnonzero(ok)), [ex.itinerary[i] for i in range(12) if out[i] is None]
+    assert ok.sum() >= 10
+    assert np.max(np.abs(hovering.wrap(c[ok, 0] - ex.theta[ok]))) < 1e-7
+    assert np.max(np.abs(c[ok, 1] - ex.I[ok])) < 1e-7
+    wp = hovering.work_precision(sec, tolerances=(1e-8,), steppers=("rk8pd",), n_points=8, returns=(1,),
+                                 external=("scipy",), repeat=1)
+    assert [r["method"] for r in wp.table] == ["rk8pd", "scipy DOP853"]
+    with pytest.raises(ValueError, match="external"):
+        hovering.work_precision(sec, external=("julia",))

@@ -284,7 +284,8 @@ def _reverse(fm, theta, I, m: int, n_threads: int):
 # the flow
 
 
-def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_threads, progress, reversal=True):
+def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_threads, progress, reversal=True,
+          external=()):
     from .normal.flowmap import FlowMap
 
     rng = np.random.default_rng(seed)
@@ -343,14 +344,123 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
             done += 1
             if callable(progress):
                 progress(done, total)
+    notes = []
+    if "scipy" in external:
+        extra, note = _scipy_rows(section, theta, I, ref_th, ref_I, tolerances)
+        rows += extra
+        notes.append(note)
     s = section.sys
     target = (f"flow {s.V1!r} + {s.V2!r}, eps={s.eps:g}, geometry={s.geometry}, qw=({s.qw1:g}, {s.qw2:g}), "
               f"h={section.h:g}")
-    notes = []
     if long_ms:
         notes.append(f"long orbits: {n_long} points; the error after m returns is against the reference's own "
                      "m returns (at eps != 0 chaotic orbits separate exponentially, whatever the method)")
     return WorkPrecision("flow", rows, refinfo, target, int(theta.size), notes)
+
+
+# ------------------------------------------------------------------------------------------------
+# an independent implementation for comparison: scipy's solve_ivp (DOP853) with events
+
+
+def scipy_return_map(sys, z0, rtol: float):
+    """One return of the flow by scipy's ``solve_ivp`` (DOP853, atol = rtol / 100) with events, for the
+    work-precision comparison (scipy must be installed). Walls reflect; a crossing of a wall's line
+    beside / above the step does nothing; the section is the first p1 sign change + -> - after q1's
+    minimum or a reflection. Events within 1e-9 of a restart are ignored (a restart sits on the
+    event it handled). Grazing and corner hits are not classified: this is a reference for regular
+    returns, as users write it, not a second product.
+
+    Returns
+    -------
+    ndarray or None
+        The state at the return (None if it did not return within 50 segments).
+    """
+    from scipy.integrate import solve_ivp
+
+    from .flow.system import _terms
+
+    V1, V2, eps, qw1, qw2 = sys.V1, sys.V2, sys.eps, sys.qw1, sys.qw2
+    terms = _terms(sys.coupling) if eps != 0 else []
+
+    def rhs(t, z):
+        g1 = g2 = 0.0
+        for c, i, j in terms:
+            if i:
+                g1 += c * i * z[0] ** (i - 1) * z[2] ** j
+            if j:
+                g2 += c * j * z[0] ** i * z[2] ** (j - 1)
+        return [z[1], -V1.dV(z[0]) - eps * g1, z[3], -V2.dV(z[2]) - eps * g2]
+
+    def right(t, z):
+        return z[0] - qw1
+
+    def upper(t, z):
+        return z[2] - qw2
+
+    def p1(t, z):
+        return z[1]
+
+    right.direction = upper.direction = -1
+    walls = sys.geometry != "none"
+    step = sys.geometry == "step"
+    z, t, armed = np.array(z0, float), 0.0, False
+    # Segments of 1.37 periods: an event at a segment's very end (a return after exactly one
+    # period, as at eps = 0 without impact) can be missed there and is filtered at the next start.
+    T = 1.37 * 2 * np.pi / max(V1.frequency(max(1e-12, 0.5 * z[1] ** 2 + V1.V(z[0]))), 1e-3)
+    for _ in range(50):
+        sol = solve_ivp(rhs, (t, t + T), z, method="DOP853", rtol=rtol, atol=rtol * 1e-2,
+                        events=[right, upper, p1], dense_output=False)
+        evs = []
+        for k in range(3):
+            for te, ye in zip(sol.t_events[k], sol.y_events[k]):
+                if te > t + 1e-9:
+                    evs.append((te, k, ye))
+        handled = False
+        for te, k, ye in sorted(evs, key=lambda e: e[0]):
+            if k == 2:
+                if ye[1] == 0:
+                    continue
+                dp = -V1.dV(ye[0])
+                if dp > 0:
+                    armed = True
+                elif armed:
+                    return ye
+                continue
+            if k == 0 and walls and (not step or ye[2] < qw2):
+                z = ye.copy()
+                z[0], z[1] = qw1, -z[1]
+            elif k == 1 and step and ye[0] < qw1:
+                z = ye.copy()
+                z[2], z[3] = qw2, -z[3]
+            else:
+                continue
+            t, armed, handled = te, True, True
+            break
+        if not handled:
+            z, t = sol.y[:, -1], sol.t[-1]
+    return None
+
+
+def _scipy_rows(section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
+    try:
+        import scipy  # noqa: F401
+    except ImportError:
+        return [], "scipy not installed: no scipy curve (pip install scipy)"
+    th, ii = theta[:n_max], I[:n_max]
+    z0 = section.point(th, ii)
+    rows = []
+    for tol in tolerances:
+        t0 = time.perf_counter()
+        out = [scipy_return_map(section.sys, z, max(tol, 1e-13)) for z in z0]
+        sec = (time.perf_counter() - t0) / len(z0)
+        ok = np.array([o is not None for o in out])
+        zz = np.array([o if o is not None else np.full(4, np.nan) for o in out])
+        c = section.coordinates(zz)
+        err = float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]),
+                              initial=0.0))
+        rows.append({"method": "scipy DOP853", "tolerance": float(tol), "error": err, "seconds": sec, "unit": "return",
+                     "failed": int(np.count_nonzero(~ok))})
+    return rows, f"scipy DOP853 (solve_ivp with events, Python field): {len(z0)} points"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -407,7 +517,7 @@ def _hovering(m, tolerances, n_points, repeat, seed, n_threads, progress):
 def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Optional[Sequence] = None, *,
                    quantity: str = "auto", n_points: Optional[int] = None, returns: Sequence[int] = (1, 100, 10_000),
                    quick: bool = False, repeat: int = 2, seed: int = 0, n_threads: int = 1,
-                   progress=False) -> WorkPrecision:
+                   external: Sequence[str] = (), progress=False) -> WorkPrecision:
     """Measure what accuracy costs in time for a target (see the module docstring).
 
     Parameters
@@ -437,6 +547,9 @@ def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Opti
         Seed of the starting points.
     n_threads : int, optional
         Threads of the timed runs (default 1, so times are per core).
+    external : sequence of str, optional
+        Flow only: independent implementations to add as curves when installed: ``"scipy"``
+        (solve_ivp DOP853 with events, :func:`scipy_return_map`; one-return errors on 16 points).
     progress : callable, optional
         ``progress(done, total)`` after each flow setting.
 
@@ -485,7 +598,11 @@ def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Opti
         rets = sorted({integer("returns", m, 1, 10**7) for m in returns} | {1})
         if quick:
             rets = [m for m in rets if m <= 100]
-        return _flow(section, tols, sts, n, rets, repeat, seed, n_threads, progress)
+        ext = tuple(external)
+        for e in ext:
+            if e != "scipy":
+                raise ValueError(f"external must name 'scipy', got {e!r}")
+        return _flow(section, tols, sts, n, rets, repeat, seed, n_threads, progress, external=ext)
     if not hasattr(target, "iterate") or not hasattr(target, "step"):
         raise ValueError(f"target must be a Section, FlowMap, TruncatedMap or TruncatedFamily, got {target!r}")
     if quantity not in ("auto", "rotation"):

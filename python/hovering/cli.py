@@ -141,7 +141,13 @@ def _accuracy(args) -> int:
     t0 = time.perf_counter()
     try:
         target = Section(scene.system.build(), scene.h) if isinstance(scene, FlowScene) else scene_map(scene)
-        wp = work_precision(target, quick=args.quick)
+        kw = {}
+        if isinstance(target, Section):
+            import importlib.util
+
+            # the independent scipy curve whenever scipy is there (it is optional)
+            kw["external"] = ("scipy",) if importlib.util.find_spec("scipy") else ()
+        wp = work_precision(target, quick=args.quick, **kw)
     except ValueError as e:
         return _error(e)
     fig = wp.plot()
