@@ -211,3 +211,18 @@ def test_scipy_curve_is_an_independent_implementation_that_agrees():
     assert [r["method"] for r in wp.table] == ["rk8pd", "scipy DOP853"]
     with pytest.raises(ValueError, match="external"):
         hovering.work_precision(sec, external=("julia",))
+
+
+def test_hovering_area_diagram_against_its_largest_setting():
+    # The largest (samples, n_steps) is the reference; each smaller setting's |area - reference|
+    # must lie within 4x the two stated error bars combined (each bar is ~2 sigma of the
+    # stratified sampling plus the iteration-count part: a 4x margin keeps this from flaking)
+    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    wp = hovering.work_precision(m, quantity="hovering_area", tolerances=[(400, 250), (1600, 500), (6400, 1000)],
+                                 repeat=1)
+    assert wp.kind == "hovering_area" and [r["tolerance"] for r in wp.table] == ["400x250", "1600x500"]
+    for r in wp.table:
+        assert r["error"] <= 4 * (r["stated_error"] + wp.reference["error"]), r
+        assert r["seconds"] > 0 and r["unit"] == "call"
+    with pytest.raises(ValueError, match="at least two"):
+        hovering.work_precision(m, quantity="hovering_area", tolerances=[(400, 250)])

@@ -349,6 +349,10 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
         extra, note = _scipy_rows(section, theta, I, ref_th, ref_I, tolerances)
         rows += extra
         notes.append(note)
+    if "heyoka" in external:
+        extra, note = _heyoka_rows(section, theta, I, ref_th, ref_I, tolerances)
+        rows += extra
+        notes.append(note)
     s = section.sys
     target = (f"flow {s.V1!r} + {s.V2!r}, eps={s.eps:g}, geometry={s.geometry}, qw=({s.qw1:g}, {s.qw2:g}), "
               f"h={section.h:g}")
@@ -439,6 +443,87 @@ def scipy_return_map(sys, z0, rtol: float):
         if not handled:
             z, t = sol.y[:, -1], sol.t[-1]
     return None
+
+
+def heyoka_return_map(sys, z0_list, rtol: float):
+    """Returns of the flow by heyoka.py's Taylor integrator with events (heyoka must be installed; V1,
+    V2 Harmonic or Tan, polynomial coupling), for the work-precision comparison: same event logic
+    as :func:`scipy_return_map`. Compiles one integrator (JIT, ~1 s) and returns (states, seconds of
+    the returns alone); None for a state that did not return.
+    """
+    import heyoka as hy
+
+    from .flow.system import Harmonic, Tan, _terms
+
+    q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
+
+    def force(V, q):
+        if isinstance(V, Tan):
+            return (V.omega**2 / V.alpha) * hy.tan(V.alpha * q) / hy.cos(V.alpha * q) ** 2
+        if isinstance(V, Harmonic):
+            return V.omega**2 * q
+        raise ValueError(f"heyoka curve: V must be Harmonic or Tan, got {V!r}")
+
+    f1, f2 = force(sys.V1, q1), force(sys.V2, q2)
+    if sys.eps != 0:
+        for c, i, j in _terms(sys.coupling):
+            i, j = int(i), int(j)
+            if i:
+                f1 = f1 + sys.eps * c * i * q1 ** (i - 1) * q2**j
+            if j:
+                f2 = f2 + sys.eps * c * j * q1**i * q2 ** (j - 1)
+    ev = [hy.t_event(q1 - sys.qw1, direction=hy.event_direction.negative),
+          hy.t_event(p1, direction=hy.event_direction.negative),
+          hy.t_event(p1, direction=hy.event_direction.positive),
+          hy.t_event(q2 - sys.qw2, direction=hy.event_direction.negative)]
+    ta = hy.taylor_adaptive([(q1, p1), (p1, -f1), (q2, p2), (p2, -f2)], list(z0_list[0]), t_events=ev, tol=rtol)
+    walls, step = sys.geometry != "none", sys.geometry == "step"
+    out = []
+    t0 = time.perf_counter()
+    for z0 in z0_list:
+        ta.time = 0.0
+        ta.state[:] = z0
+        ta.reset_cooldowns()
+        armed, res = False, None
+        for _ in range(60):
+            oc = int(ta.propagate_until(ta.time + 50.0)[0])
+            st = ta.state
+            if oc == -1 and walls and (not step or st[2] < sys.qw2):
+                st[0], st[1] = sys.qw1, -st[1]
+                armed = True
+            elif oc == -4 and step and st[0] < sys.qw1:
+                st[2], st[3] = sys.qw2, -st[3]
+                armed = True
+            elif oc == -3:
+                armed = True
+            elif oc == -2 and armed:
+                res = st.copy()
+                break
+        out.append(res)
+    return out, time.perf_counter() - t0
+
+
+def _heyoka_rows(section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
+    try:
+        import heyoka  # noqa: F401
+    except ImportError:
+        return [], "heyoka.py not installed: no heyoka curve (pip install heyoka)"
+    th, ii = theta[:n_max], I[:n_max]
+    z0 = section.point(th, ii)
+    rows = []
+    for tol in tolerances:
+        try:
+            out, sec = heyoka_return_map(section.sys, z0, max(tol, 1e-15))
+        except ValueError as e:
+            return [], str(e)
+        ok = np.array([o is not None for o in out])
+        c = section.coordinates(np.array([o if o is not None else np.full(4, np.nan) for o in out]))
+        err = float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]),
+                              initial=0.0))
+        rows.append({"method": "heyoka.py Taylor", "tolerance": float(tol), "error": err, "seconds": sec / len(z0),
+                     "unit": "return", "failed": int(np.count_nonzero(~ok))})
+    return rows, (f"heyoka.py Taylor + events: {len(z0)} points, its Python-side cost per propagate_until call "
+                  "included, JIT compilation not")
 
 
 def _scipy_rows(section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
@@ -549,7 +634,9 @@ def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Opti
         Threads of the timed runs (default 1, so times are per core).
     external : sequence of str, optional
         Flow only: independent implementations to add as curves when installed: ``"scipy"``
-        (solve_ivp DOP853 with events, :func:`scipy_return_map`; one-return errors on 16 points).
+        (solve_ivp DOP853 with events, :func:`scipy_return_map`), ``"heyoka"`` (heyoka.py's Taylor
+        integrator with events, :func:`heyoka_return_map`; Harmonic/Tan only); one-return errors on
+        16 points. A missing package or an unsupported system adds a note instead of a curve.
     progress : callable, optional
         ``progress(done, total)`` after each flow setting.
 
@@ -600,8 +687,8 @@ def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Opti
             rets = [m for m in rets if m <= 100]
         ext = tuple(external)
         for e in ext:
-            if e != "scipy":
-                raise ValueError(f"external must name 'scipy', got {e!r}")
+            if e not in ("scipy", "heyoka"):
+                raise ValueError(f"external must name 'scipy' or 'heyoka', got {e!r}")
         return _flow(section, tols, sts, n, rets, repeat, seed, n_threads, progress, external=ext)
     if not hasattr(target, "iterate") or not hasattr(target, "step"):
         raise ValueError(f"target must be a Section, FlowMap, TruncatedMap or TruncatedFamily, got {target!r}")

@@ -146,7 +146,7 @@ def _accuracy(args) -> int:
             import importlib.util
 
             # the independent scipy curve whenever scipy is there (it is optional)
-            kw["external"] = ("scipy",) if importlib.util.find_spec("scipy") else ()
+            kw["external"] = tuple(e for e in ("scipy", "heyoka") if importlib.util.find_spec(e))
         wp = work_precision(target, quick=args.quick, **kw)
     except ValueError as e:
         return _error(e)
