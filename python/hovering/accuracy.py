@@ -316,7 +316,7 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
             ok = r.status == 0
             # an error below the reference's own cannot be resolved: it is reported as that error
             err = max(float(np.max(_section_distance(r.theta[ok], r.I[ok], ref_th[ok], ref_I[ok]), initial=0.0)),
-                      refinfo["error"])
+                      refinfo["error"]) if ok.any() else math.nan  # no return: no error to speak of
             row = {"method": st, "tolerance": float(tol), "error": err, "seconds": sec / theta.size, "unit": "return",
                    "failed": int(np.count_nonzero(~ok)), "steps": float(np.mean(r.steps))}
             if long_ms:

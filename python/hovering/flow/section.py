@@ -18,7 +18,7 @@ __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS
 
 #: Steppers the flow offers: GSL's explicit Runge-Kutta methods and Adams multistep method, and
 #: ``"exact"``, the flow in closed form where the system has one (see :meth:`Section.return_map`).
-STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "exact")
+STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "exact")
 
 
 def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd", event_tol: float = 1e-15,
@@ -37,8 +37,8 @@ def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd
     hovering._core.flow.FlowOptions
     """
     if not is_choice(stepper, STEPPERS):
-        raise ValueError(f"stepper must be one of {STEPPERS} (the implicit GSL steppers need a Jacobian the flow does "
-                         f"not provide; 'exact' is the closed-form flow), got {stepper!r}")
+        raise ValueError(f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
+                         f"solvers, and this flow is not stiff), got {stepper!r}")
     return _core.flow.FlowOptions(
         stepper=stepper, rtol=real_number("rtol", rtol, 1e-16, False, 1, True), atol=real_number("atol", atol, 0),
         event_tol=real_number("event_tol", event_tol, 0), max_steps=integer("max_steps", max_steps, 1, 2**62),
@@ -226,10 +226,13 @@ class Section:
             Section coordinates of the starting points.
         rtol, atol : float, optional
             Tolerances of GSL's step-size control (not read by ``"exact"``).
-        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "exact"}, optional
+        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "exact"}, optional
             GSL stepper: an explicit Runge-Kutta method, or the variable-order Adams multistep
             method (its events are located on an rk8pd extension of each step; on this smooth,
-            oscillatory flow it is ~7x slower than rk8pd at matched accuracy). ``"exact"``: the
+            oscillatory flow it is ~7x slower than rk8pd at matched accuracy), or an implicit
+            Gauss-Legendre method (``rk4imp``, ``rk2imp``: symplectic at a fixed step, with the
+            flow's Jacobian; under the adaptive step control 30-500x slower than rk8pd at matched
+            error, and its long-orbit error still grows nearly as m^2: README "Long orbits"). ``"exact"``: the
             flow in closed form, for eps = 0 (or no coupling) with V1, V2 each Harmonic or Tan
             (each oscillator turns on its own action-angle circle, an impact is an angle jump
             theta -> -theta_w: returns are computed event to event, to rounding, ~1e-15) and for

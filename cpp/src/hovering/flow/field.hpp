@@ -116,6 +116,49 @@ struct Field {
         return 0;  // GSL_SUCCESS
     }
 
+    /// d(dz/dt)/dz (row-major dim x dim) and df/dt = 0, in GSL's calling convention (params = this
+    /// Field): for GSL's implicit steppers. V'' in closed form for Harmonic and Tan (in u), by a
+    /// central difference of V' otherwise; the coupling's Hessian from its polynomial terms.
+    static int jacobian(double, const double* z, double* J, double* dfdt, void* params) {
+        const Field& F = *static_cast<const Field*>(params);
+        const int n = F.dim;
+        for (int i = 0; i < n * n; ++i) J[i] = 0;
+        for (int i = 0; i < n; ++i) dfdt[i] = 0;
+        J[0 * n + 1] = 1;
+        J[2 * n + 3] = 1;
+        auto osc = [&](const Force& f, int qi) {
+            const int pi = qi + 1;
+            if (f.kind == Kind::Harmonic) {
+                J[pi * n + qi] = -f.a;
+            } else if (f.kind == Kind::Tan) {
+                const double u = z[f.aux];
+                J[pi * n + f.aux] = -f.a * (1 + 3 * u * u);          // d/du of -a u (1 + u^2)
+                J[f.aux * n + f.aux] = 2 * f.b * u * z[pi];          // d/du of b (1 + u^2) p
+                J[f.aux * n + pi] = f.b * (1 + u * u);               // d/dp
+            } else {
+                const double q = z[qi], d = 1e-6 * (1 + std::fabs(q));
+                J[pi * n + qi] = -(f.p->dV(q + d) - f.p->dV(q - d)) / (2 * d);
+            }
+        };
+        osc(F.f1, 0);
+        osc(F.f2, 2);
+        if (F.ckind != CKind::None) {
+            for (const auto& t : F.coupling->terms) {  // Vc = sum c q1^i q2^j
+                const double c = t[0];
+                const int i = int(t[1]), j = int(t[2]);
+                const double q1 = z[0], q2 = z[2];
+                const double h11 = i >= 2 ? c * i * (i - 1) * ipow(q1, i - 2) * ipow(q2, j) : 0.0;
+                const double h22 = j >= 2 ? c * j * (j - 1) * ipow(q1, i) * ipow(q2, j - 2) : 0.0;
+                const double h12 = i >= 1 && j >= 1 ? c * i * j * ipow(q1, i - 1) * ipow(q2, j - 1) : 0.0;
+                J[1 * n + 0] -= F.eps * h11;
+                J[1 * n + 2] -= F.eps * h12;
+                J[3 * n + 0] -= F.eps * h12;
+                J[3 * n + 2] -= F.eps * h22;
+            }
+        }
+        return 0;  // GSL_SUCCESS
+    }
+
 private:
     template <Kind K1, Kind K2>
     void pick_c();

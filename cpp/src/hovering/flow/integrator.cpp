@@ -19,16 +19,18 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "rkck") return gsl_odeiv2_step_rkck;
     if (name == "rk8pd") return gsl_odeiv2_step_rk8pd;
     if (name == "msadams") return gsl_odeiv2_step_msadams;
+    if (name == "rk2imp") return gsl_odeiv2_step_rk2imp;
+    if (name == "rk4imp") return gsl_odeiv2_step_rk4imp;
     if (name == "exact") return nullptr;
     bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods), msadams "
-        "(variable-order Adams multistep) or exact (closed-form flow, where the system has one); the implicit steppers need a Jacobian the flow does not "
-        "provide; got '" + name + "'");
+        "(variable-order Adams multistep), rk2imp, rk4imp (implicit Gauss-Legendre, symplectic at a fixed "
+        "step; with the Jacobian) or exact (closed-form flow, where the system has one); got '" + name + "'");
 }
 
 Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
     : field_(s), atol_(o.atol), rtol_(o.rtol), qlim1_(s.V1->q_limit()), qlim2_(s.V2->q_limit()) {
     gsl_quiet();
-    sys_ = gsl_odeiv2_system{field_.fn, nullptr, std::size_t(field_.dim), &field_};
+    sys_ = gsl_odeiv2_system{field_.fn, &Field::jacobian, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
     kind_ = detail::exact_kind(s, o);
     if (kind_ != ExactKind::None) {
@@ -45,6 +47,14 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
             gsl_odeiv2_driver_free(driver_);
             throw std::bad_alloc();
         }
+    } else if (T == gsl_odeiv2_step_rk2imp || T == gsl_odeiv2_step_rk4imp) {
+        // GSL's implicit steppers read the tolerances of their Newton iteration from a driver's
+        // control: the driver owns the stepper, which the adaptive loop below drives as any other.
+        imp_driver_ = gsl_odeiv2_driver_alloc_standard_new(&sys_, T, 1e-3, o.atol, o.rtol, 1.0, 0.0);
+        if (!imp_driver_) throw std::bad_alloc();
+        step_ = imp_driver_->s;
+        order_ = int(gsl_odeiv2_step_order(step_));
+        grow_below_ = std::pow(0.9, order_);
     } else {
         step_ = gsl_odeiv2_step_alloc(T, std::size_t(field_.dim));
         if (!step_) throw std::bad_alloc();
@@ -57,6 +67,8 @@ Integrator::~Integrator() {
     if (driver_) {
         gsl_odeiv2_driver_free(driver_);
         gsl_odeiv2_step_free(ext_);
+    } else if (imp_driver_) {
+        gsl_odeiv2_driver_free(imp_driver_);
     } else if (step_) {
         gsl_odeiv2_step_free(step_);
     }

@@ -73,6 +73,7 @@ private:
     gsl_odeiv2_control* control_ = nullptr;  // msadams only (the driver's)
     gsl_odeiv2_driver* driver_ = nullptr;    // msadams only: owns step, control and evolve
     gsl_odeiv2_step* ext_ = nullptr;       // msadams only: rk8pd for event extensions
+    gsl_odeiv2_driver* imp_driver_ = nullptr;  // rk2imp / rk4imp: owns step_ (their Newton reads its control)
     int ext_sub_ = 1;                      // substeps of the extension
     double t_ms_ = 0;                      // msadams: running time (its history is in time)
     double atol_, rtol_;
