@@ -21,6 +21,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import hovering
+from hovering.accuracy import _best_time
 
 V1, V2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7)
 QW1, H = -1.0, 1.0
@@ -114,12 +115,7 @@ def angle_error(theta0, I, theta1):
 
 def timed(fn, repeat):
     """Best wall time of repeat calls (this VM's single runs vary up to 1.5x) and the last result."""
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+    return _best_time(fn, repeat)
 
 
 def work_precision(methods, settings, th, I, repeat):

@@ -15,15 +15,7 @@ using namespace hovering;
 namespace {
 
 FlowSystem make(std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2, Geometry g, double eps) {
-    FlowSystem s;
-    s.V1 = std::move(V1);
-    s.V2 = std::move(V2);
-    s.coupling = Coupling::bilinear();
-    s.eps = eps;
-    s.qw1 = -1.0;
-    s.qw2 = -0.5;
-    s.geometry = g;
-    return s;
+    return hovering_test::step_system(std::move(V1), std::move(V2), g, eps);
 }
 
 }  // namespace

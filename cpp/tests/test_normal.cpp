@@ -18,15 +18,7 @@ namespace {
 const double kPi = 3.14159265358979323846;
 
 FlowSystem issue_system(double eps, Geometry g = Geometry::Step) {
-    FlowSystem s;
-    s.V1 = std::make_shared<Harmonic>(1.0);
-    s.V2 = std::make_shared<Tan>(1.4, 0.7);
-    s.coupling = Coupling::bilinear();
-    s.eps = eps;
-    s.qw1 = -1.0;
-    s.qw2 = -0.5;
-    s.geometry = g;
-    return s;
+    return hovering_test::step_system(std::make_shared<Harmonic>(1.0), std::make_shared<Tan>(1.4, 0.7), g, eps);
 }
 
 FlowOptions tight() {

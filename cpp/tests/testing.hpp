@@ -7,9 +7,27 @@
 #include <cstdarg>
 #include <cstdio>
 #include <stdexcept>
+#include <memory>
 #include <string>
 
+#include "hovering/flow/system.hpp"
+
 namespace hovering_test {
+
+/// The step system shape: V1, V2, bilinear coupling eps q1 q2, walls at qw = (-1, -0.5).
+inline hovering::FlowSystem step_system(std::shared_ptr<const hovering::Potential> V1,
+                                        std::shared_ptr<const hovering::Potential> V2, hovering::Geometry g,
+                                        double eps) {
+    hovering::FlowSystem s;
+    s.V1 = std::move(V1);
+    s.V2 = std::move(V2);
+    s.coupling = hovering::Coupling::bilinear();
+    s.eps = eps;
+    s.qw1 = -1.0;
+    s.qw2 = -0.5;
+    s.geometry = g;
+    return s;
+}
 
 /// printf into a std::string (the context a failing check prints).
 inline std::string msg(const char* fmt, ...) {

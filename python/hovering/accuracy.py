@@ -345,12 +345,8 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
             if callable(progress):
                 progress(done, total)
     notes = []
-    if "scipy" in external:
-        extra, note = _scipy_rows(section, theta, I, ref_th, ref_I, tolerances)
-        rows += extra
-        notes.append(note)
-    if "heyoka" in external:
-        extra, note = _heyoka_rows(section, theta, I, ref_th, ref_I, tolerances)
+    for name in external:
+        extra, note = _external_rows(name, section, theta, I, ref_th, ref_I, tolerances)
         rows += extra
         notes.append(note)
     s = section.sys
@@ -503,49 +499,40 @@ def heyoka_return_map(sys, z0_list, rtol: float):
     return out, time.perf_counter() - t0
 
 
-def _heyoka_rows(section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
-    try:
-        import heyoka  # noqa: F401
-    except ImportError:
-        return [], "heyoka.py not installed: no heyoka curve (pip install heyoka)"
-    th, ii = theta[:n_max], I[:n_max]
-    z0 = section.point(th, ii)
+def _external_rows(name, section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
+    """Rows of an independent implementation (``"scipy"`` or ``"heyoka"``) on the first n_max points,
+    and a note (what it is, or why it is missing)."""
+    import importlib.util
+
+    if importlib.util.find_spec(name) is None:
+        return [], f"{name} not installed: no {name} curve (pip install {name})"
+    z0 = section.point(theta[:n_max], I[:n_max])
+
+    def run_scipy(tol):
+        t0 = time.perf_counter()
+        out = [scipy_return_map(section.sys, z, max(tol, 1e-13)) for z in z0]
+        return out, time.perf_counter() - t0
+
+    def run_heyoka(tol):
+        return heyoka_return_map(section.sys, z0, max(tol, 1e-15))
+
+    run, method, note = {
+        "scipy": (run_scipy, "scipy DOP853", "scipy DOP853 (solve_ivp with events, Python field)"),
+        "heyoka": (run_heyoka, "heyoka.py Taylor", "heyoka.py Taylor + events (its Python-side cost per "
+                                                   "propagate_until call included, JIT compilation not)")}[name]
     rows = []
     for tol in tolerances:
         try:
-            out, sec = heyoka_return_map(section.sys, z0, max(tol, 1e-15))
-        except ValueError as e:
-            return [], str(e)
+            out, sec = run(tol)
+        except ValueError as e:  # a system the implementation cannot express
+            return [], f"no {name} curve: {e}"
         ok = np.array([o is not None for o in out])
         c = section.coordinates(np.array([o if o is not None else np.full(4, np.nan) for o in out]))
         err = float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]),
-                              initial=0.0))
-        rows.append({"method": "heyoka.py Taylor", "tolerance": float(tol), "error": err, "seconds": sec / len(z0),
-                     "unit": "return", "failed": int(np.count_nonzero(~ok))})
-    return rows, (f"heyoka.py Taylor + events: {len(z0)} points, its Python-side cost per propagate_until call "
-                  "included, JIT compilation not")
-
-
-def _scipy_rows(section, theta, I, ref_th, ref_I, tolerances, n_max: int = 16):
-    try:
-        import scipy  # noqa: F401
-    except ImportError:
-        return [], "scipy not installed: no scipy curve (pip install scipy)"
-    th, ii = theta[:n_max], I[:n_max]
-    z0 = section.point(th, ii)
-    rows = []
-    for tol in tolerances:
-        t0 = time.perf_counter()
-        out = [scipy_return_map(section.sys, z, max(tol, 1e-13)) for z in z0]
-        sec = (time.perf_counter() - t0) / len(z0)
-        ok = np.array([o is not None for o in out])
-        zz = np.array([o if o is not None else np.full(4, np.nan) for o in out])
-        c = section.coordinates(zz)
-        err = float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]),
-                              initial=0.0))
-        rows.append({"method": "scipy DOP853", "tolerance": float(tol), "error": err, "seconds": sec, "unit": "return",
+                              initial=0.0)) if ok.any() else math.nan
+        rows.append({"method": method, "tolerance": float(tol), "error": err, "seconds": sec / len(z0), "unit": "return",
                      "failed": int(np.count_nonzero(~ok))})
-    return rows, f"scipy DOP853 (solve_ivp with events, Python field): {len(z0)} points"
+    return rows, f"{note}: {len(z0)} points"
 
 
 # ------------------------------------------------------------------------------------------------

@@ -253,14 +253,7 @@ ReturnResult Tracer::trace_angles(const std::array<double, 4>& z0, bool first_cr
         stop(FlowStatus::StepLimit, y);
     }
     while (!done) {
-        if (r.steps >= opt.max_steps) {
-            r.status = FlowStatus::StepLimit;
-            break;
-        }
-        if (cancel && (r.steps & 255) == 255 && cancel->load(std::memory_order_relaxed)) {
-            r.status = FlowStatus::Interrupted;
-            break;
-        }
+        if (halted(r, cancel)) break;
         // The next event: the earliest angle target of either oscillator.
         double tau = kInf, target = 0;
         Ev ev = Ev::Section;
@@ -355,19 +348,9 @@ ReturnResult Tracer::trace_angles(const std::array<double, 4>& z0, bool first_cr
             ++work_.label_operations;
         }
     }
-    if (!done) {
-        double y[4];
-        current(y);
-        for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
-        r.time = t;
-        if (dense) dense->push(dense->offset + t, y, TrajectoryPoint::End);
-    }
-    if (labels && r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None) {
-        r.itinerary = crossed ? "0" : "u";
-        ++work_.label_operations;
-    }
-    r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
-    work_.steps += r.steps;
+    double y[4] = {0, 0, 0, 0};
+    if (!done) current(y);
+    finish(r, y, t, done, crossed, H0);
     return r;
 }
 

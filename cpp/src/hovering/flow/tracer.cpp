@@ -151,14 +151,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
     const bool is_step = s.geometry == Geometry::Step;
     bool done = false;
     while (!done) {
-        if (r.steps >= opt.max_steps) {
-            r.status = FlowStatus::StepLimit;
-            break;
-        }
-        if (cancel && (r.steps & 255) == 255 && cancel->load(std::memory_order_relaxed)) {
-            r.status = FlowStatus::Interrupted;
-            break;
-        }
+        if (halted(r, cancel)) break;
         double y0[kMaxDim], d0[kMaxDim];
         for (int i = 0; i < n; ++i) {
             y0[i] = y[i];
@@ -324,18 +317,35 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
         armed = armed || (seen_negative && y[1] > 0);
     }
+    finish(r, y, t, done, crossed, H0);
+    return r;
+}
+
+bool Tracer::halted(ReturnResult& r, const std::atomic<bool>* cancel) const {
+    if (r.steps >= o_.max_steps) {
+        r.status = FlowStatus::StepLimit;
+        return true;
+    }
+    // The flag is read every 256 steps: an atomic load per step would show in the inner loop.
+    if (cancel && (r.steps & 255) == 255 && cancel->load(std::memory_order_relaxed)) {
+        r.status = FlowStatus::Interrupted;
+        return true;
+    }
+    return false;
+}
+
+void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool crossed, double H0) {
     if (!done) {  // stopped between events (step limit, non-finite, outside a well, interrupted)
         for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = y[i];
         r.time = t;
-        if (dense) dense->push(dense->offset + t, y, TrajectoryPoint::End);
+        if (dense_) dense_->push(dense_->offset + t, y, TrajectoryPoint::End);
     }
-    if (labels && r.status == FlowStatus::Ok && r.itinerary.empty() && s.geometry != Geometry::None) {
+    if (labels_ && r.status == FlowStatus::Ok && r.itinerary.empty() && s_.geometry != Geometry::None) {
         r.itinerary = crossed ? "0" : "u";
         ++work_.label_operations;
     }
-    r.energy_error = std::fabs(s.energy(r.z.data()) - H0);
+    r.energy_error = std::fabs(s_.energy(r.z.data()) - H0);
     work_.steps += r.steps;
-    return r;
 }
 
 }  // namespace hovering::detail

@@ -85,6 +85,13 @@ private:
     void sample(const double* y0, const double* d0, double t0, double t_end);
     // Stepper "exact", uncoupled system: the return event to event (exact.cpp).
     ReturnResult trace_angles(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel);
+    /// Whether the loop must stop before its next step (step limit, or a cancel seen every 256
+    /// steps); sets r.status.
+    bool halted(ReturnResult& r, const std::atomic<bool>* cancel) const;
+    /// The end of every return (both loops): where a return that stopped between events (!done)
+    /// stopped (state y at time t), the "0" / "u" label of an Ok return without impact, the energy
+    /// error against H0, and the step count.
+    void finish(ReturnResult& r, const double* y, double t, bool done, bool crossed, double H0);
     // Uniform samples in [t0, t_end) of the angle flow from the angles of o at t0.
     void sample_angles(const AngleOscillator* o, double t0, double t_end);
     const FlowSystem& s_;
