@@ -37,7 +37,7 @@ namespace ei = Eigen::internal;
 inline void arcs_packet(const AnalyticArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
     const Packet zero = ei::pset1<Packet>(0.0);
     Om = ei::padd(ei::pset1<Packet>(a.Omega0), ei::pmul(ei::pset1<Packet>(a.tau0), k));
-    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), ei::psqrt(ei::pmax(ei::pnegate(k), zero)));
+    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), detail::psqrt_rn(ei::pmax(ei::pnegate(k), zero)));
     JR = ei::pand(ei::pcmp_lt(k, zero),
                   ei::padd(ei::pset1<Packet>(2.0 * (kPi - a.theta_w)), ei::pmul(ei::pset1<Packet>(a.tau1), k)));
 }
