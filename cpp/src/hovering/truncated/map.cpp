@@ -44,8 +44,8 @@ double arcs_kmin(const AnalyticArcs& a) {
     if (a.tau0 < 0) return -(detail::kMaxAngle - a.Omega0) / -a.tau0;
     return -kInf;
 }
-double arcs_kmin(const TabulatedArcs&) { return -kInf; }
-double arcs_kmax(const TabulatedArcs& a) { return a.kmax(); }
+double arcs_kmin(const TabulatedArcs& a) { return a.omega_limit(-1.0); }
+double arcs_kmax(const TabulatedArcs& a) { return std::min(a.kmax(), a.omega_limit(1.0)); }
 void validate_arcs(const AnalyticArcs& a) { a.validate(); }
 void validate_arcs(const TabulatedArcs&) {}
 void validate_forcing(const SineForcing&) {}
