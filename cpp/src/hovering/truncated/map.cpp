@@ -240,10 +240,34 @@ bool MapCore<A, F>::merged_start(double p, double K0, double K1, double kick, do
     const double kmin = sent(below) ? below : nearest_true(below, K0, sent);
     const double kmax = std::min(sent(above) ? above : nearest_true(above, K0, sent), top);
     if (!(kmin < kmax)) return false;
-    // For each candidate arc: the height where the image of its start passes p, by bisection on
-    // which side of p it lies (t_a moves smoothly with k, but its rounding is not monotone at the
-    // ulp level), then the nearest 64 doubles on either side for t_a(k) == p exactly.
-    constexpr std::int64_t kScan = 64;
+    // Search the interval for a height k at which a candidate start's image t_a(k) is p exactly,
+    // the heights nearest K0 first. t_a moves with k, but its own rounding (a few ulps of
+    // |Omega| + 3 pi) is not monotone in k and can exceed that motion over the whole interval, so
+    // an interval of up to 4096 doubles is searched entirely; a longer one (|K| << |K1|, where
+    // the sqrt(-K) of |J_1| makes t_a move fast) is bisected on the side of p that t_a lies on,
+    // and the 64 doubles either side of the crossing are searched.
+    const std::int64_t lo_k = order_key(kmin), hi_k = order_key(kmax);
+    auto hit = [&](int i, std::int64_t kk) {
+        const double k = from_key(kk);
+        const ArcLengths a = arcs_.at(k);
+        const Starts st(a);
+        if (!(image_of(i, st) == p && classify(start_of(i, st), k, a).region == owner[i])) return false;
+        phi0 = start_of(i, st);
+        Ks = k;
+        return true;
+    };
+    auto search = [&](std::int64_t c, std::int64_t half_width, auto&& arcs_to_try) {
+        for (std::int64_t n = 0; n <= 2 * half_width; ++n) {
+            const std::int64_t kk = n % 2 ? c - (n + 1) / 2 : c + n / 2;  // c, c - 1, c + 1, c - 2, ...
+            if (kk < lo_k || kk > hi_k) continue;
+            for (int i = 0; i < 3; ++i)
+                if (arcs_to_try(i) && hit(i, kk)) return true;
+        }
+        return false;
+    };
+    constexpr std::int64_t kWhole = 4096, kScan = 64;
+    if (hi_k - lo_k <= kWhole)
+        return search(std::min(std::max(order_key(K0), lo_k), hi_k), hi_k - lo_k, [&](int i) { return candidate[i]; });
     for (int i = 0; i < 3; ++i) {
         if (!candidate[i]) continue;
         const double glo = offset(i, kmin), ghi = offset(i, kmax);
@@ -252,19 +276,7 @@ bool MapCore<A, F>::merged_start(double p, double K0, double K1, double kick, do
             const bool rising = glo < 0.0;
             centre = nearest_true(kmin, kmax, [&](double k) { return (offset(i, k) >= 0.0) == rising; });
         }
-        const std::int64_t c = order_key(centre), lo_k = order_key(kmin), hi_k = order_key(kmax);
-        for (std::int64_t n = 0; n <= 2 * kScan; ++n) {
-            const std::int64_t kk = n % 2 ? c - (n + 1) / 2 : c + n / 2;  // c, c - 1, c + 1, c - 2, ...
-            if (kk < lo_k || kk > hi_k) continue;
-            const double k = from_key(kk);
-            const ArcLengths a = arcs_.at(k);
-            const Starts st(a);
-            if (image_of(i, st) == p && classify(start_of(i, st), k, a).region == owner[i]) {
-                phi0 = start_of(i, st);
-                Ks = k;
-                return true;
-            }
-        }
+        if (search(order_key(centre), kScan, [&](int j) { return j == i; })) return true;
     }
     return false;
 }
