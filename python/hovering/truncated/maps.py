@@ -220,15 +220,17 @@ class _MapAPI(MapAnalyses):
         Notes
         -----
         The image arcs ``F(J_a)`` are half-open like the arcs, each owning the image of its arc's
-        start, so the inverse gives every start back: ``step_inverse(*step(s, K))`` is ``(s, K)``
-        bit for bit for each start ``s`` of :meth:`corner_curves`. In floating point ``step``
-        rounds ``phi + omega`` and ``K + eps f(phibar)``, so distinct doubles can share an image
-        and ``step_inverse(step(x))`` can only be one of them: x up to ~1 ulp of
-        ``|phi| + |omega|`` in phi and ulp(Kbar) in K (plus how far phi moves with that change
-        of K, e.g. near K = 0 where ``|J_1| = 2 lam sqrt(-K)``). For a start, the one returned is
-        again a start of the same arc, at a height that step merges with K (usually K itself).
-        A point within that rounding of an arc's *end* can share its image with the start of the
-        next image arc, and comes back as that start.
+        start, so every start goes back to its arc: for a start ``s`` of :meth:`corner_curves`,
+        ``step_inverse(*step(s, K))`` is ``(s, K)`` bit for bit unless step merges K with other
+        heights. For step rounds ``phi + omega`` and ``K + eps f(phibar)``, so distinct doubles can
+        share an image, and the inverse can return only one of them: at a height within ulp(Kbar)
+        of K, and in phi within ~2 ulps of ``|phi| + |omega|`` plus what phi moves with that
+        change of K (a lot near K = 0, where ``|J_1| = 2 lam sqrt(-K)``). For a start that is a
+        point of the same arc - the start at its own height whenever one has exactly this image
+        (searched for). A point within that rounding of
+        an arc's *end* can share its image with the start of the next image arc, and comes back
+        as that start; arcs shorter than the rounding (within ~1e-15 of the band floor, J_1 for
+        ``|K| < ~1e-28``) can share their starts' images, and one of those starts comes back.
         """
         p, k, scalar = point_pair(phi, K, "step_inverse")
         a, b = self._step_inverse(p, k)
