@@ -1,6 +1,7 @@
 #pragma once
 // The one place where a point of the truncated map is assigned to an arc (internal): the scalar
-// step, the inverse and the scalar kernel call it; the SIMD kernel repeats exactly its arithmetic.
+// step, the inverse and the scalar kernel call it; the SIMD kernel gets the same regions (it uses
+// a cheaper offset test away from the arc ends and these comparisons near them).
 //
 // Boundary convention. Each arc is half-open and owns its left end: J_1 = [s_1, s_R),
 // J_R = [s_R, s_0), J_0 = [s_0, s_1) on the circle [-pi, pi), where s_1, s_R, s_0 are the doubles
@@ -9,7 +10,8 @@
 // recomputed offset (which rounds differently, and put some handed-out starts in the arc before).
 // The image arcs are half-open the same way: F maps J_a onto [t_a, t_next), t_a = image of s_a
 // computed by the very expression of the forward step, so the inverse gives every image start
-// back to the arc that owns it, and F is a bijection of the band.
+// back to the arc that owns it: in exact arithmetic F is a bijection of the band. (In floating
+// point step() can send several doubles to one; MapCore::step_inverse says which it returns.)
 
 #include <cmath>
 
