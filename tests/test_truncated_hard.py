@@ -352,10 +352,12 @@ def test_step_inverse_accepts_every_image_near_the_band_edges(name, rng):
 
 def sine_bound(eps, p, K1, sin_ulp):
     """Largest |K_simd - K_scalar| after one step from the same state with the same phibar = p:
-    the two sines differ by <= sin_ulp + 1 ulp of sin(p) (SLEEF's bound plus glibc's < 1 ulp),
-    scaled by |eps|, plus the rounding of eps sin (1 ulp) and of the sum (1 ulp of Kbar)."""
+    the two sines differ by <= sin_ulp + 1 ulps of sin(p) (SLEEF's bound plus glibc's < 1 ulp;
+    the ulp of the true sine, which can lie a binade above the computed one: hence the factor
+    1 + 2^-50), scaled by |eps|, plus the rounding of eps sin (1 ulp) and of the sum (1 ulp of
+    Kbar). It is nearly attained: measured up to 0.87-0.996 of it."""
     s = np.abs(np.sin(p))
-    return np.abs(eps) * (sin_ulp + 1) * ulp(s) + ulp(np.abs(eps) * s) + ulp(K1)
+    return np.abs(eps) * (sin_ulp + 1) * ulp(s * (1 + 2**-50)) + ulp(np.abs(eps) * s) + ulp(K1)
 
 
 @pytest.mark.parametrize("sin_ulp", [1.0, 3.5])
@@ -374,10 +376,10 @@ def test_simd_and_scalar_agree_bit_for_bit_in_phi_and_within_the_sine_bound_in_K
     assert np.array_equal(v.phi_final, s.phi_final)
     assert np.array_equal(v.region, s.region)
     dK = np.abs(v.K_final - s.K_final)[ok]
-    bound = sine_bound(m.eps, s.phi_final, s.K_final, sin_ulp)[ok]
+    bound = sine_bound(m.eps, s.phi_final, np.maximum(np.abs(s.K_final), np.abs(v.K_final)), sin_ulp)[ok]
     assert np.all(dK <= bound)
-    # (Measured: K differs on ~0.4 % of first steps with the 1-ulp sin, ~9 % with the 3.5-ulp one,
-    # by at most 1 ulp of Kbar.)
+    # (Measured: K differs on 0.4-0.9 % of first steps with the 1-ulp sin, 4-9 % with the 3.5-ulp
+    # one, by up to 4 ulps of max(|K|, |eps sin|) - many ulps of Kbar where the two cancel.)
 
 
 @pytest.mark.parametrize("name", ["paper+0.3", "Omega0-2.5", "J0_floor", "family-"])
