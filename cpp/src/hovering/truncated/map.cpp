@@ -232,9 +232,11 @@ bool MapCore<A, F>::merged_start(double p, double K0, double K1, double kick, do
     // rounding of t_a, a few ulps of 2 pi) is not the one; nearly every p is clear of all three.
     const double slack = 8.0 * (std::nextafter(kTwoPi, kInf) - kTwoPi);
     auto clear = [&](double g1, double g2) { return (g1 > slack && g2 > slack) || (g1 < -slack && g2 < -slack); };
+    const Starts at_below(arcs_.at(below)), at_above(arcs_.at(above));
     bool candidate[3];
     bool any = false;
-    for (int i = 0; i < 3; ++i) any |= candidate[i] = !clear(offset(i, below), offset(i, above));
+    for (int i = 0; i < 3; ++i)
+        any |= candidate[i] = !clear(detail::wrap(image_of(i, at_below) - p), detail::wrap(image_of(i, at_above) - p));
     if (!any) return false;
     auto sent = [&](double k) { return k + kick == K1; };
     const double kmin = sent(below) ? below : nearest_true(below, K0, sent);
