@@ -177,7 +177,8 @@ void bind_common(Cls& cls) {
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def("valid_band",
              [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },
-             "Open interval (lo, hi) of K on which the map is defined.");
+             "Open interval (lo, hi) of K on which the map is defined: all three arcs in (0, 2 pi) and the\n"
+             "rotation |Omega(K)| <= 1e6 (beyond, one step keeps less than ~2e-10 rad of phi).");
 }
 
 }  // namespace

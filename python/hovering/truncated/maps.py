@@ -170,7 +170,8 @@ class _MapAPI(MapAnalyses):
         Parameters
         ----------
         phi, K : array_like or float
-            Points (broadcast together). ``K`` must lie in :meth:`valid_band`.
+            Points (broadcast together). ``K`` must lie in :meth:`valid_band`; ``|phi| <= 1e6``
+            (wrapped to [-pi, pi) first).
 
         Returns
         -------
@@ -181,18 +182,30 @@ class _MapAPI(MapAnalyses):
         ------
         ValueError
             For a non-finite value or a K outside the band (the message names it and the band).
+
+        Notes
+        -----
+        Arcs are half-open and own their left ends: ``J_1 = [start_1, start_R)``,
+        ``J_R = [start_R, start_0)``, ``J_0 = [start_0, start_1)`` on the circle, with the starts
+        exactly the doubles :meth:`arcs` and :meth:`corner_curves` return; a point is placed by
+        comparing it with them, so ``region(corner_curves(K)["1R"], K)`` is ``RIGHT``. (An arc
+        shorter than the rounding of its ends - within ~1e-15 of the band floor, or |J_1| for
+        ``|K| < ~1e-30`` - can hold no double; its start then lies in the next arc.) The SIMD
+        kernel of :meth:`iterate` follows the same convention bit for bit.
         """
         p, k, scalar = point_pair(phi, K, "step")
         a, b = self._step(p, k)
         return (float(a), float(b)) if scalar else (a, b)
 
     def step_inverse(self, phi, K):
-        """One backward step: the exact inverse of :meth:`step`.
+        """One backward step: the inverse of :meth:`step`, with the same boundary convention.
 
         Parameters
         ----------
         phi, K : array_like or float
-            Image points; the preimage height ``K - eps f(phi)`` must lie in the band.
+            Image points; the preimage height ``K - eps f(phi)`` must lie in the band (up to the
+            rounding of the forward step: every image :meth:`step` makes of a band point is
+            accepted, also when ``K - eps f(phi)`` rounds onto the band's edge).
 
         Returns
         -------
@@ -202,7 +215,22 @@ class _MapAPI(MapAnalyses):
         Raises
         ------
         ValueError
-            For a non-finite value or a preimage outside the band.
+            For a non-finite value or an image of no band height.
+
+        Notes
+        -----
+        The image arcs ``F(J_a)`` are half-open like the arcs, each owning the image of its arc's
+        start, so every start goes back to its arc: for a start ``s`` of :meth:`corner_curves`,
+        ``step_inverse(*step(s, K))`` is ``(s, K)`` bit for bit unless step merges K with other
+        heights. For step rounds ``phi + omega`` and ``K + eps f(phibar)``, so distinct doubles can
+        share an image, and the inverse can return only one of them: at a height within ulp(Kbar)
+        of K, and in phi within ~2 ulps of ``|phi| + |omega|`` plus what phi moves with that
+        change of K (a lot near K = 0, where ``|J_1| = 2 lam sqrt(-K)``). For a start that is a
+        point of the same arc - the start at its own height whenever one has exactly this image
+        (searched for). A point within that rounding of
+        an arc's *end* can share its image with the start of the next image arc, and comes back
+        as that start; arcs shorter than the rounding (within ~1e-15 of the band floor, J_1 for
+        ``|K| < ~1e-28``) can share their starts' images, and one of those starts comes back.
         """
         p, k, scalar = point_pair(phi, K, "step_inverse")
         a, b = self._step_inverse(p, k)
@@ -275,6 +303,8 @@ class _MapAPI(MapAnalyses):
             ``len_1, len_R, len_0`` (|J_1|, |J_R|, |J_0|; 0, 0, 2 pi for K >= 0) and ``start_1,
             start_R, start_0`` (left ends in [-pi, pi), NaN for K >= 0). The left ends are the
             corner-singularity curves: ``start_1 = phi_01``, ``start_R = phi_1R``, ``start_0 = phi_R0``.
+            Each arc owns its left end, and these are the exact doubles :meth:`step`,
+            :meth:`region` and :meth:`iterate` compare with (see :meth:`step`).
         """
         k = np.ascontiguousarray(real_array("K", K).ravel())
         a = self._arcs(k)
@@ -293,7 +323,8 @@ class _MapAPI(MapAnalyses):
         Returns
         -------
         dict of ndarray
-            Keys ``'01'``, ``'1R'``, ``'R0'``: angles in ``[-pi, pi)``.
+            Keys ``'01'``, ``'1R'``, ``'R0'``: angles in ``[-pi, pi)``, the left ends of J_1, J_R,
+            J_0, each owned by that arc (``region(cc["1R"], K)`` is ``RIGHT``; see :meth:`step`).
         """
         a = self.arcs(K)
         return {"01": a["start_1"], "1R": a["start_R"], "R0": a["start_0"]}
@@ -360,7 +391,11 @@ class _MapAPI(MapAnalyses):
         Notes
         -----
         An orbit whose image leaves the band stops with status ``ESCAPED`` and keeps that image
-        as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps.
+        as its final state; an initial point outside the band is ``ESCAPED`` after 0 steps. The
+        band is where the rotation stays within |Omega| <= 1e6, so an orbit driven to larger
+        rotations (huge K) is ``ESCAPED`` too, never an ``OK`` orbit with a meaningless phi.
+        Both kernels compute phi and the region of every step as :meth:`step` does, bit for bit;
+        K differs only through the sin implementation (SLEEF vs libm, ~1 ulp).
         """
         record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         progress = check_progress(progress)
@@ -423,7 +458,10 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
     eps : float
         Perturbation amplitude (any finite value; the paper studies |eps| <= 0.92).
     Omega0 : float
-        Rotation at the tangency circle.
+        Rotation at the tangency circle, ``|Omega0| <= 1e6``. The band also ends where
+        ``|Omega0 + tau0 K|`` reaches 1e6: one step rounds phi + Omega, and the 2 pi n it
+        subtracts, to ulps of |Omega|, so at 1e6 phi keeps ~2e-10 rad per step (4e-16 at
+        |Omega| ~ 1); each decade of rotation beyond costs a decade of phi, and at 1e16 none is left.
     theta_w : float
         Wall angle, in the open interval (0, pi).
     tau0 : float, optional
@@ -438,8 +476,8 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
     Raises
     ------
     ValueError
-        Naming the parameter and its allowed range, for non-finite values, theta_w outside
-        (0, pi), lam <= 0 or K_max <= 0.
+        Naming the parameter and its allowed range, for non-finite values, |Omega0| > 1e6,
+        theta_w outside (0, pi), lam <= 0 or K_max <= 0.
     """
 
     def __init__(self, eps, Omega0, theta_w, tau0=1.0, tau1=0.5, lam=0.5, K_max=math.inf):
@@ -570,7 +608,8 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         Strictly increasing grid containing 0, with >= 3 points K <= 0 and max K > 0.
     Omega, JR, J1 : array_like or callable
         Values on the grid (or functions of K sampled on it). JR and J1 are used only for K <= 0;
-        J1 must vanish at K = 0.
+        J1 must vanish at K = 0. ``|Omega| <= 1e6`` (see :class:`TruncatedMap`); the band also
+        ends where the spline through Omega first exceeds it between the grid points.
     forcing : sequence of float, optional
         Sine coefficients ``b_1, b_2, ...`` of f (default ``(1.0,)``: f = sin).
     K_max : float, optional

@@ -73,6 +73,9 @@ struct TabulatedArcs {
     double band_lo() const;
     /// Largest K of the grid.
     double kmax() const { return Omega.xmax(); }
+    /// First K from 0 towards +inf (direction > 0) or -inf where the spline's |Omega| exceeds 1e6
+    /// (sampled 64 times per grid interval, then bisected); +-inf if it never does on the grid.
+    double omega_limit(double direction) const;
 
     Spline Omega;  ///< Omega(K) on the whole grid
     Spline JR;     ///< |J_R|(K) for K <= 0

@@ -67,11 +67,11 @@ public:
     double rotation(double phi, double K) const;
     /// Region and rotation together; `who` prefixes error messages.
     std::pair<Region, double> classify_point(double phi, double K, const char* who) const;
-    /// One forward step (scalar libm path).
+    /// One forward step (scalar libm path); arcs are half-open [start, next start), see arc_starts().
     std::pair<double, double> step(double phi, double K) const;
-    /// One backward step: the exact inverse of step().
+    /// One backward step: inverse of step() on the band, with the same boundary convention.
     std::pair<double, double> step_inverse(double phi, double K) const;
-    /// Left ends of J_1, J_R, J_0 on the circle K (K < 0), each in [-pi, pi).
+    /// Left ends of J_1, J_R, J_0 on the circle K (K < 0), each in [-pi, pi): each arc owns its start.
     std::vector<double> arc_starts(double K) const;
 
     /// Iterate n orbits; phi0/K0 have n entries; see IterateOutput for what is written.
@@ -91,6 +91,10 @@ public:
 
 private:
     void check_point(double phi, double K, const char* who) const;
+    /// Height K1 - kick of a preimage, clamped into the band when K1 is an image of a band height.
+    double preimage_height(double K1, double kick) const;
+    /// Whether p is the image of an arc start at a height merged with K0 by the rounding of K + kick.
+    bool merged_start(double p, double K0, double K1, double kick, double& phi0, double& Ks) const;
 
     double eps_;
     Arcs arcs_;

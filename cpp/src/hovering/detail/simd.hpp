@@ -36,5 +36,16 @@ inline Packet psin(const Packet& x) {
 #endif
 }
 
+// Correctly rounded sqrt on one packet, as std::sqrt. Eigen 3.4's psqrt for AVX-512 doubles is, by
+// default (EIGEN_FAST_MATH), rsqrt14 and two Newton steps: off by 1-4 ulp, which made the SIMD
+// kernel's |J_1| and so phi differ from step() on ~2% of the points of J_R.
+inline Packet psqrt_rn(const Packet& x) {
+#if defined(EIGEN_VECTORIZE_AVX512)
+    return _mm512_sqrt_pd(x);
+#else
+    return ei::psqrt(x);  // _mm256_sqrt_pd / _mm_sqrt_pd / std::sqrt: correctly rounded
+#endif
+}
+
 
 }  // namespace hovering::detail

@@ -13,6 +13,7 @@
 #include "hovering/detail/common.hpp"
 #include "hovering/truncated/forcing.hpp"
 #include "hovering/truncated/map.hpp"
+#include "hovering/truncated/classify.hpp"
 
 namespace hovering {
 
@@ -20,17 +21,11 @@ using detail::bad;
 using detail::fmt;
 using detail::gsl_quiet;
 using detail::kInf;
-using detail::kInvTwoPi;
 using detail::kPi;
 using detail::kTwoPi;
 using detail::require_finite;
 
-double wrap_angle(double x) {
-    double y = x - kTwoPi * std::floor((x + kPi) * kInvTwoPi);
-    if (y >= kPi) y -= kTwoPi;
-    if (y < -kPi) y += kTwoPi;
-    return y;
-}
+double wrap_angle(double x) { return detail::wrap(x); }
 
 
 // ---------------------------------------------------------------------------------------------
@@ -222,6 +217,33 @@ double TabulatedArcs::band_lo() const {
         return -good * good;
     }
     return -smax * smax;
+}
+
+double TabulatedArcs::omega_limit(double direction) const {
+    // The tabulated values obey |Omega| <= kMaxAngle (check_table), but the spline between them
+    // can overshoot; the band stops where it first exceeds the bound, as for the analytic arcs.
+    const std::vector<double>& k = Omega.x();
+    std::vector<double> nodes;  // from K = 0 outwards
+    for (double x : k)
+        if (direction > 0 ? x >= 0.0 : x <= 0.0) nodes.push_back(x);
+    if (direction < 0) std::reverse(nodes.begin(), nodes.end());
+    auto ok = [this](double x) { return std::fabs(Omega(x)) <= detail::kMaxAngle; };
+    double good = 0.0;
+    for (std::size_t i = 1; i < nodes.size(); ++i)
+        for (int j = 1; j <= 64; ++j) {
+            const double x = nodes[i - 1] + (nodes[i] - nodes[i - 1]) * (double(j) / 64.0);
+            if (ok(x)) {
+                good = x;
+                continue;
+            }
+            double badv = x;  // bisect between the last sample within the bound and the first beyond
+            for (int it = 0; it < 200 && std::fabs(badv - good) > 1e-15 * std::fabs(badv); ++it) {
+                const double mid = 0.5 * (good + badv);
+                (ok(mid) ? good : badv) = mid;
+            }
+            return good;
+        }
+    return direction > 0 ? kInf : -kInf;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
@@ -37,7 +38,7 @@ namespace ei = Eigen::internal;
 inline void arcs_packet(const AnalyticArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
     const Packet zero = ei::pset1<Packet>(0.0);
     Om = ei::padd(ei::pset1<Packet>(a.Omega0), ei::pmul(ei::pset1<Packet>(a.tau0), k));
-    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), ei::psqrt(ei::pmax(ei::pnegate(k), zero)));
+    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), detail::psqrt_rn(ei::pmax(ei::pnegate(k), zero)));
     JR = ei::pand(ei::pcmp_lt(k, zero),
                   ei::padd(ei::pset1<Packet>(2.0 * (kPi - a.theta_w)), ei::pmul(ei::pset1<Packet>(a.tau1), k)));
 }
@@ -108,6 +109,12 @@ bool cancelled(const IterateOptions& opt) {
 // Packets in flight per worker: several independent dependency chains hide the latency of one
 // step (sqrt, floor, sin) while the whole state stays in registers / L1.
 constexpr int kP = 8;
+
+// How close to an arc end the offset of phi from phi_01 must come for a packet to be classified
+// by comparing with the arc starts. The offset's rounding (phi - phi_01, its reduction mod 2 pi and
+// the starts' own) is a few ulps of |phi_01| + 2 pi < 2^20, as |Omega| <= 1e6 on the band, so
+// below 1e-9; 2^-24 = 6e-8 keeps that by a factor of 60, and only ~1 lane-step in 1e7 is that close.
+constexpr double kNearArcEnd = 0x1p-24;
 constexpr int kLanes = kP * kW;
 
 template <bool Fast, class A, class F>
@@ -126,7 +133,15 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                  three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
                  twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
                  half = ei::pset1<Packet>(0.5), eps = ei::pset1<Packet>(m.eps()), plo = ei::pset1<Packet>(lo),
-                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero);
+                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero),
+                 margin = ei::pset1<Packet>(kNearArcEnd), pi_less_margin = ei::pset1<Packet>(kPi - kNearArcEnd);
+    // detail::wrap and detail::wrap_once on packets (same operations, same order).
+    auto pwrap = [&](const Packet& x) {
+        Packet y = ei::psub(x, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(x, pi), inv2pi))));
+        y = ei::pselect(ei::pcmp_le(pi, y), ei::psub(y, twopi), y);
+        return ei::pselect(ei::pcmp_lt(y, mpi), ei::padd(y, twopi), y);
+    };
+    auto wrap_once = [&](const Packet& u) { return ei::pselect(ei::pcmp_le(pi, u), ei::psub(u, twopi), u); };
     Packet allow[4];
     for (int r = 0; r < 4; ++r) allow[r] = (opt.exit_mask >> r) & 1u ? all : zero;
 
@@ -173,16 +188,17 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     // at once); with no work left the lane computes a harmless point that is ignored everywhere.
     auto fill = [&](int j) {
         for (std::int64_t i; src.pop(i);) {
-            finish.start(i, phi0[i], K0[i]);
+            const double w = detail::wrap(phi0[i]);  // the kernel compares angles in [-pi, pi)
+            finish.start(i, w, K0[i]);
             if (!(K0[i] > lo && K0[i] < hi)) {
-                finish(i, phi0[i], K0[i], 0.0, 0, Status::Escaped);
+                finish(i, w, K0[i], 0.0, 0, Status::Escaped);
                 continue;
             }
             if (ns == 0) {
-                finish(i, phi0[i], K0[i], 0.0, 0, Status::Ok);
+                finish(i, w, K0[i], 0.0, 0, Status::Ok);
                 continue;
             }
-            lphi[j] = phi0[i];
+            lphi[j] = w;
             lK[j] = K0[i];
             lrot[j] = 0.0;
             llive[j] = on;
@@ -217,34 +233,68 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             for (int j = 0; j < kLanes; ++j)
                 if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted, visited(j));
             for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
-                finish.start(i, phi0[i], K0[i]);
+                const double w = detail::wrap(phi0[i]);
+                finish.start(i, w, K0[i]);
                 const bool inside = K0[i] > lo && K0[i] < hi;
-                finish(i, phi0[i], K0[i], 0.0, 0, inside ? Status::Interrupted : Status::Escaped);
+                finish(i, w, K0[i], 0.0, 0, inside ? Status::Interrupted : Status::Escaped);
             }
             return;
         }
-        // Classify every lane: region code and rotation omega_a (same arithmetic as classify()).
-        Packet leaving = zero;
-        for (int q = 0; q < kP; ++q) {
-            Packet Om, JR, J1;
-            arcs_packet(m.arcs(), K[q], Om, JR, J1);
-            Packet d = ei::psub(phi[q], ei::psub(pi, ei::pmul(half, ei::padd(ei::padd(Om, JR), J1))));
-            d = ei::psub(d, ei::pmul(twopi, ei::pfloor(ei::pmul(d, inv2pi))));
-            const Packet neg = ei::pcmp_lt(K[q], zero);
-            const Packet up = ei::pand(neg, ei::pcmp_lt(d, J1));
-            const Packet rt = ei::pandnot(ei::pand(neg, ei::pcmp_lt(d, ei::padd(J1, JR))), up);
-            omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
-            if (!need_reg) continue;
-            reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
-            if (out.visited)
-                for (int r = 0; r < 4; ++r) seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
-            if (watch) {
-                const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
-                                  ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
-                                  ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
-                leaving = ei::por(leaving, ei::pandnot(ei::pand(live[q], fresh[q]), ok));
+        // Classify every lane: region code and rotation omega_a, exactly as detail::classify, which
+        // compares phi with the arc starts (the boundary convention). That costs ~25 vector
+        // operations per packet, so a first pass uses the offset d of phi from phi_01 reduced mod
+        // 2 pi, which gives the same regions wherever it is farther than kNearArcEnd from an arc
+        // end (d = 0, |J_1|, |J_1| + |J_R|, 2 pi); only if some lane is that close (~1 lane-step in
+        // 1e7) are all packets classified again by comparison with the starts.
+        auto classify_packets = [&](auto exact) {  // std::bool_constant: two instantiations
+            Packet near = zero;
+            for (int q = 0; q < kP; ++q) {
+                Packet Om, JR, J1;
+                arcs_packet(m.arcs(), K[q], Om, JR, J1);
+                const Packet p01 = ei::psub(pi, ei::pmul(half, ei::padd(ei::padd(Om, JR), J1)));
+                const Packet neg = ei::pcmp_lt(K[q], zero);
+                Packet in1, inR;  // phi in J_1; phi in J_R (fast pass: in J_1 or J_R)
+                if constexpr (!decltype(exact)::value) {
+                    Packet d = ei::psub(phi[q], p01);
+                    d = ei::psub(d, ei::pmul(twopi, ei::pfloor(ei::pmul(d, inv2pi))));
+                    const Packet T = ei::padd(J1, JR);
+                    in1 = ei::pcmp_lt(d, J1);
+                    inR = ei::pcmp_lt(d, T);
+                    const Packet close = ei::por(
+                        ei::pcmp_lt(ei::pmin(ei::pabs(ei::psub(d, J1)), ei::pabs(ei::psub(d, T))), margin),
+                        ei::pcmp_lt(pi_less_margin, ei::pabs(ei::psub(d, pi))));
+                    near = ei::por(near, ei::pand(close, neg));
+                } else {
+                    const Packet s1 = pwrap(p01);
+                    const Packet uR = ei::padd(s1, J1);
+                    const Packet sR = wrap_once(uR), s0 = wrap_once(ei::padd(uR, JR));
+                    // detail::in_arc(x, a, b) as masks: (a <= x) ^ (x < b) ^ (a <= b). For a <= b
+                    // the first two are never both false (x < a <= b), so the xor is their and;
+                    // for a > b never both true, so it is their or. Both arcs compare with s_R.
+                    const Packet below_R = ei::pcmp_lt(phi[q], sR);
+                    in1 = ei::pxor(ei::pxor(ei::pcmp_le(s1, phi[q]), below_R), ei::pcmp_le(s1, sR));
+                    inR = ei::pxor(ei::pandnot(all, below_R), ei::pxor(ei::pcmp_lt(phi[q], s0), ei::pcmp_le(sR, s0)));
+                }
+                const Packet up = ei::pand(neg, in1);
+                const Packet rt = ei::pandnot(ei::pand(neg, inR), up);
+                omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
+                if (need_reg) reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
             }
-        }
+            return ei::predux_any(near);
+        };
+        if (classify_packets(std::false_type{})) classify_packets(std::true_type{});
+        Packet leaving = zero;
+        if (need_reg)
+            for (int q = 0; q < kP; ++q) {
+                if (out.visited)
+                    for (int r = 0; r < 4; ++r) seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
+                if (watch) {
+                    const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
+                                      ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
+                                      ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
+                    leaving = ei::por(leaving, ei::pandnot(ei::pand(live[q], fresh[q]), ok));
+                }
+            }
         if (watch && ei::predux_any(leaving)) {
             unpack();
             for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
@@ -277,10 +327,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         Packet outside = zero;
         for (int q = 0; q < kP; ++q) {
             rot[q] = ei::padd(rot[q], omega[q]);
-            Packet p = ei::padd(phi[q], omega[q]);
-            p = ei::psub(p, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(p, pi), inv2pi))));
-            p = ei::pselect(ei::pcmp_le(pi, p), ei::psub(p, twopi), p);
-            p = ei::pselect(ei::pcmp_lt(p, mpi), ei::padd(p, twopi), p);
+            const Packet p = pwrap(ei::padd(phi[q], omega[q]));
             phi[q] = p;
             K[q] = ei::padd(K[q], ei::pmul(eps, force_packet<Fast>(m.forcing(), p)));
             const Packet inside = ei::pand(ei::pcmp_lt(plo, K[q]), ei::pcmp_lt(K[q], phi_));
@@ -322,7 +369,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
     const Finisher finish{opt, out, progress};
     const std::int64_t ns = opt.n_steps;
     for (std::int64_t i; src.pop(i);) {
-        double phi = phi0[i], K = K0[i], rot = 0.0;
+        double phi = detail::wrap(phi0[i]), K = K0[i], rot = 0.0;
         int vis = 0;
         finish.start(i, phi, K);
         bool reported = false;
@@ -354,7 +401,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
             }
             if (out.regions) out.regions[i * ns + n] = static_cast<std::int8_t>(c.region);
             rot += c.omega;
-            phi = wrap_angle(phi + c.omega);
+            phi = detail::rotate(phi, c.omega);
             K += m.eps() * m.forcing().at(phi);
             if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
             if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
