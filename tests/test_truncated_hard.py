@@ -428,3 +428,10 @@ def test_long_orbits_never_leave_the_circle_or_the_reals(name, kernel, rng):
         assert np.all(np.isfinite(r.K[i, :kept])) and np.all((lo < r.K[i, :kept]) & (r.K[i, :kept] < hi))
         assert np.all(np.isnan(r.phi[i, n + 1 :]))
     assert (r.status == Status.OK).sum() >= 8
+
+
+def test_simd_width_is_what_the_build_uses():
+    # the packet width the kernel was compiled for: AVX2 (4) or AVX-512 (8) builds report AVX2
+    w = hovering.simd_width()
+    assert w in (1, 2, 4, 8)
+    assert hovering.simd_is_avx2() == (w >= 4)

@@ -89,6 +89,7 @@ from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one relea
 __version__ = "0.2.0"
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
+simd_width = _core.truncated.simd_width
 
 __all__ = [
     "WorkPrecision",
@@ -132,6 +133,7 @@ __all__ = [
     "golden_family",
     "wrap",
     "simd_is_avx2",
+    "simd_width",
     "Potential",
     "Harmonic",
     "Tan",

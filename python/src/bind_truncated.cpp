@@ -206,5 +206,6 @@ void register_truncated(py::module_& mod) {
         .def_property_readonly("forcing", [](const TruncatedFamily& m) { return m.forcing().b; });
     bind_common<TruncatedFamily>(tf);
 
-    mod.def("simd_is_avx2", &simd_is_avx2, "Whether the SIMD kernel of this build uses 4-wide AVX2 vectors.");
+    mod.def("simd_is_avx2", &simd_is_avx2, "Whether this build has AVX2 (its SIMD kernel uses AVX2 or wider vectors).");
+    mod.def("simd_width", &simd_width, "Doubles per SIMD packet of the kernel in this build (8 AVX-512, 4 AVX2, 2 SSE2).");
 }

@@ -116,5 +116,7 @@ double wrap_angle(double x);
 
 /// Whether this build's SIMD kernel uses 4-wide AVX2 (true) or 2-wide SSE2 (false) vectors.
 bool simd_is_avx2();
+/// Doubles per SIMD packet of the kernel in this build (8 AVX-512, 4 AVX2, 2 SSE2, 1 none).
+int simd_width();
 
 }  // namespace hovering

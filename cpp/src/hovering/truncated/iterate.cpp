@@ -426,6 +426,8 @@ bool simd_is_avx2() {
 #endif
 }
 
+int simd_width() { return detail::kW; }
+
 template <class A, class F>
 void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n,
                             const IterateOptions& opt, const IterateOutput& out) const {
