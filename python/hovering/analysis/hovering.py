@@ -112,8 +112,63 @@ def default_depth(m) -> float:
     return d if math.isfinite(d) and d > 0 else float("inf")
 
 
+def _piece(m, phi, K, n_steps: int, n_threads: int):
+    """The per-sample outcome of hovering_area for some samples (a piece of a distributed run)."""
+    no_impact = ("0u", "0")
+    r0 = m.with_eps(0.0).iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
+                                 n_threads=n_threads)
+    r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
+    return r0.status, r.status, r.steps_done, r.visited
+
+
+def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> str:
+    # Everything that changes a piece's samples or their orbits: the map (its pickle: parameters,
+    # integrator options, measured curve), the counts, the box, the seed and the piece's range.
+    import hashlib
+    import pickle
+
+    blob = pickle.dumps((m, int(n_steps), float(K_low), int(seed), int(samples), int(lo), int(hi)), protocol=4)
+    return hashlib.sha256(blob).hexdigest()
+
+
+def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, workers, client, scheduler, dask,
+                 pieces, checkpoint):
+    from ..distribute import executor, run_pieces
+    from ..sweeps import Checkpoint
+
+    n = phi.size
+    with executor(workers, client, scheduler, dask) as ex:
+        k = integer("pieces", pieces if pieces is not None else 4 * ex.workers, 1, max(1, n))
+        bounds = [(n * i // k, n * (i + 1) // k) for i in range(k)]
+        store = Checkpoint(checkpoint) if checkpoint is not None else None
+        out = [None] * k
+        todo = []
+        for i, (lo, hi) in enumerate(bounds):
+            row = store.get(_piece_key(m, n_steps, K_low, seed, samples, lo, hi)) if store else None
+            if row is not None:
+                out[i] = tuple(np.asarray(a, dtype=dt) for a, dt in zip(row, (np.int8, np.int8, np.int64, np.int8)))
+                bar.advance(2 * (hi - lo) * n_steps)
+            else:
+                todo.append(i)
+
+        def done(j, res):
+            i = todo[j]
+            lo, hi = bounds[i]
+            out[i] = res
+            if store is not None:
+                store.put(_piece_key(m, n_steps, K_low, seed, samples, lo, hi), [np.asarray(a).tolist() for a in res])
+            bar.advance(2 * (hi - lo) * n_steps)
+
+        for _ in run_pieces(ex, _piece, [(m, phi[bounds[i][0]:bounds[i][1]], K[bounds[i][0]:bounds[i][1]], n_steps,
+                                          n_threads) for i in todo], on_result=done):
+            pass
+    return tuple(np.concatenate([o[j] for o in out]) for j in range(4))
+
+
 def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optional[float] = None, seed: int = 0,
-                  n_threads: int = 0, keep_points: bool = False, progress=False) -> HoveringArea:
+                  n_threads: int = 0, keep_points: bool = False, progress=False, *, workers: Optional[int] = None,
+                  client=None, scheduler: Optional[str] = None, dask: bool = False, pieces: Optional[int] = None,
+                  checkpoint=None) -> HoveringArea:
     """Area of the hovering set HOV(eps) of a map, by its definition.
 
     HOV(eps) is the set of points that impact under F_0 (some iterate leaves J_0 u J_0u) and never
@@ -145,6 +200,23 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         One report for the whole call (both iterations, ``2 * n_samples * n_steps`` steps or
         returns): ``True`` a tqdm bar on stderr, a callable ``progress(done, total)``, ``False``
         (default) none. See :mod:`hovering._progress`.
+    workers : int, optional
+        Split the samples into ``pieces`` and run them on this many local worker processes (a
+        process pool; with ``dask=True`` a Dask LocalCluster). The result is identical to the
+        single-process one for the same seed: the samples are drawn once, here, and each piece
+        iterates a contiguous slice of them.
+    client : distributed.Client, optional
+        Run the pieces on an existing Dask cluster.
+    scheduler : str, optional
+        Address of a running Dask scheduler to run the pieces on.
+    dask : bool, optional
+        With ``workers``: a Dask LocalCluster instead of a process pool.
+    pieces : int, optional
+        Number of pieces (default 4 per worker).
+    checkpoint : path-like, optional
+        A :class:`hovering.sweeps.Checkpoint` file: each finished piece is written as it arrives,
+        keyed by every parameter that changes it (map, counts, box, seed, range); a rerun computes
+        only the missing pieces (distributed runs only).
 
     Returns
     -------
@@ -180,30 +252,38 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
 
     m0 = m.with_eps(0.0)
     unit = getattr(m, "_progress_unit", "step")
+    distributed = workers is not None or client is not None or scheduler is not None
+    if checkpoint is not None and not distributed:
+        raise ValueError("checkpoint applies to distributed runs (give workers, client or scheduler)")
     with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
-        # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
-        r0 = m0.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads,
-                        progress=bar.part(0))
-        # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
-        r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True,
-                      n_threads=n_threads, progress=bar.part(n * n_steps))
-    impacts0 = np.isin(r0.status, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
-    stayed = r.status == Status.OK
+        if distributed:
+            s0, s1, steps_done, visited = _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar,
+                                                       workers, client, scheduler, dask, pieces, checkpoint)
+        else:
+            # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
+            r0 = m0.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
+                            n_threads=n_threads, progress=bar.part(0))
+            # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
+            r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True,
+                          n_threads=n_threads, progress=bar.part(n * n_steps))
+            s0, s1, steps_done, visited = r0.status, r.status, r.steps_done, r.visited
+    impacts0 = np.isin(s0, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
+    stayed = s1 == Status.OK
     box_area = 2 * math.pi * (-K_low)
     areas = {}
     for N in (n_steps // 4, n_steps // 2, n_steps):
         # Stopped at or after N steps for any reason (exit, escape, the flow's corner hits): survived N.
-        survive = stayed | (r.steps_done >= N)
+        survive = stayed | (steps_done >= N)
         areas[N] = box_area * np.count_nonzero(impacts0 & survive) / n
     hov = impacts0 & stayed
     both = (1 << int(Region.BESIDE)) | (1 << int(Region.ABOVE))
-    hov_both = hov & ((r.visited & both) == both)
+    hov_both = hov & ((visited & both) == both)
     p = np.count_nonzero(hov) / n
     sampling = box_area * math.sqrt(max(p * (1 - p), 1.0 / n) / n)
     iteration = areas[n_steps // 2] - areas[n_steps]
     theory = m.theory().area
     floor_touched = bool(np.any(hov & (K < 0.9 * K_low)))
-    unresolved = int(np.count_nonzero(~np.isin(r.status, [int(Status.OK), int(Status.EXITED), int(Status.ESCAPED)])))
+    unresolved = int(np.count_nonzero(~np.isin(s1, [int(Status.OK), int(Status.EXITED), int(Status.ESCAPED)])))
     return HoveringArea(
         area=areas[n_steps],
         error=2 * sampling + iteration,
