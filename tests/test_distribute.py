@@ -88,3 +88,55 @@ def test_bad_distribution_arguments_are_named():
         hovering_area(M, **KW, checkpoint="x.jsonl")
     with pytest.raises(ValueError, match="pieces"):
         hovering_area(M, **KW, workers=2, pieces=0)
+
+
+def _scene_copy(tmp_path, name, **changes):
+    import tomllib
+
+    from hovering.scenes import parse_scene
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    path = root / "examples" / "scenes" / name
+    data = tomllib.loads(path.read_text())
+    data.update(changes)
+    data["output"] = str(tmp_path / (path.stem + ".png"))
+    return parse_scene(data, path)
+
+
+def test_sweep_scenes_on_workers_give_the_one_process_rows(tmp_path):
+    from hovering.scenes.compute import compute
+
+    sc = _scene_copy(tmp_path, "fig_hov_vs_eps.toml")
+    one = compute(sc, quick=True, checkpoint=tmp_path / "one.jsonl")
+    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2)
+    for a, b in zip(one.series, pool.series):
+        assert np.array_equal(a.area, b.area) and np.array_equal(a.error, b.error) and np.array_equal(a.eps, b.eps)
+    # every point is in the checkpoint, and a rerun (on a Dask LocalCluster) computes none
+    again = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2, dask=True)
+    assert again.meta["points_reused"] == sum(len(s.eps) for s in again.series)
+
+
+def test_flow_sweep_scene_on_workers(tmp_path):
+    from hovering.scenes.compute import compute
+
+    sc = _scene_copy(tmp_path, "flow_hov_vs_eps.toml", eps=[-0.1, 0.1])
+    one = compute(sc, quick=True, checkpoint=tmp_path / "one.jsonl")
+    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2)
+    assert np.array_equal(one.flow_area, pool.flow_area) and np.array_equal(one.eps, pool.eps)
+    for name in one.models:
+        assert np.array_equal(one.models[name]["area"], pool.models[name]["area"])
+
+
+def test_cli_workers_flags(tmp_path):
+    import subprocess
+    import sys
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    scene = root / "examples" / "scenes" / "fig_hov_vs_eps.toml"
+    p = subprocess.run([sys.executable, "-m", "hovering", "scene", str(scene), "--quick", "--workers", "2", "--out",
+                        str(tmp_path / "h.png")], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "h.sweep.jsonl").exists()
+    bad = subprocess.run([sys.executable, "-m", "hovering", "scene", str(scene), "--dask"], capture_output=True,
+                         text=True, timeout=60)
+    assert bad.returncode == 2 and "--dask needs --workers" in bad.stderr

@@ -2,9 +2,10 @@
 
 ``demo [--out PNG]``
     The packaged demo scene (phase portraits of F_eps for +-eps, coloured by region).
-``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress]``
+``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress] [--workers N [--dask] | --scheduler ADDRESS]``
     One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
-    and the PNG, prints the numbers shown.
+    and the PNG, prints the numbers shown. Sweep scenes run their points on N local processes, a
+    Dask LocalCluster or a running Dask scheduler, each point checkpointed as it arrives.
 ``redraw RESULT.npz [--out PNG]``
     Redraws a saved result's figure without computing.
 ``accuracy SCENE.toml [--quick] [--out PNG]``
@@ -50,11 +51,11 @@ def _progress(args) -> bool:
     return sys.stderr.isatty() if args.progress is None else args.progress
 
 
-def _run(scene, out, quick: bool, progress: bool) -> int:
+def _run(scene, out, quick: bool, progress: bool, where=None) -> int:
     from .scenes import format_summary, run_scene
 
     try:
-        summary = run_scene(scene, out=out, quick=quick, progress=progress)
+        summary = run_scene(scene, out=out, quick=quick, progress=progress, **(where or {}))
     except ValueError as e:  # a value only the computation can check (e.g. a K beyond the band's top)
         return _error(e)
     print(format_summary(summary))
@@ -73,7 +74,12 @@ def _scene(args) -> int:
         out = output_path("--out", args.out) if args.out is not None else None
     except (OSError, ValueError) as e:
         return _error(e)
-    return _run(scene, out, args.quick, _progress(args))
+    where = {}
+    if args.workers is not None or args.scheduler is not None:
+        where = dict(workers=args.workers, scheduler=args.scheduler, dask=args.dask)
+    elif args.dask:
+        return _error("--dask needs --workers N (a LocalCluster of N workers)")
+    return _run(scene, out, args.quick, _progress(args), where)
 
 
 def _demo(args) -> int:
@@ -205,6 +211,10 @@ def main(argv=None) -> int:
                     help="output PNG (default: the scene's 'output'); the result NPZ + JSON are written next to it")
     sc.add_argument("--quick", action="store_true",
                     help="divide the iterate counts by 50 (a fast check, not the paper's figure)")
+    sc.add_argument("--workers", type=_checked(int, 1, 4096), default=None,
+                    help="sweep scenes: run the points on N local worker processes (1..4096)")
+    sc.add_argument("--dask", action="store_true", help="with --workers: a Dask LocalCluster instead of a process pool")
+    sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
     rd = sub.add_parser("redraw", help="redraw a saved result (RESULT.npz) without computing")
     rd.add_argument("path", help="result file written by 'scene' (NPZ)")

@@ -70,7 +70,7 @@ def packaged_scene(name: str) -> Path:
 
 
 def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool = False, keep_figure: bool = False,
-              progress=False) -> dict:
+              progress=False, **where) -> dict:
     """Compute a scene, save its result (NPZ + JSON), draw its figure and write the PNG.
 
     Parameters
@@ -87,6 +87,9 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
         instead of closing the figure.
     progress : bool or callable, optional
         Progress bars on stderr for the long computations.
+    **where
+        ``workers``, ``client``, ``scheduler``, ``dask``: where a sweep scene's points run (see
+        :func:`compute`).
 
     Returns
     -------
@@ -99,7 +102,7 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
     png = output_path("out", out) if out is not None else scene.output
     png.parent.mkdir(parents=True, exist_ok=True)
     npz = png.with_suffix(".npz")
-    result = compute(scene, quick=quick, progress=progress, checkpoint=png.with_suffix(".sweep.jsonl"))
+    result = compute(scene, quick=quick, progress=progress, checkpoint=png.with_suffix(".sweep.jsonl"), **where)
     result.meta["output"] = str(png)
     t = time.perf_counter()
     fig = _draw(result, png)

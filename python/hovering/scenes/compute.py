@@ -386,7 +386,48 @@ def _theory_line(spec, eps_all: np.ndarray) -> tuple:
     return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
 
 
-def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint) -> HoveringAreaResult:
+def _truncated_point(ms, n_steps: int, samples: int, seed: int, kw: dict) -> dict:
+    """One point of a truncated-map |HOV| sweep (a piece: runs in any process)."""
+    t = time.perf_counter()
+    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=seed, **kw)
+    return dict(eps=ms.eps, area=float(h.area), error=float(h.error), theory=float(h.theory),
+                floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0, theta_w=ms.theta_w,
+                seconds=time.perf_counter() - t)
+
+
+def _sweep(points, ckpt, bar, where) -> tuple:
+    """Rows of a sweep's points ``[(key, fn, args)]`` in order: from the checkpoint, or computed
+    (here, or as pieces on ``where``: a dict of executor arguments) and checkpointed as each
+    arrives. Returns (rows, reused: one bool per point, True where the checkpoint had it)."""
+    rows = [ckpt.get(key) for key, _, _ in points]
+    reused = [r is not None for r in rows]
+    bar.advance(sum(reused))
+    todo = [i for i, r in enumerate(rows) if r is None]
+
+    def done(j, row):
+        i = todo[j]
+        ckpt.put(points[i][0], row)
+        rows[i] = row
+        bar.advance(1)
+
+    if where:
+        from ..distribute import executor, run_pieces
+
+        with executor(**where) as ex:
+            for _ in run_pieces(ex, _call, [(points[i][1], points[i][2]) for i in todo], on_result=done):
+                pass
+    else:
+        for j, i in enumerate(todo):
+            done(j, points[i][1](*points[i][2]))
+    return rows, reused
+
+
+def _call(fn, args):
+    return fn(*args)
+
+
+def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint,
+                    where=None) -> HoveringAreaResult:
     n_steps = scaled(scene.n_steps, quick)
     samples = max(scene.samples // QUICK_FACTOR, 400) if quick else scene.samples
     meta.update(n_steps=n_steps, samples=samples)
@@ -395,36 +436,30 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
     eps_all = np.array(scene.eps)
+    points = []
+    for s in scene.series:
+        for e in scene.eps:
+            ms = s.map_at(e)
+            kw = {} if s.K_low is None else {"K_low": s.K_low}
+            key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
+            points.append((key, _truncated_point, (ms, n_steps, samples, scene.seed, kw)))
+    with progress_bar(progress, total=len(points), desc=scene.name, unit="point") as bar:
+        all_rows, from_ckpt = _sweep(points, ckpt, bar, where)
     drawn = set()
     out = []
-    with progress_bar(progress, total=len(scene.series) * len(scene.eps), desc=scene.name, unit="point") as bar:
-        for k, s in enumerate(scene.series):
-            rows, reused = [], 0
-            for e in scene.eps:
-                ms = s.map_at(e)
-                kw = {} if s.K_low is None else {"K_low": s.K_low}
-                key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-                row = ckpt.get(key)
-                if row is None:
-                    t = time.perf_counter()
-                    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-                    row = dict(eps=e, area=float(h.area), error=float(h.error), theory=float(h.theory),
-                               floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0,
-                               theta_w=ms.theta_w, seconds=time.perf_counter() - t)
-                    ckpt.put(key, row)
-                else:
-                    reused += 1
-                rows.append(row)
-                bar.advance(1)
-            fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
-            te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
-            drawn.add(fam)
-            col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
-            out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
-                                    error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
-                                    K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
-                                    theory_curve=tc, golden_c=s.golden_c, reused=reused))
-    meta["points_reused"] = sum(s.reused for s in out)
+    ne = len(scene.eps)
+    for k, s in enumerate(scene.series):
+        rows = all_rows[k * ne:(k + 1) * ne]
+        reused = sum(from_ckpt[k * ne:(k + 1) * ne])
+        fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
+        te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
+        drawn.add(fam)
+        col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
+        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
+                                error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
+                                K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
+                                theory_curve=tc, golden_c=s.golden_c, reused=reused))
+    meta["points_reused"] = sum(from_ckpt)
     return HoveringAreaResult(scene=scene, meta=meta, series=out)
 
 
@@ -527,17 +562,23 @@ def _measured_model(fm, K_low: float):
     return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
 
 
-def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint) -> FlowHoveringResult:
+def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint,
+                   where=None) -> FlowHoveringResult:
     n = scaled(scene.n_steps, quick, floor=50)
     samples = max(scene.samples // QUICK_FACTOR, 100) if quick else scene.samples
     meta.update(n_steps=n, samples=samples)
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
-    rows, reused = [], 0
-    with progress_bar(progress, total=len(scene.eps), desc=scene.name, unit="eps") as bar:
-        for e in scene.eps:
-            _flow_point(scene, e, n, samples, ckpt, rows, bar)
-            reused += rows[-1].pop("_reused", 0)
+    points = []
+    for e in scene.eps:
+        sysd = _serial_dict(scene.system)
+        sysd["eps"] = e
+        key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
+                   seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
+        points.append((key, _flow_point, (scene, e, n, samples)))
+    with progress_bar(progress, total=len(points), desc=scene.name, unit="eps") as bar:
+        rows, from_ckpt = _sweep(points, ckpt, bar, where)
+    reused = sum(from_ckpt)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
     models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")}
               for name in scene.models}
@@ -547,17 +588,8 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
                               b1=col("b1"), seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
 
 
-def _flow_point(scene, e, n, samples, ckpt, rows, bar) -> None:
-    """One eps of a flow |HOV| sweep: from the checkpoint, or computed and checkpointed at once."""
-    sysd = _serial_dict(scene.system)
-    sysd["eps"] = e
-    key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
-               seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
-    row = ckpt.get(key)
-    if row is not None:
-        rows.append(dict(row, _reused=1))
-        bar.advance(1)
-        return
+def _flow_point(scene, e, n, samples) -> dict:
+    """One eps of a flow |HOV| sweep (a piece: runs in any process)."""
     t = time.perf_counter()
     fm = _flowmap(scene, eps=e)
     # One box for flow and models, so the same points are classified by each: the default
@@ -579,9 +611,7 @@ def _flow_point(scene, e, n, samples, ckpt, rows, bar) -> None:
         mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True)
         agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
         row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
-    ckpt.put(key, row)
-    rows.append(row)
-    bar.advance(1)
+    return row
 
 
 def _serial_dict(spec) -> dict:
@@ -680,7 +710,8 @@ def scene_map(scene: SceneSpec):
 # ------------------------------------------------------------------------------------------------
 
 
-def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: Optional[os.PathLike] = None
+def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: Optional[os.PathLike] = None,
+            workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False
             ) -> SceneResult:
     """Run a scene's simulation and return its typed result (nothing is drawn or written).
 
@@ -695,6 +726,11 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
     checkpoint : path-like, optional
         Sweep scenes (``hovering_area``, ``flow_hovering_area``): the JSON-lines file every
         finished point is written to at once (default: next to the scene's output).
+    workers, client, scheduler, dask : optional
+        Sweep scenes: run the points as pieces on ``workers`` local processes (with ``dask`` a
+        Dask LocalCluster), an existing Dask ``client`` or a ``scheduler`` address
+        (:func:`hovering.distribute.executor`); each point is checkpointed as it arrives and the
+        result is the one-process result. Other scenes: ignored (they are one computation).
 
     Returns
     -------
@@ -709,14 +745,17 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
     meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
     t0 = time.perf_counter()
     ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
+    where = None
+    if workers is not None or client is not None or scheduler is not None:
+        where = dict(workers=workers, client=client, scheduler=scheduler, dask=bool(dask))
     if isinstance(scene, OrbitScene):
         out = _orbit_scene(scene, quick, progress, meta)
     elif isinstance(scene, HoveringAreaScene):
-        out = _hovering_scene(scene, quick, progress, meta, ck)
+        out = _hovering_scene(scene, quick, progress, meta, ck, where)
     elif isinstance(scene, FlowPortraitScene):
         out = _flow_portrait(scene, quick, progress, meta)
     elif isinstance(scene, FlowHoveringScene):
-        out = _flow_hovering(scene, quick, progress, meta, ck)
+        out = _flow_hovering(scene, quick, progress, meta, ck, where)
     elif isinstance(scene, TangentToriScene):
         out = _tangent_tori(scene, quick, progress, meta)
     elif isinstance(scene, SigmaStructureScene):
