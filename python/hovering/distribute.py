@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing
+import os
 from contextlib import contextmanager
 from typing import Callable, Iterable, Iterator, Optional
 
@@ -26,6 +27,7 @@ class _Local:
     def __init__(self, workers: int):
         self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
         self.workers = workers
+        self.threads_per_piece = _share(workers)
 
     def submit(self, fn, *args):
         return self.pool.submit(fn, *args)
@@ -47,6 +49,9 @@ class _Dask:
     def __init__(self, client, own: bool, cluster=None):
         self.client, self.own, self.cluster = client, own, cluster
         self.workers = max(1, len(client.scheduler_info().get("workers", {})))
+        # A LocalCluster made here shares this machine's cores; a given cluster's workers run on
+        # machines whose cores the core's own default (all of them) fits.
+        self.threads_per_piece = _share(self.workers) if cluster is not None else 0
 
     def submit(self, fn, *args):
         # pure=False: two pieces with equal arguments are still two pieces (no result sharing)
@@ -65,6 +70,12 @@ class _Dask:
             self.client.close()
             if self.cluster is not None:
                 self.cluster.close()
+
+
+def _share(workers: int) -> int:
+    """Core threads per piece when ``workers`` processes share this machine (>= 1): without it each
+    piece's iteration would start a thread per core and oversubscribe the cores workers-fold."""
+    return max(1, (os.cpu_count() or 1) // workers)
 
 
 @contextmanager
@@ -86,7 +97,9 @@ def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str
     Yields
     ------
     object
-        ``submit(fn, *args)``, ``as_completed(futures)``, ``cancel(futures)``, ``workers``.
+        ``submit(fn, *args)``, ``as_completed(futures)``, ``cancel(futures)``, ``workers``,
+        ``threads_per_piece`` (core threads a piece should use: this machine's cores shared among
+        local workers; 0, all of a worker's cores, on a given cluster).
 
     Raises
     ------

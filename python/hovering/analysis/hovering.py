@@ -138,6 +138,7 @@ def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, worke
 
     n = phi.size
     with executor(workers, client, scheduler, dask) as ex:
+        threads = n_threads if n_threads != 0 else ex.threads_per_piece
         k = integer("pieces", pieces if pieces is not None else 4 * ex.workers, 1, max(1, n))
         bounds = [(n * i // k, n * (i + 1) // k) for i in range(k)]
         store = Checkpoint(checkpoint) if checkpoint is not None else None
@@ -160,7 +161,7 @@ def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, worke
             bar.advance(2 * (hi - lo) * n_steps)
 
         for _ in run_pieces(ex, _piece, [(m, phi[bounds[i][0]:bounds[i][1]], K[bounds[i][0]:bounds[i][1]], n_steps,
-                                          n_threads) for i in todo], on_result=done):
+                                          threads) for i in todo], on_result=done):
             pass
     return tuple(np.concatenate([o[j] for o in out]) for j in range(4))
 

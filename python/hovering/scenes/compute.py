@@ -386,10 +386,10 @@ def _theory_line(spec, eps_all: np.ndarray) -> tuple:
     return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
 
 
-def _truncated_point(ms, n_steps: int, samples: int, seed: int, kw: dict) -> dict:
+def _truncated_point(ms, n_steps: int, samples: int, seed: int, kw: dict, n_threads: int = 0) -> dict:
     """One point of a truncated-map |HOV| sweep (a piece: runs in any process)."""
     t = time.perf_counter()
-    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=seed, **kw)
+    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=seed, n_threads=n_threads, **kw)
     return dict(eps=ms.eps, area=float(h.area), error=float(h.error), theory=float(h.theory),
                 floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0, theta_w=ms.theta_w,
                 seconds=time.perf_counter() - t)
@@ -414,6 +414,9 @@ def _sweep(points, ckpt, bar, where) -> tuple:
         from ..distribute import executor, run_pieces
 
         with executor(**where) as ex:
+            # Each point keeps the core's threads (all cores): sweep points differ in cost (1-25 s per
+            # eps of the flow scene), and one thread per point on a shared machine left the costliest
+            # point alone at the end (66 s vs 50 s for flow_hov_vs_eps on 2 workers here).
             for _ in run_pieces(ex, _call, [(points[i][1], points[i][2]) for i in todo], on_result=done):
                 pass
     else:
@@ -588,7 +591,7 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
                               b1=col("b1"), seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
 
 
-def _flow_point(scene, e, n, samples) -> dict:
+def _flow_point(scene, e, n, samples, n_threads: int = 0) -> dict:
     """One eps of a flow |HOV| sweep (a piece: runs in any process)."""
     t = time.perf_counter()
     fm = _flowmap(scene, eps=e)
@@ -599,7 +602,8 @@ def _flow_point(scene, e, n, samples) -> dict:
     K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
     if "onset" in tms:
         K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
-    flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True)
+    flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True,
+                            n_threads=n_threads)
     th = fm.theory()
     row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
                theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
@@ -608,7 +612,8 @@ def _flow_point(scene, e, n, samples) -> dict:
         # A model whose band is shallower than the box (measured arcs stop at the impact zone's
         # floor) samples its own box: its points are not the flow's, so no verdict agreement.
         K_m = max(K_low, tm.valid_band()[0] * (1 - 1e-9))
-        mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True)
+        mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True,
+                              n_threads=n_threads)
         agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
         row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
     return row
