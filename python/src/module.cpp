@@ -12,9 +12,11 @@ PYBIND11_MODULE(_core, m) {
     register_flow(flow);
     auto normal = m.def_submodule("normal", "The tangential curve (normal coordinates) and the flow map.");
     register_normal(normal);
+    auto scene = m.def_submodule("scene", "The sweep executable's reading of scene files and its point runner.");
+    register_scene(scene);
     register_pickles(m);  // after every class it adds pickling to
     // `from hovering._core.flow import X` needs the submodules in sys.modules (def_submodule only
     // sets them as attributes).
     auto modules = py::module_::import("sys").attr("modules");
-    for (auto sub : {truncated, flow, normal}) modules[sub.attr("__name__")] = sub;
+    for (auto sub : {truncated, flow, normal, scene}) modules[sub.attr("__name__")] = sub;
 }
