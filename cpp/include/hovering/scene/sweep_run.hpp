@@ -47,6 +47,9 @@ std::vector<std::string> result_columns(const SweepScene& s);
 /// point's numbers: the resume key, and the readable columns after the results.
 std::vector<std::pair<std::string, std::string>> point_parameters(const SweepScene& s, const SweepPoint& p,
                                                                   const SweepCounts& c);
+/// Throws std::invalid_argument if this program cannot run the scene as written (an [integrator]
+/// accuracy target: Python turns it into a stepper and tolerances by measurement), before any work.
+void check_runnable(const SweepScene& s);
 /// Measure one point. n_threads: 0 = all cores; cancel (optional) stops it early (then
 /// interrupted is set); progress (optional) counts map steps / flow returns as hovering_area does.
 SweepRow run_point(const SweepScene& s, const SweepPoint& p, const SweepCounts& c, int n_threads = 0,
