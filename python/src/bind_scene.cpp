@@ -47,7 +47,10 @@ py::dict scene_dict(const SweepScene& s) {
             py::dict sd = map_dict(x.map);
             sd["label"] = x.label;
             sd["golden_c"] = x.golden ? py::object(py::float_(x.golden_c)) : py::object(py::none());
-            if (x.golden) sd["Omega0"] = sd["theta_w"] = py::none();
+            if (x.golden) {
+                sd["Omega0"] = py::none();
+                sd["theta_w"] = py::none();
+            }
             sd["K_low"] = x.has_K_low ? py::object(py::float_(x.K_low)) : py::object(py::none());
             sd["color"] = x.color.empty() ? py::object(py::none()) : py::object(py::str(x.color));
             series.append(sd);
@@ -96,7 +99,7 @@ void register_scene(py::module_& m) {
             const SweepCounts c = sweep_counts(s, quick);
             std::atomic<bool> cancel{false};
             SweepRow row;
-            const bool stopped = run_watched([&] { row = run_point(s, points[index], c, n_threads, &cancel); }, cancel, true);
+            const bool stopped = hovering_py::run_watched([&] { row = run_point(s, points[index], c, n_threads, &cancel); }, cancel, true);
             if (stopped || row.interrupted) {
                 PyErr_SetNone(PyExc_KeyboardInterrupt);
                 throw py::error_already_set();
