@@ -334,7 +334,9 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
     if not abs(Omega0) <= 1e6:
         raise ValueError(f"eps = {eps} and c = {c} give Omega0 = Omega_G - c eps / 2 = {Omega0:.6g}; allowed: "
                          f"|Omega0| <= 1e6 (a larger rotation cannot be reduced mod 2 pi accurately)")
-    theta_w = float(np.arccos((c / tau0) * np.sin(0.5 * Omega_G - 0.25 * c * eps)))
+    # The C library's scalar sin/acos (not NumPy's vector loops, 1 ulp off in places): correctly
+    # rounded here, and the same doubles as the C++ reader of the scene files.
+    theta_w = math.acos((c / tau0) * math.sin(0.5 * Omega_G - 0.25 * c * eps))
     return float(Omega0), theta_w
 
 
