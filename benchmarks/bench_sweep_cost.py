@@ -86,7 +86,8 @@ def main():
     print(f"\nmean per eps at 1e4 samples x 1e4 returns: {per_eps:,.0f} s on this machine ({cores} cores)")
     print(f"40 eps: {curve / 3600:.1f} h on this machine = {curve * cores / 3600:.0f} core-hours")
     for w in (1, 2, 8, 32):
-        print(f"  on {w:>2} workers of {cores} cores (pieces per eps, Dask scheduler): {curve / w / 3600:6.2f} h")
+        print(f"  on {w:>2} machines of {cores} cores, ideal division (pieces per eps on a Dask scheduler): "
+              f"{curve / w / 3600:6.2f} h")
 
 
 if __name__ == "__main__":
