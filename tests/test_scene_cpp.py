@@ -343,7 +343,7 @@ def _broken() -> dict:
     }
     # Float literals beyond the double range: inf to tomllib (toml++ refuses them; the C++ reads them as inf).
     h["eps_literal_overflow"] = mutate(HOV, (("eps",), [0.1, Raw("1e400")]))
-    f["flow_literal_overflow_negative"] = mutate(FLOW, (("system", "eps"), Raw("-1.8e308")))
+    f["flow_literal_overflow_negative"] = mutate(FLOW, (("system", "eps"), Raw("-1_8e3_08")))
     cases = {k: dump(v) for k, v in {**h, **f}.items()}
     cases["literal_overflow_after_unicode"] = HOV_TEXT.split("[[series]]")[0] + (
         'series = [{label = "αβγ δ", tau1 = 0.5, Omega0 = +1.8e308, theta_w = 1.0}]\n')

@@ -1567,7 +1567,7 @@ void parse_flow_hovering_area(const std::string& where, const toml::table& root,
 }
 
 /// Replace the float literal that ends at `at` (toml++'s position just after it, in bytes or in
-/// code points) by inf; false if it is not found there.
+/// code points; toml++ quotes it without underscores) by inf; false if it is not found there.
 bool literal_to_inf(std::string& doc, std::string_view literal, const toml::source_position& at) {
     std::size_t start = 0;
     for (std::size_t line = 1; line < at.line; ++line) {
@@ -1583,8 +1583,16 @@ bool literal_to_inf(std::string& doc, std::string_view literal, const toml::sour
             ++by_code_point;
     }
     for (const std::size_t end : {static_cast<std::size_t>(at.column) - 1, by_code_point}) {
-        if (end >= literal.size() && end <= line.size() && line.substr(end - literal.size(), literal.size()) == literal) {
-            doc.replace(start + end - literal.size(), literal.size(), "inf");
+        if (end > line.size()) continue;
+        // toml++ quotes the literal without its underscores.
+        std::size_t i = end, j = literal.size();
+        while (i > 0 && j > 0) {
+            if (line[i - 1] == '_') --i;
+            else if (line[i - 1] == literal[j - 1]) --i, --j;
+            else break;
+        }
+        if (j == 0) {
+            doc.replace(start + i, end - i, "inf");
             return true;
         }
     }
