@@ -350,6 +350,13 @@ def _broken() -> dict:
     # Key order in messages is the file's (toml++ keeps tables sorted by key).
     cases["unknown_keys_in_file_order"] = HOV_TEXT.replace("[map]", "zz = 1\naa = 2\nmm = 3\n[map]", 1)
     cases["unknown_table_keys_in_file_order"] = FLOW_TEXT.replace("[system]", "[system]\nzz = 1\nV0 = 2", 1)
+    title = 'title = "Area of the hovering set against eps (eq:hovsetsize)"\n'
+    cases["title_table_repr_in_file_order"] = HOV_TEXT.replace(title, "") + "[title.z]\nx = 1\n[title]\nb = 2\na = 1\n"
+    cases["title_array_of_tables_repr"] = HOV_TEXT.replace(title, "") + "[[title]]\nb = 1\n[[title]]\na = 2\n[title.zz]\n"
+    cases["title_nested_values_repr"] = HOV_TEXT.replace(title, (
+        'title = [[1, 2], [], [{}], {a.b = 1, "q k" = "v"}, 1979-05-27T07:32:00.999999999+14:00, 07:32:00, '
+        '1979-05-27 07:32:00Z, 0xff, -0.0, +inf, -nan, 1e16, 12345678901234567.0, 0.000123, 5e-324]\n'))
+    cases["colour_escapes_repr"] = dump(mutate(HOV, (("series", 0, "color"), "é😀\t\b\f\x00\x7f\x85\xad\u200b\ue000\U000e0001 \" ' \\")))
     cases["dotted_keys_order"] = FLOW_TEXT.replace("[section]", "[system.V3]\nz = 1\n[system.V0]\nb = 2\n[section]", 1)
     return cases
 
