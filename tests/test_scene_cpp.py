@@ -61,7 +61,7 @@ def toml_value(v) -> str:
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
-        return repr(v) if v == v and abs(v) != float("inf") else {"nan": "nan", "inf": "inf", "-inf": "-inf"}[repr(v)]
+        return repr(v)  # 'inf', '-inf' and 'nan' are TOML too
     if isinstance(v, str):
         return toml_str(v)
     if isinstance(v, list):
