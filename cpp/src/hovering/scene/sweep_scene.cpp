@@ -720,9 +720,8 @@ double bits_value(const std::string& bits) {
 }
 
 /// float(s) for a str as Python 3.11 reads it: Unicode spaces and decimal digits first become
-/// ASCII, underscores only between digits (and then the first character must be a digit), spaces
-/// stripped, a decimal (no hex) or inf/infinity/nan with an optional sign; nullopt where Python
-/// raises ValueError.
+/// ASCII, underscores only between digits, spaces stripped, then a decimal (no hex) or
+/// inf/infinity/nan with an optional sign; nullopt where Python raises ValueError.
 std::optional<double> py_float_of(std::string_view text) {
     std::string s;
     for (const char32_t c : decode(text)) {
@@ -732,17 +731,15 @@ std::optional<double> py_float_of(std::string_view text) {
         else return std::nullopt;
     }
     if (s.find('_') != std::string::npos) {
-        if (!is_ascii_digit(s[0])) return std::nullopt;
-        std::string t(1, s[0]);
-        for (std::size_t i = 1; i < s.size(); ++i) {
-            if (s[i] == '_') {
-                if (!is_ascii_digit(s[i - 1])) return std::nullopt;
-            } else {
-                if (s[i - 1] == '_' && !is_ascii_digit(s[i])) return std::nullopt;
-                t += s[i];
-            }
+        std::string t;
+        char prev = 0;
+        for (const char c : s) {
+            if (c == '_' && !is_ascii_digit(prev)) return std::nullopt;
+            if (c != '_' && prev == '_' && !is_ascii_digit(c)) return std::nullopt;
+            if (c != '_') t += c;
+            prev = c;
         }
-        if (s.back() == '_') return std::nullopt;
+        if (prev == '_') return std::nullopt;
         s = t;
     }
     const auto ws = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r'; };
@@ -1569,6 +1566,62 @@ void parse_flow_hovering_area(const std::string& where, const toml::table& root,
     s.seed = seed ? static_cast<std::uint64_t>(integer(where + ".seed", *seed, 0, INT64_MAX)) : 0;
 }
 
+/// Replace the float literal that ends at `at` (toml++'s position just after it, in bytes or in
+/// code points; toml++ quotes it without underscores) by inf; false if it is not found there.
+bool literal_to_inf(std::string& doc, std::string_view literal, const toml::source_position& at) {
+    std::size_t start = 0;
+    for (std::size_t line = 1; line < at.line; ++line) {
+        start = doc.find('\n', start);
+        if (start == std::string::npos) return false;
+        ++start;
+    }
+    const std::string_view line = std::string_view(doc).substr(start, doc.find('\n', start) - start);
+    std::size_t by_code_point = 0;  // the byte after column - 1 code points
+    for (std::size_t k = 1; k < at.column && by_code_point < line.size(); ++k) {
+        ++by_code_point;
+        while (by_code_point < line.size() && (static_cast<unsigned char>(line[by_code_point]) & 0xC0) == 0x80)
+            ++by_code_point;
+    }
+    for (const std::size_t end : {static_cast<std::size_t>(at.column) - 1, by_code_point}) {
+        if (end > line.size()) continue;
+        // toml++ quotes the literal without its underscores.
+        std::size_t i = end, j = literal.size();
+        while (i > 0 && j > 0) {
+            if (line[i - 1] == '_') --i;
+            else if (line[i - 1] == literal[j - 1]) --i, --j;
+            else break;
+        }
+        if (j == 0) {
+            doc.replace(start + i, end - i, "inf");
+            return true;
+        }
+    }
+    return false;
+}
+
+/// The TOML document, or tomllib's "not valid TOML" (with toml++'s own detail). tomllib reads a float
+/// literal beyond the double range as inf where toml++ refuses it (the one float error left once
+/// toml++ has checked the literal's syntax): such literals become inf, sign kept, and the text is
+/// read again.
+toml::table parse_toml(std::string doc, const std::string& where) {
+    // tomllib reads a byte-order mark as text (an invalid statement); toml++ would skip it.
+    if (doc.compare(0, 3, "\xEF\xBB\xBF") == 0) fail(where + ": not valid TOML: Invalid statement (at line 1, column 1)");
+    for (;;) {
+        try {
+            return toml::parse(doc);
+        } catch (const toml::parse_error& e) {
+            const std::string_view d = e.description();
+            constexpr std::string_view head = "Error while parsing floating-point: '", tail = "' could not be interpreted as a value";
+            if (d.size() > head.size() + tail.size() && d.substr(0, head.size()) == head &&
+                d.substr(d.size() - tail.size()) == tail &&
+                literal_to_inf(doc, d.substr(head.size(), d.size() - head.size() - tail.size()), e.source().begin))
+                continue;
+            fail(where + ": not valid TOML: " + std::string(d) + " (at line " + std::to_string(e.source().begin.line) +
+                 ", column " + std::to_string(e.source().begin.column) + ")");
+        }
+    }
+}
+
 /// parse_scene for the sweep kinds: `origin` is the path as given (its name is `where` in the
 /// messages, its stem the scene's name), `path` what SweepScene.path holds.
 SweepScene parse(const std::string& doc, const std::string& origin, const std::string& path) {
@@ -1577,15 +1630,7 @@ SweepScene parse(const std::string& doc, const std::string& origin, const std::s
     SweepScene s;
     s.path = path;
     s.name = path_stem(where);
-    // tomllib reads a byte-order mark as text (an invalid statement); toml++ would skip it.
-    if (doc.compare(0, 3, "\xEF\xBB\xBF") == 0) fail(where + ": not valid TOML: Invalid statement (at line 1, column 1)");
-    toml::table root;
-    try {
-        root = toml::parse(doc);
-    } catch (const toml::parse_error& e) {
-        fail(where + ": not valid TOML: " + std::string(e.description()) + " (at line " +
-             std::to_string(e.source().begin.line) + ", column " + std::to_string(e.source().begin.column) + ")");
-    }
+    const toml::table root = parse_toml(doc, where);
     if (!root.contains("kind")) fail(where + ": missing required key 'kind'; allowed: " + py_choices(kKinds));
     s.kind = text(where + ".kind", *get(root, "kind"), kKinds);
     const bool truncated = s.kind == "hovering_area";
