@@ -272,7 +272,7 @@ int main(int argc, char** argv) {
             }
             if (row.interrupted || g_cancel.load()) {
                 std::cerr << "hovering_sweep: interrupted during " << what << "; the " << k - 1
-                          << " points finished in this run are in " << out << " (rerun the same command to go on)\n";
+                          << " point(s) finished in this run are in " << out << " (rerun the same command to go on)\n";
                 return 130;
             }
             std::string line;
