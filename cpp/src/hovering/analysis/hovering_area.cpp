@@ -115,35 +115,10 @@ struct Outcomes {
     bool interrupted = false;
 };
 
-template <class Map>
-Outcomes run_truncated(const Map& m, const Map& m0, const std::vector<double>& phi, const std::vector<double>& K,
-                       const HoveringAreaOptions& o) {
-    const std::int64_t n = std::int64_t(phi.size());
-    Outcomes r;
-    r.s0.resize(phi.size());
-    r.s1.resize(phi.size());
-    r.visited.resize(phi.size());
-    r.steps_done.resize(phi.size());
-    IterateOptions io;
-    io.n_steps = o.n_steps;
-    io.exit_mask = kNoImpact;
-    io.stop_on_exit = true;
-    io.n_threads = o.n_threads;
-    io.cancel = o.cancel;
-    io.progress = o.progress;
-    IterateOutput out0;
-    out0.status = r.s0.data();
-    m0.iterate(phi.data(), K.data(), n, io, out0);
-    IterateOutput out1;
-    out1.status = r.s1.data();
-    out1.steps_done = r.steps_done.data();
-    out1.visited = r.visited.data();
-    m.iterate(phi.data(), K.data(), n, io, out1);
-    r.interrupted = o.cancel && o.cancel->load();
-    return r;
-}
-
-Outcomes run_flow(const FlowMap& m, const FlowMap& m0, const std::vector<double>& phi, const std::vector<double>& K,
+/// F_0 then F_eps with early exit from {J_0u, J_0}; Options/Output are the map's batch types
+/// (IterateOptions/Output or FlowIterateOptions/Output: the same fields).
+template <class Options, class Output, class Map>
+Outcomes run_both(const Map& m, const Map& m0, const std::vector<double>& phi, const std::vector<double>& K,
                   const HoveringAreaOptions& o) {
     const std::int64_t n = std::int64_t(phi.size());
     Outcomes r;
@@ -151,17 +126,17 @@ Outcomes run_flow(const FlowMap& m, const FlowMap& m0, const std::vector<double>
     r.s1.resize(phi.size());
     r.visited.resize(phi.size());
     r.steps_done.resize(phi.size());
-    FlowIterateOptions io;
+    Options io;
     io.n_steps = o.n_steps;
     io.exit_mask = kNoImpact;
     io.stop_on_exit = true;
     io.n_threads = o.n_threads;
     io.cancel = o.cancel;
     io.progress = o.progress;
-    FlowIterateOutput out0;
+    Output out0;
     out0.status = r.s0.data();
     m0.iterate(phi.data(), K.data(), n, io, out0);
-    FlowIterateOutput out1;
+    Output out1;
     out1.status = r.s1.data();
     out1.steps_done = r.steps_done.data();
     out1.visited = r.visited.data();
@@ -228,7 +203,7 @@ HoveringAreaResult truncated_area(const Map& m, const HoveringAreaOptions& o) {
     const Map m0(0.0, m.arcs(), m.forcing(), m.band().hi);  // Python's with_eps(0): K_max = the band's top
     std::vector<double> phi, K;
     stratified_samples(o.samples, o.K_low, o.seed, phi, K);
-    return summarise(run_truncated(m, m0, phi, K, o), K, o);
+    return summarise(run_both<IterateOptions, IterateOutput>(m, m0, phi, K, o), K, o);
 }
 
 }  // namespace
@@ -244,7 +219,7 @@ HoveringAreaResult hovering_area(const FlowMap& m, const FlowMap& m0, const Hove
     check(o, -lo);
     std::vector<double> phi, K;
     stratified_samples(o.samples, o.K_low, o.seed, phi, K);
-    return summarise(run_flow(m, m0, phi, K, o), K, o);
+    return summarise(run_both<FlowIterateOptions, FlowIterateOutput>(m, m0, phi, K, o), K, o);
 }
 
 }  // namespace hovering

@@ -185,13 +185,9 @@ void add_area(SweepRow& row, const char* prefix, const HoveringAreaResult& h) {
     row.values.emplace_back(p + "K_low", h.K_low);
 }
 
-SweepRow truncated_point(const SweepScene& sc, const SweepPoint& pt, const SweepCounts& c, int n_threads,
-                         const std::atomic<bool>* cancel, std::atomic<std::int64_t>* progress) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const Series& s = sc.series[pt.series];
-    const MapParams mp = s.at(pt.eps);
-    const TruncatedMap m = make_truncated_map(pt.eps, mp.Omega0, mp.theta_w, mp.tau0, mp.tau1, mp.lam);
-    const std::vector<double> sine{1.0};
+/// hovering_area's options of a point (its box is set by the caller).
+HoveringAreaOptions area_options(const SweepScene& sc, const SweepCounts& c, int n_threads,
+                                 const std::atomic<bool>* cancel, std::atomic<std::int64_t>* progress) {
     HoveringAreaOptions o;
     o.n_steps = c.n_steps;
     o.samples = c.samples;
@@ -199,6 +195,17 @@ SweepRow truncated_point(const SweepScene& sc, const SweepPoint& pt, const Sweep
     o.n_threads = n_threads;
     o.cancel = cancel;
     o.progress = progress;
+    return o;
+}
+
+SweepRow truncated_point(const SweepScene& sc, const SweepPoint& pt, const SweepCounts& c, int n_threads,
+                         const std::atomic<bool>* cancel, std::atomic<std::int64_t>* progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Series& s = sc.series[pt.series];
+    const MapParams mp = s.at(pt.eps);
+    const TruncatedMap m = make_truncated_map(pt.eps, mp.Omega0, mp.theta_w, mp.tau0, mp.tau1, mp.lam);
+    const std::vector<double> sine{1.0};
+    HoveringAreaOptions o = area_options(sc, c, n_threads, cancel, progress);
     if (s.has_K_low) {
         o.K_low = s.K_low;
     } else {  // Python's default box: the critical band of eq:hovsetsize, cut to the map's band
@@ -239,13 +246,7 @@ SweepRow flow_point(const SweepScene& sc, const SweepPoint& pt, const SweepCount
         fam = std::make_unique<TruncatedFamily>(onset_family(f, e, b));
         K_low = std::max(K_low, fam->band().lo * (1 - 1e-9));
     }
-    HoveringAreaOptions o;
-    o.n_steps = c.n_steps;
-    o.samples = c.samples;
-    o.seed = sc.seed;
-    o.n_threads = n_threads;
-    o.cancel = cancel;
-    o.progress = progress;
+    HoveringAreaOptions o = area_options(sc, c, n_threads, cancel, progress);
     o.K_low = K_low;
     o.keep_points = onset;
     const HoveringAreaResult h = hovering_area(*f.map, *f0.map, o);
