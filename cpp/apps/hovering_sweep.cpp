@@ -183,6 +183,28 @@ private:
     std::thread thread_;
 };
 
+/// A CSV file opened for appending whose every line is on disk (written, flushed, fsync'd) when
+/// line() returns: a crash or power cut after it cannot lose that row.
+class Appender {
+public:
+    explicit Appender(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "ab")) {
+        if (!f_) throw std::runtime_error("cannot open " + path + " for appending");
+    }
+    ~Appender() { std::fclose(f_); }
+    Appender(const Appender&) = delete;
+    Appender& operator=(const Appender&) = delete;
+    /// Append text and a newline, and make them durable; what names it in the error message.
+    void line(const std::string& text, const char* what) {
+        const std::string l = text + "\n";
+        if (std::fwrite(l.data(), 1, l.size(), f_) != l.size() || std::fflush(f_) != 0 || fsync(fileno(f_)) != 0)
+            throw std::runtime_error(std::string("writing ") + what + " to " + path_ + " failed (disk full?)");
+    }
+
+private:
+    std::string path_;
+    std::FILE* f_;
+};
+
 /// The default output: the scene's figure path with the extension .csv.
 std::string default_out(const SweepScene& s) { return fs::path(s.output).replace_extension(".csv").string(); }
 
@@ -248,10 +270,8 @@ int main(int argc, char** argv) {
                       << "), left by an interrupted run; it is recomputed if requested\n";
         }
         if (todo.empty()) return 0;
-        std::ofstream csv(out, std::ios::app | std::ios::binary);
-        if (!csv) throw std::runtime_error("cannot open " + out + " for appending");
-        if (ex.write_header) csv << header << '\n' << std::flush;
-        if (!csv) throw std::runtime_error("cannot write the header to " + out);
+        Appender csv(out);
+        if (ex.write_header) csv.line(header, "the header");
 
         std::signal(SIGINT, on_signal);
         std::signal(SIGTERM, on_signal);
@@ -278,8 +298,7 @@ int main(int argc, char** argv) {
             std::string line;
             for (const auto& [name, v] : row.values) line += (line.empty() ? "" : ",") + num(v);
             for (const auto& [name, v] : point_parameters(scene, p, counts)) line += "," + v;
-            csv << line << '\n' << std::flush;  // on disk before the next point starts
-            if (!csv) throw std::runtime_error("writing a row to " + out + " failed (disk full?)");
+            csv.line(line, "a row");  // on disk (fsync) before the next point starts
             double area = 0, err = 0, theory = 0, secs = 0;
             for (const auto& [name, v] : row.values) {
                 if (name == "area") area = v;
