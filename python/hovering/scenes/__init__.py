@@ -145,11 +145,20 @@ def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bo
     -------
     tuple
         ``(png_path, result, figure or None)``.
+
+    Raises
+    ------
+    ValueError
+        For a file that is not a scene result, or one whose values the scene schema or the result's
+        own checks refuse (see :func:`load_result`), naming the file and the field.
     """
-    result = load_result(path)
+    result = load_result(path)  # checked as it is read: the scene schema's checks, each field's type
     png = output_path("--out", out) if out is not None else Path(os.fspath(path)).with_suffix(".png")
     png.parent.mkdir(parents=True, exist_ok=True)
-    fig = _draw(result, png)
+    try:
+        fig = _draw(result, png)
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:  # a combination the checks missed
+        raise ValueError(f"{os.fspath(path)}: the result cannot be drawn ({type(e).__name__}: {e})") from None
     if not keep_figure:
         import matplotlib.pyplot as plt
 
