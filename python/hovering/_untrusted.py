@@ -26,7 +26,8 @@ import numpy as np
 from ._common import physical_memory
 
 __all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_MEMBERS", "MAX_DIRECTORY_BYTES",
-           "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "parse_json", "Archive"]
+           "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "json_cost", "json_nesting",
+           "parse_json", "Archive"]
 
 #: Longest JSON document read (characters). The largest tree hovering writes is a scene's: 36
 #: portrait panels of 10,000 orbits, each with its label, colour and kind, about 13 MB of text;
@@ -148,6 +149,41 @@ def _text(s: str, where: str) -> None:
             s.encode("utf-8")
         except UnicodeEncodeError as e:
             raise ValueError(f"{where}: a string with a lone surrogate at character {e.start}: not Unicode text") from None
+
+
+def json_cost(text: bytes) -> int:
+    """An upper bound of the memory (bytes) ``json.loads`` makes of ``text``, counted from its characters.
+
+    Each ``[``/``{`` a container (<= 96 bytes with its slot), each pair of quotes a string (<= 64 plus
+    its characters), each value after a comma or colon a number or literal (<= 40), and the text
+    itself (bytes, then str). Characters inside strings are counted too: an overestimate.
+
+    Parameters
+    ----------
+    text : bytes
+        JSON text (one document or JSON lines).
+
+    Returns
+    -------
+    int
+    """
+    return (96 * (text.count(b"[") + text.count(b"{")) + 32 * text.count(b'"')
+            + 40 * (text.count(b",") + text.count(b":") + text.count(b"\n") + 1) + 6 * len(text))
+
+
+def json_nesting(text: str) -> int:
+    """Deepest nesting of arrays and objects in JSON text (strings skipped; linear time, bounded memory).
+
+    Parameters
+    ----------
+    text : str
+        JSON text.
+
+    Returns
+    -------
+    int
+    """
+    return _nesting(text)
 
 
 def parse_json(text: str, what: str = "the JSON document"):

@@ -28,7 +28,7 @@ from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHovering
                    ZoomSpec)
 
 __all__ = ["load_scene", "parse_scene", "check_spec", "scene_table", "MAX_PANELS", "MAX_SERIES_POINTS",
-           "MAX_SCENE_BYTES", "MAX_TEXT", "MAX_PATH_CHARS", "MAX_SCENE_DEPTH", "MAX_KEY_PARTS", "MAX_CANVAS_PIXELS"]
+           "MAX_SCENE_BYTES", "MAX_TEXT", "MAX_PATH_CHARS", "MAX_SCENE_STRING", "MAX_SCENE_DEPTH", "MAX_KEY_PARTS", "MAX_CANVAS_PIXELS"]
 
 _MAP_KEYS = ("Omega0", "theta_w", "tau0", "tau1", "lam")
 _MAP_DEFAULTS = {"tau0": 1.0, "tau1": 0.5, "lam": 0.5}
@@ -78,6 +78,10 @@ _MAX_EXPR = 200
 MAX_TEXT = 200
 #: Longest path (``output``): Linux's PATH_MAX.
 MAX_PATH_CHARS = 4096
+#: Longest string or key anywhere in a scene file, checked before any field: a backstop so that no
+#: message prints more (each field's own limit is smaller: MAX_TEXT, MAX_PATH_CHARS, 200 for an
+#: expression).
+MAX_SCENE_STRING = 1 << 16
 #: Deepest nesting of tables and arrays in a scene file: its deepest is 4 (``[[panels]]``, ``zoom``,
 #: ``xlim``); Python's TOML reader recurses once per level and fails near 500.
 MAX_SCENE_DEPTH = 16
@@ -88,8 +92,10 @@ MAX_KEY_PARTS = 16
 #: so 150 million is 600 MB and ~10 s of savefig. The largest example figure has 3.9 million; the
 #: limit allows 600 dpi at 19 x 12 inches, or 1200 dpi at 10 x 12.
 MAX_CANVAS_PIXELS = 150_000_000
-#: TOML's integers are 64-bit (a larger one is an error by the TOML specification).
-_INT64 = (-(2**63), 2**63 - 1)
+#: Integers beyond a double (TOML's are 64-bit; Python's reader takes any) are refused before any
+#: field sees them: a field's own range check names its range, but no message should print a
+#: 10,000-digit number (Python refuses to, beyond 4300 digits).
+_MAX_INT_BITS = 1024
 
 
 def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
@@ -342,14 +348,14 @@ def _check_document(where: str, data) -> None:
                                  f"{MAX_SCENE_DEPTH} levels")
             items = node.items() if isinstance(node, dict) else enumerate(node)
             for k, v in items:
-                if isinstance(k, str) and len(k) > MAX_PATH_CHARS:
-                    raise ValueError(f"{at}: a key of {len(k)} characters; allowed: at most {MAX_PATH_CHARS}")
+                if isinstance(k, str) and len(k) > MAX_SCENE_STRING:
+                    raise ValueError(f"{at}: a key of {len(k)} characters; allowed: at most {MAX_SCENE_STRING}")
                 stack.append((v, f"{at}.{k}" if isinstance(node, dict) else f"{at}[{k}]", depth + 1))
-        elif isinstance(node, str) and len(node) > MAX_PATH_CHARS:
-            raise ValueError(f"{at}: a string of {len(node)} characters; allowed: at most {MAX_PATH_CHARS}")
-        elif isinstance(node, int) and not isinstance(node, bool) and not _INT64[0] <= node <= _INT64[1]:
-            raise ValueError(f"{at} is an integer of {node.bit_length()} bits; allowed: integers in [-2**63, 2**63 - 1] "
-                             f"(TOML's 64-bit integers)")
+        elif isinstance(node, str) and len(node) > MAX_SCENE_STRING:
+            raise ValueError(f"{at}: a string of {len(node)} characters; allowed: at most {MAX_SCENE_STRING}")
+        elif isinstance(node, int) and not isinstance(node, bool) and node.bit_length() > _MAX_INT_BITS:
+            raise ValueError(f"{at} = (an integer of {node.bit_length()} bits) is out of range; allowed: integers in "
+                             f"[-2**63, 2**63 - 1] (TOML's 64-bit integers)")
 
 
 def _check_canvas(where: str, spec: SceneSpec) -> None:
