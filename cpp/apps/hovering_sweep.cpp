@@ -27,6 +27,7 @@
 #include <iostream>
 #include <mutex>
 #include <new>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -94,19 +95,51 @@ std::string check_row(const std::string& line, std::size_t n_results, std::size_
     return "";
 }
 
+/// Largest CSV resumed from: a row is ~300 bytes, a sweep scene at most 36 x 200 points (2 MB), so
+/// 1 GiB holds hundreds of sweeps; its rows' fields then take a few GiB of memory.
+constexpr std::uintmax_t kMaxCsvBytes = std::uintmax_t(1) << 30;
+/// Longest CSV line read: a header or row has a few dozen fields of at most ~25 characters.
+constexpr std::size_t kMaxLine = 1 << 16;
+
+/// One line of `in` without its newline (complete: it had one), refused beyond kMaxLine bytes
+/// before more is read. False at the end of the file.
+bool read_line(std::istream& in, std::string& line, bool& complete, const std::string& path, long lineno) {
+    line.clear();
+    complete = false;
+    std::streambuf* buf = in.rdbuf();
+    for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+        if (c == '\n') {
+            complete = true;
+            return true;
+        }
+        if (line.size() == kMaxLine)
+            throw std::runtime_error(path + " line " + std::to_string(lineno) + " is longer than " +
+                                     std::to_string(kMaxLine) + " bytes: not a row of hovering_sweep (use another --out)");
+        line.push_back(char(c));
+    }
+    return !line.empty();
+}
+
 /// Read the output file: refuse a foreign header or a damaged row inside it, find a torn tail.
+/// The file is untrusted: a regular file of at most kMaxCsvBytes, lines of at most kMaxLine.
 Existing scan(const std::string& path, const std::string& header, std::size_t n_results) {
     Existing ex;
     std::error_code ec;
     if (!fs::exists(path, ec)) return ex;
+    if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path + " is not a regular file (to resume from it)");
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec) throw std::runtime_error("cannot read " + path + " (to resume from it): " + ec.message());
+    if (size > kMaxCsvBytes)
+        throw std::runtime_error(path + " has " + std::to_string(size) + " bytes; allowed: at most " +
+                                 std::to_string(kMaxCsvBytes) + " to resume from (use another --out)");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot read " + path + " (to resume from it)");
     const std::size_t n_columns = split(header).size();
     std::string line, bad_note;
     std::uintmax_t offset = 0;
     long lineno = 0, bad_line = 0;
-    while (std::getline(in, line)) {
-        const bool complete = !in.eof();  // getline sets eof only for a last line without newline
+    bool complete = false;
+    while (read_line(in, line, complete, path, lineno + 1)) {
         ++lineno;
         if (bad_line)
             throw std::runtime_error(path + " line " + std::to_string(bad_line) + " is not a valid row (" + bad_note +
@@ -253,13 +286,13 @@ int main(int argc, char** argv) {
         const std::string header = join(columns);
 
         const Existing ex = scan(out, header, results.size());
+        // A set: the file's rows are untrusted in number too (a scan per point would be quadratic).
+        const std::set<std::vector<std::string>> finished(ex.params.begin(), ex.params.end());
         std::vector<std::size_t> todo;
         for (std::size_t i = 0; i < points.size(); ++i) {
             std::vector<std::string> key;
             for (const auto& [name, value] : point_parameters(scene, points[i], counts)) key.push_back(value);
-            bool done = false;
-            for (const auto& p : ex.params) done = done || p == key;
-            if (!done) todo.push_back(i);
+            if (!finished.count(key)) todo.push_back(i);
         }
         std::cerr << scene.name << ": " << points.size() << " points (" << counts.n_steps << " steps, "
                   << counts.samples << " samples each), " << points.size() - todo.size() << " already in " << out
