@@ -365,7 +365,8 @@ def _check_canvas(where: str, spec: SceneSpec) -> None:
     w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
     pixels = (spec.dpi * w) * (spec.dpi * h)
     if pixels > MAX_CANVAS_PIXELS:
-        given = "figsize" if spec.figsize is not None else ("layout" if getattr(spec, "layout", None) else "panels")
+        given = ("figsize" if spec.figsize is not None else "layout" if getattr(spec, "layout", None) is not None
+                 else "the default figure size")
         raise ValueError(f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
                          f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
                          f"(lower dpi or figsize)")
