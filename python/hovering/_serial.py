@@ -322,7 +322,7 @@ def from_tree(tree, arrays, key: str = "root"):
         try:
             return cls(tree.get("value"))
         except (ValueError, TypeError):
-            raise ValueError(f"{key}: {str(tree.get('value'))[:40]!r} is not a {cls.__qualname__}; allowed: "
+            raise ValueError(f"{key}: {repr(tree.get('value'))[:40]} is not a {cls.__qualname__}; allowed: "
                              f"{[m.value for m in cls]}") from None
     if "__array__" in tree:
         k = tree["__array__"]

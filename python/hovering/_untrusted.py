@@ -30,12 +30,13 @@ __all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_MEMBERS"
            "parse_json", "Archive"]
 
 #: Longest JSON document read (characters). The largest tree hovering writes is a scene's: 36
-#: portrait panels of 10,000 orbits, each with its label, colour and kind, about 13 MB of text;
-#: everything bulky is an array (a member of its own), so 64 Mi characters leave ample room.
+#: portrait panels of 10,000 orbits, each with its label, colour and kind (~32 characters), about
+#: 12 MB of text; everything bulky is an array (a member of its own), so 64 Mi leave ample room.
 MAX_TREE_CHARS = 1 << 26
-#: Deepest JSON nesting read (arrays and objects). hovering's own trees are at most ~30 levels deep
-#: (a flow result's map, its system, a potential, each a record); the rebuild takes about one
-#: Python frame per level, so 100 stays far from Python's recursion limit (1000).
+#: Deepest JSON nesting read (arrays and objects). hovering's own trees are at most ~15 levels deep
+#: (measured: 12 for a flow result with its map, its system and their potentials, and for a scene
+#: result); the rebuild takes about one Python frame per level, so 100 stays far from Python's
+#: recursion limit (1000).
 MAX_TREE_DEPTH = 100
 #: Longest string (or dict key) in a JSON document. Names, labels, paths and notes of results are
 #: below 4096 characters; texts drawn on a figure have the scene schema's tighter limit

@@ -209,10 +209,10 @@ class FlowMap(MapAnalyses):
         flow is traced, no accuracy target measured: a record asking for either is refused)."""
         sys, h = record["sys"], record["h"]
         if not isinstance(sys, StepSystem):
-            raise ValueError(f"the FlowMap's sys must be a StepSystem, got a {type(sys).__name__}")
+            raise ValueError(f"the FlowMap's sys must be a StepSystem, got {type(sys).__name__}")
         options = record["options"]
         if not isinstance(options, dict):
-            raise ValueError(f"the FlowMap's options must be a dict, got a {type(options).__name__}")
+            raise ValueError(f"the FlowMap's options must be a dict, got {type(options).__name__}")
         unknown = sorted(set(options) - cls._RECORD_OPTIONS)
         if unknown:
             raise ValueError(f"the FlowMap's options {unknown} are not stored settings; allowed: "

@@ -365,13 +365,13 @@ class SceneResult:
         for key, kind in (("quick", bool), ("n_steps", int), ("samples", int), ("timings", dict), ("version", str)):
             v = self.meta.get(key)
             if v is not None and (not isinstance(v, kind) or (kind is int and isinstance(v, bool))):
-                raise ValueError(f"meta.{key} must be a {kind.__name__}, got a {type(v).__name__}")
+                raise ValueError(f"meta.{key} must be of type {kind.__name__}, got {type(v).__name__}")
         if len(self.meta.get("version") or "") > MAX_TEXT:
             raise ValueError(f"meta.version: a string of {len(self.meta['version'])} characters; allowed: at most "
                              f"{MAX_TEXT}")
         for k, v in (self.meta.get("timings") or {}).items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
-                raise ValueError(f"meta.timings.{k} must be a number of seconds, got a {type(v).__name__}")
+                raise ValueError(f"meta.timings.{k} must be a number of seconds, got {type(v).__name__}")
 
     def summary(self) -> dict:
         """The numbers shown, as a JSON-able dict (what the CLI prints and the sidecar JSON holds).
@@ -425,7 +425,7 @@ class OrbitSceneResult(SceneResult):
         ids = []
         for i, p in enumerate(self.panels):
             if not isinstance(p, (OrbitPanelResult, ZoomPanelResult)):
-                raise ValueError(f"panels[{i}] must be a panel result, got a {type(p).__name__}")
+                raise ValueError(f"panels[{i}] must be a panel result, got {type(p).__name__}")
             ids.append(p.id)
         for i, p in enumerate(self.panels):
             if isinstance(p, ZoomPanelResult) and not any(q.id == p.of and isinstance(q, OrbitPanelResult)
@@ -466,7 +466,7 @@ class HoveringAreaResult(SceneResult):
         super()._validate_loaded()
         for i, x in enumerate(self.series):
             if not isinstance(x, SeriesResult):
-                raise ValueError(f"series[{i}] must be a SeriesResult, got a {type(x).__name__}")
+                raise ValueError(f"series[{i}] must be a SeriesResult, got {type(x).__name__}")
 
 
 @dataclass
@@ -553,7 +553,7 @@ class TangentToriResult(SceneResult):
         super()._validate_loaded()
         for i, x in enumerate(self.tori):
             if not isinstance(x, TorusResult):
-                raise ValueError(f"tori[{i}] must be a TorusResult, got a {type(x).__name__}")
+                raise ValueError(f"tori[{i}] must be a TorusResult, got {type(x).__name__}")
 
 
 @dataclass

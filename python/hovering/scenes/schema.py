@@ -826,7 +826,7 @@ def load_scene(path: os.PathLike, check_output: bool = True) -> SceneSpec:
     _check_toml_text(p.name, text)
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+    except ValueError as e:  # TOMLDecodeError, or a number Python will not convert
         raise ValueError(f"{p.name}: not valid TOML: {e}") from None
     except RecursionError:  # _check_toml_text bounds the nesting; kept for a text it misjudged
         raise ValueError(f"{p.name}: arrays or tables nested too deeply; allowed: at most {MAX_SCENE_DEPTH} "
@@ -843,9 +843,16 @@ _LONG_KEY = re.compile(rf'(?:^|[\[{{,])\[?[ \t]*+{_KEY_PART}(?:[ \t]*+\.[ \t]*+{
                        re.M)
 
 
+# A run of digits longer than any number a double holds (2**1024 has 309); Python's own integer
+# conversion refuses beyond 4300 digits with a message that names no key.
+_MAX_DIGITS = 400
+_LONG_NUMBER = re.compile(rf"[0-9][0-9_]{{{_MAX_DIGITS},}}")
+
+
 def _check_toml_text(name: str, text: str) -> None:
-    """Before Python's TOML reader sees the text: no dotted key of more than MAX_KEY_PARTS parts,
-    no arrays or inline tables nested more than MAX_SCENE_DEPTH deep, each named by its line and key."""
+    """Before Python's TOML reader sees the text: no number of more than _MAX_DIGITS digits, no
+    dotted key of more than MAX_KEY_PARTS parts, no arrays or inline tables nested more than
+    MAX_SCENE_DEPTH deep; each named by its line and key."""
     # Strings become "" (newlines kept, so line numbers stay): brackets and dots in them do not count.
     skel = _TOML_SKIP.sub(lambda m: "#" if m.group()[0] == "#" else '""' + "\n" * m.group().count("\n"), text)
 
@@ -854,6 +861,11 @@ def _check_toml_text(name: str, text: str) -> None:
         key = re.match(r"\s*([^=\s][^=]*?)\s*=", skel[start:pos])
         return skel.count("\n", 0, pos) + 1, (key.group(1)[:60] if key else skel[start:pos].strip()[:60])
 
+    m = _LONG_NUMBER.search(skel)
+    if m:
+        line, key = line_of(m.start())
+        raise ValueError(f"{name}: line {line}: {key!r} has a number of {len(m.group())} digits; allowed: numbers "
+                         f"within the range of a double (at most {_MAX_DIGITS} digits)")
     m = _LONG_KEY.search(skel)
     if m:
         line, _ = line_of(m.start())
