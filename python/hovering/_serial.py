@@ -446,7 +446,9 @@ def load(path: os.PathLike, meta: bool = False):
     ------
     ValueError
         For a file that does not exist, is not a hovering result file, is malformed, or names a
-        type that is not hovering's (e.g. ``os:system``), or values the constructors refuse.
+        type that is not hovering's (e.g. ``os:system``), values the constructors refuse, a field
+        of another type than its class declares, or a size beyond a limit of
+        :mod:`hovering._untrusted` (docs/threat-model.md); naming the file and the field.
     """
     path = _path(path, "path")
     not_ours = f"{path} is not a hovering result file"
