@@ -201,7 +201,10 @@ def append_line(path: os.PathLike, line: str) -> None:
             _write_all(fd, data)
             os.fsync(fd)
         except OSError:
-            os.ftruncate(fd, size)
+            try:
+                os.ftruncate(fd, size)
+            except OSError:  # not a regular file (a device): nothing to cut
+                pass
             raise
     except OSError as e:
         raise write_error(path, e, previous=False) from None

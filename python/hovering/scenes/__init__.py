@@ -117,15 +117,18 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
     import io
     import time
 
-    from .._output import refuse_foreign, write_bytes, write_error
+    from .._output import is_ours, refuse_foreign, write_bytes, write_error
 
     t0 = time.perf_counter()
     png = output_path("out", out) if out is not None else output_path("output", scene.output,
                                                                          within=output_dirs(scene.path))
     npz, side, ckpt = png.with_suffix(".npz"), png.with_suffix(".json"), png.with_suffix(".sweep.jsonl")
-    refuse_foreign([png, npz, side] + ([ckpt] if scene.kind in SWEEP_KINDS else []), force)
+    sweep = scene.kind in SWEEP_KINDS
+    refuse_foreign([png, npz, side] + ([ckpt] if sweep else []), force)
     try:
         png.parent.mkdir(parents=True, exist_ok=True)
+        if force and sweep and ckpt.exists() and not is_ours(ckpt):
+            ckpt.unlink()  # replaced by this run's checkpoint (it is appended to, not rewritten)
     except OSError as e:
         raise write_error(png.parent, e, previous=False) from None
     result = compute(scene, quick=quick, progress=progress, checkpoint=ckpt, **where)
