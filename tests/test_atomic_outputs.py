@@ -83,7 +83,8 @@ def sweep_scene(n_steps: int = 2000, eps=(0.2,)) -> str:
 
 def cli(*args, cwd, timeout=300, pre=None):
     """``python -m hovering ARGS`` in ``cwd``; ``pre``: Python run first in the child (a file-size limit)."""
-    code = (pre or "") + "\nimport runpy, sys\nsys.argv[0] = 'hovering'\nrunpy.run_module('hovering', run_name='__main__')"
+    code = (pre or "") + ("\nimport runpy, sys\nsys.argv[0] = 'hovering'\n"
+                          "runpy.run_module('hovering', run_name='__main__')")
     return subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True, cwd=cwd,
                           timeout=timeout)
 
@@ -326,7 +327,9 @@ def test_full_tmpfs_keeps_the_previous_outputs(tmp_path):
 @pytest.fixture(scope="module")
 def sweep_exe():
     """This checkout's hovering_sweep, brought up to date in build/ctest (the directory the README's
-    ctest command builds; a no-op after scripts/test.sh)."""
+    ctest command builds; a no-op after scripts/test.sh), or the executable $HOVERING_SWEEP names."""
+    if os.environ.get("HOVERING_SWEEP"):
+        return os.environ["HOVERING_SWEEP"]
     cmake = shutil.which("cmake")
     assert cmake, "cmake is needed to build hovering_sweep (scripts/setup.sh installs it)"
     build = ROOT / "build" / "ctest"
@@ -382,7 +385,8 @@ def test_a_sweep_refuses_a_csv_another_run_holds(tmp_path, sweep_exe):
                            timeout=300)
         assert r.returncode == 2 and "is being written by another hovering_sweep run" in r.stderr, r.stderr
         assert "give another --out" in r.stderr and csv.read_bytes() == b""
-    r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True, timeout=300)
+    r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
+                       timeout=300)
     assert r.returncode == 0, r.stderr
     assert len(csv_parts(csv)[2]) == 1
 
@@ -395,7 +399,8 @@ def test_a_sweep_on_a_full_disk_keeps_its_rows(tmp_path, sweep_exe):
                           capture_output=True).returncode == 0
     before = csv.read_bytes()
     scene.write_text(sweep_scene(eps=(0.2, 0.3)))
-    launch = fsize_limit(len(before) + 40) + f"import os\nos.execv({sweep_exe!r}, {[sweep_exe, '--scene', str(scene), '--out', str(csv)]!r})"
+    argv = [sweep_exe, "--scene", str(scene), "--out", str(csv)]
+    launch = fsize_limit(len(before) + 40) + f"import os\nos.execv({sweep_exe!r}, {argv!r})"
     r = subprocess.run([sys.executable, "-c", launch], capture_output=True, text=True, timeout=300)
     assert r.returncode == 2, r.stderr
     assert "writing a row to " in r.stderr and "failed: no space left" in r.stderr
@@ -755,7 +760,8 @@ def test_files_written_before_provenance_still_load(tmp_path):
     from hovering._output import is_ours
 
     assert is_ours(tmp_path / "old.npz") and is_ours(tmp_path / "c.jsonl")
-    (tmp_path / "old.json").write_text(json.dumps({"scene": {"__dataclass__": "hovering.scenes.spec:OrbitScene"}}, indent=1))
+    old_sidecar = {"scene": {"__dataclass__": "hovering.scenes.spec:OrbitScene"}}
+    (tmp_path / "old.json").write_text(json.dumps(old_sidecar, indent=1))
     assert is_ours(tmp_path / "old.json") and is_ours(tmp_path / "old.png") is False
     (tmp_path / "old.png").write_bytes(b"png beside an old sidecar")
     assert is_ours(tmp_path / "old.png")

@@ -311,8 +311,9 @@ def output_path(where: str, path, within=None) -> "os.PathLike":
         real = p.resolve()
         bases = list(dict.fromkeys(Path(b).resolve() for b in within))
         if not any(real.is_relative_to(b) for b in bases):
-            raise ValueError(f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene writes "
-                             "only under its own folder or the working directory; give --out (out=) to write elsewhere")
+            raise ValueError(f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene "
+                             "writes only under its own folder or the working directory; give --out (out=) to write "
+                             "elsewhere")
     formats = FigureCanvasBase.get_supported_filetypes()
     if p.suffix[1:].lower() not in formats:
         raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "

@@ -156,7 +156,8 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
             else:
                 raise TypeError(f"{key}: arrays of Python objects cannot be saved without pickle")
         elif a.dtype.hasobject:  # a structured dtype with object fields: pickled, which load refuses
-            raise TypeError(f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without pickle")
+            raise TypeError(f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without "
+                            "pickle")
         return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
         try:  # first: it may refuse with a message of its own (Python code)

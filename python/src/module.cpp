@@ -19,8 +19,10 @@ PYBIND11_MODULE(_core, m) {
         "build_info",
         [] {
             py::list out;
-            for (const auto& f : hovering::build_info())
-                out.append(py::make_tuple(f.name, f.number ? py::object(py::int_(std::stoll(f.value))) : py::str(f.value)));
+            for (const auto& f : hovering::build_info()) {
+                const py::object value = f.number ? py::object(py::int_(std::stoll(f.value))) : py::str(f.value);
+                out.append(py::make_tuple(f.name, value));
+            }
             return out;
         },
         "The core's build facts as (name, value) pairs (hovering::build_info): version, git commit, compiler, "

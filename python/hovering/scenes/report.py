@@ -183,13 +183,15 @@ def format_summary(summary: dict) -> str:
         mod = ", ".join(f"{m} {f(v['area'], '.4f')} +- {f(v['error'], '.4f')} " + (
             f"(agree {f(100 * v['agree'], '.1f')}%)" if v.get("agree") is not None else
             f"(own box from K = {f(v.get('K_low'), '.4f')}: its band ends there)") for m, v in r["models"].items())
-        lines.append(f"  eps = {f(r['eps'], '+.3f')}: flow |HOV| = {f(r['flow'], '.4f')} +- {f(r['flow_error'], '.4f')} "
+        lines.append(f"  eps = {f(r['eps'], '+.3f')}: flow |HOV| = {f(r['flow'], '.4f')} "
+                     f"+- {f(r['flow_error'], '.4f')} "
                      f"[both sides {f(r['flow_both_sides'], '.4f')}], {mod}, eq:hovsetsize {f(r['theory'], '.4f')} "
                      f"({f(r['seconds'], '.1f')} s)")
     for t in summary.get("tori", []):
         lines.append(f"  {t['name']} torus: h1 = {f(t['h1'], '.5f')}, h2 = {f(t['h2'], '.5f')}, "
                      f"{t['trajectory_points']} trajectory samples, min q1 = {f(t['q1_min'], '.6f')} "
-                     f"(qw1 = {f(summary['qw1'], 'g')}), min q2 = {f(t['q2_min'], '.6f')} (qw2 = {f(summary['qw2'], 'g')})")
+                     f"(qw1 = {f(summary['qw1'], 'g')}), min q2 = {f(t['q2_min'], '.6f')} "
+                     f"(qw2 = {f(summary['qw2'], 'g')})")
     if "regions" in summary and "flow" not in summary:
         lines.append(f"  {summary['points']} points of the band, regions {summary['regions']}")
     if "output" in summary:
