@@ -212,8 +212,14 @@ public:
     /// Open (creating) and lock `path`; refuse at once if another run holds the lock.
     explicit LockedCsv(const std::string& path) : path_(path) {
         fd_ = ::open(path.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
+        if (fd_ < 0 && (errno == EACCES || errno == EROFS)) {
+            // A read-only file can still tell that its sweep is complete (shared lock: no run writes it
+            // meanwhile); writing to it fails in line().
+            read_only_ = errno;
+            fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        }
         if (fd_ < 0) throw std::runtime_error("cannot open " + path + " for appending: " + std::strerror(errno));
-        if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        if (::flock(fd_, (read_only_ ? LOCK_SH : LOCK_EX) | LOCK_NB) != 0) {
             const int err = errno;
             ::close(fd_);
             if (err == EWOULDBLOCK)
@@ -228,11 +234,13 @@ public:
     LockedCsv& operator=(const LockedCsv&) = delete;
     /// Cut the file to `size` bytes (a torn last line).
     void truncate(std::uintmax_t size) {
+        writable();
         if (::ftruncate(fd_, off_t(size)) != 0 || ::fsync(fd_) != 0)
             throw std::runtime_error("cannot cut the torn row off " + path_ + ": " + std::strerror(errno));
     }
     /// Append text and a newline, and make them durable; `what` names it in the error message.
     void line(const std::string& text, const char* what) {
+        writable();
         const std::string l = text + "\n";
         struct stat st;
         if (::fstat(fd_, &st) != 0) fail(what, errno, -1);
@@ -247,6 +255,10 @@ public:
     }
 
 private:
+    void writable() const {
+        if (read_only_)
+            throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(read_only_));
+    }
     [[noreturn]] void fail(const char* what, int err, off_t size) {
         if (size >= 0 && ::ftruncate(fd_, size) == 0) ::fsync(fd_);  // no half line left behind
         const std::string why = err == ENOSPC || err == EDQUOT || err == EFBIG
@@ -257,6 +269,7 @@ private:
     }
     std::string path_;
     int fd_ = -1;
+    int read_only_ = 0;  ///< errno of opening for writing when only reading was possible
 };
 
 /// The default output: the scene's figure path with the extension .csv.

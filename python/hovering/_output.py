@@ -215,7 +215,8 @@ def append_line(path: os.PathLike, line: str) -> None:
 @contextmanager
 def locked(path: os.PathLike):
     """An existing file opened for reading and writing (``r+b``) under the exclusive lock that
-    :func:`append_line` takes: what is read and cut there cannot race an append.
+    :func:`append_line` takes: what is read and cut there cannot race an append. A file this
+    process may only read is opened ``rb`` under a shared lock (readable, not cut).
 
     Parameters
     ----------
@@ -226,8 +227,14 @@ def locked(path: os.PathLike):
     ------
     file object
     """
-    with open(path, "r+b") as fh:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+    try:
+        fh, lock = open(path, "r+b"), fcntl.LOCK_EX
+    except OSError as e:
+        if e.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
+            raise
+        fh, lock = open(path, "rb"), fcntl.LOCK_SH
+    with fh:
+        fcntl.flock(fh.fileno(), lock)
         yield fh
 
 
