@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 import hovering  # noqa: E402
+from hovering._output import savefig  # noqa: E402  (atomic: a killed run leaves the old docs PNG)
 from hovering.accuracy import exact_available  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
@@ -86,12 +87,12 @@ def main():
             te, tr, d = exact_speed(sec)
             print(f"  exact: {1e6 * te:.2f} us per return; rk8pd at rtol 1e-13: {1e6 * tr:.2f} us; "
                   f"ratio {tr / te:.0f}x; max distance {d:.2g}")
-        wp.plot().savefig(DOCS / f"accuracy_{geometry}_eps{eps:g}.png", dpi=90)
+        savefig(wp.plot(), DOCS / f"accuracy_{geometry}_eps{eps:g}.png", dpi=90)
     m = hovering.TruncatedMap(eps=0.05, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
     wp = hovering.work_precision(m, quick=args.quick)
     print("\n## truncated map (rotation number)\n")
     print(wp.format())
-    wp.plot().savefig(DOCS / "accuracy_truncated.png", dpi=90)
+    savefig(wp.plot(), DOCS / "accuracy_truncated.png", dpi=90)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,27 @@
 #!/usr/bin/env bash
 # All set-up on a fresh Debian machine, idempotent: system libraries (apt, only if missing), a
-# virtual environment in .venv, CMake/Ninja for the C++ tests, and the hovering package itself.
+# virtual environment, CMake/Ninja for the C++ tests, and the hovering package itself.
+#
+#   bash scripts/setup.sh            # .venv with what pip resolves today (the newest releases)
+#   bash scripts/setup.sh --oldest   # .venv-oldest with every declared minimum (scripts/floors.py)
+#
+# PYTHON=python3.13 picks another interpreter (its venv is then .venv-python3.13[-oldest]).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+OLDEST=0
+for arg in "$@"; do
+  case "$arg" in
+    --oldest) OLDEST=1 ;;
+    *) echo "setup.sh: unknown option $arg (allowed: --oldest)" >&2; exit 2 ;;
+  esac
+done
+
 APT_PACKAGES=(g++ pkg-config libgsl-dev libeigen3-dev libsleef-dev catch2 libtomlplusplus-dev libcli11-dev)
 PY=${PYTHON:-python3}
+VENV=.venv
+[ -n "${PYTHON:-}" ] && VENV=".venv-$(basename "$PY")"
+[ "$OLDEST" = 1 ] && VENV="$VENV-oldest"
 
 as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
 
@@ -21,14 +37,24 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-if [ ! -x .venv/bin/python ]; then
-  echo "[setup] creating .venv"
-  "$PY" -m venv .venv
+if [ ! -x "$VENV/bin/python" ]; then
+  echo "[setup] creating $VENV"
+  "$PY" -m venv "$VENV"
 fi
 # shellcheck disable=SC1091
-. .venv/bin/activate
+. "$VENV/bin/activate"
 python -m pip install -q --upgrade pip
 python -m pip install -q cmake ninja
-echo "[setup] building and installing hovering (C++ core + Python module)"
-python -m pip install -q ".[test]"
-python -c "import hovering; print('[setup] hovering', hovering.__version__, '- SIMD AVX2:', hovering.simd_is_avx2())"
+if [ "$OLDEST" = 1 ]; then
+  # pip applies PIP_CONSTRAINT to the isolated build environment too (pybind11, scikit-build-core).
+  mkdir -p build
+  python scripts/floors.py test > build/floors.txt
+  echo "[setup] the declared minimums: $(tr '\n' ' ' < build/floors.txt)"
+  export PIP_CONSTRAINT="$PWD/build/floors.txt"
+  BUILD_DIR=build/oldest
+else
+  BUILD_DIR="build/{wheel_tag}"
+fi
+echo "[setup] building and installing hovering (C++ core + Python module) into $VENV"
+python -m pip install -q ".[test]" --config-settings=build-dir="$BUILD_DIR"
+python -c "import hovering, numpy; print('[setup] hovering', hovering.__version__, '- numpy', numpy.__version__, '- SIMD width:', hovering.simd_width())"

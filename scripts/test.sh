@@ -1,12 +1,40 @@
 #!/usr/bin/env bash
 # Quick start 2: set everything up, then run the whole test suite: ctest (C++) and pytest (Python).
+#
+#   bash scripts/test.sh            # newest releases of every dependency (what pip resolves today)
+#   bash scripts/test.sh --oldest   # the declared minimums (pyproject.toml floors), in .venv-oldest;
+#                                   # pytest only: the C++ tests do not involve a Python dependency
+# Extra arguments after -- go to pytest (e.g. -- -m "not slow").
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
-. .venv/bin/activate
-echo "[test] C++ unit tests (ctest)"
-cmake -S . -B build/ctest -G Ninja -DCMAKE_BUILD_TYPE=Release -DHOVERING_BUILD_TESTS=ON >/dev/null
-cmake --build build/ctest
-(cd build/ctest && ctest --output-on-failure)
-echo "[test] Python tests (pytest)"
-python -m pytest tests
+
+OLDEST=0
+PYTEST_ARGS=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --oldest) OLDEST=1 ;;
+    --) shift; PYTEST_ARGS=("$@"); break ;;
+    *) echo "test.sh: unknown option $1 (allowed: --oldest, -- PYTEST_ARGS)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+PY=${PYTHON:-python3}
+VENV=.venv
+[ -n "${PYTHON:-}" ] && VENV=".venv-$(basename "$PY")"
+if [ "$OLDEST" = 1 ]; then
+  bash scripts/setup.sh --oldest
+  VENV="$VENV-oldest"
+else
+  bash scripts/setup.sh
+fi
+# shellcheck disable=SC1091
+. "$VENV/bin/activate"
+if [ "$OLDEST" = 0 ]; then
+  echo "[test] C++ unit tests (ctest)"
+  cmake -S . -B build/ctest -G Ninja -DCMAKE_BUILD_TYPE=Release -DHOVERING_BUILD_TESTS=ON >/dev/null
+  cmake --build build/ctest
+  (cd build/ctest && ctest --output-on-failure)
+fi
+echo "[test] Python tests (pytest) with $(python -c 'import sys, numpy, matplotlib; print("Python", sys.version.split()[0], "numpy", numpy.__version__, "matplotlib", matplotlib.__version__)')"
+python -m pytest tests "${PYTEST_ARGS[@]}"

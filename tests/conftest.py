@@ -137,3 +137,28 @@ def rng():
 def any_map(request):
     """Each parameter set of PARAM_SETS as a TruncatedMap."""
     return make_map(PARAM_SETS[request.param])
+
+
+class CtrlCOnceStarted:
+    """A ``progress(done, total)`` callable that presses Ctrl-C (``_thread.interrupt_main``) the
+    first time it sees work done, so the interrupt always lands mid-run whatever the machine's
+    speed or load (a timer could fire before the call starts on a loaded machine, or after it ends
+    on a fast one). ``fired_at`` is the ``time.perf_counter()`` of the press, for promptness bounds."""
+
+    def __init__(self, after: int = 1):
+        self.after, self.fired_at = after, None
+
+    def __call__(self, done, total):
+        if self.fired_at is None and done >= self.after:
+            import _thread
+            import time
+
+            self.fired_at = time.perf_counter()
+            _thread.interrupt_main()
+
+
+#: Upper bound on the time from Ctrl-C to the call's return, for a loaded 2-core machine: the
+#: watcher polls every 0.1 s and the core checks its cancel flag every few steps, so an idle
+#: machine measures ~0.1-0.2 s; the bound only has to separate "promptly" from "at the end of a
+#: run of minutes", so it is generous.
+PROMPT = 10.0

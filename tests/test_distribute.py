@@ -100,7 +100,7 @@ def _scene_copy(tmp_path, name, **changes):
     data = tomllib.loads(path.read_text())
     data.update(changes)
     data["output"] = str(tmp_path / (path.stem + ".png"))
-    return parse_scene(data, path)
+    return parse_scene(data, tmp_path / path.name)  # a scene in tmp_path may write there
 
 
 def test_sweep_scenes_on_workers_give_the_one_process_rows(tmp_path):

@@ -125,7 +125,8 @@ def test_reference_coordinates():
         phi = np.linspace(0.0, np.pi, 20001)
         V = 0.5 * (ref.OMEGA2 / ref.ALPHA) ** 2 * np.tan(ref.ALPHA * qm * np.cos(phi)) ** 2
         f = np.sqrt(np.maximum(2 * (E - V), 0.0)) * qm * np.sin(phi)
-        assert abs(np.trapezoid(f, phi) / np.pi - J) < 1e-10
+        integral = np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(phi))  # trapezoid rule (np.trapezoid needs numpy 2)
+        assert abs(integral / np.pi - J) < 1e-10
     # Under the free oscillator 2, theta advances by Omega(E) t and I stays.
     y = (np.zeros(40), np.zeros(40), q2, p2)
     t, n = 3.7, 3700

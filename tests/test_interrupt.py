@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import _thread
-import threading
+import time
 
 import numpy as np
 import pytest
 
 import hovering
 from hovering import Status
+from conftest import PROMPT, CtrlCOnceStarted
 
 
 def test_interrupt_keeps_every_orbit_state():
@@ -17,14 +17,12 @@ def test_interrupt_keeps_every_orbit_state():
     rng = np.random.default_rng(5)
     n = 20_000
     phi0, K0 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.5, 0.5, n)
-    # ~2e9 orbit-steps: minutes of work, so the interrupt (after 0.3 s) always lands mid-run.
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt) as info:
-            m.iterate(phi0, K0, 100_000, record=("rotation",), n_threads=2)
-    finally:
-        timer.cancel()
+    # ~2e9 orbit-steps: minutes of work; Ctrl-C is pressed once the work has begun (CtrlCOnceStarted),
+    # so it always lands mid-run, on any machine and under any load.
+    press = CtrlCOnceStarted()
+    with pytest.raises(KeyboardInterrupt) as info:
+        m.iterate(phi0, K0, 100_000, record=("rotation",), n_threads=2, progress=press)
+    assert time.perf_counter() - press.fired_at < PROMPT
     res = info.value.partial
     assert res.n_orbits == n
     done, st = res.steps_done, res.status
@@ -34,7 +32,7 @@ def test_interrupt_keeps_every_orbit_state():
     assert set(np.unique(st).tolist()) <= {int(Status.OK), int(Status.INTERRUPTED)}
     assert np.all(done[st == Status.OK] == 100_000)
     interrupted = st == Status.INTERRUPTED
-    assert interrupted.sum() > n // 2 and np.all(done[interrupted] < 100_000)
+    assert interrupted.sum() > 0 and np.all(done[interrupted] < 100_000)
     under_way = np.flatnonzero(interrupted & (done > 0))
     assert under_way.size > 0
     # Every orbit's reported state is exactly where a fresh run of its own steps_done steps ends
@@ -56,13 +54,8 @@ def test_interrupt_reports_unstarted_out_of_band_orbits_as_escaped():
     phi0 = np.linspace(-3, 3, n)
     K0 = np.where(np.arange(n) % 2 == 0, 0.1, 5.0)
     for kernel in ("simd", "scalar"):
-        timer = threading.Timer(0.3, _thread.interrupt_main)
-        timer.start()
-        try:
-            with pytest.raises(KeyboardInterrupt) as info:
-                m.iterate(phi0, K0, 100_000, record=(), n_threads=2, kernel=kernel)
-        finally:
-            timer.cancel()
+        with pytest.raises(KeyboardInterrupt) as info:
+            m.iterate(phi0, K0, 100_000, record=(), n_threads=2, kernel=kernel, progress=CtrlCOnceStarted())
         res = info.value.partial
         outside = K0 > 1.0
         assert np.all(res.status[outside] == Status.ESCAPED) and np.all(res.steps_done[outside] == 0)
@@ -78,11 +71,16 @@ def test_exception_from_a_signal_handler_propagates_unchanged():
     def on_alarm(signum, frame):
         raise TimeoutError("budget exceeded")
 
+    def arm(done, total):  # the alarm is set once the work has begun, to ring 50 ms later, in C++
+        if done > 0 and signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0) and not rang:
+            rang.append(True)
+            signal.setitimer(signal.ITIMER_REAL, 0.05)
+
+    rang = []
     old = signal.signal(signal.SIGALRM, on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, 0.3)
     try:
         with pytest.raises(TimeoutError, match="budget exceeded"):
-            m.iterate(np.zeros(20_000), np.full(20_000, 0.1), 100_000, record=(), n_threads=2)
+            m.iterate(np.zeros(20_000), np.full(20_000, 0.1), 100_000, record=(), n_threads=2, progress=arm)
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)

@@ -118,7 +118,8 @@ def test_custom_potential_of_a_lambda_names_the_callable():
 
 
 def test_cloudpickle_stores_lambdas():
-    cloudpickle = pytest.importorskip("cloudpickle")
+    import cloudpickle  # a test dependency (pyproject [test])
+
     p = hv.CustomPotential(lambda q: 0.5 * q * q + 0.25 * q**4, lambda q: q + q**3, name="lam")
     q = cloudpickle.loads(cloudpickle.dumps(p))
     assert type(q) is hv.CustomPotential and potential_answers(q) == potential_answers(p)

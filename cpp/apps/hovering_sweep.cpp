@@ -10,12 +10,25 @@
 // the points whose parameters are already in the file, so an interrupted sweep (Ctrl-C, a kill, a
 // crash) loses only the point it was computing, and one file can hold several sweeps. A file with
 // another header is refused rather than mixed, and a last row torn by a kill is dropped.
+//
+// Lines starting with '#' are comments: "# provenance: {...}" (one line of JSON: the core's build
+// facts, hovering::build_info, plus the run's threads and seed) comes before the header of a new
+// file, and again before the rows of a later run whose facts differ, so every row is preceded by
+// the facts of the run that wrote it. A run holds an exclusive lock (flock) on the file from
+// reading it to its last row; a second run on the same file meanwhile is refused at once with a
+// message (rather than queued: a sweep takes minutes to hours, and a run that silently waits that
+// long looks hung; started twice by mistake, the second run would have nothing left to do).
 
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <atomic>
 #include <charconv>
 #include <chrono>
@@ -33,6 +46,7 @@
 #include <thread>
 #include <vector>
 
+#include "hovering/build_info.hpp"
 #include "hovering/scene/sweep_run.hpp"
 #include "hovering/scene/sweep_scene.hpp"
 
@@ -70,12 +84,16 @@ std::string join(const std::vector<std::string>& v) {
 
 /// What the output file holds, as far as resuming is concerned.
 struct Existing {
-    bool write_header = true;   ///< new, empty, or only a torn header
+    bool write_header = true;   ///< new, empty, or only comments and a torn header
     bool torn = false;          ///< its last line is incomplete or invalid and must go
     std::uintmax_t keep = 0;    ///< bytes to keep when torn
     std::string torn_note;      ///< what was wrong with the dropped line
+    std::string provenance;     ///< its last complete provenance comment line ("" if none)
     std::vector<std::vector<std::string>> params;  ///< parameter fields of its complete rows
 };
+
+/// The comment line that records what wrote the rows after it.
+const std::string kProvenance = "# provenance: ";
 
 /// Why this line is not a row under `header` ("" if it is one); fills params when it is.
 std::string check_row(const std::string& line, std::size_t n_results, std::size_t n_columns,
@@ -138,22 +156,26 @@ Existing scan(const std::string& path, const std::string& header, std::size_t n_
     std::string line, bad_note;
     std::uintmax_t offset = 0;
     long lineno = 0, bad_line = 0;
-    bool complete = false;
+    bool header_seen = false, complete = false;
     while (read_line(in, line, complete, path, lineno + 1)) {
         ++lineno;
         if (bad_line)
             throw std::runtime_error(path + " line " + std::to_string(bad_line) + " is not a valid row (" + bad_note +
                                      ") and rows follow it, so it is not a row torn by an interrupted run: the "
                                      "file was edited or damaged. Fix or remove that line, or use another --out.");
-        if (lineno == 1) {
-            if (!complete && header.compare(0, line.size(), line) == 0) {
-                ex.torn = true;  // killed while writing the header: start the file again
+        if (complete && !line.empty() && line[0] == '#') {
+            if (line.compare(0, kProvenance.size(), kProvenance) == 0) ex.provenance = line;
+        } else if (!header_seen) {
+            if (!complete && (header.compare(0, line.size(), line) == 0 || line[0] == '#')) {
+                ex.torn = true;  // killed while writing the header (or a comment): write it again
+                ex.keep = offset;
                 ex.torn_note = "an incomplete header";
             } else if (line != header) {
                 throw std::runtime_error(path + " does not have the header of this scene kind's rows (another kind "
                                          "of scene, an older version or another program's file): use another --out "
                                          "or move it away.\n  expected: " + header + "\n  found:    " + line);
             } else {
+                header_seen = true;
                 ex.write_header = false;
             }
         } else {
@@ -216,26 +238,72 @@ private:
     std::thread thread_;
 };
 
-/// A CSV file opened for appending whose every line is on disk (written, flushed, fsync'd) when
-/// line() returns: a crash or power cut after it cannot lose that row.
-class Appender {
+/// The output CSV, held under an exclusive lock (flock) for the whole run, whose every appended
+/// line is on disk (written, flushed, fsync'd) when line() returns: a crash or power cut after it
+/// cannot lose that row, and a failed write (a full disk) is cut back off, leaving no half line.
+class LockedCsv {
 public:
-    explicit Appender(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "ab")) {
-        if (!f_) throw std::runtime_error("cannot open " + path + " for appending");
+    /// Open (creating) and lock `path`; refuse at once if another run holds the lock.
+    explicit LockedCsv(const std::string& path) : path_(path) {
+        fd_ = ::open(path.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
+        if (fd_ < 0 && (errno == EACCES || errno == EROFS)) {
+            // A read-only file can still tell that its sweep is complete (shared lock: no run writes it
+            // meanwhile); writing to it fails in line().
+            read_only_ = errno;
+            fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        }
+        if (fd_ < 0) throw std::runtime_error("cannot open " + path + " for appending: " + std::strerror(errno));
+        if (::flock(fd_, (read_only_ ? LOCK_SH : LOCK_EX) | LOCK_NB) != 0) {
+            const int err = errno;
+            ::close(fd_);
+            if (err == EWOULDBLOCK)
+                throw std::runtime_error(path + " is being written by another hovering_sweep run (it holds the file's "
+                                         "lock): wait for that run to finish and rerun this command (it resumes), "
+                                         "or give another --out");
+            throw std::runtime_error("cannot lock " + path + ": " + std::strerror(err));
+        }
     }
-    ~Appender() { std::fclose(f_); }
-    Appender(const Appender&) = delete;
-    Appender& operator=(const Appender&) = delete;
-    /// Append text and a newline, and make them durable; what names it in the error message.
+    ~LockedCsv() { ::close(fd_); }  // releases the lock
+    LockedCsv(const LockedCsv&) = delete;
+    LockedCsv& operator=(const LockedCsv&) = delete;
+    /// Cut the file to `size` bytes (a torn last line).
+    void truncate(std::uintmax_t size) {
+        writable();
+        if (::ftruncate(fd_, off_t(size)) != 0 || ::fsync(fd_) != 0)
+            throw std::runtime_error("cannot cut the torn row off " + path_ + ": " + std::strerror(errno));
+    }
+    /// Append text and a newline, and make them durable; `what` names it in the error message.
     void line(const std::string& text, const char* what) {
+        writable();
         const std::string l = text + "\n";
-        if (std::fwrite(l.data(), 1, l.size(), f_) != l.size() || std::fflush(f_) != 0 || fsync(fileno(f_)) != 0)
-            throw std::runtime_error(std::string("writing ") + what + " to " + path_ + " failed (disk full?)");
+        struct stat st;
+        if (::fstat(fd_, &st) != 0) fail(what, errno, -1);
+        std::size_t done = 0;
+        while (done < l.size()) {
+            const ssize_t n = ::write(fd_, l.data() + done, l.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) fail(what, n < 0 ? errno : ENOSPC, st.st_size);
+            done += std::size_t(n);
+        }
+        if (::fsync(fd_) != 0) fail(what, errno, st.st_size);
     }
 
 private:
+    void writable() const {
+        if (read_only_)
+            throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(read_only_));
+    }
+    [[noreturn]] void fail(const char* what, int err, off_t size) {
+        if (size >= 0 && ::ftruncate(fd_, size) == 0) ::fsync(fd_);  // no half line left behind
+        const std::string why = err == ENOSPC || err == EDQUOT || err == EFBIG
+                                    ? "no space left (" + std::string(std::strerror(err)) + ")"
+                                    : std::string(std::strerror(err));
+        throw std::runtime_error(std::string("writing ") + what + " to " + path_ + " failed: " + why +
+                                 "; the rows written before are kept");
+    }
     std::string path_;
-    std::FILE* f_;
+    int fd_ = -1;
+    int read_only_ = 0;  ///< errno of opening for writing when only reading was possible
 };
 
 /// The default output: the scene's figure path with the extension .csv.
@@ -256,7 +324,8 @@ int main(int argc, char** argv) {
     app.add_flag("--quick", quick, "Counts divided by 50 (as python -m hovering scene --quick)");
     app.add_option("--out", out,
                    "CSV file to append rows to (default: the scene's output with the extension .csv); rows already "
-                   "in it with the same parameters are skipped");
+                   "in it with the same parameters are skipped. The run locks it: a second run on the same file "
+                   "meanwhile is refused");
     app.add_option("--threads", threads, "Worker threads, 0 = all cores")->check(CLI::Range(0, 4096));
     try {
         app.parse(argc, argv);
@@ -285,7 +354,14 @@ int main(int argc, char** argv) {
         for (const auto& [name, value] : point_parameters(scene, points.front(), counts)) columns.push_back(name);
         const std::string header = join(columns);
 
+        LockedCsv csv(out);  // from here to the last row, no other run writes this file
         const Existing ex = scan(out, header, results.size());
+        // What wrote the rows that follow: the core's build facts and this run's settings.
+        std::vector<hovering::BuildFact> facts = hovering::build_info();
+        const unsigned hw = std::thread::hardware_concurrency();
+        facts.push_back({"threads", std::to_string(threads > 0 ? unsigned(threads) : std::max(1u, hw)), true});
+        facts.push_back({"seed", std::to_string(scene.seed), true});
+        const std::string provenance = kProvenance + hovering::facts_json(facts);
         // A set: the file's rows are untrusted in number too (a scan per point would be quadratic).
         const std::set<std::vector<std::string>> finished(ex.params.begin(), ex.params.end());
         std::vector<std::size_t> todo;
@@ -298,12 +374,12 @@ int main(int argc, char** argv) {
                   << counts.samples << " samples each), " << points.size() - todo.size() << " already in " << out
                   << "\n";
         if (ex.torn) {
-            fs::resize_file(out, ex.keep);
+            csv.truncate(ex.keep);
             std::cerr << "hovering_sweep: " << out << ": dropped a torn row (" << ex.torn_note
                       << "), left by an interrupted run; it is recomputed if requested\n";
         }
         if (todo.empty()) return 0;
-        Appender csv(out);
+        if (ex.provenance != provenance) csv.line(provenance, "the provenance comment");
         if (ex.write_header) csv.line(header, "the header");
 
         std::signal(SIGINT, on_signal);

@@ -37,8 +37,9 @@ function(column header name out)
   set(${out} ${i} PARENT_SCOPE)
 endfunction()
 
+# The lines of a CSV that are not comments (the header and the rows).
 macro(read_csv file)
-  file(STRINGS "${file}" lines)
+  file(STRINGS "${file}" lines REGEX "^[^#]")
   list(LENGTH lines n)
 endmacro()
 
@@ -81,6 +82,18 @@ endif()
 if(NOT (steps EQUAL 100 AND samples EQUAL 400 AND om STREQUAL "3.883222077450933" AND tw STREQUAL "2.356194490192345"
         AND klow STREQUAL "-0.429169618760127"))
   message(FATAL_ERROR "row parameters: n_steps ${steps} samples ${samples} Omega0 ${om} theta_w ${tw} K_low ${klow}")
+endif()
+
+# Provenance: the file starts with one comment line of JSON, the core's build facts and the run's
+# threads and seed (the values are checked against Python's record in tests/test_atomic_outputs.py).
+file(STRINGS "${csv}" comments REGEX "^#")
+list(LENGTH comments n_comments)
+file(STRINGS "${csv}" first LIMIT_COUNT 1)
+if(NOT n_comments EQUAL 1 OR NOT first MATCHES "^# provenance: {\"hovering\": \"[0-9.]+\", \"git\": "
+   OR NOT first MATCHES "\"gsl\": " OR NOT first MATCHES "\"eigen\": " OR NOT first MATCHES "\"sleef\": "
+   OR NOT first MATCHES "\"compiler\": " OR NOT first MATCHES "\"simd_width\": [1248]," OR NOT first MATCHES "\"platform\": "
+   OR NOT first MATCHES "\"threads\": 2, \"seed\": 0}$")
+  message(FATAL_ERROR "provenance comment missing or incomplete (${n_comments} comments): ${first}")
 endif()
 
 # Rerun: both points are in the file, nothing is computed or appended.

@@ -23,15 +23,17 @@ TOML
 "$SWEEP" --scene "$WORK/s.toml" --out "$WORK/s.csv" 2> "$WORK/err" &
 pid=$!
 i=0
+# Lines that are not comments (the provenance line): the header and the rows.
+rows() { grep -vc '^#' "$1" 2>/dev/null || true; }
 # Wait for the first row (header + 1 line), at most 30 s.
-while [ "$(cat "$WORK/s.csv" 2>/dev/null | wc -l)" -lt 2 ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i + 1)); done
+while [ "$(rows "$WORK/s.csv")" -lt 2 ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i + 1)); done
 sleep 0.3
 start=$(date +%s%N)
 kill -INT $pid
 rc=0
 wait $pid || rc=$?
 stop=$(date +%s%N)
-lines=$(wc -l < "$WORK/s.csv")
+lines=$(rows "$WORK/s.csv")
 if [ "$rc" -ne 130 ] || [ "$lines" -ne 2 ] || ! grep -q "interrupted during \[2/3\]" "$WORK/err"; then
   echo "after SIGINT: status $rc (want 130), $lines lines (want 2)"; cat "$WORK/err"; exit 1
 fi
@@ -41,7 +43,7 @@ if [ "$ms" -ge 2000 ]; then echo "SIGINT took $ms ms"; exit 1; fi
 # The rerun (on a smaller scene so the test stays short) keeps the finished row: 1 already in.
 sed 's/eps = \[-0.2, 0.3, 0.2\]/eps = [-0.2]/' "$WORK/s.toml" > "$WORK/t.toml"
 "$SWEEP" --scene "$WORK/t.toml" --out "$WORK/s.csv" 2> "$WORK/err2"
-if ! grep -q "1 already in" "$WORK/err2" || [ "$(wc -l < "$WORK/s.csv")" -ne 2 ]; then
+if ! grep -q "1 already in" "$WORK/err2" || [ "$(rows "$WORK/s.csv")" -ne 2 ]; then
   echo "rerun did not resume"; cat "$WORK/err2"; exit 1
 fi
 echo "interrupt: ok (stopped $ms ms after SIGINT)"

@@ -23,6 +23,7 @@ from __future__ import annotations
 from . import _core, analysis, flow, normal, truncated
 from ._common import FlowStatus, Geometry, Region, Status, region_mask, wrap
 from ._protocols import ReturnMap
+from ._provenance import show_versions
 from ._serial import load, save
 from .analysis import (
     CriticalCurve,
@@ -161,4 +162,5 @@ __all__ = [
     "explore",
     "save",
     "load",
+    "show_versions",
 ]

@@ -276,7 +276,7 @@ def check_memory(what: str, nbytes: int) -> None:
                          f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")
 
 
-def output_path(where: str, path) -> "os.PathLike":
+def output_path(where: str, path, within=None) -> "os.PathLike":
     """A figure path checked before any computation: its format is one matplotlib writes and its
     directory exists (or can be created) and is writable.
 
@@ -287,6 +287,9 @@ def output_path(where: str, path) -> "os.PathLike":
     path : path-like
         The requested file. Without a suffix, ``.png`` is added (what ``savefig`` would write), so
         the path reported afterwards is the file that exists.
+    within : sequence of path-like, optional
+        Directories the file must lie under (symbolic links resolved), checked before anything
+        else touches the path: where a file from elsewhere (a scene) may make hovering write.
 
     Returns
     -------
@@ -309,6 +312,13 @@ def output_path(where: str, path) -> "os.PathLike":
             raise ValueError(f"{where} = {str(path)!r} exists and is not a figure file; give a name with a suffix "
                              f"(.png, .pdf, .svg, ...)")
         p = p.with_suffix(".png")
+    if within is not None:
+        real = p.resolve()
+        bases = list(dict.fromkeys(Path(b).resolve() for b in within))
+        if not any(real.is_relative_to(b) for b in bases):
+            raise ValueError(f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene "
+                             "writes only under its own folder or the working directory; give --out (out=) to write "
+                             "elsewhere")
     formats = FigureCanvasBase.get_supported_filetypes()
     if p.suffix[1:].lower() not in formats:
         raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "

@@ -29,9 +29,10 @@ import importlib
 import json
 import math
 import os
+import re
 import typing
 from pathlib import Path, PurePath
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
@@ -41,6 +42,7 @@ __all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
 
 FORMAT = "hovering-npz-1"
 _META_KEY = "__meta__"
+_MAX_INT_BITS = _untrusted.MAX_INT_BITS
 
 
 def _type_name(cls) -> str:
@@ -90,8 +92,19 @@ def _saveable_name(cls, kind: str, key: str) -> str:
     return name
 
 
+#: Longest array member name (UTF-8 bytes) taken from a tree path; a longer path, or one a zip
+#: name cannot hold exactly (NUL and other control characters, lone surrogates), gets a short name.
+_MAX_NAME = 200
+_UNSAFE_NAME = re.compile(r"[\x00-\x1f\x7f\ud800-\udfff]")
+
+
 def _put(arrays: dict, key: str, a: np.ndarray) -> str:
-    """Store ``a`` under ``key`` (made unique: dict keys may contain the separators of another path)."""
+    """Store ``a`` under a member name made from ``key`` and return that name (unique: dict keys may
+    contain the separators of another path). The tree records the name, so any name reads back; a
+    path a zip member name cannot hold exactly (zip readers cut names at NUL) gets ``#n`` instead."""
+    if (_UNSAFE_NAME.search(key) or len(key.encode("utf-8", "surrogatepass")) > _MAX_NAME
+            or not _untrusted.safe_member_name(f"{key}.npy")):  # e.g. a dict key "a/../b": load refuses it
+        key = f"#{len(arrays)}"
     k, i = key, 1
     while k in arrays or k == _META_KEY:
         k, i = f"{key}~{i}", i + 1
@@ -131,7 +144,11 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
     if isinstance(obj, enum.Enum):
         return {"__enum__": _saveable_name(type(obj), "enum", key), "value": obj.value}
     if isinstance(obj, (int, np.integer)):
-        return int(obj)
+        v = int(obj)
+        if v.bit_length() > _MAX_INT_BITS:  # beyond what str(int) and JSON read back (sys.get_int_max_str_digits)
+            raise ValueError(f"{key}: an integer of {v.bit_length()} bits cannot be saved (at most {_MAX_INT_BITS}); "
+                             "save it as a string")
+        return v
     if isinstance(obj, (float, np.floating)):
         x = float(obj)
         return x if math.isfinite(x) else {"__float__": repr(x)}
@@ -140,9 +157,19 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
         if a.dtype == object:
             # Object arrays would need pickle; string arrays (itineraries) become fixed-width text.
             if all(isinstance(v, str) for v in a.flat):
+                # NumPy's fixed-width text drops trailing NULs: such a string would not read back.
+                if any(v.endswith("\0") for v in a.flat):
+                    raise ValueError(f"{key}: a string ending in NUL ('\\0') cannot be saved in an array of "
+                                     "strings (fixed-width text drops trailing NULs)")
                 a = a.astype(str)
             else:
                 raise TypeError(f"{key}: arrays of Python objects cannot be saved without pickle")
+        elif a.dtype.hasobject:  # a structured dtype with object fields: pickled, which load refuses
+            raise TypeError(f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without "
+                            "pickle")
+        elif not _untrusted.plain_dtype(a.dtype):  # load reads plain dtypes only
+            raise TypeError(f"{key}: arrays of dtype {a.dtype} cannot be saved; allowed: booleans, integers, floats, "
+                            "complex numbers and text")
         return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
         try:  # first: it may refuse with a message of its own (Python code)
@@ -365,24 +392,49 @@ def _path(path, what: str) -> str:
     return p
 
 
+def _check_meta(value, where: str = "meta") -> None:
+    """JSON turns non-str dict keys into strings: refuse keys that would not read back."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise ValueError(f"{where}: key {k!r} is a {type(k).__name__}; metadata keys must be str (JSON would "
+                                 "read it back as a string)")
+            _check_meta(v, f"{where}[{k!r}]")
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_meta(v, f"{where}[{i}]")
+
+
+def _seed_of(obj) -> Optional[int]:
+    """The random seed behind ``obj``: its own ``seed``, or its scene's (scene results)."""
+    for o in (obj, getattr(obj, "scene", None)):
+        seed = getattr(o, "seed", None)
+        if isinstance(seed, int) and not isinstance(seed, bool):
+            return seed
+    return None
+
+
 def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     """Write ``obj`` (a result, map, system, ... or a dict/list/tuple of them) to an NPZ file.
 
     The file holds the arrays and one JSON document for everything else; nothing is pickled, so
-    reading it (:func:`load`) never runs code from the file. The object is converted before the file
-    is touched, and written to a temporary file that then replaces ``path``: an object that cannot be
-    saved, or a failed write, leaves an existing file as it was.
+    reading it (:func:`load`) never runs code from the file. The document also records what made
+    the file (``provenance``: versions, build, machine; see :func:`hovering.show_versions`). The
+    object is converted before the file is touched, and written to a temporary file that then
+    replaces ``path``: an object that cannot be saved, or a failed write (a full disk, a kill),
+    leaves an existing file as it was.
 
     Parameters
     ----------
     obj : object
         What to save: hovering's results, maps (TruncatedMap, TruncatedFamily, FlowMap), systems,
         sections, tangential curves, potentials (not those defined in Python), arrays, numbers,
-        strings, and dicts, lists and tuples of these.
+        strings, and dicts, lists and tuples of these (dict keys of any of these types).
     path : str or os.PathLike
         The file; ``.npz`` is appended if missing.
     meta : dict, optional
-        JSON-able metadata stored beside the object (returned by ``load(path, meta=True)``).
+        Metadata stored beside the object (returned by ``load(path, meta=True)``): dicts with str
+        keys, lists, str, finite numbers, bool and None.
 
     Returns
     -------
@@ -394,9 +446,15 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     TypeError
         For an object that cannot be saved (e.g. a CustomPotential: Python code), naming where it is.
     ValueError
-        For a path that is not a writable file path, or metadata that is not JSON-able.
+        For a path that is not a writable file path, metadata that is not JSON-able or has keys
+        that would not read back (non-str keys), or a value that would not (a string ending in
+        NUL in an array of strings, an integer beyond 10,000 bits), naming where it is.
+    hovering._output.WriteError
+        (a ValueError) When writing fails, e.g. ``no space left``; the previous file is intact.
     """
     from . import __version__
+    from ._output import replacing
+    from ._provenance import provenance
 
     path = _path(path, "path")
     if not path.endswith(".npz"):
@@ -405,25 +463,53 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
         raise ValueError(f"path = {path!r} is a directory, not a file")
     if meta is not None and not isinstance(meta, dict):
         raise ValueError(f"meta must be a dict of JSON-able values, got {meta!r}")
+    _check_meta(meta or {})
     arrays: dict = {}
     tree = to_tree(obj, arrays)
-    doc = {"format": FORMAT, "version": __version__, "meta": meta or {}, "tree": tree}
+    doc = {"format": FORMAT, "version": __version__, "provenance": provenance(seed=_seed_of(obj)), "meta": meta or {},
+           "tree": tree}
     try:
         text = json.dumps(doc, allow_nan=False)
     except (TypeError, ValueError) as e:  # only the metadata can hold something else
         raise ValueError(f"meta must be JSON-able (str, finite numbers, bool, None, lists and dicts): {e}") from None
-    tmp = f"{path}.tmp-{os.getpid()}"
-    try:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
-        os.replace(tmp, path)
-    except OSError as e:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise ValueError(f"cannot write {path!r}: {e.strerror or e}") from None
+    try:  # what load will check (one owner: the reading limits), so that every file saved reads back
+        _untrusted.parse_json(text, "the tree")
+    except ValueError as e:
+        raise ValueError(f"cannot save: the file would not read back: {e}") from None
+    with replacing(path) as fh:
+        np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
     return path
+
+
+#: Largest ``__meta__`` member :func:`is_result_file` reads to recognise a result file.
+_MAX_SNIFF_META = 64 << 20
+
+
+def is_result_file(path: os.PathLike) -> bool:
+    """Whether ``path`` is an NPZ written by :func:`save` (its ``__meta__`` document has this
+    format); False for anything else or anything unreadable. Reads only that member (at most 64 MiB
+    declared), never the arrays.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+
+    Returns
+    -------
+    bool
+    """
+    try:  # an untrusted file: read as load reads it (hovering._untrusted), only its __meta__ member
+        with _untrusted.Archive(os.fspath(path)) as z:
+            if _META_KEY not in z.files:
+                return False
+            dtype, shape, nbytes = z.header(_META_KEY)
+            if dtype.kind != "U" or shape != () or nbytes > _MAX_SNIFF_META:
+                return False
+            doc = _untrusted.parse_json(str(z.read(_META_KEY)))
+    except Exception:  # noqa: BLE001 - any failure to read it means: not recognised as ours
+        return False
+    return isinstance(doc, dict) and doc.get("format") == FORMAT
 
 
 def load(path: os.PathLike, meta: bool = False):

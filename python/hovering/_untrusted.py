@@ -25,9 +25,9 @@ import numpy as np
 
 from ._common import physical_memory
 
-__all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_MEMBERS", "MAX_DIRECTORY_BYTES",
-           "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "json_cost", "json_nesting",
-           "parse_json", "Archive"]
+__all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_INT_BITS", "MAX_MEMBERS",
+           "MAX_DIRECTORY_BYTES", "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "json_cost",
+           "json_nesting", "parse_json", "safe_member_name", "plain_dtype", "Archive"]
 
 #: Longest JSON document read (characters). The largest tree hovering writes is a scene's: 36
 #: portrait panels of 10,000 orbits, each with its label, colour and kind (~32 characters), about
@@ -42,9 +42,9 @@ MAX_TREE_DEPTH = 100
 #: below 4096 characters; texts drawn on a figure have the scene schema's tighter limit
 #: (:data:`hovering.scenes.schema.MAX_TEXT`).
 MAX_STRING_CHARS = 1 << 16
-#: Integers in a JSON document lie in [-2**63, 2**64): hovering writes counts, seeds and codes of
-#: 64-bit types, and a longer digit string is only slow to convert.
-_INT_RANGE = (-(2**63), 2**64)
+#: Largest integer in a JSON document, in bits (:func:`hovering.save` refuses larger ones): its
+#: decimal text (~3000 digits) converts in microseconds and stays below Python's 4300-digit limit.
+MAX_INT_BITS = 10_000
 #: Most members of an archive: a result has one per array (a scene's, a few hundred).
 MAX_MEMBERS = 100_000
 #: Largest zip central directory read (bytes). Python's zipfile reads it whole and makes an object
@@ -133,12 +133,13 @@ def _finite_float(text: str) -> float:
 
 
 def _bounded_int(text: str) -> int:
-    if len(text) > 21:  # more digits than any integer in the range (checked exactly below)
-        raise ValueError(f"the JSON integer {text[:40]}... has {len(text)} digits; allowed: integers in "
-                         f"[-2**63, 2**64)")
+    # More digits than any integer of MAX_INT_BITS bits has: refused before converting.
+    if len(text.lstrip("-")) > math.ceil(MAX_INT_BITS * math.log10(2)):
+        raise ValueError(f"the JSON integer {text[:40]}... has {len(text)} digits; allowed: integers of at most "
+                         f"{MAX_INT_BITS} bits")
     v = int(text)
-    if not _INT_RANGE[0] <= v < _INT_RANGE[1]:
-        raise ValueError(f"the JSON integer {text} is out of range; allowed: [-2**63, 2**64)")
+    if v.bit_length() > MAX_INT_BITS:
+        raise ValueError(f"the JSON integer {text[:40]}... has {v.bit_length()} bits; allowed: at most {MAX_INT_BITS}")
     return v
 
 
@@ -192,7 +193,7 @@ def parse_json(text: str, what: str = "the JSON document"):
 
     Checked before parsing: at most :data:`MAX_TREE_CHARS` characters, nesting at most
     :data:`MAX_TREE_DEPTH`. While parsing: no ``NaN``/``Infinity`` constants, no number beyond a
-    double, integers in [-2**63, 2**64). After: every string and key at most
+    double, integers of at most :data:`MAX_INT_BITS` bits. After: every string and key at most
     :data:`MAX_STRING_CHARS` characters and valid Unicode (no lone surrogates).
 
     Parameters
@@ -266,11 +267,38 @@ def _directory(fh, size: int) -> tuple:
     return members, cd_size
 
 
-def _safe_member_name(name: str) -> bool:
-    """A member name an archive written by hovering (numpy's savez) can have: relative, no ``..``."""
+def safe_member_name(name: str) -> bool:
+    """Whether an archive member name is one :func:`hovering.save` writes (and reading accepts):
+    relative, no ``..`` component, no backslash or control character.
+
+    Parameters
+    ----------
+    name : str
+        The member's name.
+
+    Returns
+    -------
+    bool
+    """
     parts = name.split("/")
     return (bool(name) and not name.startswith("/") and "\\" not in name and ".." not in parts
             and not any(ord(c) < 32 for c in name))
+
+
+def plain_dtype(dtype: np.dtype) -> bool:
+    """Whether arrays of ``dtype`` are read from a file: booleans, integers, floats, complex numbers
+    or text (no objects, records, sub-arrays, bytes or dates).
+
+    Parameters
+    ----------
+    dtype : numpy.dtype
+        The dtype.
+
+    Returns
+    -------
+    bool
+    """
+    return dtype.kind in _PLAIN_KINDS and dtype.fields is None and dtype.subdtype is None
 
 
 class Archive:
@@ -305,7 +333,7 @@ class Archive:
             except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
                 raise ValueError(f"{path} is not a hovering result file: {e}") from None
             names = [i.filename for i in self._zip.infolist()]
-            bad = next((n for n in names if not _safe_member_name(n)), None)
+            bad = next((n for n in names if not safe_member_name(n)), None)
             if bad is not None:
                 raise ValueError(f"{path}: the archive has a member named {bad[:80]!r}; a hovering result file's "
                                  "members are relative names without '..' (nothing is ever extracted)")
@@ -365,7 +393,7 @@ class Archive:
             shape, _, dtype = reader(buf)
         except (ValueError, EOFError, OSError, zipfile.BadZipFile, SyntaxError) as e:
             raise ValueError(f"{where}: {e}") from None
-        if dtype.kind not in _PLAIN_KINDS or dtype.fields is not None or dtype.subdtype is not None:
+        if not plain_dtype(dtype):
             raise ValueError(f"{where}: dtype {dtype.str!r} is refused; allowed: booleans, integers, floats, complex "
                              "numbers and text (object arrays would need pickle)")
         nbytes = math.prod(shape) * dtype.itemsize

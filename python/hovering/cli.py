@@ -17,6 +17,13 @@
 
 Every bad input (file, key, value, output path, format, colour) is ``error: ...`` on stderr and
 exit status 2, before anything is computed.
+
+Where outputs go: a scene's own ``output`` must lie under the scene file's folder or the working
+directory (``--out`` can name any place). Existing files are replaced only if hovering wrote them
+(results, sidecars, checkpoints, and figures beside them); any other file in the way is refused
+before computing unless ``--force``. Every file is written atomically, and the files written are
+named at the end; a failed write (a full disk) is one ``error:`` line (exit 2) and leaves the
+previous files intact.
 """
 
 from __future__ import annotations
@@ -51,12 +58,14 @@ def _progress(args) -> bool:
     return sys.stderr.isatty() if args.progress is None else args.progress
 
 
-def _run(scene, out, quick: bool, progress: bool, where=None) -> int:
+def _run(scene, out, quick: bool, progress: bool, where=None, force: bool = False) -> int:
     from .scenes import format_summary, run_scene
 
     try:
-        summary = run_scene(scene, out=out, quick=quick, progress=progress, **(where or {}))
-    except ValueError as e:  # a value only the computation can check (e.g. a K beyond the band's top)
+        summary = run_scene(scene, out=out, quick=quick, progress=progress, force=force, **(where or {}))
+    except (OSError, ValueError) as e:
+        # a value only the computation can check (e.g. a K beyond the band's top), a file in the
+        # way, or a write that failed (a full disk): one line, the previous files intact
         return _error(e)
     print(format_summary(summary))
     return 0
@@ -70,7 +79,8 @@ def _scene(args) -> int:
     from .scenes import load_scene
 
     try:
-        scene = load_scene(args.path)
+        # With --out the scene's own output is not used, so it is not checked.
+        scene = load_scene(args.path, check_output=args.out is None)
         out = output_path("--out", args.out) if args.out is not None else None
     except (OSError, ValueError) as e:
         return _error(e)
@@ -79,7 +89,7 @@ def _scene(args) -> int:
         where = dict(workers=args.workers, scheduler=args.scheduler, dask=args.dask)
     elif args.dask:
         return _error("--dask needs --workers N (a LocalCluster of N workers)")
-    return _run(scene, out, args.quick, _progress(args), where)
+    return _run(scene, out, args.quick, _progress(args), where, args.force)
 
 
 def _demo(args) -> int:
@@ -102,7 +112,7 @@ def _demo(args) -> int:
     except ValueError as e:
         return _error(e)
     t0 = time.perf_counter()
-    rc = _run(scene, out, False, _progress(args))
+    rc = _run(scene, out, False, _progress(args), force=args.force)
     if rc == 0:
         print(f"demo done in {time.perf_counter() - t0:.2f} s")
     return rc
@@ -117,7 +127,7 @@ def _redraw(args) -> int:
 
     try:
         out = output_path("--out", args.out) if args.out is not None else None
-        png, result, _ = redraw(args.path, out=out)
+        png, result, _ = redraw(args.path, out=out, force=args.force)
     except (OSError, ValueError) as e:
         return _error(e)
     print(f"redrew {result.scene.kind} scene {result.scene.name!r} (computed by hovering "
@@ -133,6 +143,8 @@ def _accuracy(args) -> int:
 
     matplotlib.use("Agg")
     from ._common import output_path
+    from ._output import refuse_foreign, savefig, write_text
+    from ._provenance import provenance
     from .accuracy import work_precision
     from .flow.section import Section
     from .scenes import load_scene
@@ -142,6 +154,8 @@ def _accuracy(args) -> int:
     try:
         scene = load_scene(args.path, check_output=False)
         out = output_path("--out", args.out if args.out is not None else f"accuracy_{Path(args.path).stem}.png")
+        side = Path(out).with_suffix(".json")
+        refuse_foreign([out, side], args.force)
     except (OSError, ValueError) as e:
         return _error(e)
     t0 = time.perf_counter()
@@ -157,9 +171,13 @@ def _accuracy(args) -> int:
     except ValueError as e:
         return _error(e)
     fig = wp.plot()
-    fig.savefig(out, dpi=110)
-    side = Path(out).with_suffix(".json")
-    side.write_text(json.dumps(wp.to_dict(), indent=1), encoding="utf-8")
+    # "format" first: how a later run recognises the table as one it may replace
+    table = {"format": "hovering-accuracy-1", "provenance": provenance(), **wp.to_dict()}
+    try:
+        write_text(side, json.dumps(table, indent=1))
+        savefig(fig, out, dpi=110)  # last: a figure on disk has its table beside it
+    except (OSError, ValueError) as e:
+        return _error(e)
     print(wp.format())
     print(f"wrote {out} and {side} in {time.perf_counter() - t0:.1f} s")
     return 0
@@ -196,6 +214,10 @@ def main(argv=None) -> int:
                        help="progress bars on stderr (default: when stderr is a terminal)")
         g.add_argument("--no-progress", dest="progress", action="store_false")
 
+    def force_flag(sp):
+        sp.add_argument("--force", action="store_true",
+                        help="replace existing output files even if hovering did not write them (default: refuse)")
+
     d = sub.add_parser("demo", help="the packaged demo scene: phase portraits of F_eps for +eps and -eps")
     d.add_argument("--out", default="hovering_demo.png", help="output PNG (default %(default)s)")
     d.add_argument("--eps", type=_checked(float, 0.0, 10.0), default=0.3, help="|eps| in [0, 10] (default %(default)s)")
@@ -205,10 +227,12 @@ def main(argv=None) -> int:
                    help="iterates per orbit, 1..1e7 (default %(default)s)")
     d.add_argument("--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)")
     progress_flags(d)
+    force_flag(d)
     sc = sub.add_parser("scene", help="make one figure from a scene file (examples/scenes/*.toml)")
     sc.add_argument("path", help="scene file (TOML)")
     sc.add_argument("--out", default=None,
-                    help="output PNG (default: the scene's 'output'); the result NPZ + JSON are written next to it")
+                    help="output PNG (default: the scene's 'output', which must lie under the scene's folder or the "
+                         "working directory); the result NPZ + JSON are written next to it")
     sc.add_argument("--quick", action="store_true",
                     help="divide the iterate counts by 50 (a fast check, not the paper's figure)")
     sc.add_argument("--workers", type=_checked(int, 1, 4096), default=None,
@@ -216,13 +240,16 @@ def main(argv=None) -> int:
     sc.add_argument("--dask", action="store_true", help="with --workers: a Dask LocalCluster instead of a process pool")
     sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
+    force_flag(sc)
     rd = sub.add_parser("redraw", help="redraw a saved result (RESULT.npz) without computing")
     rd.add_argument("path", help="result file written by 'scene' (NPZ)")
     rd.add_argument("--out", default=None, help="output PNG (default: RESULT.png)")
+    force_flag(rd)
     ac = sub.add_parser("accuracy", help="work-precision diagram of a scene's system (error vs time per setting)")
     ac.add_argument("path", help="scene file (TOML)")
     ac.add_argument("--quick", action="store_true", help="fewer settings, points and returns (seconds, not minutes)")
     ac.add_argument("--out", default=None, help="output PNG (default accuracy_<scene>.png); the table goes next to it as JSON")
+    force_flag(ac)
     ex = sub.add_parser("explore", help="click to launch orbits on a scene's map (interactive backend)")
     ex.add_argument("path", help="scene file (TOML)")
     ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")

@@ -69,8 +69,8 @@ def scipy_return_map(sys, z0, rtol: float):
         handled = False
         for te, k, ye in sorted(evs, key=lambda e: e[0]):
             if k == 2:
-                if ye[1] == 0:
-                    continue
+                # The direction of the p1 crossing is the sign of dp1/dt = -V1'(q1), not of p1 at
+                # the root: scipy may return p1 = 0.0 there exactly (it did at q1's minimum).
                 dp = -V1.dV(ye[0])
                 if dp > 0:
                     armed = True

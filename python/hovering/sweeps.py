@@ -1,9 +1,12 @@
 """Checkpointed sweeps: every finished point is on disk at once, an interrupted sweep resumes.
 
 A :class:`Checkpoint` is an append-only JSON-lines file. Each finished sweep point is one line
-``{"key": ..., "row": ...}``, flushed and fsync'd before the sweep moves on, so an interruption
-(Ctrl-C, a killed job, a full disk) loses at most the point being computed. A rerun with the same
-file skips every point whose key (all parameters that determine the result) is already there.
+``{"key": ..., "provenance": ..., "row": ...}`` (provenance: what computed that row, see
+:func:`hovering.show_versions`; files without it read the same), appended under an exclusive lock
+on the file and fsync'd before the sweep moves on, so an interruption (Ctrl-C, a killed job, a full
+disk) loses at most the point being computed and two processes sharing a file never mix their
+lines. A rerun with the same file skips every point whose key (all parameters that determine the
+result) is already there.
 
 A checkpoint is read as untrusted input (docs/threat-model.md): it must be a regular file whose
 parsed size (estimated from its text) fits in half of this machine's memory, a line nested deeper
@@ -19,6 +22,8 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from . import _untrusted
+from ._output import append_line, locked
+from ._provenance import provenance
 
 __all__ = ["Checkpoint", "check_row"]
 
@@ -49,23 +54,26 @@ class Checkpoint:
         self._line: dict = {}
         self.dropped = 0
         if self.path.exists():
-            _untrusted.regular_file(str(self.path))
-            data = self.path.read_bytes()
-            need, budget = _untrusted.json_cost(data), _untrusted.memory_budget()
-            if need > budget:
-                raise ValueError(f"{self.path}: a checkpoint of {len(data)} bytes, whose rows would take up to "
-                                 f"{need / 2**30:.3g} GiB, more than half of this machine's memory "
-                                 f"({2 * budget / 2**30:.3g} GiB)")
-            if data and not data.endswith(b"\n"):
-                # Killed mid-write: the last line is incomplete. Cut it off, or the next put()
-                # would be glued onto it and both points lost.
-                keep = data.rfind(b"\n") + 1
-                with open(self.path, "r+b") as f:
+            # Untrusted: a regular file (a FIFO or a device would be read forever), whose text and
+            # the rows parsed from it fit in the memory budget, checked before it is read and then
+            # before it is parsed (see _untrusted.json_cost).
+            budget = _untrusted.memory_budget()
+            size = _untrusted.regular_file(str(self.path))
+            self._check_size(size, _untrusted.json_cost(b"") + 6 * size, budget)
+            # Under the appenders' lock: a line another process is writing is not mistaken for a
+            # torn one and cut.
+            with locked(self.path) as f:
+                data = f.read()
+                self._check_size(len(data), _untrusted.json_cost(data), budget)
+                if data and not data.endswith(b"\n"):
+                    # Killed mid-write: the last line is incomplete. Cut it off, or the next put()
+                    # would be glued onto it and both points lost.
+                    keep = data.rfind(b"\n") + 1
                     f.truncate(keep)
                     f.flush()
                     os.fsync(f.fileno())
-                data = data[:keep]
-                self.dropped += 1
+                    data = data[:keep]
+                    self.dropped += 1
             for n, line in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):
                 try:
                     if _untrusted.json_nesting(line) > _untrusted.MAX_TREE_DEPTH:
@@ -75,6 +83,12 @@ class Checkpoint:
                     self._rows[k], self._line[k] = rec["row"], n
                 except (ValueError, KeyError, TypeError, RecursionError):
                     self.dropped += 1  # a damaged line: its point is recomputed
+
+    def _check_size(self, nbytes: int, need: int, budget: int) -> None:
+        if need > budget:
+            raise ValueError(f"{self.path}: a checkpoint of {nbytes} bytes, whose rows would take up to "
+                             f"{need / 2**30:.3g} GiB, more than half of this machine's memory "
+                             f"({2 * budget / 2**30:.3g} GiB)")
 
     def __len__(self) -> int:
         return len(self._rows)
@@ -110,21 +124,28 @@ class Checkpoint:
         return row
 
     def put(self, key: Any, row: Any) -> None:
-        """Store a finished point durably (flush + fsync) before returning.
+        """Store a finished point durably (locked append, flush + fsync) before returning.
 
         Parameters
         ----------
         key : JSON-serialisable
-            The point's parameters.
+            The point's parameters (its ``seed``, if it is a dict with one, goes into the record's
+            provenance too).
         row : JSON-serialisable
             Its result.
+
+        Raises
+        ------
+        hovering._output.WriteError
+            (a ValueError) When the line cannot be written (e.g. ``no space left``); the file is
+            left as it was.
         """
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        line = json.dumps({"key": key, "row": row}, sort_keys=True, allow_nan=True)
-        with open(self.path, "a", encoding="utf-8") as f:
-            f.write(line + "\n")
-            f.flush()
-            os.fsync(f.fileno())
+        seed = key.get("seed") if isinstance(key, dict) else None
+        prov = provenance(seed=seed if isinstance(seed, int) and not isinstance(seed, bool) else None)
+        # sort_keys: "key" comes first, which is how a scene run recognises the file as a checkpoint
+        line = json.dumps({"key": key, "provenance": prov, "row": row}, sort_keys=True, allow_nan=True)
+        append_line(self.path, line)
         self._rows[_canonical(key)] = row
 
 

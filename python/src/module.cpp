@@ -1,5 +1,6 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
 // (truncated, flow, normal), each registering itself; the shared enums live at the top.
+#include "hovering/build_info.hpp"
 #include "pybind.hpp"
 
 PYBIND11_MODULE(_core, m) {
@@ -14,6 +15,18 @@ PYBIND11_MODULE(_core, m) {
     register_normal(normal);
     auto scene = m.def_submodule("scene", "The sweep executable's reading of scene files and its point runner.");
     register_scene(scene);
+    m.def(
+        "build_info",
+        [] {
+            py::list out;
+            for (const auto& f : hovering::build_info()) {
+                const py::object value = f.number ? py::object(py::int_(std::stoll(f.value))) : py::str(f.value);
+                out.append(py::make_tuple(f.name, value));
+            }
+            return out;
+        },
+        "The core's build facts as (name, value) pairs (hovering::build_info): version, git commit, compiler, "
+        "GSL, Eigen and SLEEF versions, SIMD width, platform, hardware threads.");
     register_pickles(m);  // after every class it adds pickling to
     // `from hovering._core.flow import X` needs the submodules in sys.modules (def_submodule only
     // sets them as attributes).

@@ -6,6 +6,8 @@ from . import flow as flow
 from . import normal as normal
 from . import truncated as truncated
 
+def build_info() -> list[tuple[str, str | int]]: ...
+
 class Region(enum.IntEnum):
     NONE = -1
     BESIDE = 0

@@ -39,9 +39,12 @@ from .._common import output_path
 from .compute import compute
 from .report import format_summary, summarize
 from .results import SceneResult, load_result
-from .schema import MAX_PANELS, MAX_SCENE_BYTES, MAX_SERIES_POINTS, load_scene, parse_scene
+from .schema import MAX_PANELS, MAX_SCENE_BYTES, MAX_SERIES_POINTS, load_scene, output_dirs, parse_scene
 from .spec import (FLOW_KINDS, KINDS, QUICK_FACTOR, SPECIAL_ORBITS, TRUNCATED_KINDS, CriticalSpec, MapSpec, OrbitSpec,
                    PanelSpec, Scene, SceneSpec, SeriesSpec, ZoomSpec)
+
+#: The kinds that checkpoint their points (``<output>.sweep.jsonl``).
+SWEEP_KINDS = ("hovering_area", "flow_hovering_area")
 
 __all__ = [
     "KINDS", "TRUNCATED_KINDS", "FLOW_KINDS", "SPECIAL_ORBITS", "QUICK_FACTOR", "MAX_PANELS", "MAX_SERIES_POINTS",
@@ -70,8 +73,14 @@ def packaged_scene(name: str) -> Path:
 
 
 def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool = False, keep_figure: bool = False,
-              progress=False, **where) -> dict:
+              progress=False, force: bool = False, **where) -> dict:
     """Compute a scene, save its result (NPZ + JSON), draw its figure and write the PNG.
+
+    Where it writes: ``out`` if given, else the scene's ``output``, which must lie under the scene
+    file's folder or the working directory. It replaces only files hovering wrote (results,
+    sidecars, checkpoints, and figures beside them; see :mod:`hovering._output`): any other file
+    in the way is refused before anything is computed, unless ``force``. Every file is written
+    atomically (a kill or a full disk leaves the previous ones intact); the figure is written last.
 
     Parameters
     ----------
@@ -79,7 +88,7 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
         From :func:`load_scene`.
     out : path-like, optional
         PNG path (default ``scene.output``); the result is written next to it as ``.npz`` and
-        ``.json``.
+        ``.json`` (and a sweep's checkpoint as ``.sweep.jsonl``).
     quick : bool, optional
         Divide iterate counts (and samples) by :data:`QUICK_FACTOR` for a fast check; titles say so.
     keep_figure : bool, optional
@@ -87,6 +96,8 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
         instead of closing the figure.
     progress : bool or callable, optional
         Progress bars on stderr for the long computations.
+    force : bool, optional
+        Replace existing files that hovering did not write.
     **where
         ``workers``, ``client``, ``scheduler``, ``dask``: where a sweep scene's points run (see
         :func:`compute`).
@@ -94,42 +105,66 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
     Returns
     -------
     dict
-        :func:`summarize` of the result plus ``output`` (PNG), ``npz`` and ``json`` paths.
+        :func:`summarize` of the result plus ``output`` (PNG), ``npz`` and ``json`` paths, and
+        ``files``: every file written (with the checkpoint of a sweep).
+
+    Raises
+    ------
+    ValueError
+        For an output path outside the allowed folders, a file in the way that hovering did not
+        write, or a failed write (:class:`hovering._output.WriteError`, e.g. ``no space left``).
     """
+    import io
     import time
 
+    from .._output import is_ours, refuse_foreign, write_bytes, write_error
+
     t0 = time.perf_counter()
-    png = output_path("out", out) if out is not None else scene.output
-    png.parent.mkdir(parents=True, exist_ok=True)
-    npz = png.with_suffix(".npz")
-    result = compute(scene, quick=quick, progress=progress, checkpoint=png.with_suffix(".sweep.jsonl"), **where)
+    png = output_path("out", out) if out is not None else output_path("output", scene.output,
+                                                                         within=output_dirs(scene.path))
+    npz, side, ckpt = png.with_suffix(".npz"), png.with_suffix(".json"), png.with_suffix(".sweep.jsonl")
+    sweep = scene.kind in SWEEP_KINDS
+    refuse_foreign([png, npz, side] + ([ckpt] if sweep else []), force)
+    try:
+        png.parent.mkdir(parents=True, exist_ok=True)
+        if force and sweep and ckpt.exists() and not is_ours(ckpt):
+            ckpt.unlink()  # replaced by this run's checkpoint (it is appended to, not rewritten)
+    except OSError as e:
+        raise write_error(png.parent, e, previous=False) from None
+    result = compute(scene, quick=quick, progress=progress, checkpoint=ckpt, **where)
     result.meta["output"] = str(png)
     t = time.perf_counter()
-    fig = _draw(result, png)
-    result.meta["timings"]["render"] = time.perf_counter() - t
-    npz_path, json_path = result.save(npz)
+    fig = _render(result)
+    try:
+        # Drawn in memory, written after the result: a figure on disk always has its result beside it.
+        buf = io.BytesIO()
+        fig.savefig(buf, format=png.suffix[1:].lower(), dpi=result.scene.dpi)
+        result.meta["timings"]["render"] = time.perf_counter() - t
+        npz_path, json_path = result.save(npz)
+        write_bytes(png, buf.getvalue())
+    finally:
+        if not keep_figure:
+            import matplotlib.pyplot as plt
+
+            plt.close(fig)
     summary = result.summary()
     summary["runtime_s"] = time.perf_counter() - t0
-    summary.update(output=str(png), npz=npz_path, json=json_path)
+    summary.update(output=str(png), npz=npz_path, json=json_path,
+                   files=[npz_path, json_path, str(png)] + ([result.meta["checkpoint"]] if "checkpoint" in result.meta
+                                                             else []))
     if keep_figure:
         summary["figure"] = fig
         summary["result"] = result
-    else:
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
     return summary
 
 
-def _draw(result: SceneResult, png: Path):
+def _render(result: SceneResult):
     from ..plot.figures import render
 
-    fig = render(result)
-    fig.savefig(png, dpi=result.scene.dpi)
-    return fig
+    return render(result)
 
 
-def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bool = False):
+def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bool = False, force: bool = False):
     """Redraw a saved scene result without computing anything.
 
     Parameters
@@ -140,6 +175,8 @@ def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bo
         PNG path (default: the NPZ's name with ``.png``).
     keep_figure : bool, optional
         Return the figure instead of closing it.
+    force : bool, optional
+        Replace an existing file at the PNG path that hovering did not write (see :func:`run_scene`).
 
     Returns
     -------
@@ -152,16 +189,24 @@ def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bo
         For a file that is not a scene result, or one whose values the scene schema or the result's
         own checks refuse (see :func:`load_result`), naming the file and the field.
     """
+    from .._output import refuse_foreign, savefig, write_error
+
     result = load_result(path)  # checked as it is read: the scene schema's checks, each field's type
     png = output_path("--out", out) if out is not None else Path(os.fspath(path)).with_suffix(".png")
-    png.parent.mkdir(parents=True, exist_ok=True)
+    refuse_foreign([png], force)
     try:
-        fig = _draw(result, png)
+        png.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise write_error(png.parent, e, previous=False) from None
+    try:
+        fig = _render(result)
     except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:  # a combination the checks missed
         raise ValueError(f"{os.fspath(path)}: the result cannot be drawn ({type(e).__name__}: {e})") from None
-    if not keep_figure:
-        import matplotlib.pyplot as plt
+    try:
+        savefig(fig, png, dpi=result.scene.dpi)
+    finally:
+        if not keep_figure:
+            import matplotlib.pyplot as plt
 
-        plt.close(fig)
-        fig = None
-    return png, result, fig
+            plt.close(fig)
+    return png, result, (fig if keep_figure else None)

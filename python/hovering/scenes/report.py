@@ -109,25 +109,31 @@ def summarize(result) -> dict:
 def format_summary(summary: dict) -> str:
     """Human-readable text of a scene summary (what the CLI prints).
 
+    Every number goes through one formatter: a value that is not a finite number (NaN, stored as
+    None in the JSON-able summary, e.g. the theory at Omega0 = 2 pi or a checkpoint row without an
+    area) prints as ``nan`` (``inf``), never an error.
+
     Parameters
     ----------
     summary : dict
-        From :func:`summarize` (plus ``output`` and ``npz`` when the result was written).
+        From :func:`summarize` (plus ``output``, ``npz``, ``json`` and ``files`` when the result
+        was written).
 
     Returns
     -------
     str
     """
+    f = _f
     head = f"scene {summary['scene']} ({summary['kind']})"
     if "n_steps" in summary:
         head += f", {summary['n_steps']} iterates"
     lines = [head + (" [quick]" if summary["quick"] else "")]
     acc = summary.get("accuracy")
     if acc:
-        it = ", ".join(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in acc["integrator"].items()
-                       if k in ("stepper", "rtol", "atol"))
+        it = ", ".join(f"{k} {f(v, 'g')}" if isinstance(v, float) or v is None else f"{k} {v}"
+                       for k, v in acc["integrator"].items() if k in ("stepper", "rtol", "atol"))
         lines.append(f"  integrator: {it}; reversal error after {acc['reversal_returns']} returns "
-                     f"({acc['reversal_orbits']} orbits): {acc['reversal_error']:.2g} (grows as m^2)")
+                     f"({acc['reversal_orbits']} orbits): {f(acc['reversal_error'], '.2g')} (grows as m^2)")
     for p in summary.get("panels", []):
         if "zoom_of" in p:
             w = p.get("window")
@@ -135,63 +141,73 @@ def format_summary(summary: dict) -> str:
                          f"K {_fmt_pair(w['ylim'])} [{w['rule']}]")
             continue
         par = p["params"]
-        extra = f", golden c = {par['golden_c']:g} at eps = {par['golden_eps']:g}" if "golden_c" in par else ""
-        lines.append(f"  panel ({p['id']}): eps = {par['eps']:g}, Omega0 = {par['Omega0']:.5f}, "
-                     f"theta_w = {par['theta_w']:.5f}{extra}; predicted K~_c = {_f(p['K_crit'], '.4f')}, "
-                     f"rho_c = {_f(p['rho_crit'], '.4f')}")
+        extra = (f", golden c = {f(par['golden_c'], 'g')} at eps = {f(par['golden_eps'], 'g')}"
+                 if "golden_c" in par else "")
+        lines.append(f"  panel ({p['id']}): eps = {f(par['eps'], 'g')}, Omega0 = {f(par['Omega0'], '.5f')}, "
+                     f"theta_w = {f(par['theta_w'], '.5f')}{extra}; predicted K~_c = {f(p['K_crit'], '.4f')}, "
+                     f"rho_c = {f(p['rho_crit'], '.4f')}")
         if p["orbits"] and p["orbits"][0]["kind"] == "fan":
-            lines.append(f"    {len(p['orbits'])} orbits from K0 = {p['orbits'][0]['K0']:.4g} to "
-                         f"{p['orbits'][-1]['K0']:.4g}, {p['n_escaped']} escaped the band")
+            lines.append(f"    {len(p['orbits'])} orbits from K0 = {f(p['orbits'][0]['K0'], '.4g')} to "
+                         f"{f(p['orbits'][-1]['K0'], '.4g')}, {p['n_escaped']} escaped the band")
         else:
             for o in p["orbits"]:
                 hov = ("hovering" if o.get("hovering") else
                        ("no impact" if o.get("impacts") == 0 else f"{o.get('impacts')} impacts"))
-                lines.append(f"    {o['label']:>10}: K0 = {o['K0']:+.5f}, K_min = {o['K_min']:+.5f}, "
-                             f"rho = {_f(o.get('rho'), '.4f')}, {hov}, {o['status']}")
+                lines.append(f"    {o['label']:>10}: K0 = {f(o['K0'], '+.5f')}, K_min = {f(o['K_min'], '+.5f')}, "
+                             f"rho = {f(o.get('rho'), '.4f')}, {hov}, {o['status']}")
         c = p.get("critical")
         if c is not None:
             if c["found"]:
-                lines.append(f"    critical curve: K0 = {c['K0']:+.5f}, K_min = {c['K_min']:+.5f}, "
-                             f"rho = {c['rotation_mean']:.4f} (Birkhoff {c['rotation']:.6f}); predicted "
-                             f"K~_c = {_f(c['K_pred'], '+.4f')}, rho_c = {_f(c['rotation_pred'], '.4f')}")
+                lines.append(f"    critical curve: K0 = {f(c['K0'], '+.5f')}, K_min = {f(c['K_min'], '+.5f')}, "
+                             f"rho = {f(c['rotation_mean'], '.4f')} (Birkhoff {f(c['rotation'], '.6f')}); predicted "
+                             f"K~_c = {f(c['K_pred'], '+.4f')}, rho_c = {f(c['rotation_pred'], '.4f')}")
             else:
                 lines.append(f"    critical curve: not found ({c['reason']})")
     for s in summary.get("series", []):
         lines.append(f"  {s['label']}:")
         for r in s["points"]:
             flag = "  (box floor touched)" if r["floor_touched"] else ""
-            lines.append(f"    eps = {r['eps']:+.3f}: |HOV| = {r['area']:.4f} +- {r['error']:.4f}, "
-                         f"theory {r['theory']:.4f}{flag}")
+            lines.append(f"    eps = {f(r['eps'], '+.3f')}: |HOV| = {f(r['area'], '.4f')} +- {f(r['error'], '.4f')}, "
+                         f"theory {f(r['theory'], '.4f')}{flag}")
     if "flow" in summary and "model" in summary:
         o = summary["onset"]
-        lines.append(f"  onset: Omega0 = {o['Omega0']:.5f}, theta_w = {o['theta_w']:.5f}, tau0 = {o['tau0']:.4f}, "
-                     f"tau1 = {o['tau1']:.4f}, lam = {o['lam']:.4f}; model: {summary['model_name']} forcing")
+        lines.append(f"  onset: Omega0 = {f(o['Omega0'], '.5f')}, theta_w = {f(o['theta_w'], '.5f')}, "
+                     f"tau0 = {f(o['tau0'], '.4f')}, tau1 = {f(o['tau1'], '.4f')}, lam = {f(o['lam'], '.4f')}; "
+                     f"model: {summary['model_name']} forcing")
         for name in ("flow", "model"):
             d = summary[name]
             hov = sum(1 for x in d["orbits"] if x.get("hovering"))
             lines.append(f"  {name:>5}: {len(d['orbits'])} orbits, {hov} hovering, regions {d['regions']}, "
                          f"statuses {d['statuses']}")
     for r in summary.get("points", []) if isinstance(summary.get("points"), list) else []:
-        mod = ", ".join(f"{m} {v['area']:.4f} +- {v['error']:.4f} " + (
-            f"(agree {100 * v['agree']:.1f}%)" if v["agree"] is not None else
-            f"(own box from K = {v['K_low']:.4f}: its band ends there)") for m, v in r["models"].items())
-        lines.append(f"  eps = {r['eps']:+.3f}: flow |HOV| = {r['flow']:.4f} +- {r['flow_error']:.4f} "
-                     f"[both sides {r['flow_both_sides']:.4f}], {mod}, eq:hovsetsize {r['theory']:.4f} "
-                     f"({r['seconds']:.1f} s)")
+        mod = ", ".join(f"{m} {f(v['area'], '.4f')} +- {f(v['error'], '.4f')} " + (
+            f"(agree {f(100 * v['agree'], '.1f')}%)" if v.get("agree") is not None else
+            f"(own box from K = {f(v.get('K_low'), '.4f')}: its band ends there)") for m, v in r["models"].items())
+        lines.append(f"  eps = {f(r['eps'], '+.3f')}: flow |HOV| = {f(r['flow'], '.4f')} "
+                     f"+- {f(r['flow_error'], '.4f')} "
+                     f"[both sides {f(r['flow_both_sides'], '.4f')}], {mod}, eq:hovsetsize {f(r['theory'], '.4f')} "
+                     f"({f(r['seconds'], '.1f')} s)")
     for t in summary.get("tori", []):
-        lines.append(f"  {t['name']} torus: h1 = {t['h1']:.5f}, h2 = {t['h2']:.5f}, {t['trajectory_points']} "
-                     f"trajectory samples, min q1 = {_f(t['q1_min'], '.6f')} (qw1 = {summary['qw1']:g}), "
-                     f"min q2 = {_f(t['q2_min'], '.6f')} (qw2 = {summary['qw2']:g})")
+        lines.append(f"  {t['name']} torus: h1 = {f(t['h1'], '.5f')}, h2 = {f(t['h2'], '.5f')}, "
+                     f"{t['trajectory_points']} trajectory samples, min q1 = {f(t['q1_min'], '.6f')} "
+                     f"(qw1 = {f(summary['qw1'], 'g')}), min q2 = {f(t['q2_min'], '.6f')} "
+                     f"(qw2 = {f(summary['qw2'], 'g')})")
     if "regions" in summary and "flow" not in summary:
         lines.append(f"  {summary['points']} points of the band, regions {summary['regions']}")
     if "output" in summary:
-        lines.append(f"wrote {summary['output']} and {summary['npz']} in {summary['runtime_s']:.2f} s")
+        files = summary.get("files") or [summary["output"], summary["npz"]]
+        lines.append(f"wrote {', '.join(str(x) for x in files)} in {f(summary['runtime_s'], '.2f')} s")
     return "\n".join(lines)
 
 
 def _f(x, fmt: str) -> str:
-    return "nan" if x is None else format(x, fmt)
+    """``x`` formatted with ``fmt``; ``nan`` for None (how the JSON-able summary holds a NaN)."""
+    if x is None:
+        return "nan"
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+        return str(x)
+    return format(float(x), fmt)
 
 
 def _fmt_pair(p) -> str:
-    return f"[{p[0]:.3f}, {p[1]:.3f}]"
+    return f"[{_f(p[0], '.3f')}, {_f(p[1], '.3f')}]"

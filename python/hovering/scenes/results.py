@@ -20,6 +20,9 @@ import numpy as np
 from .. import _serial
 from .spec import SceneSpec
 
+#: The ``format`` of a scene result's sidecar JSON.
+SIDECAR_FORMAT = "hovering-scene-1"
+
 __all__ = [
     "Geometry", "OrbitSet", "OrbitPanelResult", "ZoomPanelResult", "SeriesResult", "TorusResult",
     "SceneResult", "OrbitSceneResult", "HoveringAreaResult", "FlowPortraitResult", "FlowHoveringResult",
@@ -387,6 +390,9 @@ class SceneResult:
     def save(self, path: os.PathLike) -> tuple:
         """Write the result as NPZ (arrays + the typed tree) and a sidecar JSON (scene, meta, summary).
 
+        Both record what made them (``provenance``: versions, build, machine, seed) and are
+        written atomically: a failure leaves the previous files as they were.
+
         Parameters
         ----------
         path : path-like
@@ -396,13 +402,22 @@ class SceneResult:
         -------
         tuple of str
             The two paths written.
+
+        Raises
+        ------
+        hovering._output.WriteError
+            (a ValueError) When a file cannot be written (e.g. ``no space left``).
         """
+        from .._output import write_text
+        from .._provenance import provenance
+
         npz = _serial.save(self, path, meta=jsonable(self.meta))
         side = str(Path(npz).with_suffix(".json"))
-        doc = dict(scene=jsonable(_serial.to_tree(self.scene, {})), meta=jsonable(self.meta),
+        # "format" first: it is how a later run recognises the file as one it may replace.
+        doc = dict(format=SIDECAR_FORMAT, provenance=provenance(seed=getattr(self.scene, "seed", None)),
+                   scene=jsonable(_serial.to_tree(self.scene, {})), meta=jsonable(self.meta),
                    summary=jsonable(self.summary()))
-        with open(side, "w", encoding="utf-8") as fh:
-            json.dump(doc, fh, indent=1, allow_nan=False)
+        write_text(side, json.dumps(doc, indent=1, allow_nan=False))
         return npz, side
 
 

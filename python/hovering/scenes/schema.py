@@ -303,6 +303,22 @@ _OUTPUTS_KEYS = ("record", "trajectory_dt")
 _STEPPERS = STEPPERS
 
 
+def output_dirs(path: Optional[os.PathLike]) -> tuple:
+    """Where a scene's own ``output`` may lie: under the scene file's folder or the working
+    directory (a scene from elsewhere cannot make hovering write anywhere else; ``--out`` can).
+
+    Parameters
+    ----------
+    path : path-like or None
+        The scene file (None: a scene without a file, the working directory only).
+
+    Returns
+    -------
+    tuple of Path
+    """
+    return (Path.cwd(),) + ((Path(path).parent,) if path is not None else ())
+
+
 def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bool = True) -> SceneSpec:
     """Validate a scene given as a dict (the parsed TOML) and build its spec.
 
@@ -313,8 +329,9 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bo
     path : path-like, optional
         Where it came from (used in messages and as the scene name).
     check_output : bool, optional
-        Check that ``output`` can be written (format, writable directory); off for uses that
-        write nothing (the explorer).
+        Check that ``output`` can be written (format, writable directory, under the scene's
+        folder or the working directory: :func:`output_dirs`); off for uses that write nothing
+        (the explorer) or write elsewhere (``--out``).
 
     Returns
     -------
@@ -389,7 +406,8 @@ def _parse_scene(data, p: Optional[Path], where: str, check_output: bool) -> Sce
         name=name,
         kind=kind,
         title=_str(f"{where}.title", data["title"]) if "title" in data else name,
-        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS))
+        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS),
+                            within=output_dirs(p))
                 if check_output else Path(_str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS))),
         dpi=_int(f"{where}.dpi", data["dpi"], 30, 1200) if "dpi" in data else 130,
         figsize=_size(f"{where}.figsize", data["figsize"]) if "figsize" in data else None,
