@@ -292,12 +292,16 @@ def test_json_document_limits(tmp_path):
              match=r"deep\.npz is not a hovering result file: its __meta__ entry is nested 200001 levels deep; "
                    r"allowed: at most 100")
     cases = {
-        "string": (_doc({"__list__": ["x" * 500_000]}), r"a string of 500000 characters; allowed: at most 65536"),
-        "key": (_doc({"__dict__": {"k" * 70_000: 1}}), r"a key at .*: a string of 70000 characters"),
+        "string": (_doc({"__list__": ["x" * 1_100_000]}), r"a string of 1100000 characters; allowed: at most 1048576"),
+        "key": (_doc({"__dict__": {"k" * 1_100_000: 1}}), r"a key at .*: a string of 1100000 characters"),
         "nan": ('{"format": "hovering-npz-1", "tree": NaN}', r"holds NaN, which hovering never writes"),
         "infinity": ('{"format": "hovering-npz-1", "tree": -Infinity}', r"holds -Infinity"),
         "overflow": ('{"format": "hovering-npz-1", "tree": 1e400}', r"1e400 is beyond the range of a double"),
-        "int": ('{"format": "hovering-npz-1", "tree": ' + "9" * 30 + "}", r"has 30 digits; allowed: integers in"),
+        # hovering.save refuses integers beyond 10,000 bits; a longer digit string is not converted.
+        "int": ('{"format": "hovering-npz-1", "tree": ' + "9" * 5000 + "}",
+                r"has 5000 digits; allowed: integers of at most 10000 bits"),
+        "int_bits": ('{"format": "hovering-npz-1", "tree": ' + "9" * 3011 + "}",
+                     rf"has {int('9' * 3011).bit_length()} bits; allowed: at most 10000"),
         "float_node": (_doc({"__float__": "1e5"}), r"root: malformed result file: \{'__float__': '1e5'\}; allowed: "
                                                    r"'nan', 'inf', '-inf'"),
     }
@@ -330,11 +334,17 @@ def test_archive_directory_and_member_names(tmp_path):
         _refused(hv.load, special, match=r"cannot read .*: not a regular file")
 
 
-def test_non_utf8_and_non_unicode_text(tmp_path):
+def test_non_utf8_and_non_unicode_text(genuine, tmp_path):
+    # A lone surrogate is data in a tree (hovering.save takes any str), but not a text to show: a
+    # scene's title or an orbit's label with one is refused (printing or drawing it would fail).
     surrogate = '{"format": "hovering-npz-1", "tree": {"__list__": ["ok", "\\udcff"]}}'
-    _refused(hv.load, _write(tmp_path / "surrogate.npz", surrogate),
-             match=r"surrogate\.npz .*at the document.tree.__list__\[1\]: a string with a lone surrogate at character "
-                   r"0: not Unicode text")
+    assert hv.load(_write(tmp_path / "data.npz", surrogate)) == ["ok", "\udcff"]
+    path = _craft(genuine["result"], tmp_path / "title.npz", lambda d: _scene_fields(d).update(title="t\ud800"))
+    _refused(load_result, path, match=r"title\.npz: root\.scene: tiny\.toml\.title: a lone surrogate at character 1; "
+                                      r"allowed: Unicode text")
+    path = _craft(genuine["result"], tmp_path / "label.npz",
+                  lambda d: _orbit_fields(d).update(labels={"__list__": ["a", "\udcff", "c"]}))
+    _refused(load_result, path, match=r"label\.npz: root\.panels\[0\]\.orbits: labels\[1\]: a lone surrogate")
     path = tmp_path / "bytes.npz"
     with zipfile.ZipFile(path, "w") as z:
         z.writestr("__meta__.npy", _npy(np.array(b'{"format": "\xff\xfe"}')))
@@ -423,7 +433,7 @@ def test_redraw_refuses_what_the_scene_schema_refuses(case, genuine, tmp_path, c
                    r"dpi = 130 and layout make a figure of 121 x 92\.6 inches, a canvas of 189 million pixels"),
         # Before: 97 s and 360 MB of savefig.
         "title": (lambda d: _scene_fields(d).update(title="T" * 500_000),
-                  r"a string of 500000 characters; allowed: at most 65536"),
+                  r"root\.scene: tiny\.toml\.title: a string of 500000 characters; allowed: at most 65536"),
     }[case]
     path = _craft(genuine["result"], tmp_path / f"{case}.npz", edit)
     tracemalloc.start()
@@ -636,3 +646,24 @@ def test_every_result_type_round_trips_its_checks(tmp_path):
         back = hv.load(hv.save(r, tmp_path / name))
         assert type(back) is type(r), name
 
+
+
+def test_what_save_writes_load_reads(tmp_path):
+    # The reading limits are also save's: nothing is written that load would refuse.
+    key = "a/../b"  # a dict key that, as a member name, would have a '..' component
+    back = hv.load(hv.save({key: np.arange(3.0), "t": "x" * 1000}, tmp_path / "names"))
+    assert np.array_equal(back[key], np.arange(3.0)) and back["t"] == "x" * 1000
+    with zipfile.ZipFile(tmp_path / "names.npz") as z:
+        assert all(_untrusted.safe_member_name(n) for n in z.namelist())
+    with pytest.raises(ValueError, match=r"cannot save: the file would not read back: .*a string of 1100000 "
+                                         r"characters; allowed: at most 1048576"):
+        hv.save({"note": "x" * 1_100_000}, tmp_path / "long")
+    deep = 1.0
+    for _ in range(60):
+        deep = [deep]
+    with pytest.raises(ValueError, match=r"cannot save: the file would not read back: the tree is nested 121 levels "
+                                         r"deep; allowed: at most 100"):
+        hv.save(deep, tmp_path / "deep")
+    with pytest.raises(TypeError, match=r"root: arrays of dtype datetime64\[D\] cannot be saved"):
+        hv.save(np.array(["2020-01-01"], dtype="M8[D]"), tmp_path / "dates")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["names.npz"]

@@ -38,10 +38,11 @@ MAX_TREE_CHARS = 1 << 26
 #: result); the rebuild takes about one Python frame per level, so 100 stays far from Python's
 #: recursion limit (1000).
 MAX_TREE_DEPTH = 100
-#: Longest string (or dict key) in a JSON document. Names, labels, paths and notes of results are
-#: below 4096 characters; texts drawn on a figure have the scene schema's tighter limit
-#: (:data:`hovering.scenes.schema.MAX_TEXT`).
-MAX_STRING_CHARS = 1 << 16
+#: Longest string (or dict key) in a JSON document. A string there is data (names, labels, paths
+#: and notes of results are below 4096 characters; a dict key may be anything :func:`hovering.save`
+#: takes); texts drawn on a figure have the scene schema's much tighter limit
+#: (:data:`hovering.scenes.schema.MAX_TEXT`). 1 Mi characters bound one string to 4 MiB.
+MAX_STRING_CHARS = 1 << 20
 #: Largest integer in a JSON document, in bits (:func:`hovering.save` refuses larger ones): its
 #: decimal text (~3000 digits) converts in microseconds and stays below Python's 4300-digit limit.
 MAX_INT_BITS = 10_000
@@ -146,11 +147,6 @@ def _bounded_int(text: str) -> int:
 def _text(s: str, where: str) -> None:
     if len(s) > MAX_STRING_CHARS:
         raise ValueError(f"{where}: a string of {len(s)} characters; allowed: at most {MAX_STRING_CHARS}")
-    if not s.isascii():
-        try:
-            s.encode("utf-8")
-        except UnicodeEncodeError as e:
-            raise ValueError(f"{where}: a string with a lone surrogate at character {e.start}: not Unicode text") from None
 
 
 def json_cost(text: bytes) -> int:
@@ -194,7 +190,8 @@ def parse_json(text: str, what: str = "the JSON document"):
     Checked before parsing: at most :data:`MAX_TREE_CHARS` characters, nesting at most
     :data:`MAX_TREE_DEPTH`. While parsing: no ``NaN``/``Infinity`` constants, no number beyond a
     double, integers of at most :data:`MAX_INT_BITS` bits. After: every string and key at most
-    :data:`MAX_STRING_CHARS` characters and valid Unicode (no lone surrogates).
+    :data:`MAX_STRING_CHARS` characters (a string is data: any str :func:`hovering.save` takes,
+    lone surrogates included; texts that are shown are checked where they are shown).
 
     Parameters
     ----------

@@ -150,6 +150,11 @@ def _str(where: str, value, choices=None, limit: int = MAX_TEXT) -> str:
         raise ValueError(f"{where} must be a non-empty string, got {value!r}")
     if len(value) > limit:
         raise ValueError(f"{where}: a string of {len(value)} characters; allowed: at most {limit}")
+    if not value.isascii():  # a file from elsewhere (a result) may hold what no TOML file can
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError as e:
+            raise ValueError(f"{where}: a lone surrogate at character {e.start}; allowed: Unicode text") from None
     if choices is not None and value not in choices:
         raise ValueError(f"{where} = {value!r} is not allowed; allowed: {', '.join(repr(c) for c in choices)}")
     return value
