@@ -9,7 +9,9 @@
 // the results, then every parameter that changes them (as shortest round-trip text); a rerun skips
 // the points whose parameters are already in the file, so an interrupted sweep (Ctrl-C, a kill, a
 // crash) loses only the point it was computing, and one file can hold several sweeps. A file with
-// another header is refused rather than mixed, and a last row torn by a kill is dropped.
+// another header is refused rather than mixed, and a last row torn by a kill is dropped. The file
+// resumed from is untrusted (docs/threat-model.md): a regular file of at most 1 GiB whose lines are
+// at most 64 KiB, checked before they are read.
 //
 // Lines starting with '#' are comments: "# provenance: {...}" (one line of JSON: the core's build
 // facts, hovering::build_info, plus the run's threads and seed) comes before the header of a new
