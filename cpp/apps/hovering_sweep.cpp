@@ -9,7 +9,9 @@
 // the results, then every parameter that changes them (as shortest round-trip text); a rerun skips
 // the points whose parameters are already in the file, so an interrupted sweep (Ctrl-C, a kill, a
 // crash) loses only the point it was computing, and one file can hold several sweeps. A file with
-// another header is refused rather than mixed, and a last row torn by a kill is dropped.
+// another header is refused rather than mixed, and a last row torn by a kill is dropped. The file
+// resumed from is untrusted (docs/threat-model.md): a regular file of at most 1 GiB whose lines are
+// at most 64 KiB, checked before they are read.
 //
 // Lines starting with '#' are comments: "# provenance: {...}" (one line of JSON: the core's build
 // facts, hovering::build_info, plus the run's threads and seed) comes before the header of a new
@@ -40,6 +42,7 @@
 #include <iostream>
 #include <mutex>
 #include <new>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -112,18 +115,51 @@ std::string check_row(const std::string& line, std::size_t n_results, std::size_
     return "";
 }
 
+/// Largest CSV resumed from: a row is ~300 bytes, a sweep scene at most 36 x 200 points (2 MB), so
+/// 1 GiB holds hundreds of sweeps; its rows' fields then take a few GiB of memory.
+constexpr std::uintmax_t kMaxCsvBytes = std::uintmax_t(1) << 30;
+/// Longest CSV line read: a header or row has a few dozen fields of at most ~25 characters.
+constexpr std::size_t kMaxLine = 1 << 16;
+
+/// One line of `in` without its newline (complete: it had one), refused beyond kMaxLine bytes
+/// before more is read. False at the end of the file.
+bool read_line(std::istream& in, std::string& line, bool& complete, const std::string& path, long lineno) {
+    line.clear();
+    complete = false;
+    std::streambuf* buf = in.rdbuf();
+    for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+        if (c == '\n') {
+            complete = true;
+            return true;
+        }
+        if (line.size() == kMaxLine)
+            throw std::runtime_error(path + " line " + std::to_string(lineno) + " is longer than " +
+                                     std::to_string(kMaxLine) + " bytes: not a row of hovering_sweep (use another --out)");
+        line.push_back(char(c));
+    }
+    return !line.empty();
+}
+
 /// Read the output file: refuse a foreign header or a damaged row inside it, find a torn tail.
+/// The file is untrusted: a regular file of at most kMaxCsvBytes, lines of at most kMaxLine.
 Existing scan(const std::string& path, const std::string& header, std::size_t n_results) {
     Existing ex;
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return ex;
+    if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path + " is not a regular file (to resume from it)");
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec) throw std::runtime_error("cannot read " + path + " (to resume from it): " + ec.message());
+    if (size > kMaxCsvBytes)
+        throw std::runtime_error(path + " has " + std::to_string(size) + " bytes; allowed: at most " +
+                                 std::to_string(kMaxCsvBytes) + " to resume from (use another --out)");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot read " + path + " (to resume from it)");
     const std::size_t n_columns = split(header).size();
     std::string line, bad_note;
     std::uintmax_t offset = 0;
     long lineno = 0, bad_line = 0;
-    bool header_seen = false;
-    while (std::getline(in, line)) {
-        const bool complete = !in.eof();  // getline sets eof only for a last line without newline
+    bool header_seen = false, complete = false;
+    while (read_line(in, line, complete, path, lineno + 1)) {
         ++lineno;
         if (bad_line)
             throw std::runtime_error(path + " line " + std::to_string(bad_line) + " is not a valid row (" + bad_note +
@@ -328,13 +364,13 @@ int main(int argc, char** argv) {
         facts.push_back({"threads", std::to_string(threads > 0 ? unsigned(threads) : std::max(1u, hw)), true});
         facts.push_back({"seed", std::to_string(scene.seed), true});
         const std::string provenance = kProvenance + hovering::facts_json(facts);
+        // A set: the file's rows are untrusted in number too (a scan per point would be quadratic).
+        const std::set<std::vector<std::string>> finished(ex.params.begin(), ex.params.end());
         std::vector<std::size_t> todo;
         for (std::size_t i = 0; i < points.size(); ++i) {
             std::vector<std::string> key;
             for (const auto& [name, value] : point_parameters(scene, points[i], counts)) key.push_back(value);
-            bool done = false;
-            for (const auto& p : ex.params) done = done || p == key;
-            if (!done) todo.push_back(i);
+            if (!finished.count(key)) todo.push_back(i);
         }
         std::cerr << scene.name << ": " << points.size() << " points (" << counts.n_steps << " steps, "
                   << counts.samples << " samples each), " << points.size() - todo.size() << " already in " << out

@@ -260,12 +260,17 @@ def require_angles(name: str, a) -> None:
                          f"[-pi, pi) accurately in double precision), got {a[i]}")
 
 
+def physical_memory() -> int:
+    """Bytes of physical memory of this machine (64 GiB where the system does not say)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 2**36
+
+
 def check_memory(what: str, nbytes: int) -> None:
     """Refuse, before any work, a result that would need more than half of this machine's memory."""
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        total = 2**36
+    total = physical_memory()
     if nbytes > total // 2:
         raise ValueError(f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
                          f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")

@@ -11,6 +11,11 @@ Types take part by defining ``_to_record(self) -> dict`` and a classmethod
 reading runs the constructor's checks again), by being dataclasses (results: their fields), or
 enums. A type with a record is written by its record even when it is a dataclass.
 
+Reading treats the file as untrusted (:mod:`hovering._untrusted`, docs/threat-model.md): every size
+it declares is checked against a stated limit before it is read, only the arrays the tree names
+are read, records are rebuilt from their stored parameters without computing, and every dataclass
+field is checked against its declared type (and the class's own ``_validate_loaded`` checks).
+
 The public entry points are :func:`hovering.save`, :func:`hovering.load` and the ``save`` method
 that :class:`Saveable` gives the result types.
 """
@@ -19,22 +24,25 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 import importlib
 import json
 import math
 import os
 import re
-import zipfile
+import typing
 from pathlib import Path, PurePath
 from typing import Any, Optional
 
 import numpy as np
 
+from . import _untrusted
+
 __all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
 
 FORMAT = "hovering-npz-1"
 _META_KEY = "__meta__"
-_MAX_INT_BITS = 10_000
+_MAX_INT_BITS = _untrusted.MAX_INT_BITS
 
 
 def _type_name(cls) -> str:
@@ -94,7 +102,8 @@ def _put(arrays: dict, key: str, a: np.ndarray) -> str:
     """Store ``a`` under a member name made from ``key`` and return that name (unique: dict keys may
     contain the separators of another path). The tree records the name, so any name reads back; a
     path a zip member name cannot hold exactly (zip readers cut names at NUL) gets ``#n`` instead."""
-    if _UNSAFE_NAME.search(key) or len(key.encode("utf-8", "surrogatepass")) > _MAX_NAME:
+    if (_UNSAFE_NAME.search(key) or len(key.encode("utf-8", "surrogatepass")) > _MAX_NAME
+            or not _untrusted.safe_member_name(f"{key}.npy")):  # e.g. a dict key "a/../b": load refuses it
         key = f"#{len(arrays)}"
     k, i = key, 1
     while k in arrays or k == _META_KEY:
@@ -158,6 +167,9 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
         elif a.dtype.hasobject:  # a structured dtype with object fields: pickled, which load refuses
             raise TypeError(f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without "
                             "pickle")
+        elif not _untrusted.plain_dtype(a.dtype):  # load reads plain dtypes only
+            raise TypeError(f"{key}: arrays of dtype {a.dtype} cannot be saved; allowed: booleans, integers, floats, "
+                            "complex numbers and text")
         return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
         try:  # first: it may refuse with a message of its own (Python code)
@@ -185,10 +197,44 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
                     "dataclass or hovering object)")
 
 
-def _dataclass_from_fields(cls, fields: dict):
-    """A dataclass instance from its saved fields, without running ``__init__``/``__post_init__``
-    (the values were valid when saved). A field missing from the file takes its default; a field
-    without default missing, or a name that is not a field, is a ValueError."""
+@functools.lru_cache(maxsize=None)
+def _field_types(cls) -> dict:
+    try:
+        return typing.get_type_hints(cls)
+    except Exception:  # an annotation that does not resolve: its fields are not type-checked
+        return {}
+
+
+def _type_name_of(hint) -> str:
+    args = typing.get_args(hint)
+    if typing.get_origin(hint) is typing.Union:
+        return " or ".join("None" if a is type(None) else _type_name_of(a) for a in args)
+    return getattr(hint, "__name__", str(hint))
+
+
+def _conforms(value, hint) -> bool:
+    """Whether a value read from a file has a field's declared type (numbers: int where float is declared)."""
+    if hint is None or hint is Any or hint is object:
+        return True
+    if typing.get_origin(hint) is typing.Union:
+        return any(_conforms(value, a) for a in typing.get_args(hint))
+    if hint is type(None):
+        return value is None
+    if hint is float:
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    if hint is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    if isinstance(hint, type):
+        return isinstance(value, hint)
+    return True  # a generic alias (list[str], ...): the class's _validate_loaded checks its items
+
+
+def _dataclass_from_fields(cls, fields: dict, key: str = "root"):
+    """A dataclass instance from its saved fields, without running ``__init__``/``__post_init__`` (no
+    computation). Each field must have its declared type (None also where the default is None); a
+    field missing from the file takes its default; a field without default missing, or a name that
+    is not a field, is a ValueError. Then the class's ``_validate_loaded(self)``, if it has one,
+    checks the values (a scene spec: the scene schema's checks)."""
     if not isinstance(fields, dict):
         raise ValueError(f"malformed result file: the fields of {cls.__qualname__} are not a mapping")
     known = {f.name: f for f in dataclasses.fields(cls)}
@@ -196,10 +242,14 @@ def _dataclass_from_fields(cls, fields: dict):
     if unknown:
         raise ValueError(f"the file's {cls.__qualname__} has fields {unknown} this version does not know (written by "
                          "another version of hovering?)")
+    hints = _field_types(cls)
     obj = object.__new__(cls)
     for name, f in known.items():
         if name in fields:
             value = fields[name]
+            if not (_conforms(value, hints.get(name)) or (value is None and f.default is None)):
+                raise ValueError(f"{key}.{name} must be of type {_type_name_of(hints[name])} (the type of "
+                                 f"{cls.__qualname__}.{name}), got {type(value).__name__}")
         elif f.default is not dataclasses.MISSING:
             value = f.default
         elif f.default_factory is not dataclasses.MISSING:
@@ -208,10 +258,58 @@ def _dataclass_from_fields(cls, fields: dict):
             raise ValueError(f"the file's {cls.__qualname__} lacks the field {name!r} (written by another version of "
                              "hovering?)")
         object.__setattr__(obj, name, value)
+    check = getattr(cls, "_validate_loaded", None)
+    if check is not None:
+        try:
+            check(obj)
+        except ValueError as e:
+            raise ValueError(f"{key}: {e}") from None
     return obj
 
 
-def from_tree(tree, arrays):
+def _array_refs(tree) -> dict:
+    """The arrays a tree names (key -> its ``object`` flag), walked as :func:`from_tree` reads it."""
+    refs, stack = {}, [tree]
+    while stack:
+        t = stack.pop()
+        if isinstance(t, dict):
+            if "__float__" in t or "__path__" in t or "__enum__" in t:
+                continue
+            if "__array__" in t:
+                if isinstance(t["__array__"], str):
+                    refs[t["__array__"]] = refs.get(t["__array__"], False) or t.get("object") is True
+                continue
+            for tag, part in (("__dataclass__", "fields"), ("__record__", "data"), ("__dict__", "__dict__")):
+                if tag in t:
+                    sub = t.get(part)
+                    if part == "data":
+                        stack.append(sub)
+                    elif isinstance(sub, dict):
+                        stack.extend(sub.values())
+                    break
+            else:
+                for tag in ("__items__", "__tuple__", "__list__"):
+                    if tag in t:
+                        if isinstance(t[tag], list):
+                            for v in t[tag]:
+                                stack.extend(v if tag == "__items__" and isinstance(v, list) else [v])
+                        break
+    return refs
+
+
+def _from_record(cls, name: str, data, key: str):
+    """``cls._from_record(data)``, anything it raises a ValueError naming where the record is."""
+    if not isinstance(data, dict):
+        raise ValueError(f"{key}: malformed result file: the record of {name} is not a mapping")
+    try:
+        return cls._from_record(data)
+    except ValueError as e:
+        raise ValueError(f"{key}: {e}") from None
+    except Exception as e:  # a missing or wrongly typed argument (TypeError, KeyError, OverflowError, ...)
+        raise ValueError(f"{key}: malformed result file ({type(e).__name__}: {e})") from None
+
+
+def from_tree(tree, arrays, key: str = "root"):
     """Inverse of :func:`to_tree`.
 
     Parameters
@@ -220,6 +318,8 @@ def from_tree(tree, arrays):
         What :func:`to_tree` returned (after a JSON round trip).
     arrays : mapping
         The arrays it refers to.
+    key : str, optional
+        Path of ``tree`` (as :func:`to_tree` names it), for the messages.
 
     Returns
     -------
@@ -228,45 +328,57 @@ def from_tree(tree, arrays):
     Raises
     ------
     ValueError
-        For a malformed tree, a type that is not hovering's, or a missing array.
+        For a malformed tree, a type that is not hovering's, a missing array, or a value a
+        constructor or a field's type refuses, naming its path.
     """
     if tree is None or isinstance(tree, (bool, str, int, float)):
         return tree
     if not isinstance(tree, dict):
-        raise ValueError(f"malformed result file: a bare {type(tree).__name__} in the tree")
+        raise ValueError(f"malformed result file: a bare {type(tree).__name__} in the tree at {key}")
     if "__float__" in tree:
+        if tree["__float__"] not in ("nan", "inf", "-inf"):  # finite numbers are written as numbers
+            raise ValueError(f"{key}: malformed result file: {{'__float__': {str(tree['__float__'])[:40]!r}}}; "
+                             "allowed: 'nan', 'inf', '-inf'")
         return float(tree["__float__"])
     if "__path__" in tree:
+        if not isinstance(tree["__path__"], str):
+            raise ValueError(f"{key}: malformed result file: a path that is not a string")
         return Path(tree["__path__"])
     if "__enum__" in tree:
-        return _resolve(tree["__enum__"], "enum")(tree["value"])
+        cls = _resolve(tree["__enum__"], "enum")
+        try:
+            return cls(tree.get("value"))
+        except (ValueError, TypeError):
+            raise ValueError(f"{key}: {repr(tree.get('value'))[:40]} is not a {cls.__qualname__}; allowed: "
+                             f"{[m.value for m in cls]}") from None
     if "__array__" in tree:
         k = tree["__array__"]
         if not isinstance(k, str) or k not in arrays:
             raise ValueError(f"malformed result file: the array {k!r} is missing")
-        a = arrays[k]
-        return a.astype(object) if tree.get("object") else a
+        a, obj = arrays[k], tree.get("object", False)
+        if not isinstance(obj, bool) or (obj and a.dtype.kind != "U"):
+            raise ValueError(f"{key}: malformed result file: 'object' must be true only for an array of text")
+        return a.astype(object) if obj else a
     if "__dataclass__" in tree:
         cls = _resolve(tree["__dataclass__"], "dataclass")
-        fields = tree["fields"]
+        fields = tree.get("fields")
         if not isinstance(fields, dict):
             raise ValueError(f"malformed result file: the fields of {tree['__dataclass__']} are not a mapping")
-        return _dataclass_from_fields(cls, {name: from_tree(sub, arrays) for name, sub in fields.items()})
+        return _dataclass_from_fields(cls, {name: from_tree(sub, arrays, f"{key}.{name}") for name, sub in fields.items()},
+                                      key)
     if "__record__" in tree:
         cls = _resolve(tree["__record__"], "record")
-        data = from_tree(tree["data"], arrays)
-        if not isinstance(data, dict):
-            raise ValueError(f"malformed result file: the record of {tree['__record__']} is not a mapping")
-        return cls._from_record(data)
+        return _from_record(cls, tree["__record__"], from_tree(tree.get("data"), arrays, f"{key}@"), key)
     if "__dict__" in tree:
-        return {k: from_tree(v, arrays) for k, v in tree["__dict__"].items()}
+        return {k: from_tree(v, arrays, f"{key}.{k}") for k, v in tree["__dict__"].items()}
     if "__items__" in tree:
-        return {from_tree(k, arrays): from_tree(v, arrays) for k, v in tree["__items__"]}
+        return {from_tree(k, arrays, f"{key}#k{i}"): from_tree(v, arrays, f"{key}#{i}")
+                for i, (k, v) in enumerate(tree["__items__"])}
     if "__tuple__" in tree:
-        return tuple(from_tree(v, arrays) for v in tree["__tuple__"])
+        return tuple(from_tree(v, arrays, f"{key}[{i}]") for i, v in enumerate(tree["__tuple__"]))
     if "__list__" in tree:
-        return [from_tree(v, arrays) for v in tree["__list__"]]
-    raise ValueError(f"malformed result file: unknown node {sorted(tree)}")
+        return [from_tree(v, arrays, f"{key}[{i}]") for i, v in enumerate(tree["__list__"])]
+    raise ValueError(f"malformed result file: unknown node {sorted(tree)[:10]} at {key}")
 
 
 def _path(path, what: str) -> str:
@@ -360,6 +472,10 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
         text = json.dumps(doc, allow_nan=False)
     except (TypeError, ValueError) as e:  # only the metadata can hold something else
         raise ValueError(f"meta must be JSON-able (str, finite numbers, bool, None, lists and dicts): {e}") from None
+    try:  # what load will check (one owner: the reading limits), so that every file saved reads back
+        _untrusted.parse_json(text, "the tree")
+    except ValueError as e:
+        raise ValueError(f"cannot save: the file would not read back: {e}") from None
     with replacing(path) as fh:
         np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
     return path
@@ -383,16 +499,14 @@ def is_result_file(path: os.PathLike) -> bool:
     -------
     bool
     """
-    try:
-        with zipfile.ZipFile(path) as z:
-            info = z.getinfo(_META_KEY + ".npy")
-            if info.file_size > _MAX_SNIFF_META:
+    try:  # an untrusted file: read as load reads it (hovering._untrusted), only its __meta__ member
+        with _untrusted.Archive(os.fspath(path)) as z:
+            if _META_KEY not in z.files:
                 return False
-            with z.open(info) as f:
-                text = np.lib.format.read_array(f, allow_pickle=False)
-        if text.dtype.kind != "U" or text.ndim != 0:
-            return False
-        doc = json.loads(str(text))
+            dtype, shape, nbytes = z.header(_META_KEY)
+            if dtype.kind != "U" or shape != () or nbytes > _MAX_SNIFF_META:
+                return False
+            doc = _untrusted.parse_json(str(z.read(_META_KEY)))
     except Exception:  # noqa: BLE001 - any failure to read it means: not recognised as ours
         return False
     return isinstance(doc, dict) and doc.get("format") == FORMAT
@@ -418,40 +532,51 @@ def load(path: os.PathLike, meta: bool = False):
     ------
     ValueError
         For a file that does not exist, is not a hovering result file, is malformed, or names a
-        type that is not hovering's (e.g. ``os:system``), or values the constructors refuse.
+        type that is not hovering's (e.g. ``os:system``), values the constructors refuse, a field
+        of another type than its class declares, or a size beyond a limit of
+        :mod:`hovering._untrusted` (docs/threat-model.md); naming the file and the field.
     """
     path = _path(path, "path")
     not_ours = f"{path} is not a hovering result file"
-    try:
-        z = np.load(path, allow_pickle=False)
-    except (OSError, EOFError) as e:
-        raise ValueError(f"cannot read {path}: {e}") from None
-    except (ValueError, zipfile.BadZipFile) as e:  # pickled data refused, a bad .npy header or archive
-        raise ValueError(f"{not_ours}: {e}") from None
-    if not isinstance(z, np.lib.npyio.NpzFile):
-        raise ValueError(f"{not_ours} (a single .npy array, not an NPZ archive)")
-    with z:
+    # Everything the file declares is checked before what it describes is read (module _untrusted).
+    with _untrusted.Archive(path) as z:
         if _META_KEY not in z.files:
             raise ValueError(f"{not_ours} (no {_META_KEY} entry)")
+        dtype, shape, _ = z.header(_META_KEY)
+        if dtype.kind != "U" or shape != ():
+            raise ValueError(f"{not_ours}: its {_META_KEY} entry is not a string")
+        if dtype.itemsize // 4 > _untrusted.MAX_TREE_CHARS:
+            raise ValueError(f"{not_ours}: its {_META_KEY} entry has {dtype.itemsize // 4} characters; allowed: at most "
+                             f"{_untrusted.MAX_TREE_CHARS}")
+        text = z.read(_META_KEY)
         try:
-            text = z[_META_KEY]
-            if text.dtype.kind != "U" or text.ndim != 0:
-                raise ValueError(f"its {_META_KEY} entry is not a string")
-            doc = json.loads(str(text))
-            arrays = {k: z[k] for k in z.files if k != _META_KEY}
-        except (OSError, EOFError, zipfile.BadZipFile, ValueError, RecursionError) as e:
-            raise ValueError(f"{not_ours}: {e}") from None
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else None
-        raise ValueError(f"{path}: unknown result format {found!r} (this version reads {FORMAT})")
-    if "tree" not in doc:
-        raise ValueError(f"{path}: malformed result file (no tree)")
+            text = str(text)
+        except (ValueError, UnicodeError) as e:  # code points beyond Unicode
+            raise ValueError(f"{not_ours}: its {_META_KEY} entry is not text: {e}") from None
+        doc = _untrusted.parse_json(text, f"{not_ours}: its {_META_KEY} entry")
+        if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+            found = doc.get("format") if isinstance(doc, dict) else None
+            raise ValueError(f"{path}: unknown result format {found!r} (this version reads {FORMAT})")
+        if "tree" not in doc:
+            raise ValueError(f"{path}: malformed result file (no tree)")
+        refs = _array_refs(doc["tree"])
+        need = _untrusted.TREE_BYTES_PER_CHAR * len(text)
+        for k, as_object in refs.items():
+            if k not in z.files:
+                raise ValueError(f"{path}: malformed result file: the array {k!r} is missing")
+            dtype, shape, nbytes = z.header(k)
+            need += nbytes + (math.prod(shape) * _untrusted._OBJECT_BYTES_PER_ITEM if as_object else 0)
+        budget = _untrusted.memory_budget()
+        if need > budget:
+            raise ValueError(f"{path}: its arrays and tree need {need / 2**30:.3g} GiB (as its headers declare), more "
+                             f"than half of this machine's memory ({2 * budget / 2**30:.3g} GiB)")
+        arrays = {k: z.read(k) for k in refs}  # the only members read: unnamed ones stay compressed, unread
     try:
         obj = from_tree(doc["tree"], arrays)
-    except (KeyError, TypeError, AttributeError, IndexError, RecursionError) as e:
-        raise ValueError(f"{path}: malformed result file ({type(e).__name__}: {e})") from None
     except ValueError as e:
         raise ValueError(f"{path}: {e}") from None
+    except Exception as e:  # KeyError, TypeError, RecursionError, ...: a tree save never writes
+        raise ValueError(f"{path}: malformed result file ({type(e).__name__}: {e})") from None
     extra = doc.get("meta", {})
     return (obj, extra if isinstance(extra, dict) else {}) if meta else obj
 

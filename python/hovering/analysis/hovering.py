@@ -131,6 +131,21 @@ def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> str:
     return hashlib.sha256(blob).hexdigest()
 
 
+def _piece_arrays(row, n: int) -> tuple:
+    """A checkpointed piece (untrusted): four lists of n integers, each within its array's dtype."""
+    names, dtypes = ("status_F0", "status", "steps_done", "visited"), (np.int8, np.int8, np.int64, np.int8)
+    if not isinstance(row, list) or len(row) != 4:
+        raise ValueError("row must be a list of 4 lists (statuses under F_0 and F_eps, steps done, regions visited)")
+    out = []
+    for name, a, dt in zip(names, row, dtypes):
+        arr = np.asarray(a) if isinstance(a, list) else np.zeros(0, dtype=object)
+        if arr.shape != (n,) or arr.dtype.kind not in "iu" or (n and not (np.iinfo(dt).min <= arr.min() and
+                                                                           arr.max() <= np.iinfo(dt).max)):
+            raise ValueError(f"row.{name} must be {n} integers within {np.dtype(dt).name}")
+        out.append(arr.astype(dt))
+    return tuple(out)
+
+
 def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, workers, client, scheduler, dask,
                  pieces, checkpoint):
     from ..distribute import executor, run_pieces
@@ -145,9 +160,10 @@ def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, worke
         out = [None] * k
         todo = []
         for i, (lo, hi) in enumerate(bounds):
-            row = store.get(_piece_key(m, n_steps, K_low, seed, samples, lo, hi)) if store else None
+            key = _piece_key(m, n_steps, K_low, seed, samples, lo, hi)
+            row = store.get(key, lambda r, n=hi - lo: _piece_arrays(r, n)) if store else None
             if row is not None:
-                out[i] = tuple(np.asarray(a, dtype=dt) for a, dt in zip(row, (np.int8, np.int8, np.int64, np.int8)))
+                out[i] = _piece_arrays(row, hi - lo)
                 bar.advance(2 * (hi - lo) * n_steps)
             else:
                 todo.append(i)

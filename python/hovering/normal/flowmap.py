@@ -15,8 +15,8 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import (MAX_MODES, MAX_TRAJECTORY_POINTS, Region, check_memory, flag, integer, is_choice,
-                       iterate_arguments, point_pair, trajectory_arguments, wrap)
+from .._common import (MAX_MODES, MAX_TRAJECTORY_POINTS, Region, check_memory, flag, forcing_array, integer,
+                       is_choice, iterate_arguments, point_pair, trajectory_arguments, wrap)
 from .._progress import check_progress, progress_bar
 from .._protocols import MapAnalyses
 from .._serial import Saveable
@@ -198,17 +198,38 @@ class FlowMap(MapAnalyses):
         return {"sys": self.sys, "h": self.h, "coordinates": self.coordinates, "options": dict(self.integrator_options),
                 "curve": None if self.curve is None else self.curve._samples(), "forcing": self._forcing}
 
+    #: The integrator options a saved FlowMap holds (:attr:`integrator_options`): a file's options
+    #: are these or nothing, never an ``accuracy`` target (that would measure, i.e. compute, on load).
+    _RECORD_OPTIONS = frozenset({"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol",
+                                 "corner_tol"})
+
     @classmethod
     def _from_record(cls, record: dict) -> "FlowMap":
-        """Inverse of :meth:`_to_record` (validated again; no flow is traced)."""
+        """Inverse of :meth:`_to_record`: validated again, and rebuilt from the stored values only (no
+        flow is traced, no accuracy target measured: a record asking for either is refused)."""
         sys, h = record["sys"], record["h"]
+        if not isinstance(sys, StepSystem):
+            raise ValueError(f"the FlowMap's sys must be a StepSystem, got {type(sys).__name__}")
+        options = record["options"]
+        if not isinstance(options, dict):
+            raise ValueError(f"the FlowMap's options must be a dict, got {type(options).__name__}")
+        unknown = sorted(set(options) - cls._RECORD_OPTIONS)
+        if unknown:
+            raise ValueError(f"the FlowMap's options {unknown} are not stored settings; allowed: "
+                             f"{sorted(cls._RECORD_OPTIONS)} (a saved map holds the setting an accuracy target chose, "
+                             f"never the target: reading a file does not measure)")
+        if not is_choice(record["coordinates"], ("normal", "section")):
+            raise ValueError(f"the FlowMap's coordinates must be 'normal' or 'section', got {record['coordinates']!r}")
         curve = None
         if record["curve"] is not None:
             curve = TangentialCurve._from_samples(Section(sys, h), record["curve"])
-        options = record["options"]
-        if not isinstance(options, dict):
-            raise ValueError(f"the FlowMap's options must be a dict, got {options!r}")
-        return _restore_flowmap(cls, sys, h, record["coordinates"], options, curve, {"_forcing": record["forcing"]})
+        elif record["coordinates"] == "normal":
+            raise ValueError("the FlowMap is in normal coordinates but the file holds no tangential curve (a saved "
+                             "map holds its measured curve; reading a file does not measure one)")
+        forcing = record["forcing"]
+        if forcing is not None:
+            forcing = np.asarray(forcing_array(forcing), dtype=float)
+        return _restore_flowmap(cls, sys, h, record["coordinates"], options, curve, {"_forcing": forcing})
 
     # ---------------------------------------------------------------- the map interface
 

@@ -23,7 +23,7 @@ from ..scenes.spec import QUICK_FACTOR
 from .primitives import draw_geometry, plot_orbits
 from .style import QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS
 
-__all__ = ["render", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
+__all__ = ["render", "figure_inches", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
            "flow_hovering_figure", "tangent_tori_figure", "sigma_structure_figure"]
 
 
@@ -80,12 +80,37 @@ def orbit_label(label: str, kind: str, K0: float, rho: Optional[float]) -> str:
     return head if rho is None else rf"{head}: $\rho={rho:.3f}$"
 
 
+#: Figure size (inches) of the kinds with a fixed grid of axes, when the scene gives no ``figsize``.
+_FIGSIZE = {"hovering_area": (13.0, 5.2), "flow_portrait": (13.0, 5.6), "flow_hovering_area": (13.0, 5.2),
+            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0)}
+
+
+def figure_inches(scene, n_panels: int = 1) -> tuple:
+    """Width and height (inches) of a scene's figure: its ``figsize``, or its kind's and layout's default.
+
+    Parameters
+    ----------
+    scene : SceneSpec
+        The scene.
+    n_panels : int, optional
+        Its number of panels (orbit scenes without a layout: one column of them).
+
+    Returns
+    -------
+    tuple of float
+    """
+    if scene.figsize is not None:
+        return tuple(scene.figsize)
+    if scene.kind in _FIGSIZE:
+        return _FIGSIZE[scene.kind]
+    rows, cols = scene.layout if scene.layout is not None else (n_panels, 1)
+    return (6.0 * cols + 1.0, 4.6 * rows + 0.6)
+
+
 def _grid(n: int, layout, figsize, sharey: bool = False):
     import matplotlib.pyplot as plt
 
     rows, cols = layout if layout is not None else (n, 1)
-    if figsize is None:
-        figsize = (6.0 * cols + 1.0, 4.6 * rows + 0.6)
     fig, axes = plt.subplots(rows, cols, figsize=figsize, constrained_layout=True, squeeze=False, sharey=sharey)
     flat = list(axes.ravel())
     for ax in flat[n:]:
@@ -175,7 +200,7 @@ def orbit_figure(result: OrbitSceneResult):
     matplotlib.figure.Figure
     """
     scene, q = result.scene, _quick(result)
-    fig, axes = _grid(len(result.panels), scene.layout, scene.figsize)
+    fig, axes = _grid(len(result.panels), scene.layout, figure_inches(scene, len(result.panels)))
     by_id = {p.id: p for p in result.panels}
     for ax, p in zip(axes, result.panels):
         if isinstance(p, OrbitPanelResult):
@@ -205,7 +230,7 @@ def hovering_area_figure(result: HoveringAreaResult):
     matplotlib.figure.Figure
     """
     scene = result.scene
-    fig, (ax, axr) = _grid(2, (1, 2), scene.figsize or (13.0, 5.2))
+    fig, (ax, axr) = _grid(2, (1, 2), figure_inches(scene))
     any_floor = False
     for s in result.series:
         eb = ax.errorbar(s.eps, s.area, yerr=s.error, fmt="o", ms=4, capsize=3, color=s.color,
@@ -269,7 +294,7 @@ def flow_portrait_figure(result: FlowPortraitResult):
     matplotlib.figure.Figure
     """
     scene, q = result.scene, _quick(result)
-    fig, axes = _grid(2, (1, 2), scene.figsize or (13.0, 5.6), sharey=True)
+    fig, axes = _grid(2, (1, 2), figure_inches(scene), sharey=True)
     o = result.onset
     titles = (f"(a) full return map (flow), {result.meta.get('n_steps')} returns",
               f"(b) truncated model ({result.model_name} forcing), onset arcs "
@@ -310,7 +335,7 @@ def flow_hovering_figure(result: FlowHoveringResult):
     matplotlib.figure.Figure
     """
     scene = result.scene
-    fig, (ax, axa) = _grid(2, (1, 2), scene.figsize or (13.0, 5.2))
+    fig, (ax, axa) = _grid(2, (1, 2), figure_inches(scene))
     e = result.eps
     order = np.argsort(e)
     eb = ax.errorbar(e[order], result.flow_area[order], yerr=result.flow_error[order], fmt="o", ms=5, capsize=3,
@@ -364,7 +389,7 @@ def tangent_tori_figure(result: TangentToriResult):
     import matplotlib.pyplot as plt
 
     scene = result.scene
-    fig = plt.figure(figsize=scene.figsize or (12.0, 8.0), constrained_layout=True)
+    fig = plt.figure(figsize=figure_inches(scene), constrained_layout=True)
     gs = fig.add_gridspec(2, 2)
     axc = [fig.add_subplot(gs[0, 0]), fig.add_subplot(gs[0, 1])]
     ax1, ax2 = fig.add_subplot(gs[1, 0]), fig.add_subplot(gs[1, 1])
@@ -415,7 +440,7 @@ def sigma_structure_figure(result: SigmaStructureResult):
     matplotlib.figure.Figure
     """
     scene = result.scene
-    fig, axes = _grid(6, (3, 2), scene.figsize or (12.0, 12.0))
+    fig, axes = _grid(6, (3, 2), figure_inches(scene))
     s = scene.marker_size
     rows = (("q2", "p2", "q21", "p21", r"$q_2$", r"$p_2$"),
             ("theta", "I", "theta1", "I1", r"$\theta$", r"$I$"),

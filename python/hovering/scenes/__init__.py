@@ -182,17 +182,26 @@ def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bo
     -------
     tuple
         ``(png_path, result, figure or None)``.
+
+    Raises
+    ------
+    ValueError
+        For a file that is not a scene result, or one whose values the scene schema or the result's
+        own checks refuse (see :func:`load_result`), naming the file and the field.
     """
     from .._output import refuse_foreign, savefig, write_error
 
-    result = load_result(path)
+    result = load_result(path)  # checked as it is read: the scene schema's checks, each field's type
     png = output_path("--out", out) if out is not None else Path(os.fspath(path)).with_suffix(".png")
     refuse_foreign([png], force)
     try:
         png.parent.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise write_error(png.parent, e, previous=False) from None
-    fig = _render(result)
+    try:
+        fig = _render(result)
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError) as e:  # a combination the checks missed
+        raise ValueError(f"{os.fspath(path)}: the result cannot be drawn ({type(e).__name__}: {e})") from None
     try:
         savefig(fig, png, dpi=result.scene.dpi)
     finally:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from typing import Optional
+from typing import Callable, Optional
 
 import numpy as np
 
@@ -21,7 +21,7 @@ from .._common import Region, Status, wrap
 from ..plot.style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
 from ..analysis.hovering import default_depth
-from ..sweeps import Checkpoint
+from ..sweeps import Checkpoint, check_row
 from ..truncated.theory import golden_family, hovering_area_theory
 from .results import (FlowHoveringResult, FlowPortraitResult, Geometry, HoveringAreaResult, OrbitPanelResult,
                       OrbitSceneResult, OrbitSet, SceneResult, SeriesResult, SigmaStructureResult, TangentToriResult,
@@ -395,11 +395,30 @@ def _truncated_point(ms, n_steps: int, samples: int, seed: int, kw: dict, n_thre
                 seconds=time.perf_counter() - t)
 
 
+#: The fields of a truncated-map sweep point (what _hovering_scene reads of a checkpointed row).
+_TRUNCATED_ROW = dict(eps=float, area=float, error=float, theory=float, floor_touched=bool, K_low=float, Omega0=float,
+                      theta_w=float)
+#: The fields of a flow sweep point (_flow_hovering), its models' fields under "models".
+_FLOW_ROW = dict(eps=float, flow=float, flow_err=float, flow_both=float, K_low=float, theory=float, b1=float,
+                 seconds=float, unresolved=float)
+_MODEL_ROW = dict(area=float, error=float, agree=float, K_low=float)
+
+
+def _row_check(fields: dict, eps: float) -> Callable:
+    """A check of a checkpointed row (untrusted): the fields its reader takes, and the point's own eps."""
+    def check(row):
+        check_row(row, fields)
+        if row["eps"] != eps:
+            raise ValueError(f"row.eps = {row['eps']!r} is not the point's eps = {eps!r}")
+    return check
+
+
 def _sweep(points, ckpt, bar, where) -> tuple:
-    """Rows of a sweep's points ``[(key, fn, args)]`` in order: from the checkpoint, or computed
-    (here, or as pieces on ``where``: a dict of executor arguments) and checkpointed as each
-    arrives. Returns (rows, reused: one bool per point, True where the checkpoint had it)."""
-    rows = [ckpt.get(key) for key, _, _ in points]
+    """Rows of a sweep's points ``[(key, fn, args, check)]`` in order: from the checkpoint (each row
+    checked first: the file is untrusted), or computed (here, or as pieces on ``where``: a dict of
+    executor arguments) and checkpointed as each arrives. Returns (rows, reused: one bool per
+    point, True where the checkpoint had it)."""
+    rows = [ckpt.get(key, check) for key, _, _, check in points]
     reused = [r is not None for r in rows]
     bar.advance(sum(reused))
     todo = [i for i, r in enumerate(rows) if r is None]
@@ -445,7 +464,7 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
             ms = s.map_at(e)
             kw = {} if s.K_low is None else {"K_low": s.K_low}
             key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-            points.append((key, _truncated_point, (ms, n_steps, samples, scene.seed, kw)))
+            points.append((key, _truncated_point, (ms, n_steps, samples, scene.seed, kw), _row_check(_TRUNCATED_ROW, e)))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="point") as bar:
         all_rows, from_ckpt = _sweep(points, ckpt, bar, where)
     drawn = set()
@@ -578,7 +597,8 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
         sysd["eps"] = e
         key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
                    seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
-        points.append((key, _flow_point, (scene, e, n, samples)))
+        models = (tuple(scene.models), _MODEL_ROW)
+        points.append((key, _flow_point, (scene, e, n, samples), _row_check(dict(_FLOW_ROW, models=models), e)))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="eps") as bar:
         rows, from_ckpt = _sweep(points, ckpt, bar, where)
     reused = sum(from_ckpt)

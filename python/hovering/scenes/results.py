@@ -59,6 +59,30 @@ def jsonable(x):
     return x
 
 
+# ------------------------------------------------------------------------------------------------
+# Checks of a result read from a file (hovering._serial calls ``_validate_loaded`` after checking
+# each field's declared type): what the figure draws is what a computation could have made. Texts
+# and colours get the scene schema's checks.
+
+
+def _texts(where: str, values, n: Optional[int] = None, color: bool = False) -> None:
+    from .schema import _color, _str
+
+    if not isinstance(values, list) or (n is not None and len(values) != n):
+        raise ValueError(f"{where} must be a list of {n if n is not None else 'some'} strings, got "
+                         f"{'a list of ' + str(len(values)) if isinstance(values, list) else type(values).__name__}")
+    for i, v in enumerate(values):
+        (_color if color else _str)(f"{where}[{i}]", v)
+
+
+def _array(where: str, a, ndim: int, kinds: str = "iuf", shape: Optional[tuple] = None) -> None:
+    if not isinstance(a, np.ndarray) or a.ndim != ndim or a.dtype.kind not in kinds:
+        got = f"shape {a.shape} dtype {a.dtype}" if isinstance(a, np.ndarray) else type(a).__name__
+        raise ValueError(f"{where} must be a {ndim}-D array of numbers, got {got}")
+    if shape is not None and a.shape != shape:
+        raise ValueError(f"{where} has shape {a.shape}; it must have shape {shape} (as the arrays it goes with)")
+
+
 @dataclass
 class Geometry:
     """The lines a phase portrait on (phi, K) draws: K = 0, L1, L2 and the corner curves.
@@ -84,6 +108,17 @@ class Geometry:
     K_corner: np.ndarray
     corners: dict
     measured: bool = False
+
+    def _validate_loaded(self) -> None:
+        _array("K", self.K, 1)
+        for name in ("L1", "L2"):
+            if getattr(self, name) is not None:
+                _array(name, getattr(self, name), 1, shape=self.K.shape)
+        _array("K_corner", self.K_corner, 1)
+        for k, v in self.corners.items():
+            if k not in ("01", "1R", "R0"):
+                raise ValueError(f"corners has the key {str(k)[:40]!r}; allowed: '01', '1R', 'R0'")
+            _array(f"corners.{k}", v, 1, shape=self.K_corner.shape)
 
 
 @dataclass
@@ -116,6 +151,20 @@ class OrbitSet:
     colors: list
     kinds: list
     rho: Optional[np.ndarray] = None
+
+    def _validate_loaded(self) -> None:
+        _array("phi", self.phi, 2)
+        n, m = self.phi.shape
+        _array("K", self.K, 2, shape=(n, m))
+        if self.region is not None:
+            _array("region", self.region, 2, "iu", shape=(n, max(m - 1, 0)))
+        _array("status", self.status, 1, "iu", shape=(n,))
+        _array("steps_done", self.steps_done, 1, "iu", shape=(n,))
+        _texts("labels", self.labels, n)
+        _texts("colors", self.colors, n, color=True)
+        _texts("kinds", self.kinds, n)
+        if self.rho is not None:
+            _array("rho", self.rho, 1, shape=(n,))
 
     @classmethod
     def of(cls, res, labels, colors, kinds, rho=None) -> "OrbitSet":
@@ -242,6 +291,18 @@ class SeriesResult:
     golden_c: Optional[float] = None
     reused: int = 0
 
+    def _validate_loaded(self) -> None:
+        from .schema import _color, _str
+
+        _str("label", self.label)
+        _color("color", self.color)
+        _array("eps", self.eps, 1)
+        for name in ("area", "error", "theory", "K_low", "Omega0", "theta_w"):
+            _array(name, getattr(self, name), 1, shape=self.eps.shape)
+        _array("floor_touched", self.floor_touched, 1, "b", shape=self.eps.shape)
+        _array("theory_eps", self.theory_eps, 1)
+        _array("theory_curve", self.theory_curve, 1, shape=self.theory_eps.shape)
+
 
 @dataclass
 class TorusResult:
@@ -272,6 +333,18 @@ class TorusResult:
     trajectory: np.ndarray
     color: str
 
+    def _validate_loaded(self) -> None:
+        from .schema import _color, _str
+
+        _str("name", self.name, ("right", "upper"))
+        _color("color", self.color)
+        _array("q1", self.q1, 1)
+        for name in ("p1", "q2", "p2"):
+            _array(name, getattr(self, name), 1, shape=self.q1.shape)
+        _array("trajectory", self.trajectory, 2)
+        if self.trajectory.shape[1] != 5:
+            raise ValueError(f"trajectory has shape {self.trajectory.shape}; it must be (m, 5): t, q1, p1, q2, p2")
+
 
 @dataclass
 class SceneResult:
@@ -287,6 +360,21 @@ class SceneResult:
 
     scene: SceneSpec
     meta: dict
+
+    def _validate_loaded(self) -> None:
+        # What the figure and the summary take from meta (the scene itself was checked as it was read).
+        from .schema import MAX_TEXT
+
+        for key, kind in (("quick", bool), ("n_steps", int), ("samples", int), ("timings", dict), ("version", str)):
+            v = self.meta.get(key)
+            if v is not None and (not isinstance(v, kind) or (kind is int and isinstance(v, bool))):
+                raise ValueError(f"meta.{key} must be of type {kind.__name__}, got {type(v).__name__}")
+        if len(self.meta.get("version") or "") > MAX_TEXT:
+            raise ValueError(f"meta.version: a string of {len(self.meta['version'])} characters; allowed: at most "
+                             f"{MAX_TEXT}")
+        for k, v in (self.meta.get("timings") or {}).items():
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise ValueError(f"meta.timings.{k} must be a number of seconds, got {type(v).__name__}")
 
     def summary(self) -> dict:
         """The numbers shown, as a JSON-able dict (what the CLI prints and the sidecar JSON holds).
@@ -345,6 +433,20 @@ class OrbitSceneResult(SceneResult):
 
     panels: list = field(default_factory=list)
 
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        if len(self.panels) != len(getattr(self.scene, "panels", ())):
+            raise ValueError(f"panels: {len(self.panels)} results for the scene's {len(self.scene.panels)} panels")
+        ids = []
+        for i, p in enumerate(self.panels):
+            if not isinstance(p, (OrbitPanelResult, ZoomPanelResult)):
+                raise ValueError(f"panels[{i}] must be a panel result, got {type(p).__name__}")
+            ids.append(p.id)
+        for i, p in enumerate(self.panels):
+            if isinstance(p, ZoomPanelResult) and not any(q.id == p.of and isinstance(q, OrbitPanelResult)
+                                                          for q in self.panels):
+                raise ValueError(f"panels[{i}].of = {p.of!r} names no orbit panel; panels: {ids}")
+
     def panel(self, id: str):
         """The panel with this id.
 
@@ -374,6 +476,12 @@ class HoveringAreaResult(SceneResult):
     """
 
     series: list = field(default_factory=list)
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        for i, x in enumerate(self.series):
+            if not isinstance(x, SeriesResult):
+                raise ValueError(f"series[{i}] must be a SeriesResult, got {type(x).__name__}")
 
 
 @dataclass
@@ -455,6 +563,12 @@ class TangentToriResult(SceneResult):
     tori: list = field(default_factory=list)
     qw1: float = 0.0
     qw2: float = 0.0
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        for i, x in enumerate(self.tori):
+            if not isinstance(x, TorusResult):
+                raise ValueError(f"tori[{i}] must be a TorusResult, got {type(x).__name__}")
 
 
 @dataclass

@@ -10,9 +10,11 @@ second, not after its simulation.
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
 import operator
 import os
+import re
 import tomllib
 from pathlib import Path
 from typing import Optional
@@ -25,7 +27,8 @@ from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHovering
                    PotentialSpec, SceneSpec, SeriesSpec, SigmaStructureScene, SystemSpec, TangentToriScene,
                    ZoomSpec)
 
-__all__ = ["load_scene", "parse_scene", "MAX_PANELS", "MAX_SERIES_POINTS", "MAX_SCENE_BYTES"]
+__all__ = ["load_scene", "parse_scene", "check_spec", "scene_table", "MAX_PANELS", "MAX_SERIES_POINTS",
+           "MAX_SCENE_BYTES", "MAX_TEXT", "MAX_PATH_CHARS", "MAX_SCENE_STRING", "MAX_SCENE_DEPTH", "MAX_KEY_PARTS", "MAX_CANVAS_PIXELS"]
 
 _MAP_KEYS = ("Omega0", "theta_w", "tau0", "tau1", "lam")
 _MAP_DEFAULTS = {"tau0": 1.0, "tau1": 0.5, "lam": 0.5}
@@ -69,6 +72,30 @@ MAX_SCENE_BYTES = 1 << 20
 #: Longest expression string accepted: a parameter is a formula like "2 * pi * (sqrt(5) - 1) / 2",
 #: never a program; a 50,000-deep one exhausted the parser's memory.
 _MAX_EXPR = 200
+#: Longest text drawn on a figure or naming something in it (title, panel id, orbit and series
+#: labels, colour names), in characters: the paper's longest title has ~60; savefig took 0.4 s with
+#: a 200-character title and two minutes with a 500,000-character one.
+MAX_TEXT = 200
+#: Longest path (``output``): Linux's PATH_MAX.
+MAX_PATH_CHARS = 4096
+#: Longest string or key anywhere in a scene file, checked before any field: a backstop so that no
+#: message prints more (each field's own limit is smaller: MAX_TEXT, MAX_PATH_CHARS, 200 for an
+#: expression).
+MAX_SCENE_STRING = 1 << 16
+#: Deepest nesting of tables and arrays in a scene file: its deepest is 4 (``[[panels]]``, ``zoom``,
+#: ``xlim``); Python's TOML reader recurses once per level and fails near 500.
+MAX_SCENE_DEPTH = 16
+#: Most parts of one dotted key (``a.b.c = 1``; a scene's have at most 3): Python's TOML reader takes
+#: time and memory quadratic in them (100,000 parts: 8 GB).
+MAX_KEY_PARTS = 16
+#: Largest figure canvas, in pixels (dpi^2 x width x height in inches): Agg holds 4 bytes per pixel,
+#: so 150 million is 600 MB and ~10 s of savefig. The largest example figure has 3.9 million; the
+#: limit allows 600 dpi at 19 x 12 inches, or 1200 dpi at 10 x 12.
+MAX_CANVAS_PIXELS = 150_000_000
+#: Integers beyond a double (TOML's are 64-bit; Python's reader takes any) are refused before any
+#: field sees them: a field's own range check names its range, but no message should print a
+#: 10,000-digit number (Python refuses to, beyond 4300 digits).
+_MAX_INT_BITS = 1024
 
 
 def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
@@ -85,7 +112,11 @@ def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> 
                 f"{where}: cannot evaluate {value!r}; allowed: a number or an expression of numbers, "
                 f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos") from None
     elif isinstance(value, (int, float)):
-        v = float(value)
+        try:
+            v = float(value)
+        except OverflowError:
+            raise ValueError(f"{where} is an integer of {value.bit_length()} bits, beyond the range of a double; "
+                             f"allowed: a finite number") from None
     else:
         raise ValueError(f"{where} must be a number, got {value!r}")
     if not math.isfinite(v):
@@ -114,9 +145,16 @@ def _bool(where: str, value) -> bool:
     return value
 
 
-def _str(where: str, value, choices=None) -> str:
+def _str(where: str, value, choices=None, limit: int = MAX_TEXT) -> str:
     if not isinstance(value, str) or not value.strip():
         raise ValueError(f"{where} must be a non-empty string, got {value!r}")
+    if len(value) > limit:
+        raise ValueError(f"{where}: a string of {len(value)} characters; allowed: at most {limit}")
+    if not value.isascii():  # a file from elsewhere (a result) may hold what no TOML file can
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError as e:
+            raise ValueError(f"{where}: a lone surrogate at character {e.start}; allowed: Unicode text") from None
     if choices is not None and value not in choices:
         raise ValueError(f"{where} = {value!r} is not allowed; allowed: {', '.join(repr(c) for c in choices)}")
     return value
@@ -313,8 +351,51 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bo
         names the key (as ``panels[1].zoom.of``), the value and the allowed keys or range.
     """
     p = Path(path) if path is not None else None
-    name = p.stem if p is not None else "scene"
     where = p.name if p is not None else "scene"
+    _check_document(where, data)
+    spec = _parse_scene(data, p, where, check_output)
+    _check_canvas(where, spec)
+    return spec
+
+
+def _check_document(where: str, data) -> None:
+    """Limits of the parsed document as a whole, before any field: nesting depth, string and key
+    lengths, integers of 64 bits (TOML's). Iterative, so a deep document cannot exhaust the stack."""
+    stack = [(data, where, 0)]
+    while stack:
+        node, at, depth = stack.pop()
+        if isinstance(node, (dict, list)):
+            if depth > MAX_SCENE_DEPTH:
+                raise ValueError(f"{at}: tables and arrays nested more than {MAX_SCENE_DEPTH} deep; allowed: at most "
+                                 f"{MAX_SCENE_DEPTH} levels")
+            items = node.items() if isinstance(node, dict) else enumerate(node)
+            for k, v in items:
+                if isinstance(k, str) and len(k) > MAX_SCENE_STRING:
+                    raise ValueError(f"{at}: a key of {len(k)} characters; allowed: at most {MAX_SCENE_STRING}")
+                stack.append((v, f"{at}.{k}" if isinstance(node, dict) else f"{at}[{k}]", depth + 1))
+        elif isinstance(node, str) and len(node) > MAX_SCENE_STRING:
+            raise ValueError(f"{at}: a string of {len(node)} characters; allowed: at most {MAX_SCENE_STRING}")
+        elif isinstance(node, int) and not isinstance(node, bool) and node.bit_length() > _MAX_INT_BITS:
+            raise ValueError(f"{at} = (an integer of {node.bit_length()} bits) is out of range; allowed: integers in "
+                             f"[-2**63, 2**63 - 1] (TOML's 64-bit integers)")
+
+
+def _check_canvas(where: str, spec: SceneSpec) -> None:
+    """The figure's canvas (dpi and its size in inches, given or its kind's default) within MAX_CANVAS_PIXELS."""
+    from ..plot.figures import figure_inches
+
+    w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
+    pixels = (spec.dpi * w) * (spec.dpi * h)
+    if pixels > MAX_CANVAS_PIXELS:
+        given = ("figsize" if spec.figsize is not None else "layout" if getattr(spec, "layout", None) is not None
+                 else "the default figure size")
+        raise ValueError(f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
+                         f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
+                         f"(lower dpi or figsize)")
+
+
+def _parse_scene(data, p: Optional[Path], where: str, check_output: bool) -> SceneSpec:
+    name = p.stem if p is not None else "scene"
     data = _table(where, data)
     if "kind" not in data:
         raise ValueError(f"{where}: missing required key 'kind'; allowed: {', '.join(repr(k) for k in KINDS)}")
@@ -330,8 +411,9 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bo
         name=name,
         kind=kind,
         title=_str(f"{where}.title", data["title"]) if "title" in data else name,
-        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"]), within=output_dirs(p))
-                if check_output else Path(_str(f"{where}.output", data["output"]))),
+        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS),
+                            within=output_dirs(p))
+                if check_output else Path(_str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS))),
         dpi=_int(f"{where}.dpi", data["dpi"], 30, 1200) if "dpi" in data else 130,
         figsize=_size(f"{where}.figsize", data["figsize"]) if "figsize" in data else None,
     )
@@ -761,12 +843,220 @@ def load_scene(path: os.PathLike, check_output: bool = True) -> SceneSpec:
     if len(raw) > MAX_SCENE_BYTES:
         raise ValueError(f"{p.name}: larger than {MAX_SCENE_BYTES} bytes; a scene file is a few hundred")
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
         raise ValueError(f"{p.name}: not UTF-8 text (TOML files are UTF-8): byte {e.start}") from None
-    except tomllib.TOMLDecodeError as e:
+    _check_toml_text(p.name, text)
+    try:
+        data = tomllib.loads(text)
+    except ValueError as e:  # TOMLDecodeError, or a number Python will not convert
         raise ValueError(f"{p.name}: not valid TOML: {e}") from None
+    except RecursionError:  # _check_toml_text bounds the nesting; kept for a text it misjudged
+        raise ValueError(f"{p.name}: arrays or tables nested too deeply; allowed: at most {MAX_SCENE_DEPTH} "
+                         f"levels") from None
     return parse_scene(data, p, check_output=check_output)
+
+
+# TOML strings and comments, skipped when counting brackets and dots (multi-line strings first).
+_TOML_SKIP = re.compile(r'"""(?:[^"\\]|\\.|"(?!""))*"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*',
+                        re.S)
+# A dotted key of more than MAX_KEY_PARTS parts, where a key can start (possessive: linear time).
+_KEY_PART = r'(?:[A-Za-z0-9_-]++|"")'
+_LONG_KEY = re.compile(rf'(?:^|[\[{{,])\[?[ \t]*+{_KEY_PART}(?:[ \t]*+\.[ \t]*+{_KEY_PART}){{{MAX_KEY_PARTS},}}',
+                       re.M)
+
+
+# A run of digits longer than any number a double holds (2**1024 has 309); Python's own integer
+# conversion refuses beyond 4300 digits with a message that names no key.
+_MAX_DIGITS = 400
+_LONG_NUMBER = re.compile(rf"[0-9][0-9_]{{{_MAX_DIGITS},}}")
+
+
+def _check_toml_text(name: str, text: str) -> None:
+    """Before Python's TOML reader sees the text: no number of more than _MAX_DIGITS digits, no
+    dotted key of more than MAX_KEY_PARTS parts, no arrays or inline tables nested more than
+    MAX_SCENE_DEPTH deep; each named by its line and key."""
+    # Strings become "" (newlines kept, so line numbers stay): brackets and dots in them do not count.
+    skel = _TOML_SKIP.sub(lambda m: "#" if m.group()[0] == "#" else '""' + "\n" * m.group().count("\n"), text)
+
+    def line_of(pos: int) -> tuple:
+        start = skel.rfind("\n", 0, pos) + 1
+        key = re.match(r"\s*([^=\s][^=]*?)\s*=", skel[start:pos])
+        return skel.count("\n", 0, pos) + 1, (key.group(1)[:60] if key else skel[start:pos].strip()[:60])
+
+    m = _LONG_NUMBER.search(skel)
+    if m:
+        line, key = line_of(m.start())
+        raise ValueError(f"{name}: line {line}: {key!r} has a number of {len(m.group())} digits; allowed: numbers "
+                         f"within the range of a double (at most {_MAX_DIGITS} digits)")
+    m = _LONG_KEY.search(skel)
+    if m:
+        line, _ = line_of(m.start())
+        raise ValueError(f"{name}: line {line}: the key {m.group().lstrip('[{, ')[:60]!r}... has more than "
+                         f"{MAX_KEY_PARTS} dotted parts; allowed: at most {MAX_KEY_PARTS}")
+    depth = outer = 0
+    for b in re.finditer(r"[\[\]{}]", skel):
+        if b.group() in "[{":
+            depth += 1
+            outer = b.start() if depth == 1 else outer
+            if depth > MAX_SCENE_DEPTH:
+                line, key = line_of(outer)
+                raise ValueError(f"{name}: line {line}: {key!r} nests arrays or tables more than {MAX_SCENE_DEPTH} "
+                                 f"deep; allowed: at most {MAX_SCENE_DEPTH} levels")
+        else:
+            depth = max(depth - 1, 0)
+
+
+# ------------------------------------------------------------------------------------------------
+# A spec read from elsewhere (a saved result): the same checks as a scene file's
+
+
+def _map_table(m: MapSpec) -> dict:
+    t = {"eps": m.eps, "tau0": m.tau0, "tau1": m.tau1, "lam": m.lam}
+    if m.golden_c is not None:
+        t["golden"] = {"c": m.golden_c, "eps": m.golden_eps}
+    else:
+        t.update(Omega0=m.Omega0, theta_w=m.theta_w)
+    return t
+
+
+def _some(**kw) -> dict:
+    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in kw.items() if v is not None}
+
+
+def _panel_table(spec, pn: PanelSpec) -> dict:
+    if pn.zoom is not None:
+        z = pn.zoom
+        zt = _some(of=z.of, on=z.on, pad=z.pad, orbits=z.orbits if z.on == "islands" else None,
+                   xlim=z.xlim, ylim=z.ylim)
+        return {"id": pn.id, "zoom": zt}
+    t = {"id": pn.id, **_map_table(pn.map), **_some(xlim=pn.xlim, ylim=pn.ylim)}
+    if spec.kind == "portrait":
+        t.update(n_orbits=pn.n_orbits, **_some(K0_range=pn.K0_range))
+        return t
+    t["special"] = list(pn.special)
+    t["orbits"] = [_some(label=o.label, K0=o.K0, phi0=o.phi0, line=o.line, color=o.color) for o in pn.orbits]
+    if pn.critical is not None:
+        c = pn.critical
+        t["critical"] = _some(n_steps=c.n_steps, K_range=c.K_range, line=c.line, color=c.color)
+    return t
+
+
+def _system_table(s) -> dict:
+    pot = lambda v: _some(kind=v.kind, omega=v.omega, alpha=v.alpha)  # noqa: E731
+    coupling = ("bilinear" if s.coupling == ((1.0, 1, 1),) else "none" if s.coupling == ()
+                else [list(term) for term in s.coupling])
+    return {"V1": pot(s.V1), "V2": pot(s.V2), "coupling": coupling, "eps": s.eps, "qw1": s.qw1, "qw2": s.qw2,
+            "geometry": s.geometry}
+
+
+def scene_table(spec: SceneSpec) -> dict:
+    """The scene file (as the parsed TOML dict) that :func:`parse_scene` reads as ``spec``.
+
+    Parameters
+    ----------
+    spec : SceneSpec
+        A scene spec (e.g. one read from a saved result).
+
+    Returns
+    -------
+    dict
+        Every value written out (defaults included); expressions appear as their values.
+    """
+    t = {"kind": spec.kind, "title": spec.title, "output": str(spec.output), "dpi": spec.dpi,
+         **_some(figsize=spec.figsize)}
+    if isinstance(spec, OrbitScene):
+        t.update(n_steps=spec.n_steps, marker_size=spec.marker_size, corner_curves=spec.corner_curves,
+                 panels=[_panel_table(spec, pn) for pn in spec.panels], **_some(layout=spec.layout))
+        if spec.kind == "portrait":
+            t.update(line=spec.line, color_by=spec.color_by)
+        else:
+            t.update(rotation=spec.rotation, leading_curve=spec.leading_curve)
+    elif isinstance(spec, HoveringAreaScene):
+        t.update(n_steps=spec.n_steps, eps=list(spec.eps), samples=spec.samples, seed=spec.seed,
+                 series=[_some(label=s.label, tau0=s.tau0, tau1=s.tau1, lam=s.lam, golden_c=s.golden_c,
+                               Omega0=s.Omega0, theta_w=s.theta_w, color=s.color, K_low=s.K_low) for s in spec.series])
+    else:
+        allowed, _ = _FLOW_RECORDS[spec.kind]
+        ig = spec.integrator
+        t.update(system=_system_table(spec.system), section={"h": spec.h},
+                 integrator={"accuracy": ig.accuracy} if ig.accuracy is not None else
+                 {"stepper": ig.stepper, "rtol": ig.rtol, "atol": ig.atol},
+                 outputs={"record": list(spec.outputs.record),
+                          **({"trajectory_dt": spec.outputs.trajectory_dt} if "trajectory" in allowed else {})})
+        extra = {"flow_portrait": ("n_steps", "n_orbits", "K0_range", "model", "corner_K", "marker_size"),
+                 "flow_hovering_area": ("n_steps", "eps", "samples", "seed", "models"),
+                 "tangent_tori": ("n_returns", "n_points"),
+                 "sigma_structure": ("grid", "K_range", "marker_size")}[spec.kind]
+        t.update(_some(**{k: getattr(spec, k) for k in extra}))
+    return t
+
+
+def _first_difference(a, b, where: str):
+    """Where two specs first differ (None if they agree; floats within 1e-12 relative agree, so that a
+    value derived again, e.g. a golden-family Omega0, may differ in its last bits on another machine)."""
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        if type(a) is not type(b):
+            return where, a, b
+        for f in dataclasses.fields(a):
+            d = _first_difference(getattr(a, f.name), getattr(b, f.name), f"{where}.{f.name}")
+            if d:
+                return d
+        return None
+    if isinstance(a, (tuple, list)):
+        if type(a) is not type(b) or len(a) != len(b):
+            return where, a, b
+        for i, (x, y) in enumerate(zip(a, b)):
+            d = _first_difference(x, y, f"{where}[{i}]")
+            if d:
+                return d
+        return None
+    if isinstance(a, float) and isinstance(b, float):
+        return None if a == b or math.isclose(a, b, rel_tol=1e-12, abs_tol=0.0) else (where, a, b)
+    return None if type(a) is type(b) and a == b else (where, a, b)
+
+
+def check_spec(spec: SceneSpec) -> SceneSpec:
+    """Check a scene spec from elsewhere (a saved result) with the checks a scene file gets.
+
+    The spec is written out as its scene file (:func:`scene_table`) and read by :func:`parse_scene`
+    (the output path is not checked: nothing is written to it); the spec read must be ``spec``,
+    so every value is in range and of its type, and no field holds what a scene file cannot give.
+
+    Parameters
+    ----------
+    spec : SceneSpec
+        The spec.
+
+    Returns
+    -------
+    SceneSpec
+        ``spec``.
+
+    Raises
+    ------
+    ValueError
+        Naming the field and the allowed values, as for a scene file.
+    """
+    if not isinstance(spec, SceneSpec) or spec.kind not in KINDS:
+        raise ValueError(f"a scene spec of kind {getattr(spec, 'kind', None)!r}; allowed kinds: {', '.join(KINDS)}")
+    if spec.path is not None and not isinstance(spec.path, Path):
+        raise ValueError(f"scene.path must be a path, got {spec.path!r}")
+    try:
+        table = scene_table(spec)
+    except (AttributeError, TypeError) as e:  # a field of another type than the kind has
+        raise ValueError(f"a {spec.kind} scene spec with a field of the wrong type ({e})") from None
+    again = parse_scene(table, spec.path, check_output=False)
+    d = _first_difference(spec, again, "scene")
+    if d is not None:
+        where, a, b = d
+        raise ValueError(f"{where} = {_clip(a)} is not what a scene file can give (its other values give {_clip(b)})")
+    return spec
+
+
+def _clip(value) -> str:
+    r = repr(value)
+    return r if len(r) <= 80 else r[:77] + "..."
 
 
 # ------------------------------------------------------------------------------------------------

@@ -423,6 +423,12 @@ class SceneSpec:
     dpi: int = 130
     figsize: Optional[tuple] = None
 
+    def _validate_loaded(self) -> None:
+        """A spec read from a file (:func:`hovering.load`) gets the checks a scene file gets."""
+        from .schema import check_spec
+
+        check_spec(self)
+
 
 @dataclass(frozen=True, kw_only=True)
 class OrbitScene(SceneSpec):

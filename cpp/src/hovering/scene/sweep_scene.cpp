@@ -54,6 +54,9 @@ constexpr std::size_t kMaxSceneBytes = 1 << 20;  // MAX_SCENE_BYTES
 constexpr std::size_t kMaxPanels = 36;           // MAX_PANELS (also the most series)
 constexpr std::size_t kMaxSeriesPoints = 200;    // MAX_SERIES_POINTS
 constexpr std::size_t kMaxExpr = 200;            // _MAX_EXPR
+constexpr std::size_t kMaxText = 200;            // MAX_TEXT (a text drawn on the figure)
+constexpr std::size_t kMaxPathChars = 4096;      // MAX_PATH_CHARS
+constexpr double kMaxCanvasPixels = 150e6;       // MAX_CANVAS_PIXELS
 
 [[noreturn]] void fail(const std::string& msg) { throw std::invalid_argument(msg); }
 
@@ -843,13 +846,18 @@ std::int64_t integer(const std::string& where, const toml::node& value, std::int
     return v;
 }
 
-/// _str: a string with something besides whitespace (str.strip()), optionally one of choices.
-std::string text(const std::string& where, const toml::node& value, const Keys* choices = nullptr) {
+/// _str: a string with something besides whitespace (str.strip()) of at most limit characters,
+/// optionally one of choices.
+std::string text(const std::string& where, const toml::node& value, const Keys* choices = nullptr,
+                 std::size_t limit = kMaxText) {
     bool blank = true;
     if (value.is_string())
         for (const char32_t c : decode(value.as_string()->get())) blank = blank && py_isspace(c);
     if (blank) fail(where + " must be a non-empty string, got " + py_repr(value));
     const std::string& s = value.as_string()->get();
+    const std::size_t n = decode(s).size();
+    if (n > limit)
+        fail(where + ": a string of " + std::to_string(n) + " characters; allowed: at most " + std::to_string(limit));
     if (choices && !contains(*choices, s))
         fail(where + " = " + py_repr(value) + " is not allowed; allowed: " + py_choices(*choices));
     return s;
@@ -1236,16 +1244,27 @@ SweepScene parse(const std::string& doc, const std::string& origin, const std::s
     if (truncated) check_keys(where, root, kHovKeys, {"kind", "output", "n_steps", "eps", "series"});
     else check_keys(where, root, kFlowHovKeys, {"kind", "output", "system", "n_steps", "eps"});
     s.title = root.contains("title") ? text(where + ".title", *get(root, "title")) : s.name;
-    s.output = posix_path(text(where + ".output", *get(root, "output")));
+    s.output = posix_path(text(where + ".output", *get(root, "output"), nullptr, kMaxPathChars));
     if (const toml::node* d = get(root, "dpi")) s.dpi = static_cast<int>(integer(where + ".dpi", *d, 30, 1200));
+    double inches[2] = {13.0, 5.2};  // both sweep kinds' default figure (plot.figures._FIGSIZE)
+    const bool sized = root.contains("figsize");
     if (const toml::node* f = get(root, "figsize")) {
         if (!f->is_array() || f->as_array()->size() != 2)
             fail(where + ".figsize must be [width, height] in inches, got " + py_repr(*f));
         for (std::size_t i = 0; i < 2; ++i)
-            real(where + ".figsize[" + std::to_string(i) + "]", (*f->as_array())[i], Bounds{0.5, 60.0});
+            inches[i] = real(where + ".figsize[" + std::to_string(i) + "]", (*f->as_array())[i], Bounds{0.5, 60.0});
     }
     if (truncated) parse_hovering_area(where, root, s);
     else parse_flow_hovering_area(where, root, s);
+    // _check_canvas: the figure python -m hovering would draw (hovering_sweep draws none).
+    const double pixels = (s.dpi * inches[0]) * (s.dpi * inches[1]);
+    if (pixels > kMaxCanvasPixels) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "%g x %g inches, a canvas of %.0f million pixels; allowed: at most %.0f million",
+                      inches[0], inches[1], pixels / 1e6, kMaxCanvasPixels / 1e6);
+        fail(where + ": dpi = " + std::to_string(s.dpi) + " and " + (sized ? "figsize" : "the default figure size") + " make a figure of " +
+             buf + " (lower dpi or figsize)");
+    }
     return s;
 }
 
