@@ -265,7 +265,7 @@ def test_scene_cli_refuses_a_bad_out_path(tmp_path, capsys):
 
 def test_output_path_names_the_file_savefig_writes(tmp_path):
     # savefig("out/x") writes out/x.png: the summary used to name "out/x".
-    from hovering._common import output_path
+    from hovering._output import output_path
 
     assert output_path("out", tmp_path / "sub" / "x") == tmp_path / "sub" / "x.png"
     assert output_path("out", tmp_path / "x.pdf") == tmp_path / "x.pdf"
@@ -296,7 +296,7 @@ def test_scene_cli_reports_values_only_the_run_can_check_in_one_line(tmp_path, c
 
 
 def test_output_path_refuses_what_savefig_would_fail_on(tmp_path):
-    from hovering._common import output_path
+    from hovering._output import output_path
 
     with pytest.raises(ValueError, match="no NUL byte"):
         output_path("out", str(tmp_path / "a\0b.png"))

@@ -20,9 +20,10 @@ systems also save to NPZ without pickle (``result.save(path)``, :func:`save`, :f
 
 from __future__ import annotations
 
+from ._version import __version__
 from . import _core, analysis, flow, normal, truncated
-from ._common import FlowStatus, Geometry, Region, Status, region_mask, wrap
-from ._protocols import ReturnMap
+from ._enums import FlowStatus, Geometry, Region, region_mask, Status, wrap
+from .interface import ReturnMap
 from ._provenance import show_versions
 from ._serial import load, save
 from .analysis import (
@@ -87,7 +88,6 @@ from .explore import explore
 from .accuracy import WorkPrecision, work_precision
 from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one release)
 
-__version__ = "0.2.0"
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
 simd_width = _core.truncated.simd_width

@@ -14,7 +14,7 @@
 Which existing files a scene may replace (:func:`refuse_foreign`): only files hovering wrote,
 recognised by their content, never by their name alone:
 
-* an NPZ whose ``__meta__`` document has hovering's format (:func:`hovering._serial.is_result_file`);
+* an NPZ whose ``__meta__`` document has hovering's format (:func:`hovering._untrusted.is_result_file`);
 * a JSON file whose first key is ``"format"`` with a value starting ``hovering-`` (scene sidecars,
   accuracy tables), or a scene sidecar of a version before that key (starts with the scene's typed
   tree);
@@ -33,7 +33,9 @@ import stat
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["WriteError", "replacing", "write_bytes", "write_text", "savefig", "append_line", "locked",
+from ._untrusted import is_result_file
+
+__all__ = ["output_path", "WriteError", "replacing", "write_bytes", "write_text", "savefig", "append_line", "locked",
            "refuse_foreign", "is_ours"]
 
 _NO_SPACE = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "no space left (disk quota exceeded)",
@@ -269,8 +271,6 @@ def is_ours(path: os.PathLike) -> bool:
         if not p.is_file():
             return False
         if p.suffix.lower() == ".npz":
-            from ._serial import is_result_file
-
             return is_result_file(p)
         if p.suffix.lower() == ".jsonl":
             head = _head(p)
@@ -304,3 +304,72 @@ def refuse_foreign(paths, force: bool = False) -> None:
         if os.path.lexists(p) and not is_ours(p):
             raise ValueError(f"{os.fspath(p)} exists and was not written by hovering: refusing to replace it. Move or "
                              "delete it, choose another output path, or pass --force (force=True) to replace it")
+
+
+def output_path(where: str, path, within=None) -> "os.PathLike":
+    """A figure path checked before any computation: its format is one matplotlib writes and its
+    directory exists (or can be created) and is writable.
+
+    Parameters
+    ----------
+    where : str
+        What the path is (``"--out"``, ``"scene.output"``) for the message.
+    path : path-like
+        The requested file. Without a suffix, ``.png`` is added (what ``savefig`` would write), so
+        the path reported afterwards is the file that exists.
+    within : sequence of path-like, optional
+        Directories the file must lie under (symbolic links resolved), checked before anything
+        else touches the path: where a file from elsewhere (a scene) may make hovering write.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        Naming the path and the allowed formats, or the directory that cannot be written.
+    """
+
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip() or "\0" in str(path):
+        raise ValueError(f"{where} must be a file path (non-empty, no NUL byte), got {path!r}")
+    p = Path(path)
+    if p.suffix == "":
+        if p.exists():  # "out" meaning out.png would silently write next to an existing out/ or /dev/null
+            raise ValueError(f"{where} = {str(path)!r} exists and is not a figure file; give a name with a suffix "
+                             f"(.png, .pdf, .svg, ...)")
+        p = p.with_suffix(".png")
+    if within is not None:
+        real = p.resolve()
+        bases = list(dict.fromkeys(Path(b).resolve() for b in within))
+        if not any(real.is_relative_to(b) for b in bases):
+            raise ValueError(f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene "
+                             "writes only under its own folder or the working directory; give --out (out=) to write "
+                             "elsewhere")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if p.suffix[1:].lower() not in formats:
+        raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "
+                         f"allowed suffixes: {', '.join('.' + f for f in sorted(formats))}")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{where} = {str(path)!r} exists and is not a regular file")
+    parent = p.parent if str(p.parent) else Path(".")
+    anc = parent
+    while not anc.exists() and anc != anc.parent:
+        anc = anc.parent
+    if not anc.is_dir():
+        raise ValueError(f"{where} = {str(path)!r}: {anc} is not a directory")
+    if not os.access(anc, os.W_OK | os.X_OK):
+        raise ValueError(f"{where} = {str(path)!r}: the directory {anc} is not writable")
+    if anc == parent:
+        # os.access says yes to root everywhere (/proc, read-only mounts): try it, leaving no trace.
+        existed = p.exists()
+        try:
+            with open(p, "ab"):
+                pass
+        except OSError as e:
+            raise ValueError(f"{where} = {str(path)!r} cannot be written: {e.strerror}") from None
+        if not existed:
+            p.unlink()
+    return p

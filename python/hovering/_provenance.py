@@ -22,6 +22,11 @@ import platform
 import sys
 from typing import Optional
 
+import numpy as np
+
+from . import _core
+from ._version import __version__
+
 __all__ = ["provenance", "show_versions"]
 
 
@@ -35,10 +40,6 @@ def _dist_version(name: str) -> Optional[str]:
 
 @functools.lru_cache(maxsize=None)
 def _static() -> tuple:
-    import numpy as np
-
-    from . import __version__, _core
-
     core = dict(_core.build_info())
     rec = {
         "hovering": __version__,

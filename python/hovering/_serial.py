@@ -37,11 +37,13 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _untrusted
+from ._output import replacing
+from ._provenance import provenance
+from ._version import __version__
+from ._untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
 
 __all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
 
-FORMAT = "hovering-npz-1"
-_META_KEY = "__meta__"
 _MAX_INT_BITS = _untrusted.MAX_INT_BITS
 
 
@@ -452,10 +454,6 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     hovering._output.WriteError
         (a ValueError) When writing fails, e.g. ``no space left``; the previous file is intact.
     """
-    from . import __version__
-    from ._output import replacing
-    from ._provenance import provenance
-
     path = _path(path, "path")
     if not path.endswith(".npz"):
         path += ".npz"
@@ -481,35 +479,8 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     return path
 
 
-#: Largest ``__meta__`` member :func:`is_result_file` reads to recognise a result file.
-_MAX_SNIFF_META = 64 << 20
 
 
-def is_result_file(path: os.PathLike) -> bool:
-    """Whether ``path`` is an NPZ written by :func:`save` (its ``__meta__`` document has this
-    format); False for anything else or anything unreadable. Reads only that member (at most 64 MiB
-    declared), never the arrays.
-
-    Parameters
-    ----------
-    path : path-like
-        The file.
-
-    Returns
-    -------
-    bool
-    """
-    try:  # an untrusted file: read as load reads it (hovering._untrusted), only its __meta__ member
-        with _untrusted.Archive(os.fspath(path)) as z:
-            if _META_KEY not in z.files:
-                return False
-            dtype, shape, nbytes = z.header(_META_KEY)
-            if dtype.kind != "U" or shape != () or nbytes > _MAX_SNIFF_META:
-                return False
-            doc = _untrusted.parse_json(str(z.read(_META_KEY)))
-    except Exception:  # noqa: BLE001 - any failure to read it means: not recognised as ours
-        return False
-    return isinstance(doc, dict) and doc.get("format") == FORMAT
 
 
 def load(path: os.PathLike, meta: bool = False):

@@ -23,7 +23,7 @@ import zipfile
 
 import numpy as np
 
-from ._common import physical_memory
+from ._checks import physical_memory
 
 __all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_INT_BITS", "MAX_MEMBERS",
            "MAX_DIRECTORY_BYTES", "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "json_cost",
@@ -66,7 +66,7 @@ _PLAIN_KINDS = "biufcU"
 def memory_budget() -> int:
     """Bytes a file may make the reader hold: half of this machine's physical memory.
 
-    The same budget as a computed result (:func:`hovering._common.check_memory`): a result this
+    The same budget as a computed result (:func:`hovering._checks.check_memory`): a result this
     machine could have computed can be read back; a file cannot make it hold more.
 
     Returns
@@ -416,3 +416,39 @@ class Archive:
                 return np.lib.format.read_array(f, allow_pickle=False)
         except (ValueError, EOFError, OSError, zipfile.BadZipFile) as e:
             raise ValueError(f"{self.path}: array {key[:80]!r}: {e}") from None
+
+
+# The NPZ format of hovering.save: its name and the member holding the JSON tree. Here, not in
+# _serial, because recognising a file as ours is reading an untrusted file, and the writers
+# (hovering._output) need it without depending on the serializer.
+FORMAT = "hovering-npz-1"
+_META_KEY = "__meta__"
+#: Largest ``__meta__`` member :func:`is_result_file` reads to recognise a result file.
+_MAX_SNIFF_META = 64 << 20
+
+
+def is_result_file(path: os.PathLike) -> bool:
+    """Whether ``path`` is an NPZ written by :func:`hovering.save` (its ``__meta__`` document has this
+    format); False for anything else or anything unreadable. Reads only that member (at most 64 MiB
+    declared), never the arrays.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+
+    Returns
+    -------
+    bool
+    """
+    try:  # an untrusted file: read as load reads it, only its __meta__ member
+        with Archive(os.fspath(path)) as z:
+            if _META_KEY not in z.files:
+                return False
+            dtype, shape, nbytes = z.header(_META_KEY)
+            if dtype.kind != "U" or shape != () or nbytes > _MAX_SNIFF_META:
+                return False
+            doc = parse_json(str(z.read(_META_KEY)))
+    except Exception:  # noqa: BLE001 - any failure to read it means: not recognised as ours
+        return False
+    return isinstance(doc, dict) and doc.get("format") == FORMAT

@@ -31,7 +31,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from ._common import integer, is_choice, real_number
+from ._checks import integer, is_choice, real_number
 
 __all__ = ["WorkPrecision", "work_precision", "choose_setting", "exact_available", "FLOW_STEPPERS_DEFAULT"]
 

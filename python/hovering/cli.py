@@ -75,7 +75,7 @@ def _scene(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._common import output_path
+    from ._output import output_path
     from .scenes import load_scene
 
     try:
@@ -98,7 +98,7 @@ def _demo(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._common import output_path
+    from ._output import output_path
     from .scenes import packaged_scene, parse_scene
 
     path = packaged_scene("demo")
@@ -122,7 +122,7 @@ def _redraw(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._common import output_path
+    from ._output import output_path
     from .scenes import redraw
 
     try:
@@ -142,7 +142,7 @@ def _accuracy(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._common import output_path
+    from ._output import output_path
     from ._output import refuse_foreign, savefig, write_text
     from ._provenance import provenance
     from .accuracy import work_precision

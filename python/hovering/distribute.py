@@ -16,7 +16,7 @@ import os
 from contextlib import contextmanager
 from typing import Callable, Iterable, Iterator, Optional
 
-from ._common import integer
+from ._checks import integer
 
 __all__ = ["executor", "run_pieces"]
 

@@ -36,7 +36,9 @@ from typing import Optional
 
 import numpy as np
 
-from ._common import Region, Status, integer, real_number, require_angles, require_map, require_type, wrap
+from ._checks import integer, real_number, require_angles, require_type
+from ._enums import Region, Status, wrap
+from .interface import require_map
 from .plotting import REGION_COLORS
 
 __all__ = ["explore", "Explorer", "Orbit", "default_K_range", "default_n_steps", "main", "COLORS", "DEFAULT_N_STEPS",

@@ -1,6 +1,7 @@
 """Analyses written once for every map (TruncatedMap, TruncatedFamily, FlowMap): rotation numbers
 and regularity, the hovering set HOV(eps), and the critical invariant curve."""
 
+from ..interface import register
 from .critical import CriticalCurve, critical_curve, max_angular_gap
 from .hovering import HoveringArea, hovering_area
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
@@ -16,3 +17,8 @@ __all__ = [
     "critical_curve",
     "max_angular_gap",
 ]
+
+# The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the
+# interface's hooks: the models sit below the analyses and never import them.
+register("hovering_area", hovering_area)
+register("critical_curve", critical_curve)

@@ -11,7 +11,9 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .._common import REGION_LABELS, Region, Status, is_choice, real_array, region_mask, require_map
+from .._checks import is_choice, real_array
+from .._enums import Region, REGION_LABELS, region_mask, Status
+from ..interface import require_map
 from .._serial import Saveable
 from .._progress import check_progress, progress_bar
 from .rotation import regularity, rotation_number

@@ -15,7 +15,9 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import Region, Status, check_memory, flag, integer, real_number, require_map, thread_count
+from .._checks import check_memory, flag, integer, real_number, thread_count
+from .._enums import Region, Status
+from ..interface import require_map
 from .._serial import Saveable
 from .._progress import check_progress, progress_bar
 

@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-from .._common import is_choice, real_array
+from .._checks import is_choice, real_array
+from ..interface import IterateResult
 
 __all__ = ["birkhoff_weights", "birkhoff_average", "rotation_number", "regularity"]
 
@@ -86,7 +87,6 @@ def _omegas(res, i: int) -> np.ndarray:
 
 
 def _result(name: str, res):
-    from ..truncated.maps import IterateResult
 
     if not isinstance(res, IterateResult):
         raise ValueError(f"{name} must be the IterateResult of a map's iterate(...), got {type(res).__name__}")

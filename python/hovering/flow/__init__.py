@@ -1,7 +1,7 @@
 """The physical system of sec:setup: potentials with action-angle variables, the oscillators-step
 system and its onset parameters, the section Sigma_h and the return map of the impact flow."""
 
-from .._common import TrajectoryPoint
+from .._enums import TrajectoryPoint
 from .potentials import CustomPotential, check_potential
 from .section import STEPPERS, FlowStatus, ReturnMapResult, Section, flow_options
 from .system import Bilinear, Harmonic, Numerical, OnsetParameters, Polynomial, Potential, StepSystem, Tan, onset_parameters

@@ -8,8 +8,10 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from .._common import (MAX_TRAJECTORY_POINTS, FlowStatus, integer, is_choice, real_array, real_number, status_code,
-                       thread_count, trajectory_arguments, trajectory_rows)
+from .._checks import integer, is_choice, real_array, real_number, thread_count
+from .._enums import status_code
+from .._enums import FlowStatus
+from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .._progress import check_progress, progress_bar
 from .._serial import Saveable
 from .system import StepSystem

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from typing import Optional
 
 from .. import _core
-from .._common import Geometry, is_choice, real_number
+from .._checks import is_choice, real_number
+from .._enums import Geometry
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
 
 __all__ = [

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._common import Region, forcing_array, real_number, require_type, wrap
+from .._checks import forcing_array, real_number, require_type
+from .._enums import Region, wrap
 from .._serial import Saveable
 from ..flow.section import Section
 from ..truncated.maps import TruncatedFamily, TruncatedMap

@@ -17,7 +17,8 @@ import operator
 import numpy as np
 
 from .. import _core
-from .._common import MAX_MODES, integer, real_array, require_angles, require_finite, require_type, wrap
+from .._checks import integer, MAX_MODES, real_array, require_angles, require_finite, require_type
+from .._enums import wrap
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 

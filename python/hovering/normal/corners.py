@@ -10,7 +10,8 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import integer, real_array, require_finite, wrap
+from .._checks import integer, real_array, require_finite
+from .._enums import wrap
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section
 from ..flow.system import onset_parameters

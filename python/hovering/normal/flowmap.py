@@ -15,15 +15,16 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 from .. import _core
-from .._common import (MAX_MODES, MAX_TRAJECTORY_POINTS, Region, check_memory, flag, forcing_array, integer,
-                       is_choice, iterate_arguments, point_pair, trajectory_arguments, wrap)
+from .._checks import check_memory, flag, forcing_array, integer, is_choice, MAX_MODES, point_pair
+from .._enums import Region, wrap
+from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, trajectory_arguments
 from .._progress import check_progress, progress_bar
-from .._protocols import MapAnalyses
+from ..interface import IterateResult, MapAnalyses
 from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
 from ..truncated import theory as _theory  # the module (hovering.truncated does not export the function)
-from ..truncated.maps import IterateResult, TruncatedFamily, TruncatedMap
+from ..truncated.maps import TruncatedFamily, TruncatedMap
 from .coordinates import TangentialCurve
 
 __all__ = ["FlowMap", "FlowSteps", "FLOW_RECORD_KEYS"]

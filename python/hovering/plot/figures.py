@@ -16,7 +16,7 @@ from typing import Optional
 
 import numpy as np
 
-from .._common import Region
+from .._enums import Region
 from ..scenes.results import (FlowHoveringResult, FlowPortraitResult, HoveringAreaResult, OrbitPanelResult,
                               OrbitSceneResult, SigmaStructureResult, TangentToriResult)
 from ..scenes.spec import QUICK_FACTOR

@@ -3,7 +3,7 @@ read them (a scene's result stores colour names; the figures turn them into arti
 
 from __future__ import annotations
 
-from .._common import Region
+from .._enums import Region
 
 __all__ = ["REGION_COLORS", "REGION_LABELS", "SPECIAL_COLORS", "SPECIAL_LABELS", "CORNER_STYLES", "GEOMETRY_COLOR",
            "orbit_color", "QUICK_MARK"]

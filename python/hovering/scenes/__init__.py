@@ -35,7 +35,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Optional
 
-from .._common import output_path
+from .._output import output_path
 from .compute import compute
 from .report import format_summary, summarize
 from .results import SceneResult, load_result

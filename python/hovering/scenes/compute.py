@@ -17,9 +17,10 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from .._common import Region, Status, wrap
+from .._enums import Region, Status, wrap
 from ..plot.style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
+from .._version import __version__
 from ..analysis.hovering import default_depth
 from ..sweeps import Checkpoint, check_row
 from ..truncated.theory import golden_family, hovering_area_theory
@@ -762,7 +763,6 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
     SceneResult
         The kind's result type, with ``meta`` (version, quick, timings).
     """
-    from .. import __version__
 
     if not isinstance(scene, SceneSpec):
         raise ValueError(f"scene must be a scene spec from hovering.scenes.load_scene, got {type(scene).__name__}")

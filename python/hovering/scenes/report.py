@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._common import Region, Status
+from .._enums import Region, Status
 from .results import (FlowHoveringResult, FlowPortraitResult, HoveringAreaResult, OrbitPanelResult, OrbitSceneResult,
                       OrbitSet, SigmaStructureResult, TangentToriResult, jsonable)
 

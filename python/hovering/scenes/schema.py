@@ -19,7 +19,7 @@ import tomllib
 from pathlib import Path
 from typing import Optional
 
-from .._common import output_path
+from .._output import output_path
 from ..flow.section import STEPPERS
 from ..truncated.theory import OMEGA_G, golden_family
 from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHoveringScene, FlowPortraitScene,

@@ -1,7 +1,8 @@
 """The truncated near-tangency model (sec:truncatedmapnum): the paper's F_eps, the general family
 F_{eps1,eps2} with tabulated arcs and any odd forcing, and the closed-form theory of both."""
 
-from .maps import IterateResult, TruncatedFamily, TruncatedMap
+from ..interface import IterateResult  # re-exported: hovering.truncated.IterateResult (its old home)
+from .maps import TruncatedFamily, TruncatedMap
 from .theory import (
     OMEGA_G,
     K_crit,

@@ -9,19 +9,17 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, field
-from typing import Iterable, Optional, Sequence, Union
+from typing import Iterable, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
-from .._common import (Region, Status, check_memory, is_choice, iterate_arguments, real_array, real_number,
-                       point_pair, require_angles, require_finite, status_code, thread_count, trajectory_rows, wrap,
-                       forcing_array)
+from .._checks import (check_memory, forcing_array, is_choice, point_pair, real_array, real_number, require_angles, require_finite, thread_count)
+from .._enums import Region, wrap
+from ..interface import iterate_arguments
 from .._progress import check_progress, progress_bar
 from .._pickle import reduce_compiled
-from .._protocols import MapAnalyses
-from .._serial import Saveable
+from ..interface import IterateResult, MapAnalyses
 from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
@@ -29,136 +27,6 @@ __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 _RECORD_KEYS = ("orbit", "regions", "rotation", "visited")
 
 
-@dataclass(frozen=True)
-class IterateResult(Saveable):
-    """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
-
-    Attributes
-    ----------
-    phi, K : ndarray or None
-        Orbits, shape ``(n_orbits, n_steps + 1)``, when ``"orbit"`` was recorded; NaN after an
-        orbit stopped (see ``status`` and ``steps_done``).
-    region : ndarray of int8 or None
-        Region code (:class:`Region`) of the point each step was taken from, shape
-        ``(n_orbits, n_steps)``, when ``"regions"`` was recorded; ``Region.NONE`` after a stop.
-    rotation : ndarray or None
-        The paper's rotation number rho: the mean of omega_a over the steps taken (NaN for an
-        orbit that took no step), when ``"rotation"`` was recorded.
-    phi_final, K_final : ndarray
-        Last state reached by each orbit.
-    status : ndarray of int8
-        Per-orbit :class:`Status`.
-    steps_done : ndarray of int64
-        Number of steps each orbit took.
-    exit_step : ndarray of int64 or None
-        First n at which the orbit point lay outside ``exit_regions`` (-1 if never), when
-        ``exit_regions`` was given.
-    n_steps : int
-        Steps requested per orbit.
-    map : TruncatedMap, TruncatedFamily or FlowMap
-        The map that produced the result (used by :func:`hovering.rotation_number`).
-    theta, I : ndarray or None
-        Flow only, record ``"section"``: section coordinates of the orbit points.
-    z : ndarray or None
-        Flow only, record ``"states"``: the points of Sigma_h, shape ``(n_orbits, n_steps + 1, 4)``.
-    time, energy_error : ndarray or None
-        Flow only, records ``"times"``, ``"energy_error"``: per return, shape ``(n_orbits, n_steps)``
-        (``|H - h|`` of each image before it is put back on Sigma_h).
-    integrator_steps : ndarray of int64 or None
-        Flow only, record ``"steps"``: accepted integrator steps of each return.
-    itinerary : list of list of str or None
-        Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'.
-    visited : ndarray of int8 or None
-        Record ``"visited"``: per orbit, bit r set when it took a step from a point of Region r
-        (including the point where it left ``exit_regions``); e.g. a hovering orbit has the bits of
-        both J_0 (ABOVE) and J_0u (BESIDE).
-    trajectory : ndarray or None
-        Flow only, record ``"trajectory"``: the flow between the returns, rows ``(t, q1, p1, q2,
-        p2)`` of all orbits one after the other, shape ``(N_total, 5)`` (orbit i is
-        ``trajectory[trajectory_index[i]:trajectory_index[i + 1]]``, see :meth:`trajectory_of`).
-        Per orbit, in time order: the states at the uniform times ``t = k * trajectory_dt`` of the
-        orbit's clock (it starts at 0 and runs on across returns), plus the exact states just
-        before and after every impact (on the wall), each return point on Sigma_h and where the
-        orbit stopped (``trajectory_kind`` tells which).
-    trajectory_index : ndarray of int64 or None
-        Offsets of each orbit's rows, shape ``(n_orbits + 1,)``.
-    trajectory_kind : ndarray of int8 or None
-        :class:`hovering.TrajectoryPoint` of each row: SAMPLE, IMPACT_IN, IMPACT_OUT, RETURN, END.
-    trajectory_truncated : ndarray of bool or None
-        Per orbit: it reached its share of ``max_trajectory_points`` and recorded no further point
-        (the orbit itself was followed to the end).
-    work : dict or None
-        Flow only: what the integration did, summed over the call (ints): ``field_evaluations``,
-        ``coupling_evaluations``, ``wall_searches``, ``section_searches``, ``label_operations``
-        (crossings of q1 = qw1 and itinerary bookkeeping), ``dense_samples`` (trajectory samples),
-        ``steps`` (accepted integrator steps). Effects nobody asked for cost nothing: no walls, no
-        wall search; eps = 0, no coupling evaluation; no labels, no label operation; no trajectory,
-        no dense sample.
-    """
-
-    phi: Optional[np.ndarray]
-    K: Optional[np.ndarray]
-    region: Optional[np.ndarray]
-    rotation: Optional[np.ndarray]
-    phi_final: np.ndarray
-    K_final: np.ndarray
-    status: np.ndarray
-    steps_done: np.ndarray
-    exit_step: Optional[np.ndarray]
-    n_steps: int
-    map: object = field(default=None, repr=False, compare=False)
-    theta: Optional[np.ndarray] = None
-    I: Optional[np.ndarray] = None
-    z: Optional[np.ndarray] = None
-    time: Optional[np.ndarray] = None
-    energy_error: Optional[np.ndarray] = None
-    integrator_steps: Optional[np.ndarray] = None
-    itinerary: Optional[list] = None
-    visited: Optional[np.ndarray] = None
-    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
-    work: Optional[dict] = None
-
-    def trajectory_of(self, i: int) -> np.ndarray:
-        """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
-
-        Parameters
-        ----------
-        i : int
-            Orbit index (negative counts from the end).
-
-        Returns
-        -------
-        ndarray
-            Its kinds are ``trajectory_kind[trajectory_index[i]:trajectory_index[i + 1]]``.
-
-        Raises
-        ------
-        ValueError
-            If no trajectory was recorded or i is out of range.
-        """
-        return trajectory_rows(self, i)
-
-    @property
-    def n_orbits(self) -> int:
-        """Number of orbits."""
-        return int(self.status.shape[0])
-
-    def count(self, status: Union[Status, int]) -> int:
-        """Number of orbits with the given status.
-
-        Parameters
-        ----------
-        status : Status or int
-            The outcome to count.
-
-        Returns
-        -------
-        int
-        """
-        return int(np.count_nonzero(self.status == status_code(Status, status)))
 
 
 class _MapAPI(MapAnalyses):

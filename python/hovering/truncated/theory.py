@@ -17,7 +17,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .._common import forcing_array, integer, real_array, real_number, require_angles, require_finite, wrap
+from .._checks import forcing_array, integer, real_array, real_number, require_angles, require_finite
+from .._enums import wrap
 from .._serial import Saveable
 
 __all__ = [

@@ -1,0 +1,187 @@
+"""Argument checks shared by every public call: a bad value is a ValueError naming the parameter,
+the value and what is allowed, raised before any work (README: "Outcomes are values, bad input is an
+error"). The lowest layer of the package: it imports nothing of hovering but the compiled core.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import operator
+import os
+
+import numpy as np
+
+__all__ = ["MAX_ANGLE", "MAX_MODES", "real_number", "integer", "flag", "require_type", "is_choice",
+           "thread_count", "forcing_array", "point_pair", "real_array", "require_finite", "require_angles",
+           "physical_memory", "check_memory"]
+
+#: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
+#: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
+MAX_ANGLE = 1e6
+
+
+def real_number(name: str, value, lo=None, lo_open=True, hi=None, hi_open=True) -> float:
+    """A finite real number (not a bool, string or complex) in an optional interval, or a ValueError naming it.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name (for the message).
+    value : object
+        What was passed.
+    lo, hi : float, optional
+        Interval ends (None: unbounded).
+    lo_open, hi_open : bool, optional
+        Whether the ends are excluded.
+
+    Returns
+    -------
+    float
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()  # a 0-d array is a number, as numpy scalars are
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {_short(value)}")
+    try:
+        v = float(value)
+    except OverflowError:
+        raise ValueError(f"{name} must be a real number within the range of a double, got {_short(value)}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and (v >= hi if hi_open else v > hi)):
+        rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{')' if hi_open else ']'}"
+        raise ValueError(f"{name} must lie in {rng}, got {v}")
+    return v
+
+
+def integer(name: str, value, lo: int, hi: int) -> int:
+    """An integer (not a bool, float or string) in [lo, hi], or a ValueError naming it and the range."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iu":
+        value = value.item()
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise ValueError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}") from None
+    if isinstance(value, (bool, np.bool_)) or not lo <= v <= hi:
+        raise ValueError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
+    return v
+
+
+def flag(name: str, value) -> bool:
+    """A True/False argument (not 'yes', None or 1), or a ValueError naming it."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {_short(value)}")
+    return bool(value)
+
+
+def require_type(name: str, value, cls, what: str):
+    """``value`` if it is an instance of cls, else a ValueError naming the parameter and what it must be."""
+    if not isinstance(value, cls):
+        raise ValueError(f"{name} must be {what}, got {_short(value)}")
+    return value
+
+
+def is_choice(value, choices) -> bool:
+    """Whether value is one of the string choices (False, not an error, for arrays and other types)."""
+    return isinstance(value, str) and value in choices
+
+
+def thread_count(value) -> int:
+    """The ``n_threads`` argument every parallel call takes: an integer in [0, 4096], 0 = all cores."""
+    try:
+        v = operator.index(value)
+    except TypeError:
+        v = None
+    if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= 4096:
+        raise ValueError(f"n_threads must be an integer in [0, 4096] (0 = all cores), got {value!r}")
+    return v
+
+
+#: Most sine coefficients of a forcing f: the theory's cost grows with each (1000 took 20 s) and the
+#: measured f of the flow needs ~8.
+MAX_MODES = 64
+
+
+def forcing_array(value) -> np.ndarray:
+    """Sine coefficients ``b_1, b_2, ...`` of a forcing: 1 to MAX_MODES finite real numbers."""
+    if isinstance(value, str):
+        raise ValueError(f"forcing must be a sequence of sine coefficients, got {value!r}")
+    b = np.atleast_1d(real_array("forcing", value))
+    if b.ndim != 1 or not 1 <= b.size <= MAX_MODES:
+        raise ValueError(f"forcing must be a 1-D sequence of 1 to {MAX_MODES} sine coefficients, got shape {b.shape}")
+    require_finite("forcing", b)
+    return b
+
+
+def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
+    """Points (phi, K) of a map: real, finite, |phi| <= 1e6, broadcast together (C-ordered); and
+    whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0)."""
+    na, nb = (f"{who}: {n}" if who else n for n in names)
+    scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
+    p, k = real_array(na, phi), real_array(nb, K)  # type errors first, named
+    require_angles(na, p)
+    require_finite(nb, k)
+    try:
+        p, k = np.broadcast_arrays(p, k)
+    except ValueError:
+        raise ValueError(f"{who + ': ' if who else ''}{names[0]} and {names[1]} must have broadcastable shapes, got "
+                         f"{np.shape(phi)} and {np.shape(K)}") from None
+    # np.ascontiguousarray would turn 0-d into 1-d; the bindings copy non-contiguous views themselves.
+    return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
+
+
+def real_array(name: str, value) -> np.ndarray:
+    """``value`` as a float array; a ValueError naming it for strings, objects, booleans or complex numbers."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be real numbers, got {value!r}") from None
+    if a.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be real numbers, got dtype {a.dtype} ({_short(value)})")
+    return a.astype(float, copy=False)
+
+
+def require_finite(name: str, a) -> None:
+    """Raise a ValueError naming the first non-finite entry of ``a``."""
+    a = np.asarray(a)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
+        raise ValueError(f"{_entry(name, i)} must be finite, got {a[i]}")
+
+
+def require_angles(name: str, a) -> None:
+    """Raise unless every entry is a finite angle that can be wrapped accurately (|x| <= MAX_ANGLE)."""
+    require_finite(name, a)
+    a = np.asarray(a)
+    if a.size and np.max(np.abs(a)) > MAX_ANGLE:
+        i = np.unravel_index(int(np.argmax(np.abs(a.ravel()) > MAX_ANGLE)), a.shape)
+        raise ValueError(f"{_entry(name, i)} must be an angle in [-1e6, 1e6] (larger ones cannot be wrapped to "
+                         f"[-pi, pi) accurately in double precision), got {a[i]}")
+
+
+def physical_memory() -> int:
+    """Bytes of physical memory of this machine (64 GiB where the system does not say)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 2**36
+
+
+def check_memory(what: str, nbytes: int) -> None:
+    """Refuse, before any work, a result that would need more than half of this machine's memory."""
+    total = physical_memory()
+    if nbytes > total // 2:
+        raise ValueError(f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
+                         f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")
+
+
+def _entry(name: str, index: tuple) -> str:
+    """``name[i]`` (or ``name[i, j]``, or ``name`` for a scalar): the entry a message is about."""
+    return f"{name}[{', '.join(str(int(k)) for k in index)}]" if index else name
+
+
+def _short(value) -> str:
+    r = repr(value)
+    return r if len(r) <= 60 else r[:57] + "..."

@@ -1,0 +1,388 @@
+"""The one interface both models share: a return map on (phi, K), its result type and the argument
+checks of its calls (DynamicalSystemsBase's idea that a flow's Poincare map *is* a map). Every
+analysis is written once against it; it lives below every model, so models and analyses import it,
+never each other.
+"""
+
+from __future__ import annotations
+
+import operator
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Optional, Protocol, Sequence, Tuple, Union, runtime_checkable
+
+import numpy as np
+
+from ._checks import _short, check_memory, integer, is_choice, real_number
+from ._enums import Status, region_mask, status_code
+from ._serial import Saveable
+
+__all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "trajectory_arguments",
+           "trajectory_rows", "require_map", "MAX_TRAJECTORY_POINTS", "register", "hook"]
+
+#: Functions of the layers above the models that the models' convenience methods call
+#: (``m.hovering_area()``, ``FlowMap(accuracy=...)``): each higher module registers its own when
+#: it is imported (``import hovering`` imports all of them), so the arrows still point down.
+_HOOKS: dict = {}
+
+
+def register(name: str, fn: Callable) -> Callable:
+    """Make ``fn`` the implementation of the hook ``name`` (called by the module that owns it).
+
+    Parameters
+    ----------
+    name : str
+        The hook's name (``"hovering_area"``, ``"critical_curve"``, ``"choose_setting"``).
+    fn : callable
+        Its implementation.
+
+    Returns
+    -------
+    callable
+        ``fn``, so this can decorate it.
+    """
+    _HOOKS[name] = fn
+    return fn
+
+
+def hook(name: str) -> Callable:
+    """The implementation registered for ``name``.
+
+    Raises
+    ------
+    RuntimeError
+        If the module that owns it was never imported (``import hovering`` imports them all).
+    """
+    try:
+        return _HOOKS[name]
+    except KeyError:
+        raise RuntimeError(f"{name} is provided by a part of hovering that is not loaded; import hovering first") from None
+
+
+@runtime_checkable
+class ReturnMap(Protocol):
+    """What :mod:`hovering.analysis` needs of a map: TruncatedMap, TruncatedFamily and FlowMap have it."""
+
+    eps: float
+
+    def step(self, phi, K):
+        """One forward step."""
+
+    def step_inverse(self, phi, K):
+        """One backward step."""
+
+    def region(self, phi, K):
+        """Region of the return from each point."""
+
+    def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ..., exit_regions: Optional[Iterable] = None,
+                stop_on_exit: bool = False, n_threads: int = 0, progress=False):
+        """Many orbits at once -> IterateResult (progress: see hovering._progress)."""
+
+    def with_eps(self, eps: float) -> "ReturnMap":
+        """The same map at another eps (F_0 for the hovering set's definition)."""
+
+    def valid_band(self) -> Tuple[float, float]:
+        """Open interval of K on which the map is defined."""
+
+    def theory(self):
+        """Leading-order predictions (hovering.Theory) for this map's parameters."""
+
+    def L1(self, K):
+        """Angle of the line L1 at heights K (def:L1L2)."""
+
+    def L2(self, K):
+        """Angle of the line L2 at heights K (def:L1L2)."""
+
+
+class MapAnalyses:
+    """The analyses as methods, for every map (mixed into TruncatedMap, TruncatedFamily, FlowMap)."""
+
+    def hovering_area(self, n_steps: int = 10_000, samples: int = 100_000, **kwargs):
+        """Area of the hovering set HOV(eps), with error estimate and theory; see :func:`hovering.hovering_area`.
+
+        Parameters
+        ----------
+        n_steps : int, optional
+            Iterates that count as "never impacts".
+        samples : int, optional
+            Sample points (stratified over the box below K = 0).
+        **kwargs
+            ``K_low``, ``seed``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
+            stderr; a callable ``progress(done, total)``).
+
+        Returns
+        -------
+        HoveringArea
+            ``.area``, ``.error``, ``.theory`` and diagnostics.
+        """
+        return hook("hovering_area")(self, n_steps=n_steps, samples=samples, **kwargs)
+
+    def critical_curve(self, n_steps: int = 20_000, **kwargs):
+        """Lowest invariant curve in the no-impact regions; see :func:`hovering.critical_curve`.
+
+        Parameters
+        ----------
+        n_steps : int, optional
+            Iterates per tested orbit.
+        **kwargs
+            ``K_range``, ``regions``, ``line``, ``grid``, ``digits``, ``tol``, ``n_threads``,
+            ``search``, ``progress`` (True: a tqdm bar on stderr; a callable ``progress(done, total)``).
+
+        Returns
+        -------
+        CriticalCurve
+            ``.K_min``, ``.rotation``, ``.K_pred``, ``.rotation_pred``, ``.hovers``, ``.note``, ...
+        """
+        return hook("critical_curve")(self, n_steps=n_steps, **kwargs)
+
+    def hovers(self) -> bool:
+        """Whether the leading-order theory predicts a hovering set for this map (see :meth:`theory`)."""
+        return bool(self.theory().hovers)
+
+
+@dataclass(frozen=True)
+class IterateResult(Saveable):
+    """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
+
+    Attributes
+    ----------
+    phi, K : ndarray or None
+        Orbits, shape ``(n_orbits, n_steps + 1)``, when ``"orbit"`` was recorded; NaN after an
+        orbit stopped (see ``status`` and ``steps_done``).
+    region : ndarray of int8 or None
+        Region code (:class:`Region`) of the point each step was taken from, shape
+        ``(n_orbits, n_steps)``, when ``"regions"`` was recorded; ``Region.NONE`` after a stop.
+    rotation : ndarray or None
+        The paper's rotation number rho: the mean of omega_a over the steps taken (NaN for an
+        orbit that took no step), when ``"rotation"`` was recorded.
+    phi_final, K_final : ndarray
+        Last state reached by each orbit.
+    status : ndarray of int8
+        Per-orbit :class:`Status`.
+    steps_done : ndarray of int64
+        Number of steps each orbit took.
+    exit_step : ndarray of int64 or None
+        First n at which the orbit point lay outside ``exit_regions`` (-1 if never), when
+        ``exit_regions`` was given.
+    n_steps : int
+        Steps requested per orbit.
+    map : TruncatedMap, TruncatedFamily or FlowMap
+        The map that produced the result (used by :func:`hovering.rotation_number`).
+    theta, I : ndarray or None
+        Flow only, record ``"section"``: section coordinates of the orbit points.
+    z : ndarray or None
+        Flow only, record ``"states"``: the points of Sigma_h, shape ``(n_orbits, n_steps + 1, 4)``.
+    time, energy_error : ndarray or None
+        Flow only, records ``"times"``, ``"energy_error"``: per return, shape ``(n_orbits, n_steps)``
+        (``|H - h|`` of each image before it is put back on Sigma_h).
+    integrator_steps : ndarray of int64 or None
+        Flow only, record ``"steps"``: accepted integrator steps of each return.
+    itinerary : list of list of str or None
+        Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'.
+    visited : ndarray of int8 or None
+        Record ``"visited"``: per orbit, bit r set when it took a step from a point of Region r
+        (including the point where it left ``exit_regions``); e.g. a hovering orbit has the bits of
+        both J_0 (ABOVE) and J_0u (BESIDE).
+    trajectory : ndarray or None
+        Flow only, record ``"trajectory"``: the flow between the returns, rows ``(t, q1, p1, q2,
+        p2)`` of all orbits one after the other, shape ``(N_total, 5)`` (orbit i is
+        ``trajectory[trajectory_index[i]:trajectory_index[i + 1]]``, see :meth:`trajectory_of`).
+        Per orbit, in time order: the states at the uniform times ``t = k * trajectory_dt`` of the
+        orbit's clock (it starts at 0 and runs on across returns), plus the exact states just
+        before and after every impact (on the wall), each return point on Sigma_h and where the
+        orbit stopped (``trajectory_kind`` tells which).
+    trajectory_index : ndarray of int64 or None
+        Offsets of each orbit's rows, shape ``(n_orbits + 1,)``.
+    trajectory_kind : ndarray of int8 or None
+        :class:`hovering.TrajectoryPoint` of each row: SAMPLE, IMPACT_IN, IMPACT_OUT, RETURN, END.
+    trajectory_truncated : ndarray of bool or None
+        Per orbit: it reached its share of ``max_trajectory_points`` and recorded no further point
+        (the orbit itself was followed to the end).
+    work : dict or None
+        Flow only: what the integration did, summed over the call (ints): ``field_evaluations``,
+        ``coupling_evaluations``, ``wall_searches``, ``section_searches``, ``label_operations``
+        (crossings of q1 = qw1 and itinerary bookkeeping), ``dense_samples`` (trajectory samples),
+        ``steps`` (accepted integrator steps). Effects nobody asked for cost nothing: no walls, no
+        wall search; eps = 0, no coupling evaluation; no labels, no label operation; no trajectory,
+        no dense sample.
+    """
+
+    phi: Optional[np.ndarray]
+    K: Optional[np.ndarray]
+    region: Optional[np.ndarray]
+    rotation: Optional[np.ndarray]
+    phi_final: np.ndarray
+    K_final: np.ndarray
+    status: np.ndarray
+    steps_done: np.ndarray
+    exit_step: Optional[np.ndarray]
+    n_steps: int
+    map: object = field(default=None, repr=False, compare=False)
+    theta: Optional[np.ndarray] = None
+    I: Optional[np.ndarray] = None
+    z: Optional[np.ndarray] = None
+    time: Optional[np.ndarray] = None
+    energy_error: Optional[np.ndarray] = None
+    integrator_steps: Optional[np.ndarray] = None
+    itinerary: Optional[list] = None
+    visited: Optional[np.ndarray] = None
+    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
+    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
+    work: Optional[dict] = None
+
+    def trajectory_of(self, i: int) -> np.ndarray:
+        """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
+
+        Parameters
+        ----------
+        i : int
+            Orbit index (negative counts from the end).
+
+        Returns
+        -------
+        ndarray
+            Its kinds are ``trajectory_kind[trajectory_index[i]:trajectory_index[i + 1]]``.
+
+        Raises
+        ------
+        ValueError
+            If no trajectory was recorded or i is out of range.
+        """
+        return trajectory_rows(self, i)
+
+    @property
+    def n_orbits(self) -> int:
+        """Number of orbits."""
+        return int(self.status.shape[0])
+
+    def count(self, status: Union[Status, int]) -> int:
+        """Number of orbits with the given status.
+
+        Parameters
+        ----------
+        status : Status or int
+            The outcome to count.
+
+        Returns
+        -------
+        int
+        """
+        return int(np.count_nonzero(self.status == status_code(Status, status)))
+
+
+def require_map(name: str, m):
+    """``m`` if it is a return map (TruncatedMap, TruncatedFamily, FlowMap: the ReturnMap protocol)."""
+    if not isinstance(m, ReturnMap):
+        raise ValueError(f"{name} must be a map (hovering.TruncatedMap, TruncatedFamily or FlowMap), got {_short(m)}")
+    return m
+
+
+def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> tuple:
+    """Check the arguments every map's ``iterate`` shares; ``(record tuple, n_steps, exit mask)``.
+
+    Raises
+    ------
+    ValueError
+        Naming the unknown record key, the bad step count or region, or an exit set that is
+        empty or missing where ``stop_on_exit`` needs it.
+    """
+    if isinstance(record, str):
+        record = (record,)
+    try:
+        record = tuple(record)
+    except TypeError:
+        raise ValueError(f"record must be a sequence of keys from {list(allowed)} (or () for none), got {record!r}") from None
+    unknown = [r for r in record if not is_choice(r, allowed)]
+    if unknown:
+        raise ValueError(f"record: unknown key(s) {unknown}; allowed: {list(allowed)}")
+    try:
+        if isinstance(n_steps, (bool, np.bool_)):
+            raise TypeError
+        n_steps = operator.index(n_steps)
+    except TypeError:
+        raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
+    if n_steps < 0:
+        raise ValueError(f"n_steps must be >= 0, got {n_steps}")
+    if n_steps > 2**53:
+        raise ValueError(f"n_steps must be <= 2**53, got {n_steps}")
+    if isinstance(stop_on_exit, (bool, np.bool_)) is False:
+        raise ValueError(f"stop_on_exit must be True or False, got {stop_on_exit!r}")
+    try:
+        mask = region_mask(exit_regions) if exit_regions is not None else 0
+    except ValueError as e:
+        raise ValueError(f"exit_regions: {e}") from None
+    if exit_regions is not None and mask == 0:
+        raise ValueError("exit_regions must name at least one region")
+    if stop_on_exit and mask == 0:
+        raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
+    return record, n_steps, mask
+
+
+#: Default bound of the points a trajectory recording keeps in total (all orbits of one call):
+#: 10 million points are ~410 MB (five float64 and one int8 each).
+MAX_TRAJECTORY_POINTS = 10_000_000
+
+
+def trajectory_arguments(trajectory_dt, max_trajectory_points, n_orbits: int) -> tuple:
+    """Check the arguments of a trajectory recording before anything is computed.
+
+    Parameters
+    ----------
+    trajectory_dt : float
+        Sample spacing, > 0.
+    max_trajectory_points : int
+        Bound of the points of all orbits together.
+    n_orbits : int
+        Number of orbits of the call.
+
+    Returns
+    -------
+    (float, int)
+        The sample spacing and the points each orbit may keep (``max_trajectory_points //
+        n_orbits``: an orbit that would record more stops recording and is flagged in
+        ``trajectory_truncated``).
+
+    Raises
+    ------
+    ValueError
+        For a spacing that is not a finite number > 0, a bound below two points per orbit (the
+        start and one more), or a bound whose worst case would not fit in memory.
+    """
+    dt = real_number("trajectory_dt", trajectory_dt, 0.0)
+    least = 2 * max(n_orbits, 1)
+    cap = integer(f"max_trajectory_points (at least 2 per orbit: {n_orbits} orbits)", max_trajectory_points, least,
+                  2**62)
+    per_orbit = cap // max(n_orbits, 1)
+    # Per-orbit vectors (growing by doubling) and the flat arrays they are copied into: ~3x the
+    # 41 bytes of a point in the worst case.
+    check_memory(f"a trajectory of up to {cap} points (max_trajectory_points)", 3 * 41 * per_orbit * n_orbits)
+    return dt, per_orbit
+
+
+def trajectory_rows(res, i) -> np.ndarray:
+    """Rows ``(t, q1, p1, q2, p2)`` of orbit i of a result with a recorded trajectory.
+
+    Parameters
+    ----------
+    res : IterateResult or ReturnMapResult
+        A result with ``trajectory`` and ``trajectory_index``.
+    i : int
+        Orbit index (negative counts from the end).
+
+    Returns
+    -------
+    ndarray
+        Shape ``(m_i, 5)``, a view into ``res.trajectory``.
+
+    Raises
+    ------
+    ValueError
+        If no trajectory was recorded or i is out of range.
+    """
+    if res.trajectory is None:
+        raise ValueError("no trajectory was recorded: pass record=('trajectory',) (FlowMap.iterate) or "
+                         "trajectory_dt (Section.return_map)")
+    n = res.trajectory_index.size - 1
+    i = integer("i (orbit index)", i, -n, n - 1) % n
+    return res.trajectory[res.trajectory_index[i] : res.trajectory_index[i + 1]]
