@@ -21,7 +21,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import hovering
-from hovering.accuracy import _best_time
+from hovering.diagnostics.work_precision import _best_time
 
 V1, V2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7)
 QW1, H = -1.0, 1.0

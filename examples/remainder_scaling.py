@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 import hovering
-from hovering import fullmap as fm
+from hovering import normal as fm
 
 V1, V2, H, QW1, QW2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7), 1.0, -1.0, -0.5
 

@@ -19,7 +19,8 @@ import pytest
 
 import hovering
 from hovering import Bilinear, FlowMap, Harmonic, Section, StepSystem, Tan
-from hovering.accuracy import _reference_run, choose_setting
+from hovering.diagnostics import choose_setting
+from hovering.diagnostics.work_precision import _reference_run
 
 ROOT = Path(__file__).resolve().parents[1]
 V1, V2 = Harmonic(1.0), Tan(1.4, 0.7)
@@ -200,7 +201,7 @@ def test_scipy_curve_is_an_independent_implementation_that_agrees():
     # start: each start and its neighbours up to 4 ulps away must give the same answer. (It used to: the
     # reference skipped p1 events whose p1 was exactly 0.0 at the root, which scipy returns on some
     # machines; the section crossing was then missed and the next return taken, 1.4 rad away.)
-    from hovering.references import scipy_return_map
+    from hovering.diagnostics import scipy_return_map
 
     sec = Section(system(0.0, "step"), 1.0)
     th, I = np.linspace(-3.0, 3.0, 12), np.full(12, 0.2)

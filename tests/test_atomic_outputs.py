@@ -39,7 +39,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import hovering  # noqa: E402
-from hovering import _core, scenes  # noqa: E402
+from hovering import _core, pipeline, scenes  # noqa: E402
 from hovering._output import WriteError  # noqa: E402
 from hovering._provenance import provenance  # noqa: E402
 from hovering.sweeps import Checkpoint  # noqa: E402
@@ -113,7 +113,7 @@ import numpy as np
 import matplotlib
 matplotlib.use("Agg")
 import hovering
-from hovering import scenes
+from hovering import pipeline, scenes
 
 action, variant, block, d = sys.argv[1:5]
 
@@ -153,7 +153,7 @@ if action == "save":
 else:
     text = open(os.path.join(d, "p.toml")).read().replace("TITLE", variant)
     scene = scenes.parse_scene(tomllib.loads(text), os.path.join(d, "p.toml"), check_output=False)
-    scenes.run_scene(scene, out=os.path.join(d, "r.png"))
+    pipeline.run_scene(scene, out=os.path.join(d, "r.png"))
 print("done", flush=True)
 """
 
@@ -536,7 +536,7 @@ def test_a_scene_cannot_write_outside_its_folder_and_the_working_directory(dirs,
     monkeypatch.chdir(dirs / "work")
     spec = scenes.parse_scene(tomllib.loads(scene.read_text()), scene, check_output=False)
     with pytest.raises(ValueError, match="a scene writes only under its own folder or the working directory"):
-        scenes.run_scene(spec)
+        pipeline.run_scene(spec)
 
 
 @pytest.mark.parametrize("output,where", [("r.png", "work"), ("ABS/scenes/out/r.png", "scenes")])

@@ -20,7 +20,7 @@ from matplotlib.colors import to_rgba_array
 import hovering
 from hovering import Region, Status
 from hovering.explore import COLORS, DEFAULT_N_STEPS, Explorer, default_K_range, main
-from hovering.plotting import REGION_COLORS
+from hovering.plot.style import REGION_COLORS
 
 PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
 

@@ -21,10 +21,11 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import Region, scenes
+from hovering import Region, pipeline, scenes
 from hovering.plot import render
 from hovering.plot.style import REGION_COLORS
-from hovering.scenes import load_result, parse_scene, run_scene
+from hovering.scenes import load_result, parse_scene
+from hovering.pipeline import run_scene
 
 SCENE_DIR = Path(__file__).resolve().parents[1] / "examples" / "scenes"
 FLOW_FILES = ("flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma")
@@ -91,7 +92,7 @@ def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, mo
 
     for cls in (hovering.FlowMap, hovering.TruncatedMap, hovering.TruncatedFamily):
         monkeypatch.setattr(cls, "iterate", refuse)
-    png, result, fig = scenes.redraw(s["npz"], out=tmp_path / "again.png", keep_figure=True)
+    png, result, fig = pipeline.redraw(s["npz"], out=tmp_path / "again.png", keep_figure=True)
     try:
         assert png.stat().st_size > 10_000
         a, b = _artists(s["figure"]), _artists(fig)

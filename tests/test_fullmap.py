@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import fullmap as fm
+from hovering import normal as fm
 
 V1, V2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7)
 

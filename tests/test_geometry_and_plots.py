@@ -16,7 +16,8 @@ import pytest
 import hovering
 import numpy_reference as ref
 from conftest import PARAM_SETS, cdiff, make_map
-from hovering import plotting
+from hovering import pipeline as plotting
+from hovering.plot import primitives
 
 OMEGA_G = 2 * np.pi * (np.sqrt(5.0) - 1.0) / 2  # written out independently of the package
 
@@ -255,12 +256,12 @@ def test_plot_orbits_rejects_missing_records_and_bad_colouring():
     try:
         r = m.iterate([0.0], [0.1], 5, record=("rotation",))
         with pytest.raises(ValueError, match=r"needs a result with record='orbit'"):
-            plotting.plot_orbits(ax, r)
+            primitives.plot_orbits(ax, r)
         r = m.iterate([0.0], [0.1], 5, record=("orbit",))
         with pytest.raises(ValueError, match=r"color_by='region' needs a result with record='regions'"):
-            plotting.plot_orbits(ax, r)
+            primitives.plot_orbits(ax, r)
         with pytest.raises(ValueError, match=r"color_by must be 'region' or 'orbit', got 'x'"):
-            plotting.plot_orbits(ax, r, color_by="x")
+            primitives.plot_orbits(ax, r, color_by="x")
     finally:
         plt.close(fig)
 

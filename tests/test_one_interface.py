@@ -52,12 +52,33 @@ def test_enums_are_the_cores():
         Region.parse("above the step")
 
 
-def test_old_module_paths_still_work():
-    from hovering import fullmap, geometry, maps, potentials, system
+OLD_PATHS = [  # (old module, name, the object it must still give)
+    ("maps", "TruncatedMap", lambda: hv.TruncatedMap), ("geometry", "K_crit", lambda: hv.K_crit),
+    ("fullmap", "TangentialCurve", lambda: hv.TangentialCurve), ("system", "Section", lambda: hv.Section),
+    ("system", "to_normal", lambda: hv.to_normal), ("potentials", "CustomPotential", lambda: hv.CustomPotential),
+    ("accuracy", "work_precision", lambda: hv.work_precision), ("references", "scipy_return_map",
+                                                                 lambda: hv.diagnostics.scipy_return_map),
+    ("plotting", "phase_portrait", lambda: hv.pipeline.phase_portrait),
+    ("figures", "render", lambda: hv.plot.figures.render), ("scenes", "run_scene", lambda: hv.pipeline.run_scene),
+    ("scenes", "redraw", lambda: hv.pipeline.redraw),
+]
 
-    assert maps.TruncatedMap is hv.TruncatedMap and geometry.K_crit is hv.K_crit
-    assert fullmap.TangentialCurve is hv.TangentialCurve and system.Section is hv.Section
-    assert potentials.CustomPotential is hv.CustomPotential
+
+@pytest.mark.parametrize("old,name,new", OLD_PATHS)
+def test_old_module_paths_still_work_and_warn(old, name, new):
+    # Every old path keeps working for one release and says what replaces it and when it goes.
+    import importlib
+
+    import hovering.pipeline  # noqa: F401  (the new homes the expected objects are read from)
+    import hovering.plot.figures  # noqa: F401
+
+    mod = importlib.import_module(f"hovering.{old}")
+    with pytest.warns(DeprecationWarning, match=rf"hovering\.{old}\.{name} is deprecated and will be removed in "
+                                                rf"hovering 0\.4\.0; use hovering\.[\w.]+\.{name} instead"):
+        value = getattr(mod, name)
+    assert value is new()
+    with pytest.raises(AttributeError):
+        getattr(mod, "no_such_name")
 
 
 def test_stubs_name_what_the_compiled_module_has():

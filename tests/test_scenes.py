@@ -22,7 +22,8 @@ import pytest
 import hovering
 from hovering import Region, Status, scenes
 from hovering.scenes.compute import zoom_window_critical, zoom_window_islands
-from hovering.scenes import load_scene, parse_scene, run_scene
+from hovering.scenes import load_scene, parse_scene
+from hovering.pipeline import run_scene
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "examples" / "scenes"
 EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "fig_hov_vs_eps"}

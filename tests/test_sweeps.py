@@ -8,7 +8,7 @@ import pathlib
 import pytest
 
 import hovering
-from hovering import scenes
+from hovering import pipeline, scenes
 from hovering.sweeps import Checkpoint
 
 SCENE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_hov_vs_eps.toml"
@@ -41,15 +41,15 @@ def test_interrupted_sweep_resumes(tmp_path, monkeypatch):
 
     monkeypatch.setattr(hovering.TruncatedMap, "hovering_area", flaky)
     with pytest.raises(KeyboardInterrupt):
-        scenes.run_scene(scene, out=out, quick=True)
+        pipeline.run_scene(scene, out=out, quick=True)
     ckpt = out.with_suffix(".sweep.jsonl")
     assert len(ckpt.read_text().splitlines()) == 3  # the three finished points are on disk
 
     calls["n"] = 100  # no more interruptions; count the resumed run's measurements
-    summary = scenes.run_scene(scene, out=out, quick=True)
+    summary = pipeline.run_scene(scene, out=out, quick=True)
     total = sum(len(s["points"]) for s in summary["series"])
     assert summary["points_reused"] == 3 and calls["n"] - 100 == total - 3
     # Same numbers as a run that was never interrupted.
     monkeypatch.setattr(hovering.TruncatedMap, "hovering_area", real)
-    fresh = scenes.run_scene(scene, out=tmp_path / "fresh.png", quick=True)
+    fresh = pipeline.run_scene(scene, out=tmp_path / "fresh.png", quick=True)
     assert json.dumps(fresh["series"], sort_keys=True) == json.dumps(summary["series"], sort_keys=True)

@@ -30,7 +30,8 @@ import pytest
 import hovering as hv
 from hovering import _serial, _untrusted, scenes
 from hovering.cli import main
-from hovering.scenes import load_result, load_scene, redraw, run_scene
+from hovering.scenes import load_result, load_scene
+from hovering.pipeline import redraw, run_scene
 from hovering.scenes.schema import (MAX_CANVAS_PIXELS, MAX_KEY_PARTS, MAX_SCENE_DEPTH, MAX_TEXT, check_spec,
                                     scene_table)
 from hovering.sweeps import Checkpoint
@@ -203,11 +204,11 @@ def test_pickled_object_arrays_are_refused_from_their_header(tmp_path):
 
 
 def test_flowmap_record_asking_for_an_accuracy_target_is_refused_without_measuring(genuine, tmp_path, monkeypatch):
-    import hovering.accuracy
+    import hovering.diagnostics.tolerance
 
     calls = []
-    real = hovering.accuracy.choose_setting
-    monkeypatch.setattr(hovering.accuracy, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
+    real = hovering.interface.hook("choose_setting")
+    monkeypatch.setitem(hovering.interface._HOOKS, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
     assert hv.load(genuine["flowmap"]).integrator_options["stepper"] == "rk8pd" and calls == []
     # Before: this 3 KB record ran a work-precision measurement for more than 300 s (it was killed).
     path = _craft(genuine["flowmap"], tmp_path / "accuracy.npz",

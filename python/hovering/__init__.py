@@ -84,15 +84,15 @@ from .truncated import (
     rho_crit,
 )
 from .truncated.theory import theory
+from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
 from .explore import explore
-from .accuracy import WorkPrecision, work_precision
-from . import fullmap, geometry  # noqa: E402,F401  (old module paths, one release)
 
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
 simd_width = _core.truncated.simd_width
 
 __all__ = [
+    "__version__",
     "WorkPrecision",
     "work_precision",
     "TruncatedMap",
@@ -164,3 +164,15 @@ __all__ = [
     "load",
     "show_versions",
 ]
+
+# Old module paths (hovering.geometry, hovering.fullmap, ...) stay importable and warn on use
+# (hovering._deprecated); they are not imported here, so they cost nothing until asked for.
+_OLD_MODULES = ("accuracy", "references", "fullmap", "geometry", "maps", "potentials", "system", "plotting", "figures")
+
+
+def __getattr__(name: str):
+    if name in _OLD_MODULES:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -59,7 +59,8 @@ def _progress(args) -> bool:
 
 
 def _run(scene, out, quick: bool, progress: bool, where=None, force: bool = False) -> int:
-    from .scenes import format_summary, run_scene
+    from .pipeline import run_scene
+    from .scenes import format_summary
 
     try:
         summary = run_scene(scene, out=out, quick=quick, progress=progress, force=force, **(where or {}))
@@ -123,7 +124,7 @@ def _redraw(args) -> int:
 
     matplotlib.use("Agg")
     from ._output import output_path
-    from .scenes import redraw
+    from .pipeline import redraw
 
     try:
         out = output_path("--out", args.out) if args.out is not None else None
@@ -145,7 +146,7 @@ def _accuracy(args) -> int:
     from ._output import output_path
     from ._output import refuse_foreign, savefig, write_text
     from ._provenance import provenance
-    from .accuracy import work_precision
+    from .diagnostics import work_precision
     from .flow.section import Section
     from .scenes import load_scene
     from .scenes.compute import scene_map

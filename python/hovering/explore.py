@@ -39,7 +39,8 @@ import numpy as np
 from ._checks import integer, real_number, require_angles, require_type
 from ._enums import Region, Status, wrap
 from .interface import require_map
-from .plotting import REGION_COLORS
+from .normal.flowmap import FlowMap
+from ._style import REGION_COLORS
 
 __all__ = ["explore", "Explorer", "Orbit", "default_K_range", "default_n_steps", "main", "COLORS", "DEFAULT_N_STEPS",
            "MAX_N_STEPS"]
@@ -51,7 +52,7 @@ DEFAULT_N_STEPS = {"truncated": 2000, "flow": 500}
 #: Most steps per orbit :func:`explore` accepts (one orbit of the flow at 1e7 returns is ~100 s).
 MAX_N_STEPS = 10**7
 
-#: Colour of the points of each region: :data:`hovering.plotting.REGION_COLORS`, plus one for the
+#: Colour of the points of each region: :data:`hovering.plot.style.REGION_COLORS`, plus one for the
 #: flow's Region.MULTI (two or more impacts in one return), which the truncated maps never produce
 #: (if the plotting module gains its own, that one wins).
 COLORS = {Region.MULTI: "#8172b3", **REGION_COLORS}
@@ -81,8 +82,6 @@ _LEGEND_STOPPED = 5  # stopped orbits listed in the legend (the most recent)
 
 
 def _is_flow(m) -> bool:
-    from .normal import FlowMap
-
     return isinstance(m, FlowMap)
 
 

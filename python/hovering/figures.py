@@ -1,5 +1,6 @@
-"""Old module path of the figure makers (one release): see :mod:`hovering.plot.figures`."""
+"""Old path of :mod:`hovering.plot.figures` (deprecated; removed in 0.4.0)."""
 
-from .plot.figures import *  # noqa: F401,F403
-from .plot.figures import __all__  # noqa: F401
-from .plot.style import SPECIAL_COLORS, SPECIAL_LABELS  # noqa: F401
+from ._deprecated import moved_module
+
+__getattr__ = moved_module(__name__, "hovering.plot.figures", {"SPECIAL_COLORS": "hovering._style",
+                                                               "SPECIAL_LABELS": "hovering._style"})

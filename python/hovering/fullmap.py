@@ -1,7 +1,5 @@
-"""Old path of :mod:`hovering.normal` (kept for one release; import from the new one)."""
+"""Old path of :mod:`hovering.normal` (deprecated; removed in 0.4.0)."""
 
-import sys as _sys
+from ._deprecated import moved_module
 
-from . import normal as _normal  # noqa: F401
-
-_sys.modules[__name__] = _sys.modules["hovering.normal"]
+__getattr__ = moved_module(__name__, "hovering.normal")

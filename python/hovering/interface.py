@@ -25,21 +25,25 @@ __all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "tr
 _HOOKS: dict = {}
 
 
-def register(name: str, fn: Callable) -> Callable:
-    """Make ``fn`` the implementation of the hook ``name`` (called by the module that owns it).
+def register(name: str, fn: Optional[Callable] = None) -> Callable:
+    """Make ``fn`` the implementation of the hook ``name`` (called by the module that owns it);
+    without ``fn``, a decorator that does so.
 
     Parameters
     ----------
     name : str
-        The hook's name (``"hovering_area"``, ``"critical_curve"``, ``"choose_setting"``).
-    fn : callable
+        The hook's name (``"hovering_area"``, ``"critical_curve"``, ``"choose_setting"``,
+        ``"check_spec"``).
+    fn : callable, optional
         Its implementation.
 
     Returns
     -------
     callable
-        ``fn``, so this can decorate it.
+        ``fn`` (or the decorator).
     """
+    if fn is None:
+        return lambda f: register(name, f)
     _HOOKS[name] = fn
     return fn
 

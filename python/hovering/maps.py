@@ -1,8 +1,5 @@
-"""Old path of :mod:`hovering.truncated.maps` (kept for one release; import from the new one)."""
+"""Old path of :mod:`hovering.truncated.maps` (deprecated; removed in 0.4.0)."""
 
-import sys as _sys
+from ._deprecated import moved_module
 
-from .truncated.maps import *  # noqa: F401,F403
-from . import truncated as _pkg  # noqa: F401
-
-_sys.modules[__name__] = _sys.modules["hovering.truncated.maps"]
+__getattr__ = moved_module(__name__, "hovering.truncated.maps")

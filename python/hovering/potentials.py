@@ -1,8 +1,5 @@
-"""Old path of :mod:`hovering.flow.potentials` (kept for one release; import from the new one)."""
+"""Old path of :mod:`hovering.flow.potentials` (deprecated; removed in 0.4.0)."""
 
-import sys as _sys
+from ._deprecated import moved_module
 
-from .flow.potentials import *  # noqa: F401,F403
-from . import flow as _pkg  # noqa: F401
-
-_sys.modules[__name__] = _sys.modules["hovering.flow.potentials"]
+__getattr__ = moved_module(__name__, "hovering.flow.potentials")

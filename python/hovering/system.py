@@ -1,6 +1,7 @@
-"""Old path of :mod:`hovering.flow` (system, section) and the normal-coordinate functions now in
-:mod:`hovering.normal` (kept for one release; import from the new ones)."""
+"""Old path of :mod:`hovering.flow` (system, section) and of the normal-coordinate functions now in
+:mod:`hovering.normal.coordinates` (deprecated; removed in 0.4.0)."""
 
-from .flow.section import *  # noqa: F401,F403
-from .flow.system import *  # noqa: F401,F403
-from .normal.coordinates import forcing_function, from_normal, tangential_curve, to_normal  # noqa: F401
+from ._deprecated import moved_module
+
+__getattr__ = moved_module(__name__, "hovering.flow", {n: "hovering.normal.coordinates" for n in (
+    "forcing_function", "from_normal", "tangential_curve", "to_normal")})

@@ -19,7 +19,7 @@ from .._checks import check_memory, flag, forcing_array, integer, is_choice, MAX
 from .._enums import Region, wrap
 from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, trajectory_arguments
 from .._progress import check_progress, progress_bar
-from ..interface import IterateResult, MapAnalyses
+from ..interface import IterateResult, MapAnalyses, hook
 from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -98,7 +98,7 @@ class FlowMap(MapAnalyses):
         wall points as its interpolation error below 1e-12 needs).
     accuracy : float, optional
         An accuracy target instead of ``stepper``/``rtol``/``atol``: the fastest setting measured
-        (here, on this system and energy: :func:`hovering.accuracy.choose_setting`) to keep the
+        (here, on this system and energy: :func:`hovering.diagnostics.choose_setting`) to keep the
         section-coordinate error of one return (of ``accuracy_returns`` returns) within it. What
         was chosen is in :attr:`integrator_options` and :attr:`accuracy_choice` (with its measured
         error and cost per return). A ValueError names the best reachable error if none reaches it.
@@ -145,9 +145,9 @@ class FlowMap(MapAnalyses):
         #: What an ``accuracy`` target chose (None without one): the row of the measurement.
         self.accuracy_choice = None
         if accuracy is not None:
-            from ..accuracy import choose_setting
-
-            self.accuracy_choice = choose_setting(self.section, accuracy, accuracy_returns)
+            # Resolved above the models (hovering.diagnostics.tolerance registers it): measuring
+            # is the harness's business, the map only takes what it chose.
+            self.accuracy_choice = hook("choose_setting")(self.section, accuracy, accuracy_returns)
             stepper, rtol = self.accuracy_choice["method"], self.accuracy_choice["tolerance"]
             atol = rtol
         atol = rtol if atol is None else atol
@@ -571,15 +571,13 @@ class FlowMap(MapAnalyses):
         CriticalCurve
             ``K0`` (height on the line), ``K_min``, ``K_max`` (the curve's extent), rotation.
         """
-        from ..analysis import critical_curve
-
         if self.coordinates != "normal":
             raise ValueError("the impact zone floor is searched in normal coordinates: use coordinates='normal'")
         if K_range is None:
             Ku, d = self.upper_tangent_K(), 0.05 + 2 * abs(self.eps)
             lo = self.valid_band()[0]
             K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3))
-        return critical_curve(self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi),
+        return hook("critical_curve")(self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi),
                               search="highest", **kwargs)
 
     def step_rotations(self, res: IterateResult, i: int) -> np.ndarray:

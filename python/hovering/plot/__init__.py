@@ -7,6 +7,6 @@ computing side).
 
 from .figures import render
 from .primitives import draw_geometry, plot_orbits
-from .style import REGION_COLORS, SPECIAL_COLORS, SPECIAL_LABELS
+from .._style import REGION_COLORS, SPECIAL_COLORS, SPECIAL_LABELS
 
 __all__ = ["render", "draw_geometry", "plot_orbits", "REGION_COLORS", "SPECIAL_COLORS", "SPECIAL_LABELS"]

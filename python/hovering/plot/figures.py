@@ -19,11 +19,11 @@ import numpy as np
 from .._enums import Region
 from ..scenes.results import (FlowHoveringResult, FlowPortraitResult, HoveringAreaResult, OrbitPanelResult,
                               OrbitSceneResult, SigmaStructureResult, TangentToriResult)
-from ..scenes.spec import QUICK_FACTOR
+from ..scenes.spec import QUICK_FACTOR, figure_inches
 from .primitives import draw_geometry, plot_orbits
-from .style import QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS
+from .._style import QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS
 
-__all__ = ["render", "figure_inches", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
+__all__ = ["render", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
            "flow_hovering_figure", "tangent_tori_figure", "sigma_structure_figure"]
 
 
@@ -80,31 +80,8 @@ def orbit_label(label: str, kind: str, K0: float, rho: Optional[float]) -> str:
     return head if rho is None else rf"{head}: $\rho={rho:.3f}$"
 
 
-#: Figure size (inches) of the kinds with a fixed grid of axes, when the scene gives no ``figsize``.
-_FIGSIZE = {"hovering_area": (13.0, 5.2), "flow_portrait": (13.0, 5.6), "flow_hovering_area": (13.0, 5.2),
-            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0)}
 
 
-def figure_inches(scene, n_panels: int = 1) -> tuple:
-    """Width and height (inches) of a scene's figure: its ``figsize``, or its kind's and layout's default.
-
-    Parameters
-    ----------
-    scene : SceneSpec
-        The scene.
-    n_panels : int, optional
-        Its number of panels (orbit scenes without a layout: one column of them).
-
-    Returns
-    -------
-    tuple of float
-    """
-    if scene.figsize is not None:
-        return tuple(scene.figsize)
-    if scene.kind in _FIGSIZE:
-        return _FIGSIZE[scene.kind]
-    rows, cols = scene.layout if scene.layout is not None else (n_panels, 1)
-    return (6.0 * cols + 1.0, 4.6 * rows + 0.6)
 
 
 def _grid(n: int, layout, figsize, sharey: bool = False):

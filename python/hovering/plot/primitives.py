@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._enums import Region
-from .style import CORNER_STYLES, GEOMETRY_COLOR, REGION_COLORS, REGION_LABELS, orbit_color
+from .._style import CORNER_STYLES, GEOMETRY_COLOR, REGION_COLORS, REGION_LABELS, orbit_color
 
 __all__ = ["draw_geometry", "plot_orbits", "break_seam"]
 

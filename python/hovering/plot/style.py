@@ -1,59 +1,6 @@
-"""Colours, line styles and legend texts: the one place both the computing and the drawing side
-read them (a scene's result stores colour names; the figures turn them into artists)."""
+"""The figures' colours, line styles and legend texts (public path; they live in
+:mod:`hovering._style`, below both the computing side, which stores colour names in results, and
+the drawing side)."""
 
-from __future__ import annotations
-
-from .._enums import Region
-
-__all__ = ["REGION_COLORS", "REGION_LABELS", "SPECIAL_COLORS", "SPECIAL_LABELS", "CORNER_STYLES", "GEOMETRY_COLOR",
-           "orbit_color", "QUICK_MARK"]
-
-#: Colour of each region in region-coloured plots (J_0u, J_0, J_1, J_R, and two or more impacts).
-REGION_COLORS = {
-    Region.BESIDE: "#4c72b0",
-    Region.ABOVE: "#55a868",
-    Region.UPPER: "#dd8452",
-    Region.RIGHT: "#c44e52",
-    Region.MULTI: "#8172b3",
-}
-
-#: Legend text of each region.
-REGION_LABELS = {r: f"J_{r.label}" if r != Region.MULTI else "2+ impacts" for r in REGION_COLORS}
-
-#: Colours of the paper's special orbits (matplotlib's default cycle, as in the paper).
-SPECIAL_COLORS = {"blue": "C0", "orange": "C1", "green": "C2", "red": "C3"}
-
-#: Legend text of the special orbits' starts (sec:truncatedmapnumact).
-SPECIAL_LABELS = {
-    "blue": r"L1, $K_0=\tilde K_c$",
-    "orange": r"L1, $K_0=\tilde K_c+0.05|\varepsilon|$",
-    "green": r"L1, $K_0=0$",
-    "red": r"L2, $K_0=0$",
-}
-
-#: Line style of each corner-singularity curve phi_ab (dashed black family).
-CORNER_STYLES = {"01": ":", "1R": "--", "R0": "-."}
-
-#: Grey of K = 0, L1, L2 and the step's walls.
-GEOMETRY_COLOR = "0.55"
-
-#: Title suffix of a quick run.
-QUICK_MARK = " [quick]"
-
-
-def orbit_color(i: int, offset: int = 0) -> str:
-    """The i-th colour of matplotlib's default cycle (shifted by ``offset``).
-
-    Parameters
-    ----------
-    i : int
-        Orbit index.
-    offset : int, optional
-        First colour used.
-
-    Returns
-    -------
-    str
-        ``"C0"`` .. ``"C9"``.
-    """
-    return f"C{(i + offset) % 10}"
+from .._style import *  # noqa: F401,F403
+from .._style import __all__  # noqa: F401

@@ -13,13 +13,19 @@ from __future__ import annotations
 import math
 import os
 import time
+from dataclasses import asdict, replace
 from typing import Callable, Optional
 
 import numpy as np
 
 from .._enums import Region, Status, wrap
-from ..plot.style import SPECIAL_COLORS, orbit_color
+from .._style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
+from ..analysis import rotation_number
+from ..diagnostics.work_precision import _reverse
+from ..normal.compare import truncated_from_flow
+from ..normal.corners import corner_curves
+from ..normal.flowmap import FlowMap
 from .._version import __version__
 from ..analysis.hovering import default_depth
 from ..sweeps import Checkpoint, check_row
@@ -111,8 +117,6 @@ def flow_geometry(fm, K_range, n_circles: int, rtol: float, n: int = 200) -> Geo
     -------
     Geometry
     """
-    from ..normal.corners import corner_curves
-
     lo = fm.valid_band()[0]
     K = np.linspace(max(K_range[0], 0.95 * lo), K_range[1], n)
     corners, Kc = {}, np.zeros(0)
@@ -290,8 +294,6 @@ def zoom_window_islands(orbits: OrbitSet, names, pad: float = 0.3) -> dict:
 
 
 def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, progress) -> tuple:
-    from ..analysis import rotation_number
-
     m = p.map.build()
     critical = None
     if scene.kind == "portrait":
@@ -491,8 +493,6 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
 
 
 def _flowmap(scene, eps: Optional[float] = None, coordinates: str = "normal"):
-    from ..normal.flowmap import FlowMap
-
     return FlowMap(scene.system.build(eps=eps), h=scene.h, coordinates=coordinates, **scene.integrator.options())
 
 
@@ -544,8 +544,6 @@ def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
     returns are run m returns back by time reversal from their m-th point; the distance to their
     start (phi, K) is the reversal error. It needs no reference, and like the error it grows as
     m^2 with the number of returns (``hovering.work_precision``)."""
-    from ..accuracy import _reverse
-
     ok = np.flatnonzero(res.steps_done >= m)[:n_orbits]
     out = {"integrator": {k: v for k, v in fm.integrator_options.items()}, "reversal_returns": int(m),
            "reversal_orbits": int(ok.size), "reversal_error": float("nan")}
@@ -565,9 +563,6 @@ def _measured_model(fm, K_low: float):
     wall, ``FlowMap.impact_zone_floor``) hold no J_1 / J_R arcs: the family then stops at the
     lowest circle that has them, and its band is shallower than the box asked for.
     """
-    from ..normal.compare import truncated_from_flow
-    from ..normal.corners import corner_curves
-
     depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
     s = np.linspace(math.sqrt(depth), 0.0, 17)[:-1]
     K = np.concatenate([-s**2, [0.01, 0.03, 0.05]])
@@ -578,8 +573,6 @@ def _measured_model(fm, K_low: float):
     keep[first:] = True
     keep &= ok
     if not keep.all():
-        from dataclasses import replace
-
         cc = replace(cc, **{f: getattr(cc, f)[keep] for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1",
                                                               "Omega", "Omega_spread", "other")})
     return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
@@ -641,8 +634,6 @@ def _flow_point(scene, e, n, samples, n_threads: int = 0) -> dict:
 
 
 def _serial_dict(spec) -> dict:
-    from dataclasses import asdict
-
     return asdict(spec)
 
 

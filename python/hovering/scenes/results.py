@@ -18,6 +18,10 @@ from typing import Optional
 import numpy as np
 
 from .. import _serial
+from .._enums import Region, Status
+from .._output import write_text
+from .._provenance import provenance
+from .schema import MAX_TEXT, _color, _str
 from .spec import SceneSpec
 
 #: The ``format`` of a scene result's sidecar JSON.
@@ -292,7 +296,6 @@ class SeriesResult:
     reused: int = 0
 
     def _validate_loaded(self) -> None:
-        from .schema import _color, _str
 
         _str("label", self.label)
         _color("color", self.color)
@@ -334,7 +337,6 @@ class TorusResult:
     color: str
 
     def _validate_loaded(self) -> None:
-        from .schema import _color, _str
 
         _str("name", self.name, ("right", "upper"))
         _color("color", self.color)
@@ -363,7 +365,6 @@ class SceneResult:
 
     def _validate_loaded(self) -> None:
         # What the figure and the summary take from meta (the scene itself was checked as it was read).
-        from .schema import MAX_TEXT
 
         for key, kind in (("quick", bool), ("n_steps", int), ("samples", int), ("timings", dict), ("version", str)):
             v = self.meta.get(key)
@@ -383,8 +384,6 @@ class SceneResult:
         -------
         dict
         """
-        from .report import summarize
-
         return summarize(self)
 
     def save(self, path: os.PathLike) -> tuple:
@@ -408,8 +407,6 @@ class SceneResult:
         hovering._output.WriteError
             (a ValueError) When a file cannot be written (e.g. ``no space left``).
         """
-        from .._output import write_text
-        from .._provenance import provenance
 
         npz = _serial.save(self, path, meta=jsonable(self.meta))
         side = str(Path(npz).with_suffix(".json"))
@@ -631,3 +628,95 @@ def load_result(path: os.PathLike) -> SceneResult:
         raise ValueError(f"{os.fspath(path)} holds a {type(obj).__name__}, not a scene result "
                          "(written by `python -m hovering scene`)")
     return obj
+
+
+def _orbits(o: OrbitSet) -> list:
+    out = []
+    for i, lab in enumerate(o.labels):
+        K = o.K[i]
+        d = dict(label=lab, kind=o.kinds[i], phi0=float(o.phi[i, 0]), K0=float(K[0]), K_min=float(np.nanmin(K)),
+                 K_max=float(np.nanmax(K)), status=Status(int(o.status[i])).name, steps=int(o.steps_done[i]))
+        if o.rho is not None:
+            d["rho"] = float(o.rho[i])
+        if o.region is not None:
+            reg = o.region[i]
+            d["impacts"] = int(np.count_nonzero((reg == int(Region.UPPER)) | (reg == int(Region.RIGHT))
+                                                | (reg == int(Region.MULTI))))
+            d["hovering"] = bool(d["impacts"] == 0 and d["K_min"] < 0 and o.status[i] == int(Status.OK))
+        out.append(d)
+    return out
+
+
+def _region_counts(region) -> dict:
+    if region is None:
+        return {}
+    return {Region(r).label: int(np.count_nonzero(region == int(r))) for r in Region if r != Region.NONE}
+
+
+def summarize(result) -> dict:
+    """The numbers a scene result shows, as a JSON-able dict.
+
+    Parameters
+    ----------
+    result : SceneResult
+        Any scene result.
+
+    Returns
+    -------
+    dict
+        ``scene``, ``kind``, ``title``, ``quick``, ``n_steps`` (when it has one), ``runtime_s`` and
+        per kind: ``panels`` (orbit scenes), ``series`` (hovering_area), ``flow`` / ``model``
+        (flow_portrait), ``points`` (flow_hovering_area), ``tori`` (tangent_tori), ``regions``
+        (sigma_structure).
+    """
+    sc, meta = result.scene, result.meta
+    s = dict(scene=sc.name, kind=sc.kind, title=sc.title, quick=bool(meta.get("quick")),
+             runtime_s=float(meta.get("timings", {}).get("total", float("nan"))))
+    for k in ("n_steps", "samples", "points_reused", "checkpoint", "grid", "accuracy"):
+        if k in meta:
+            s[k] = meta[k]
+    if isinstance(result, OrbitSceneResult):
+        panels = []
+        for p in result.panels:
+            if isinstance(p, OrbitPanelResult):
+                info = dict(id=p.id, params=p.params, K_crit=p.K_crit, rho_crit=p.rho_crit, band_floor=p.band_floor,
+                            orbits=_orbits(p.orbits), n_escaped=int(np.count_nonzero(p.orbits.status == int(Status.ESCAPED))),
+                            xlim=list(p.xlim), ylim=list(p.ylim), n_orbits_drawn=p.orbits.n_orbits)
+                if p.critical is not None:
+                    info["critical"] = p.critical
+            else:
+                info = dict(id=p.id, zoom_of=p.of, window=p.window)
+            panels.append(info)
+        s["panels"] = panels
+    elif isinstance(result, HoveringAreaResult):
+        s["series"] = [dict(label=r.label, golden_c=r.golden_c, points=[
+            dict(eps=float(e), area=float(a), error=float(er), theory=float(t), floor_touched=bool(f), K_low=float(kl),
+                 Omega0=float(O), theta_w=float(tw))
+            for e, a, er, t, f, kl, O, tw in zip(r.eps, r.area, r.error, r.theory, r.floor_touched, r.K_low, r.Omega0,
+                                                 r.theta_w)]) for r in result.series]
+    elif isinstance(result, FlowPortraitResult):
+        s.update(onset=result.onset, forcing=result.forcing[:3], model_name=result.model_name, work=result.work)
+        for name, o in (("flow", result.flow), ("model", result.model)):
+            s[name] = dict(orbits=_orbits(o), regions=_region_counts(o.region),
+                           statuses={Status(int(v)).name: int(np.count_nonzero(o.status == v))
+                                     for v in np.unique(o.status)})
+    elif isinstance(result, FlowHoveringResult):
+        pts = []
+        for i, e in enumerate(result.eps):
+            d = dict(eps=float(e), flow=float(result.flow_area[i]), flow_error=float(result.flow_error[i]),
+                     flow_both_sides=float(result.flow_both_sides[i]), theory=float(result.theory[i]),
+                     K_low=float(result.K_low[i]), b1=float(result.b1[i]), seconds=float(result.seconds[i]),
+                     unresolved=int(result.unresolved[i]))
+            d["models"] = {m: {k: float(v[i]) for k, v in cols.items()} for m, cols in result.models.items()}
+            pts.append(d)
+        s["points"] = pts
+    elif isinstance(result, TangentToriResult):
+        s["tori"] = [dict(name=t.name, h1=t.h1, h2=t.h2, trajectory_points=int(t.trajectory.shape[0]),
+                          q1_min=float(np.nanmin(t.trajectory[:, 1])) if t.trajectory.size else None,
+                          q2_min=float(np.nanmin(t.trajectory[:, 3])) if t.trajectory.size else None)
+                     for t in result.tori]
+        s.update(qw1=result.qw1, qw2=result.qw2, status=meta.get("status", {}), work=meta.get("work", {}))
+    elif isinstance(result, SigmaStructureResult):
+        s["regions"] = _region_counts(result.region)
+        s["points"] = int(result.phi.size)
+    return jsonable(s)

@@ -22,6 +22,8 @@ from typing import Optional
 from .._output import output_path
 from ..flow.section import STEPPERS
 from ..truncated.theory import OMEGA_G, golden_family
+from ..interface import register
+from .spec import figure_inches
 from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHoveringScene, FlowPortraitScene,
                    HoveringAreaScene, IntegratorSpec, MapSpec, OrbitScene, OrbitSpec, OutputsSpec, PanelSpec,
                    PotentialSpec, SceneSpec, SeriesSpec, SigmaStructureScene, SystemSpec, TangentToriScene,
@@ -382,7 +384,6 @@ def _check_document(where: str, data) -> None:
 
 def _check_canvas(where: str, spec: SceneSpec) -> None:
     """The figure's canvas (dpi and its size in inches, given or its kind's default) within MAX_CANVAS_PIXELS."""
-    from ..plot.figures import figure_inches
 
     w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
     pixels = (spec.dpi * w) * (spec.dpi * h)
@@ -1016,6 +1017,7 @@ def _first_difference(a, b, where: str):
     return None if type(a) is type(b) and a == b else (where, a, b)
 
 
+@register("check_spec")
 def check_spec(spec: SceneSpec) -> SceneSpec:
     """Check a scene spec from elsewhere (a saved result) with the checks a scene file gets.
 

@@ -11,6 +11,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
+from ..flow.system import Harmonic, Tan
+from ..flow.system import Bilinear, Polynomial, StepSystem
+from ..interface import hook
+from ..truncated.maps import TruncatedMap
 from ..truncated.theory import golden_family
 
 __all__ = [
@@ -18,7 +22,7 @@ __all__ = [
     "MapSpec", "OrbitSpec", "CriticalSpec", "ZoomSpec", "PanelSpec", "SeriesSpec",
     "PotentialSpec", "SystemSpec", "IntegratorSpec", "OutputsSpec",
     "SceneSpec", "OrbitScene", "HoveringAreaScene", "FlowPortraitScene", "FlowHoveringScene",
-    "TangentToriScene", "SigmaStructureScene", "Scene",
+    "TangentToriScene", "SigmaStructureScene", "Scene", "figure_inches",
 ]
 
 #: Scene kinds of the truncated map (sec:truncatedmapnum).
@@ -72,8 +76,6 @@ class MapSpec:
         -------
         TruncatedMap
         """
-        from ..truncated.maps import TruncatedMap
-
         return TruncatedMap(self.eps, self.Omega0, self.theta_w, self.tau0, self.tau1, self.lam)
 
     def as_dict(self) -> dict:
@@ -279,8 +281,6 @@ class PotentialSpec:
         -------
         hovering.Harmonic or hovering.Tan
         """
-        from ..flow import Harmonic, Tan
-
         return Harmonic(self.omega) if self.kind == "harmonic" else Tan(self.omega, self.alpha)
 
 
@@ -324,8 +324,6 @@ class SystemSpec:
         -------
         StepSystem
         """
-        from ..flow.system import Bilinear, Polynomial, StepSystem
-
         if not self.coupling:
             c = None
         elif self.coupling == ((1.0, 1, 1),):
@@ -424,10 +422,9 @@ class SceneSpec:
     figsize: Optional[tuple] = None
 
     def _validate_loaded(self) -> None:
-        """A spec read from a file (:func:`hovering.load`) gets the checks a scene file gets."""
-        from .schema import check_spec
-
-        check_spec(self)
+        """A spec read from a file (:func:`hovering.load`) gets the checks a scene file gets (the
+        schema, above the spec, registers them as the ``check_spec`` hook)."""
+        hook("check_spec")(self)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -606,3 +603,30 @@ class SigmaStructureScene(FlowScene):
 
 #: Old name of the truncated orbit scenes' spec (kept for one release).
 Scene = SceneSpec
+
+
+#: Figure size (inches) of the kinds with a fixed grid of axes, when the scene gives no ``figsize``.
+_FIGSIZE = {"hovering_area": (13.0, 5.2), "flow_portrait": (13.0, 5.6), "flow_hovering_area": (13.0, 5.2),
+            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0)}
+
+
+def figure_inches(scene, n_panels: int = 1) -> tuple:
+    """Width and height (inches) of a scene's figure: its ``figsize``, or its kind's and layout's default.
+
+    Parameters
+    ----------
+    scene : SceneSpec
+        The scene.
+    n_panels : int, optional
+        Its number of panels (orbit scenes without a layout: one column of them).
+
+    Returns
+    -------
+    tuple of float
+    """
+    if scene.figsize is not None:
+        return tuple(scene.figsize)
+    if scene.kind in _FIGSIZE:
+        return _FIGSIZE[scene.kind]
+    rows, cols = scene.layout if scene.layout is not None else (n_panels, 1)
+    return (6.0 * cols + 1.0, 4.6 * rows + 0.6)

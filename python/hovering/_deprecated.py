@@ -1,0 +1,80 @@
+"""Old names and module paths, kept for one release: each warns with a DeprecationWarning naming its
+replacement and the release that removes it. The one place deprecations live (CHANGELOG.md lists
+them); an old module path is a two-line file that hands its attribute lookups to
+:func:`moved_module`.
+
+The new module is found by name at the moment an old name is used (``importlib``), as
+scipy's ``_lib/deprecation.py`` does: an old path is a leaf that nothing imports, and resolving it
+lazily keeps ``import hovering`` from loading what the old path points to.
+"""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+from typing import Callable, Optional
+
+__all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
+
+#: The release that removes every name deprecated in this one.
+REMOVED_IN = "0.4.0"
+
+
+def warn(old: str, new: str, stacklevel: int = 3) -> None:
+    """Warn that ``old`` is deprecated in favour of ``new``.
+
+    Parameters
+    ----------
+    old, new : str
+        What the caller used, and what to use instead.
+    stacklevel : int, optional
+        Passed to :func:`warnings.warn` (3: the caller of the function that calls this).
+    """
+    warnings.warn(f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead",
+                  DeprecationWarning, stacklevel=stacklevel)
+
+
+def moved_module(old: str, new: str, names: Optional[dict] = None) -> Callable[[str], object]:
+    """The module ``__getattr__`` of an old path: every name it is asked for comes from ``new``
+    (or, for a name in ``names``, from the module path given there), with a warning.
+
+    Parameters
+    ----------
+    old : str
+        The old module's name (``__name__``).
+    new : str
+        The module that holds its names now.
+    names : dict, optional
+        ``{name: "module.path"}`` for names that moved elsewhere than ``new``.
+
+    Returns
+    -------
+    callable
+        To assign to the old module's ``__getattr__``.
+    """
+    names = dict(names or {})
+
+    def __getattr__(name: str):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        where = names.get(name, new)
+        value = getattr(importlib.import_module(where), name)  # AttributeError: the old path never had it
+        warn(f"{old}.{name}", f"{where}.{name}")
+        return value
+
+    return __getattr__
+
+
+def renamed_argument(func: str, old: str, new: str, stacklevel: int = 4) -> None:
+    """Warn that argument ``old`` of ``func`` is deprecated in favour of ``new``.
+
+    Parameters
+    ----------
+    func : str
+        The function (``"hovering_area"``).
+    old, new : str
+        The argument used, and what to use instead (may be a short phrase).
+    stacklevel : int, optional
+        Passed to :func:`warnings.warn`.
+    """
+    warn(f"{func}({old}=...)", f"{func}({new})", stacklevel=stacklevel)

@@ -1,0 +1,11 @@
+"""Measuring the product itself: what accuracy costs (work-precision diagrams), accuracy targets
+(the fastest setting that reaches an error), and independent reference implementations of one
+return (scipy's ``solve_ivp``, heyoka.py's Taylor integrator). Sits above the models and analyses.
+"""
+
+from .references import heyoka_return_map, scipy_return_map
+from .tolerance import choose_setting
+from .work_precision import FLOW_STEPPERS_DEFAULT, WorkPrecision, exact_available, work_precision
+
+__all__ = ["WorkPrecision", "work_precision", "choose_setting", "exact_available", "FLOW_STEPPERS_DEFAULT",
+           "scipy_return_map", "heyoka_return_map"]
