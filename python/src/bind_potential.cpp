@@ -4,9 +4,9 @@
 // (through the trampoline PyPotential) or two callables (CallablePotential, behind
 // hovering.CustomPotential). The base class Potential answers every energy question from V and dV
 // alone, so nothing else is needed from Python. The core may call them from the return map's worker
-// threads with the GIL released: every call into Python takes the GIL itself, and a Python
-// exception travels up through the core (and GSL's frames) as pybind11::error_already_set, which
-// the flow's thread pool hands to the calling thread.
+// threads with the GIL released: every call into Python takes the GIL itself (through the gate of
+// gil.hpp), and a Python exception travels up through the core (and GSL's frames) as
+// pybind11::error_already_set, which the flow's thread pool hands to the calling thread.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -15,8 +15,8 @@
 
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/system.hpp"
+#include "gil.hpp"
 #include "pybind.hpp"
-#include "signals.hpp"
 
 using namespace hovering;
 
@@ -26,41 +26,17 @@ using hovering::detail::kInf;
 
 using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
-/// Holds the GIL for one call into Python from any thread. On a thread Python does not know (the
-/// return map's workers), the first call creates a Python thread state; it is kept, with one extra
-/// reference, until the thread ends, instead of being created and destroyed on every call (which
-/// made a two-thread return map with Python potentials 16x slower: 21 ms instead of 1.3 ms per
-/// return). Threads Python created are left alone: Python deletes their states itself.
+/// Holds the GIL for one call into Python from any thread (gil.hpp). Once the interpreter exits
+/// the call is refused: InterpreterExiting travels up through the core like a Python exception, to
+/// a caller that then parks until the process ends.
 class CallbackGil {
 public:
-    CallbackGil() : fresh_(park_if_finalizing() && PyGILState_GetThisThreadState() == nullptr), gil_() {
-        if (fresh_) {
-            gil_.inc_ref();
-            keeper().kept = true;
-        }
+    CallbackGil() {
+        if (!gil_) throw hovering_py::InterpreterExiting();
     }
 
 private:
-    // Taking the GIL while the interpreter finalises would end this thread by forced unwinding
-    // through C++ frames (std::terminate): park it until the process ends (see GilRelease).
-    static bool park_if_finalizing() {
-        while (hovering_py::GilRelease::finalizing()) std::this_thread::sleep_for(std::chrono::seconds(1));
-        return true;
-    }
-    struct Keeper {
-        bool kept = false;
-        ~Keeper() {
-            if (!kept || !Py_IsInitialized()) return;
-            py::gil_scoped_acquire gil;
-            gil.dec_ref();  // the extra reference: the state is deleted when `gil` ends
-        }
-    };
-    static Keeper& keeper() {
-        thread_local Keeper k;
-        return k;
-    }
-    bool fresh_;
-    py::gil_scoped_acquire gil_;
+    hovering_py::Gil gil_;
 };
 
 /// hovering.Potential.ReturnError, set by register_potential (leaked, like the module).
@@ -188,12 +164,12 @@ public:
     /// The last reference may go from a thread without the GIL (a core object holding the
     /// potential): dropping the callables needs it.
     ~CallablePotential() override {
-        if (!Py_IsInitialized()) {  // interpreter gone: leak rather than touch freed state
+        const hovering_py::Gil gil;
+        if (!gil) {  // the interpreter is exiting: leak rather than touch it
             V_.release();
             dV_.release();
             return;
         }
-        py::gil_scoped_acquire gil;
         V_ = py::object();
         dV_ = py::object();
     }
@@ -227,12 +203,8 @@ std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
                              py::repr(obj).cast<std::string>());
     const Potential* cpp = obj.cast<const Potential*>();
     std::shared_ptr<py::object> owner(new py::object(obj), [](py::object* o) {
-        if (!Py_IsInitialized()) {
-            o->release();
-            delete o;
-            return;
-        }
-        py::gil_scoped_acquire gil;
+        const hovering_py::Gil gil;
+        if (!gil) o->release();  // the interpreter is exiting: leak the reference rather than touch it
         delete o;
     });
     return std::shared_ptr<const Potential>(owner, cpp);

@@ -1,9 +1,11 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
 // (truncated, flow, normal), each registering itself; the shared enums live at the top.
+#include "gil.hpp"
 #include "pybind.hpp"
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";
+    hovering_py::register_gil_gate(m);  // before anything can take the GIL from another thread
     register_enums(m);
     auto truncated = m.def_submodule("truncated", "The truncated near-tangency family F_{eps1,eps2}.");
     register_truncated(truncated);

@@ -1,0 +1,237 @@
+#pragma once
+// The one owner of every GIL acquisition the bindings make on their own initiative: the caller's
+// re-acquisition after a long computation (GilRelease), the progress and signal watcher, the calls
+// of Python-defined potentials from the core's worker threads, and the Python references dropped
+// on threads that do not hold the GIL. (The GIL a Python caller holds when it calls in is not ours.)
+//
+// Why: from the moment CPython sets its finalising flag, a thread other than the finalising one
+// that takes the GIL is ended by CPython (pthread_exit, a forced unwinding). Through C++ frames that
+// is std::terminate (a noexcept destructor, a joinable std::thread) or "FATAL: exception not
+// rethrown" (a catch (...) that keeps the exception), i.e. an abort of the whole process at exit.
+// Checking the flag before taking the GIL cannot help: the flag may be set between the check and
+// the acquisition, or while the thread waits for the GIL.
+//
+// How: every such acquisition passes a gate first. An `atexit` hook (registered when the module is
+// imported; atexit callbacks run with the GIL held, after the non-daemon threads are joined and
+// before CPython sets its finalising flag) closes the gate and then waits, with the GIL released,
+// until no thread is between "passed the gate" and "done with the GIL". After that no thread but
+// the finalising one takes the GIL through us: a caller whose long computation ends later parks
+// (sleeps until the process ends, as CPython 3.14 does with daemon threads), a Python potential
+// called later raises InterpreterExiting instead (it unwinds to that parked caller), a progress
+// report is skipped, a reference is leaked. The gate is a single atomic word: no lock that a fork
+// or an exit could leave held.
+//
+// While the finalising thread itself waits in a long computation (a hovering call in a later atexit
+// callback), it cannot finalise: other threads (its own workers) may pass then, and it waits for
+// them before it takes the GIL back.
+
+#include <Python.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include "pybind.hpp"
+
+namespace hovering_py {
+
+/// What a Python-defined potential raises (as a C++ exception the core hands to the caller) when it
+/// is called after the interpreter began to exit: the caller's thread then parks until the end.
+class InterpreterExiting : public std::runtime_error {
+public:
+    InterpreterExiting()
+        : std::runtime_error("the Python interpreter is exiting: a Python-defined potential cannot be called any more") {}
+};
+
+/// The gate every GIL acquisition of the bindings goes through (see the top of this file).
+class GilGate {
+public:
+    /// How a thread passed the gate.
+    enum class Pass : std::uint8_t {
+        Refused,    ///< gate closed for this thread: do not take the GIL
+        Counted,    ///< passed; the finaliser waits for leave()
+        Finaliser,  ///< the thread that closed the gate (it may always take the GIL; not counted)
+    };
+
+    /// Ask to take the GIL (holding it already or not). Never blocks. A Refused thread must not
+    /// take the GIL nor run Python code; any other pass must be given back with leave().
+    static Pass enter() noexcept {
+        if (finaliser()) return Py_IsInitialized() ? Pass::Finaliser : Pass::Refused;
+        std::uint64_t w = word().load();
+        for (;;) {
+            // Open, or closed while the finaliser waits in a computation before it finalised.
+            const bool open = !(w & kClosed) || ((w & kBusyMask) != 0 && !finalizing());
+            if (!open) return Pass::Refused;
+            if (word().compare_exchange_weak(w, w + 1)) return Pass::Counted;
+        }
+    }
+
+    /// Done with the GIL (released it, or returned to Python): the end of what enter() began.
+    static void leave(Pass p) noexcept {
+        if (p != Pass::Counted) return;
+        std::uint64_t w = word().load();
+        // Never below zero: a fork child starts from zero passes (after_fork_in_child).
+        while ((w & kInsideMask) != 0 && !word().compare_exchange_weak(w, w - 1)) {
+        }
+    }
+
+    /// The atexit hook (GIL held): close the gate, then wait, with the GIL released, until every
+    /// thread that passed it is done. Idempotent.
+    static void close() {
+        finaliser() = true;
+        word().fetch_or(kClosed);
+        if (inside() == 0) return;
+        Py_BEGIN_ALLOW_THREADS
+        wait_until_empty();
+        Py_END_ALLOW_THREADS
+    }
+
+    /// Sleep until the process ends (a thread that may not take the GIL again).
+    [[noreturn]] static void park() noexcept {
+        for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+    }
+
+    /// Whether CPython's finalising flag is set (from then on only the finalising thread may take
+    /// the GIL).
+    static bool finalizing() noexcept {
+#if PY_VERSION_HEX >= 0x030D0000
+        return Py_IsFinalizing() != 0;
+#else
+        return _Py_IsFinalizing() != 0;
+#endif
+    }
+
+    /// Called by the finaliser when it releases the GIL for a computation (others may pass then);
+    /// true if it was the finaliser (then end_busy() must follow).
+    static bool begin_busy() noexcept {
+        if (!finaliser()) return false;
+        word().fetch_add(kBusyOne);
+        return true;
+    }
+
+    /// The finaliser's computation ended: no one passes any more; wait until those who did are
+    /// done, before the finaliser takes the GIL back.
+    static void end_busy() noexcept {
+        word().fetch_sub(kBusyOne);
+        wait_until_empty();
+    }
+
+    /// In a child made by os.fork only the forking thread exists: the passes other threads held
+    /// went with them (an exit of the child would wait for them forever).
+    static void after_fork_in_child() noexcept { word().fetch_and(kClosed); }
+
+private:
+    static constexpr std::uint64_t kClosed = std::uint64_t(1) << 63;
+    static constexpr std::uint64_t kBusyOne = std::uint64_t(1) << 32;
+    static constexpr std::uint64_t kBusyMask = (kClosed - 1) & ~(kBusyOne - 1);
+    static constexpr std::uint64_t kInsideMask = kBusyOne - 1;
+
+    /// closed (bit 63), finaliser's computations under way (bits 32-62), passes held (bits 0-31).
+    /// Trivially destructible: threads parked or running at exit() may still read it.
+    static std::atomic<std::uint64_t>& word() noexcept {
+        static std::atomic<std::uint64_t> w{0};
+        return w;
+    }
+    /// Whether the calling thread closed the gate (the thread that finalises the interpreter).
+    static bool& finaliser() noexcept {
+        static thread_local bool f = false;
+        return f;
+    }
+    static std::uint64_t inside() noexcept { return word().load() & kInsideMask; }
+    static void wait_until_empty() noexcept {
+        while (inside() != 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+};
+
+/// Releases the GIL for a pure C++ computation and takes it back at the end, through the gate:
+/// if the interpreter has begun to exit by then, the thread parks until the process ends instead
+/// (its result is never seen).
+class GilRelease {
+public:
+    GilRelease() : state_(PyEval_SaveThread()), busy_(GilGate::begin_busy()) {}
+    ~GilRelease() {
+        if (busy_) {
+            GilGate::end_busy();
+            PyEval_RestoreThread(state_);
+            return;
+        }
+        const GilGate::Pass p = GilGate::enter();
+        if (p == GilGate::Pass::Refused) GilGate::park();
+        PyEval_RestoreThread(state_);
+        GilGate::leave(p);
+    }
+    GilRelease(const GilRelease&) = delete;
+    GilRelease& operator=(const GilRelease&) = delete;
+
+private:
+    PyThreadState* state_;
+    bool busy_;
+};
+
+/// Holds the GIL for one stretch of Python work started from C++, on any thread (one holding the
+/// GIL already, a Python thread that released it, or a thread Python does not know), through the
+/// gate. Test it: false means the interpreter is exiting and nothing of Python may be touched
+/// (the GIL is not held then).
+///
+/// On a thread Python does not know (the core's workers), the first acquisition creates a Python
+/// thread state; it is kept, with one extra reference, until the thread ends, instead of being
+/// created and destroyed every time (which made a two-thread return map with Python potentials
+/// 16x slower: 21 ms instead of 1.3 ms per return). Threads Python created are left alone.
+class Gil {
+public:
+    Gil() : pass_(GilGate::enter()) {
+        if (pass_ == GilGate::Pass::Refused) return;
+        const bool fresh = PyGILState_GetThisThreadState() == nullptr;
+        gil_.emplace();
+        if (fresh) {
+            gil_->inc_ref();
+            keeper().kept = true;
+        }
+    }
+    ~Gil() {
+        gil_.reset();
+        GilGate::leave(pass_);
+    }
+    Gil(const Gil&) = delete;
+    Gil& operator=(const Gil&) = delete;
+    /// Whether the GIL is held (false: the interpreter is exiting).
+    explicit operator bool() const { return pass_ != GilGate::Pass::Refused; }
+
+private:
+    /// Drops the kept thread state when its thread ends (leaks it if the interpreter is exiting).
+    struct Keeper {
+        bool kept = false;
+        ~Keeper() {
+            if (!kept) return;
+            const GilGate::Pass p = GilGate::enter();
+            if (p == GilGate::Pass::Refused) return;
+            {
+                py::gil_scoped_acquire gil;
+                gil.dec_ref();  // the extra reference: the state is deleted when `gil` ends
+            }
+            GilGate::leave(p);
+        }
+    };
+    static Keeper& keeper() {
+        static thread_local Keeper k;
+        return k;
+    }
+    GilGate::Pass pass_;
+    std::optional<py::gil_scoped_acquire> gil_;
+};
+
+/// Registers the gate's atexit hook and its fork handler (once, at import of the module).
+inline void register_gil_gate(py::module_& m) {
+    m.def("_close_gil_gate", &GilGate::close,
+          "Close the GIL gate (run by atexit; see python/src/gil.hpp). Only for the interpreter's exit.");
+    m.def("_gil_gate_after_fork", &GilGate::after_fork_in_child, "Reset the GIL gate's passes in a fork child.");
+    py::module_::import("atexit").attr("register")(m.attr("_close_gil_gate"));
+    const py::module_ os = py::module_::import("os");
+    if (py::hasattr(os, "register_at_fork"))
+        os.attr("register_at_fork")(py::arg("after_in_child") = m.attr("_gil_gate_after_fork"));
+}
+
+}  // namespace hovering_py
