@@ -27,12 +27,11 @@ using hovering::detail::kInf;
 using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
 /// Holds the GIL for one call into Python from any thread (gil.hpp). Once the interpreter exits
-/// the call is refused: InterpreterExiting travels up through the core like a Python exception, to
-/// a caller that then parks until the process ends.
+/// the thread parks instead (its computation's result would never be seen).
 class CallbackGil {
 public:
     CallbackGil() {
-        if (!gil_) throw hovering_py::InterpreterExiting();
+        if (!gil_) hovering_py::GilGate::park();
     }
 
 private:

@@ -15,9 +15,9 @@
 // imported; atexit callbacks run with the GIL held, after the non-daemon threads are joined and
 // before CPython sets its finalising flag) closes the gate and then waits, with the GIL released,
 // until no thread is between "passed the gate" and "done with the GIL". After that no thread but
-// the finalising one takes the GIL through us: a caller whose long computation ends later parks
-// (sleeps until the process ends, as CPython 3.14 does with daemon threads), a Python potential
-// called later raises InterpreterExiting instead (it unwinds to that parked caller), a progress
+// the finalising one takes the GIL through us: a caller whose long computation ends later, or a
+// thread about to call a Python-defined potential, parks (sleeps until the process ends, as
+// CPython 3.14 does with daemon threads; one that holds the GIL releases it first), a progress
 // report is skipped, a reference is leaked. The gate is a single atomic word: no lock that a fork
 // or an exit could leave held.
 //
@@ -31,20 +31,11 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
-#include <stdexcept>
 #include <thread>
 
 #include "pybind.hpp"
 
 namespace hovering_py {
-
-/// What a Python-defined potential raises (as a C++ exception the core hands to the caller) when it
-/// is called after the interpreter began to exit: the caller's thread then parks until the end.
-class InterpreterExiting : public std::runtime_error {
-public:
-    InterpreterExiting()
-        : std::runtime_error("the Python interpreter is exiting: a Python-defined potential cannot be called any more") {}
-};
 
 /// The gate every GIL acquisition of the bindings goes through (see the top of this file).
 class GilGate {
@@ -62,16 +53,22 @@ public:
         if (finaliser()) return Py_IsInitialized() ? Pass::Finaliser : Pass::Refused;
         std::uint64_t w = word().load();
         for (;;) {
-            // Open, or closed while the finaliser waits in a computation before it finalised.
-            const bool open = !(w & kClosed) || ((w & kBusyMask) != 0 && !finalizing());
+            // Open; or closed while the finaliser waits in a computation before it finalised; or
+            // this thread holds a pass already (the finaliser waits for it: refusing it would
+            // leave that wait without end).
+            const bool open = !(w & kClosed) || ((w & kBusyMask) != 0 && !finalizing()) || held() > 0;
             if (!open) return Pass::Refused;
-            if (word().compare_exchange_weak(w, w + 1)) return Pass::Counted;
+            if (word().compare_exchange_weak(w, w + 1)) {
+                ++held();
+                return Pass::Counted;
+            }
         }
     }
 
     /// Done with the GIL (released it, or returned to Python): the end of what enter() began.
     static void leave(Pass p) noexcept {
         if (p != Pass::Counted) return;
+        --held();
         std::uint64_t w = word().load();
         // Never below zero: a fork child starts from zero passes (after_fork_in_child).
         while ((w & kInsideMask) != 0 && !word().compare_exchange_weak(w, w - 1)) {
@@ -89,8 +86,11 @@ public:
         Py_END_ALLOW_THREADS
     }
 
-    /// Sleep until the process ends (a thread that may not take the GIL again).
+    /// Sleep until the process ends: what a thread the gate refused does instead of calling
+    /// Python. A thread holding the GIL (one that called in after the gate closed) releases it
+    /// first, so that the interpreter can finalise.
     [[noreturn]] static void park() noexcept {
+        if (holds_gil()) PyEval_SaveThread();
         for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
     }
 
@@ -140,7 +140,20 @@ private:
         static thread_local bool f = false;
         return f;
     }
+    /// Passes the calling thread holds.
+    static int& held() noexcept {
+        static thread_local int n = 0;
+        return n;
+    }
     static std::uint64_t inside() noexcept { return word().load() & kInsideMask; }
+    /// Whether the calling thread holds the GIL; safe at any time, also while or after the
+    /// interpreter finalises: the thread state holding the GIL (3.11: any thread's; 3.12+: this
+    /// thread's, or null) is compared with this thread's own, pointers only (PyGILState_Check
+    /// answers 1 once its thread-local key is gone).
+    static bool holds_gil() noexcept {
+        PyThreadState* const current = py::detail::get_thread_state_unchecked();
+        return current != nullptr && current == PyGILState_GetThisThreadState();
+    }
     static void wait_until_empty() noexcept {
         while (inside() != 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
