@@ -31,7 +31,7 @@ using hovering::detail::fmt;  // all 17 digits: a message names the value the co
 class CallbackGil {
 public:
     CallbackGil() {
-        if (!gil_) hovering_py::GilGate::park();
+        if (!gil_) hovering_py::GilGate::refused();
     }
 
 private:

@@ -31,6 +31,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 
 #include "pybind.hpp"
@@ -44,7 +45,7 @@ public:
     enum class Pass : std::uint8_t {
         Refused,    ///< gate closed for this thread: do not take the GIL
         Counted,    ///< passed; the finaliser waits for leave()
-        Finaliser,  ///< the thread that closed the gate (it may always take the GIL; not counted)
+        Finaliser,  ///< the thread that closed the gate, before CPython finalises (not counted)
     };
 
     /// Ask to take the GIL (holding it already or not). Never blocks. A Refused thread must not
@@ -92,6 +93,14 @@ public:
     [[noreturn]] static void park() noexcept {
         if (holds_gil()) PyEval_SaveThread();
         for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+    }
+
+    /// What a computation does where it needs Python and the gate refused: park, except on the
+    /// finalising thread (refused only once CPython finalises), which nothing would end: there the
+    /// computation fails instead (a hovering call from a destructor run by the finalisation).
+    [[noreturn]] static void refused() {
+        if (finaliser()) throw std::runtime_error("Python can no longer be called: the interpreter is finalising");
+        park();
     }
 
     /// Whether CPython's finalising flag is set (from then on only the finalising thread may take
@@ -236,15 +245,13 @@ private:
     std::optional<py::gil_scoped_acquire> gil_;
 };
 
-/// Registers the gate's atexit hook and its fork handler (once, at import of the module).
-inline void register_gil_gate(py::module_& m) {
-    m.def("_close_gil_gate", &GilGate::close,
-          "Close the GIL gate (run by atexit; see python/src/gil.hpp). Only for the interpreter's exit.");
-    m.def("_gil_gate_after_fork", &GilGate::after_fork_in_child, "Reset the GIL gate's passes in a fork child.");
-    py::module_::import("atexit").attr("register")(m.attr("_close_gil_gate"));
+/// Registers the gate's atexit hook and its fork handler (once, at import of the module; they are
+/// not names of the module: nothing else may call them).
+inline void register_gil_gate() {
+    py::module_::import("atexit").attr("register")(py::cpp_function(&GilGate::close));
     const py::module_ os = py::module_::import("os");
     if (py::hasattr(os, "register_at_fork"))
-        os.attr("register_at_fork")(py::arg("after_in_child") = m.attr("_gil_gate_after_fork"));
+        os.attr("register_at_fork")(py::arg("after_in_child") = py::cpp_function(&GilGate::after_fork_in_child));
 }
 
 }  // namespace hovering_py
