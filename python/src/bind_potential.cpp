@@ -9,6 +9,7 @@
 // pybind11::error_already_set, which the flow's thread pool hands to the calling thread.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <string>
@@ -26,17 +27,42 @@ using hovering::detail::kInf;
 
 using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
-/// Holds the GIL for one call into Python from any thread (gil.hpp). Once the interpreter exits
-/// the thread parks instead (its computation's result would never be seen).
-class CallbackGil {
+/// A Python exception of a Python-defined potential on its way through the core (GSL's frames, the
+/// worker threads) to the caller, where the module's translator raises it again unchanged. Its
+/// Python part is dropped through the gate (gil.hpp): a second worker's exception is discarded on
+/// that worker, without the GIL, and pybind11's own exception would take the GIL for it there
+/// unconditionally (PyGILState_Ensure), also while the interpreter exits.
+class PotentialError : public std::exception {
 public:
-    CallbackGil() {
-        if (!gil_) hovering_py::GilGate::refused();
-    }
+    /// Takes over e (GIL held).
+    explicit PotentialError(py::error_already_set&& e)
+        : what_(e.what()), error_(new py::error_already_set(std::move(e)), drop) {}
+    const char* what() const noexcept override { return what_.c_str(); }
+    /// Set the potential's exception as the Python error (GIL held).
+    void restore() const { error_->restore(); }
 
 private:
-    hovering_py::Gil gil_;
+    static void drop(py::error_already_set* e) {
+        const hovering_py::Gil gil;
+        if (gil) delete e;  // else the interpreter is exiting: leak it
+    }
+    std::string what_;
+    std::shared_ptr<py::error_already_set> error_;
 };
+
+/// f() with the GIL, taken on any thread through the gate (gil.hpp); a Python exception leaves it
+/// as PotentialError. Once the interpreter exits the thread parks instead (its computation's
+/// result would never be seen).
+template <class F>
+auto in_python(F&& f) -> decltype(f()) {
+    const hovering_py::Gil gil;
+    if (!gil) hovering_py::GilGate::refused();
+    try {
+        return f();
+    } catch (py::error_already_set& e) {
+        throw PotentialError(std::move(e));
+    }
+}
 
 /// hovering.Potential.ReturnError, set by register_potential (leaked, like the module).
 PyObject* potential_return_error = nullptr;
@@ -102,7 +128,15 @@ public:
     double dV(double q) const override { return call("dV", q); }
 
     std::string name() const override {
-        CallbackGil gil;
+        return in_python([&] { return name_of_class(); });
+    }
+
+    double q_limit() const override {  // asked once per orbit, on the worker threads too
+        return in_python([&] { return limit_of_class(); });
+    }
+
+private:
+    std::string name_of_class() const {
         const py::handle self = python_self(this);
         if (!self) return "Potential(<Python object released>)";
         const std::string fallback = py::type::handle_of(self).attr("__name__").cast<std::string>() + "()";
@@ -122,8 +156,7 @@ public:
         return v.cast<std::string>();
     }
 
-    double q_limit() const override {  // asked once per orbit, on the worker threads too
-        CallbackGil gil;
+    double limit_of_class() const {
         const py::handle self = python_self(this);
         if (!self) return kInf;
         bool called = false;
@@ -136,18 +169,19 @@ public:
         return lim;
     }
 
-private:
     double call(const char* fn, double q) const {
-        CallbackGil gil;
-        const py::function f = py::get_override(static_cast<const Potential*>(this), fn);
-        if (!f) {
-            if (!python_self(this))
-                throw std::runtime_error(std::string("Potential.") + fn + ": the Python object of this potential was released");
-            throw py::type_error(name() + " does not define " + fn +
-                                 "(self, q): subclass hovering.Potential and define V(self, q) and dV(self, q), "
-                                 "or use hovering.CustomPotential(V, dV)");
-        }
-        return checked_value(f(q), *this, fn, q);
+        return in_python([&] {
+            const py::function f = py::get_override(static_cast<const Potential*>(this), fn);
+            if (!f) {
+                if (!python_self(this))
+                    throw std::runtime_error(std::string("Potential.") + fn +
+                                             ": the Python object of this potential was released");
+                throw py::type_error(name() + " does not define " + fn +
+                                     "(self, q): subclass hovering.Potential and define V(self, q) and dV(self, q), "
+                                     "or use hovering.CustomPotential(V, dV)");
+            }
+            return checked_value(f(q), *this, fn, q);
+        });
     }
 };
 
@@ -183,8 +217,7 @@ public:
 
 private:
     double call(const py::object& f, const char* fn, double q) const {
-        CallbackGil gil;
-        return checked_value(f(q), *this, fn, q);
+        return in_python([&] { return checked_value(f(q), *this, fn, q); });
     }
     py::object V_, dV_;
     double q_limit_;
@@ -369,6 +402,14 @@ void register_potential(py::module_& m) {
                    ", lam=" + g(p.lam) + ", theta_w=" + g(p.theta_w) + ", I_tan=" + g(p.I_tan) + ")";
         });
     register_potential_pickles(m);
+    // A Python-defined potential's exception reaches the caller as the exception it raised.
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const PotentialError& e) {
+            e.restore();
+        }
+    });
     m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"),
           py::arg("rtol") = 1e-6);
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),

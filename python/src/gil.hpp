@@ -21,6 +21,11 @@
 // report is skipped, a reference is leaked. The gate is a single atomic word: no lock that a fork
 // or an exit could leave held.
 //
+// pybind11 takes the GIL on its own in two places our threads reach: its lazy one-time set-up of
+// NumPy (done at import instead: register_gil_gate) and the destructor of a Python exception
+// (error_already_set) dropped on a thread without the GIL (bind_potential.cpp wraps the exceptions
+// of Python-defined potentials so that they are dropped through the gate).
+//
 // While the finalising thread itself waits in a long computation (a hovering call in a later atexit
 // callback), it cannot finalise: other threads (its own workers) may pass then, and it waits for
 // them before it takes the GIL back.
@@ -248,6 +253,12 @@ private:
 /// Registers the gate's atexit hook and its fork handler (once, at import of the module; they are
 /// not names of the module: nothing else may call them).
 inline void register_gil_gate() {
+    // pybind11 sets up its NumPy state lazily, and the first use releases and re-takes the GIL
+    // (gil_safe_call_once_and_store), outside the gate: first used by a daemon thread's call that
+    // started as the interpreter exits, that aborted the process. Done here, on the importing
+    // thread, it never happens later.
+    py::detail::npy_api::get();
+    (void)py::dtype(py::buffer_info(static_cast<double*>(nullptr), 0));  // its PEP 3118 parser, the other one
     py::module_::import("atexit").attr("register")(py::cpp_function(&GilGate::close));
     const py::module_ os = py::module_::import("os");
     if (py::hasattr(os, "register_at_fork"))
