@@ -4,13 +4,16 @@ the process (issue 18; README "Outcomes are values": Ctrl-C and exit).
 From the moment CPython sets its finalising flag, a thread other than the finalising one that takes
 the GIL is ended by a forced unwinding, which through C++ frames aborts the process (std::terminate,
 "FATAL: exception not rethrown"). The bindings take every GIL through one gate
-(python/src/gil.hpp) that an atexit hook closes first. Each scenario below is a separate process: a
-daemon thread starts a long call, the main thread waits until the call is under way (its first
-progress report, its first Python call from a core thread) and exits shortly after, at delays spread
-over the watcher's 100 ms cycle. Measured on main before the gate (200 runs each, this 2-core VM):
-iterate with a progress callable 200/200 aborted, FlowMap.iterate with progress 190/200 (3 of them
-SIGSEGV), return_map(progress=True) 60/200, a CustomPotential on two threads 109/200; the plain call
-0/200 (the issue saw ~1 in 1000).
+(python/src/gil.hpp) that an atexit hook closes first; pybind11's own lazy NumPy set-up, which
+took the GIL on a call's first use of an array, is done at import. Each scenario below is a
+separate process: a daemon thread starts a long call, the main thread waits until the call is under
+way (its first progress report, its first Python call from a core thread) and exits shortly after,
+at delays spread over the watcher's 100 ms cycle. Measured with these scenarios before the gate (200
+runs each, a loaded 2-core VM): iterate with a progress callable 178/200 aborted (5 of them
+SIGSEGV), FlowMap.iterate with progress 185/200 (7 SIGSEGV), return_map(progress=True) 200/200, a
+CustomPotential on two threads 155/200 ("FATAL: exception not rethrown"), the plain call 0/200 here
+but 6/600 at delay 0 (the first use of pybind11's NumPy state, which releases and re-takes the GIL).
+After: 0 of each (and 0/600 plain at delay 0).
 """
 
 from __future__ import annotations
