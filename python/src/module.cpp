@@ -1,7 +1,8 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
 // (truncated, flow, normal), each registering itself; the shared enums live at the top.
-#include "gil.hpp"
 #include "pybind.hpp"
+// (after pybind.hpp, which it needs)
+#include "gil.hpp"
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";
