@@ -1,7 +1,6 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
 // (truncated, flow, normal), each registering itself; the shared enums live at the top.
 #include "pybind.hpp"
-// (after pybind.hpp, which it needs)
 #include "gil.hpp"
 
 PYBIND11_MODULE(_core, m) {
