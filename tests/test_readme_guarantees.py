@@ -123,7 +123,7 @@ def test_ctrl_c_stops_critical_curve():
 
 
 def test_ctrl_c_stops_a_scene(tmp_path):
-    from hovering import scenes
+    from hovering import pipeline, scenes
 
     scene = scenes.load_scene(ROOT / "examples" / "scenes" / "fig_hov_vs_eps.toml")  # a full |HOV| sweep
-    assert _interrupted(lambda: scenes.run_scene(scene, out=tmp_path / "hov.png", quick=False)) < 30
+    assert _interrupted(lambda: pipeline.run_scene(scene, out=tmp_path / "hov.png", quick=False)) < 30
