@@ -86,6 +86,7 @@ from .truncated import (
 from .truncated.theory import theory
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
 from .explore import explore
+from . import paper
 
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
@@ -93,6 +94,9 @@ simd_width = _core.truncated.simd_width
 
 __all__ = [
     "__version__",
+    "paper",
+    "diagnostics",
+    "pipeline",
     "WorkPrecision",
     "work_precision",
     "TruncatedMap",
@@ -165,13 +169,15 @@ __all__ = [
     "show_versions",
 ]
 
-# Old module paths (hovering.geometry, hovering.fullmap, ...) stay importable and warn on use
-# (hovering._deprecated); they are not imported here, so they cost nothing until asked for.
+# Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):
+# the scene pipeline, the figures and the module that joins them; and the old module paths
+# (hovering.geometry, hovering.fullmap, ...), which warn on use (hovering._deprecated).
+_LAZY_MODULES = ("pipeline", "scenes", "plot")
 _OLD_MODULES = ("accuracy", "references", "fullmap", "geometry", "maps", "potentials", "system", "plotting", "figures")
 
 
 def __getattr__(name: str):
-    if name in _OLD_MODULES:
+    if name in _LAZY_MODULES or name in _OLD_MODULES:
         import importlib
 
         return importlib.import_module(f"{__name__}.{name}")
