@@ -55,10 +55,10 @@ def _parse(cls, value) -> "Region":
     raise ValueError(f"unknown region {value!r}; allowed: {allowed}")
 
 
-Region.label = property(_label)
+Region.label = property(_label)  # type: ignore[method-assign,assignment]  # declared in _core's stub
 
 
-Region.parse = classmethod(_parse)
+Region.parse = classmethod(_parse)  # type: ignore[method-assign,assignment]
 
 
 def region_mask(regions) -> int:

@@ -6,4 +6,4 @@ from ._core import build_info
 __all__ = ["__version__"]
 
 #: The version of this build (PEP 440).
-__version__: str = dict(build_info())["hovering"]
+__version__: str = str(dict(build_info())["hovering"])

@@ -140,7 +140,7 @@ class MapAnalyses:
 
     def hovers(self) -> bool:
         """Whether the leading-order theory predicts a hovering set for this map (see :meth:`theory`)."""
-        return bool(self.theory().hovers)
+        return bool(self.theory().hovers)  # type: ignore[attr-defined]  # every ReturnMap has theory()
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ Physical system (the README's, built for this package: the paper has no numeric 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .flow.section import Section
 from .flow.system import Bilinear, Harmonic, StepSystem, Tan
@@ -79,7 +80,7 @@ def system(eps: float = 0.0, geometry: str = "step", **overrides) -> StepSystem:
     -------
     StepSystem
     """
-    kw = dict(V1=V1, V2=V2, coupling=Bilinear(), qw1=QW1, qw2=QW2)
+    kw: dict[str, Any] = dict(V1=V1, V2=V2, coupling=Bilinear(), qw1=QW1, qw2=QW2)
     kw.update({k: v for k, v in overrides.items() if v is not None})
     return StepSystem(eps=eps, geometry=geometry, **kw)
 

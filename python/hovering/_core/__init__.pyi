@@ -15,6 +15,11 @@ class Region(enum.IntEnum):
     UPPER = 2
     RIGHT = 3
     MULTI = 4
+    # Added by hovering._enums (the paper's labels and a parser):
+    @property
+    def label(self) -> str: ...
+    @classmethod
+    def parse(cls, value: object) -> Region: ...
 
 class Status(enum.IntEnum):
     OK = 0

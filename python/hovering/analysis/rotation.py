@@ -43,7 +43,7 @@ def birkhoff_weights(n: int) -> np.ndarray:
     return w / w.sum()
 
 
-def birkhoff_average(values, axis: int = -1) -> np.ndarray:
+def birkhoff_average(values, axis: int = -1) -> "np.ndarray | float":
     """Weighted Birkhoff average of a time series along ``axis``.
 
     Parameters
