@@ -7,7 +7,7 @@ from __future__ import annotations
 from ._enums import Region
 
 __all__ = ["REGION_COLORS", "REGION_LABELS", "SPECIAL_COLORS", "SPECIAL_LABELS", "CORNER_STYLES", "GEOMETRY_COLOR",
-           "orbit_color", "QUICK_MARK"]
+           "WALL_REGION_COLORS", "CORNER_COLORS", "orbit_color", "QUICK_MARK"]
 
 #: Colour of each region in region-coloured plots (J_0u, J_0, J_1, J_R, and two or more impacts).
 REGION_COLORS = {
@@ -31,6 +31,20 @@ SPECIAL_LABELS = {
     "green": r"L1, $K_0=0$",
     "red": r"L2, $K_0=0$",
 }
+
+#: The paper's region colours of the wall-section figures (fig:wallsection: J_R yellow, J_0 gray,
+#: J_1 cyan; J_0u, outside the wall's tangency line, pale blue; two or more impacts as elsewhere).
+WALL_REGION_COLORS = {
+    Region.RIGHT: "#f2c200",
+    Region.ABOVE: "#9a9a9a",
+    Region.UPPER: "#00d5e0",
+    Region.BESIDE: "#dce9f5",
+    Region.MULTI: "#8172b3",
+}
+
+#: Colour of each incoming direction of the corner and its corner-singularity curve (the paper's
+#: fig:corner_directions: p_R0 red, p_01 blue, p_1R green).
+CORNER_COLORS = {"R0": "#d0021b", "01": "#0515c6", "1R": "#417505"}
 
 #: Line style of each corner-singularity curve phi_ab (dashed black family).
 CORNER_STYLES = {"01": ":", "1R": "--", "R0": "-."}

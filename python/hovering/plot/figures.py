@@ -17,14 +17,16 @@ from typing import Optional
 import numpy as np
 
 from .._enums import Region
-from ..scenes.results import (FlowHoveringResult, FlowPortraitResult, HoveringAreaResult, OrbitPanelResult,
-                              OrbitSceneResult, SigmaStructureResult, TangentToriResult)
+from ..scenes.results import (CornerDirectionsResult, FlowHoveringResult, FlowPortraitResult, HoveringAreaResult,
+                              OrbitPanelResult, OrbitSceneResult, SigmaStructureResult, TangentToriResult,
+                              WallSectionResult, WallTangencyResult)
 from ..scenes.spec import QUICK_FACTOR, figure_inches
 from .primitives import draw_geometry, plot_orbits
-from .._style import QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS
+from .._style import CORNER_COLORS, GEOMETRY_COLOR, QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS, WALL_REGION_COLORS
 
 __all__ = ["render", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
-           "flow_hovering_figure", "tangent_tori_figure", "sigma_structure_figure"]
+           "flow_hovering_figure", "tangent_tori_figure", "sigma_structure_figure", "corner_directions_figure",
+           "wall_tangency_figure", "wall_section_figure"]
 
 
 def panel_title(tag: str, params: dict) -> str:
@@ -452,6 +454,328 @@ def sigma_structure_figure(result: SigmaStructureResult):
     return fig
 
 
+# ------------------------------------------------------------------------------------------------
+# The corner and the wall section
+
+
+#: Legend text of each incoming direction (eq:p2corner).
+_DIRECTION_LABELS = {"R0": r"$p_{R0}=(-p_1^w, P_2)$", "01": r"$p_{01}=(p_1^w, -P_2)$",
+                     "1R": r"$p_{1R}=(-p_1^w, -P_2)$"}
+#: Legend text of the wall-section regions in the paper's colours.
+_WALL_LABELS = {Region.RIGHT: r"$J_R$", Region.ABOVE: r"$J_0$", Region.UPPER: r"$J_1$",
+                Region.BESIDE: r"$J_{0u}$", Region.MULTI: "2+ impacts"}
+#: Region of each arc label of a wall segment.
+_ARC_REGION = {"R": Region.RIGHT, "0": Region.ABOVE, "1": Region.UPPER}
+
+
+def _draw_step(ax, qw1: float, qw2: float, lo1: float, lo2: float) -> None:
+    """The step {q1 < qw1, q2 < qw2} shaded, its two walls in black."""
+    ax.fill([lo1, qw1, qw1, lo1], [lo2, lo2, qw2, qw2], color="0.85", zorder=0, lw=0)
+    (ln,) = ax.plot([lo1, qw1, qw1], [qw2, qw2, lo2], color="k", lw=1.2, zorder=1)
+    ln.set_gid("step")
+
+
+def _segment_color(kind: str) -> str:
+    return CORNER_COLORS[kind] if kind in CORNER_COLORS else WALL_REGION_COLORS[_ARC_REGION[kind]]
+
+
+def corner_directions_figure(result: CornerDirectionsResult):
+    """fig:corner_directions computed: the three directions that reach the corner, from the flow.
+
+    (a) configuration space: trajectories of the step system from Sigma_h to the corner, one
+    colour per direction; (b) the same at the corner, with the arrival momenta as arrows; (c) the
+    momenta at the corner, ``|p| = p1w_max``: the three admissible quarter circles and the
+    measured arrivals; (d) the corner-singularity curves of Sigma_h (normal coordinates) traced by
+    the reversed flow, parametrized by p1w, with the drawn trajectories' starts.
+
+    Parameters
+    ----------
+    result : CornerDirectionsResult
+        The computed scene.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    scene = result.scene
+    fig, (axa, axb, axc, axd) = _grid(4, (2, 2), figure_inches(scene))
+    qw1, qw2 = result.qw1, result.qw2
+    allq = np.concatenate([t.trajectory[:, [1, 3]] for t in result.trajectories]) if result.trajectories else \
+        np.array([[qw1, qw2]])
+    lo1, lo2 = min(allq[:, 0].min(), qw1) - 0.2, min(allq[:, 1].min(), qw2) - 0.2
+    hi1, hi2 = allq[:, 0].max() + 0.1, allq[:, 1].max() + 0.1
+    zoom = 0.12 * max(hi1 - lo1, hi2 - lo2)
+    styles = ("-", "--", "-.", ":")
+    fr = sorted({t.p1w for t in result.trajectories})
+    for ax in (axa, axb):
+        _draw_step(ax, qw1, qw2, lo1, lo2)
+        for i, t in enumerate(result.trajectories):
+            c = CORNER_COLORS[t.direction]
+            ls = styles[fr.index(t.p1w) % len(styles)]
+            lab = (_DIRECTION_LABELS[t.direction] + rf", $p_1^w={t.p1w:.3f}$") if ax is axa else None
+            (ln,) = ax.plot(t.trajectory[:, 1], t.trajectory[:, 3], color=c, lw=1.0, ls=ls, label=lab)
+            ln.set_gid(f"trajectory:{t.direction}:{i}")
+            if ax is axa:
+                (st,) = ax.plot(t.trajectory[0, 1], t.trajectory[0, 3], "o", color=c, ms=4)
+                st.set_gid(f"start:{t.direction}:{i}")
+            else:
+                p = t.arrival[[1, 3]] / result.p1w_max * 0.6 * zoom
+                arr = ax.annotate("", xy=(qw1, qw2), xytext=(qw1 - p[0], qw2 - p[1]),
+                                  arrowprops=dict(arrowstyle="-|>", color=c, lw=1.2))
+                arr.set_gid(f"arrival:{t.direction}:{i}")
+        ax.set_xlabel(r"$q_1$")
+        ax.set_ylabel(r"$q_2$")
+        ax.set_aspect("equal", adjustable="box")
+    axa.set_xlim(lo1, hi1)
+    axa.set_ylim(lo2 - 0.45 * (hi2 - lo2), hi2)  # room for the legend under the trajectories
+    axa.legend(fontsize=6.5, loc="lower right", framealpha=0.85, ncol=2)
+    axa.set_title("(a) trajectories of the step system from $\Sigma_h$ to the corner", fontsize=9)
+    axb.set_xlim(qw1 - zoom, qw1 + zoom)
+    axb.set_ylim(qw2 - zoom, qw2 + zoom)
+    for d, (dx, dy) in (("R0", (0.25, -0.55)), ("01", (-0.75, 0.45)), ("1R", (0.25, 0.5))):
+        axb.text(qw1 + dx * zoom, qw2 + dy * zoom, _DIRECTION_LABELS[d].split("=")[0] + "$",
+                 color=CORNER_COLORS[d], fontsize=11)
+    axb.set_title("(b) at the corner: the arrival momenta (arrows)", fontsize=9)
+    r = result.p1w_max
+    a = np.linspace(0, 2 * np.pi, 361)
+    axc.plot(r * np.cos(a), r * np.sin(a), color="0.8", lw=0.8)
+    quarter = {"R0": (np.pi / 2, np.pi), "01": (1.5 * np.pi, 2 * np.pi), "1R": (np.pi, 1.5 * np.pi)}
+    for d, (a0, a1) in quarter.items():
+        aa = np.linspace(a0, a1, 91)
+        (ln,) = axc.plot(r * np.cos(aa), r * np.sin(aa), color=CORNER_COLORS[d], lw=2.5, label=_DIRECTION_LABELS[d])
+        ln.set_gid(f"momenta:{d}")
+    axc.text(0.35 * r, 0.35 * r, "none:\nwould come from\ninside the step", fontsize=7, color="0.4", ha="center")
+    for i, t in enumerate(result.trajectories):
+        (pt,) = axc.plot(t.arrival[1], t.arrival[3], "o", color=CORNER_COLORS[t.direction], ms=5, mec="k", mew=0.5)
+        pt.set_gid(f"arrival_momentum:{t.direction}:{i}")
+    axc.axhline(0, color="0.6", lw=0.6)
+    axc.axvline(0, color="0.6", lw=0.6)
+    axc.set_aspect("equal")
+    axc.set_xlabel(r"$p_1$ at the corner")
+    axc.set_ylabel(r"$p_2$ at the corner")
+    axc.legend(fontsize=7, loc="lower left", framealpha=0.85)
+    axc.set_title(rf"(c) incoming momenta, $|p|=\sqrt{{2(h-h^w_\varepsilon)}}={r:.4f}$ (dots: measured)", fontsize=9)
+    for d, c in result.curves.items():
+        ok = c["reached"]
+        (ln,) = axd.plot(np.where(ok, c["phi"], np.nan), np.where(ok, c["K"], np.nan), "-", color=CORNER_COLORS[d],
+                         lw=1.2, marker=".", ms=3, label=rf"$\sigma_{{{d}}}$ ({int(ok.sum())}/{ok.size} reach the corner)")
+        ln.set_gid(f"curve:{d}")
+        if (~ok & np.isfinite(c["phi"])).any():
+            axd.plot(c["phi"][~ok], c["K"][~ok], "x", color=CORNER_COLORS[d], ms=4)
+    for i, t in enumerate(result.trajectories):
+        (pt,) = axd.plot(t.phi, t.K, "o", color=CORNER_COLORS[t.direction], ms=6, mec="k", mew=0.6)
+        pt.set_gid(f"start:{t.direction}:{i}")
+    axd.axhline(0.0, color=GEOMETRY_COLOR, lw=0.8)
+    axd.set_xlim(-np.pi, np.pi)
+    axd.set_xlabel(r"$\phi$")
+    axd.set_ylabel(r"$K$")
+    axd.legend(fontsize=7, loc="lower right", framealpha=0.85)
+    axd.set_title("(d) corner-singularity curves of $\Sigma_h$, traced back from the corner", fontsize=9)
+    fig.suptitle(scene.title + _quick(result) + "\n" + _system_text(scene), fontsize=9)
+    return fig
+
+
+def wall_tangency_figure(result: WallTangencyResult):
+    """fig:Sigma_0_wall computed: the wall's tangency line, its seven points and their trajectories.
+
+    (a) The wall section in the (q2, p2) plane: the interior of the tangency line
+    (``Sigma_h^{w,-}``) coloured by the flow's label of the return through each point (J_R, J_0,
+    J_1 in the paper's colours), the band ``Sigma_h^>`` outside it (J_0u), the line q2 = qw2 and
+    the caption's seven points. (b) Their trajectories (the smooth flow: they only touch
+    q1 = qw1) in configuration space, from Sigma_h to Sigma_h; (c) the same at the wall. Points
+    1-3 move down when they touch (p2 < 0: solid), 5-7 up (dashed); 1 and 7, 2 and 6, 3 and 5 touch
+    at the same place (one colour each): at eps = 0 each pair is one curve run both ways (time
+    reversal flips p2 where p1 = 0).
+
+    Parameters
+    ----------
+    result : WallTangencyResult
+        The computed scene.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    scene = result.scene
+    fig, (axw, axq, axz) = _grid(3, (1, 3), figure_inches(scene))
+    ln_, out = result.line, result.outer
+    band = axw.fill(np.concatenate([out["q2"], ln_["q2"][::-1]]), np.concatenate([out["p2"], ln_["p2"][::-1]]),
+                    color=WALL_REGION_COLORS[Region.BESIDE], lw=0, zorder=0,
+                    label=r"$\Sigma_h^{>}$: turns back before $q_1=q_1^w$ ($J_{0u}$)")
+    band[0].set_gid("band")
+    g = result.grid
+    handles = [band[0]]
+    for reg, col in WALL_REGION_COLORS.items():
+        sel = (g["region"] == int(reg)) & np.isfinite(g["q2"])
+        if sel.any():
+            h = axw.scatter(g["q2"][sel], g["p2"][sel], s=scene.marker_size, c=col, lw=0, rasterized=True,
+                            label=_WALL_LABELS[reg] + " (the flow's label)")
+            h.set_gid(f"region:{Region(reg).label}")
+            handles.append(h)
+    (lt,) = axw.plot(ln_["q2"], ln_["p2"], color="k", lw=1.2, label=r"tangency line $\Xi^0_{wall}$ ($p_1=0$)")
+    lt.set_gid("tangency")
+    handles.append(lt)
+    axw.axvline(result.qw2, color="k", lw=0.8, ls="--")
+    tab = plt.get_cmap("tab10")
+
+    def colors(number):  # one colour per place of touching: 1 and 7, 2 and 6, 3 and 5, 4
+        return tab(min(number, 8 - number) - 1)
+
+    for p in result.points:
+        (pt,) = axw.plot(p.q2, p.p2, "o", color=colors(p.number), ms=7, mec="k", mew=0.7)
+        pt.set_gid(f"point:{p.number}")
+        axw.annotate(str(p.number), (p.q2, p.p2), xytext=(6, 4), textcoords="offset points", fontsize=10, weight="bold")
+    axw.set_xlabel(r"$q_2$")
+    axw.set_ylabel(r"$p_2$")
+    axw.set_aspect("equal", adjustable="datalim")
+    leg = axw.legend(handles=handles, fontsize=7, loc="upper right", framealpha=0.85)
+    for h in leg.legend_handles:
+        if hasattr(h, "set_sizes"):
+            h.set_sizes([25.0])
+    axw.set_title(r"(a) the wall section $\Sigma_h^{*,-}$ ($q_1=q_1^w$); dashed: $q_2=q_2^w$", fontsize=9)
+    allq = np.concatenate([p.trajectory[:, [1, 3]] for p in result.points])
+    lo1, lo2 = min(allq[:, 0].min(), result.qw1) - 0.2, min(allq[:, 1].min(), result.qw2) - 0.2
+    where = {1: "above the corner", 2: "at the corner", 3: "right wall", 4: "right wall", 5: "right wall",
+             6: "at the corner", 7: "above the corner"}
+    for ax in (axq, axz):
+        _draw_step(ax, result.qw1, result.qw2, lo1, lo2)
+        ax.axvline(result.qw1, color="k", lw=0.6, ls=":")
+        for p in result.points:
+            c = colors(p.number)
+            lab = f"{p.number}: {where[p.number]} (step system: {p.status.lower()})" if ax is axq else None
+            (ln,) = ax.plot(p.trajectory[:, 1], p.trajectory[:, 3], color=c, lw=1.0, ls="-" if p.p2 <= 0 else "--",
+                            label=lab)
+            ln.set_gid(f"trajectory:{p.number}")
+            ax.plot(result.qw1, p.q2, "o", color=c, ms=5, mec="k", mew=0.5, zorder=4)
+        ax.set_xlabel(r"$q_1$")
+        ax.set_ylabel(r"$q_2$")
+    for q2 in sorted({round(p.q2, 9) for p in result.points}):
+        nums = ", ".join(str(p.number) for p in result.points if round(p.q2, 9) == q2)
+        axz.annotate(nums, (result.qw1, q2), xytext=(-8, 0), textcoords="offset points", fontsize=9, weight="bold",
+                     va="center", ha="right")
+    axq.set_xlim(lo1, allq[:, 0].max() + 0.1)
+    axq.legend(fontsize=6.5, loc="lower right", framealpha=0.9)
+    axq.set_title("(b) their trajectories (smooth flow), one return; pairs 1-7, 2-6, 3-5 share one curve", fontsize=9)
+    span = max(p.q2 for p in result.points) - min(p.q2 for p in result.points)
+    axz.set_xlim(result.qw1 - 0.15 * span, result.qw1 + 0.45 * span)
+    axz.set_ylim(min(p.q2 for p in result.points) - 0.15 * span, max(p.q2 for p in result.points) + 0.15 * span)
+    axz.set_title("(c) at the wall: each touches $q_1=q_1^w$", fontsize=9)
+    fig.suptitle(scene.title + _quick(result) + "\n" + _system_text(scene), fontsize=9)
+    return fig
+
+
+def wall_section_figure(result: WallSectionResult):
+    """fig:wallsection computed: corner-singularity curves of the wall section and a fixed circle.
+
+    Left column: the wall section in the (q2, p2) plane (top) and in wall coordinates
+    (theta, rho_w) (bottom): the tangency line, the corner-singularity curves sigma_R0^-, sigma_01^-,
+    sigma_1R^- measured by bisection of the flow's labels (red, blue, green), and the circle
+    ``rho_w = const`` coloured by the flow's label of each point (J_R yellow, J_0 gray, J_1 cyan).
+    Right column: the trajectory segments through chosen points of the circle in configuration
+    space (top: one return; bottom: at the corner), those at the circle's corner crossings in the
+    curves' colours; solid dots where each crosses the wall section, in both columns.
+
+    Parameters
+    ----------
+    result : WallSectionResult
+        The computed scene.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    scene = result.scene
+    fig, (axw, axq, axr, axz) = _grid(4, (2, 2), figure_inches(scene))
+    tg, ci, cu = result.tangency, result.circle, result.curves
+    order = np.argsort(result.tangency["theta"])
+    (lt,) = axw.plot(np.append(tg["q2"][order], tg["q2"][order][0]), np.append(tg["p2"][order], tg["p2"][order][0]),
+                     color="k", lw=1.0, label=r"tangency line $\rho_w=0$")
+    lt.set_gid("tangency")
+    axr.axhline(0.0, color="k", lw=1.0)
+    axw.axvline(result.qw2, color="k", lw=0.8, ls="--")
+    handles = [lt]
+    for reg, col in WALL_REGION_COLORS.items():
+        sel = ci["region"] == int(reg)
+        if sel.any():
+            lab = _WALL_LABELS[reg] + rf" arc of $\rho_w={result.rho_w:.4f}$"
+            h = axw.scatter(ci["q2"][sel], ci["p2"][sel], s=6, c=col, lw=0, label=lab, zorder=3)
+            h.set_gid(f"arc:{Region(reg).label}")
+            hr = axr.scatter(ci["theta"][sel], np.full(sel.sum(), result.rho_w), s=6, c=col, lw=0, zorder=3)
+            hr.set_gid(f"arc:{Region(reg).label}")
+            handles.append(h)
+    for d in ("R0", "01", "1R"):
+        c = CORNER_COLORS[d]
+        (lw,) = axw.plot(cu[f"q2_{d}"], cu[f"p2_{d}"], "-", color=c, lw=1.2, marker=".", ms=4,
+                         label=rf"$\sigma^-_{{{d}}}$")
+        lw.set_gid(f"curve:{d}")
+        (lr,) = axr.plot(cu[f"theta_{d}"], cu["rho_w"], "-", color=c, lw=1.2, marker=".", ms=4)
+        lr.set_gid(f"curve:{d}")
+        handles.append(lw)
+    for i, g in enumerate(result.segments):
+        c = _segment_color(g.kind)
+        for ax, x, y in ((axw, g.wall[2], g.wall[3]), (axr, g.theta, result.rho_w)):
+            (pt,) = ax.plot(x, y, "o", color=c, ms=6, mec="k", mew=0.6, zorder=4)
+            pt.set_gid(f"dot:{g.kind}:{i}")
+    axw.set_xlabel(r"$q_2$")
+    axw.set_ylabel(r"$p_2$")
+    axw.set_aspect("equal", adjustable="datalim")
+    axw.legend(handles=handles, fontsize=7, loc="upper right", framealpha=0.85)
+    axw.set_title(r"(a) the wall section $\Sigma_h^{w,-}$ in the $(q_2, p_2)$ plane; dashed $q_2=q_2^w$", fontsize=9)
+    axr.set_xlim(-np.pi, np.pi)
+    axr.set_ylim(-0.04 * result.rho_max, 1.05 * max(result.rho_max, np.nanmax(cu["rho_w"])))
+    axr.set_xlabel(r"$\theta$ (wall angle)")
+    axr.set_ylabel(r"$\rho_w$")
+    b = result.boundaries
+    axr.set_title(rf"(c) wall coordinates: $\theta_{{R0}}={b['R0']:.4f}$, $\theta_{{01}}={b['01']:.4f}$, "
+                  rf"$\theta_{{1R}}={b['1R']:.4f}$", fontsize=9)
+    segs = [g.trajectory[:, [1, 3]] for g in result.segments]
+    allq = np.concatenate(segs) if segs else np.array([[result.qw1, result.qw2]])
+    lo1, lo2 = min(allq[:, 0].min(), result.qw1) - 0.2, min(allq[:, 1].min(), result.qw2) - 0.2
+    zoom = 0.25
+    for ax in (axq, axz):
+        _draw_step(ax, result.qw1, result.qw2, lo1, lo2)
+        ax.axvline(result.qw1, color="k", lw=0.6, ls=":")
+        for i, g in enumerate(result.segments):
+            c = _segment_color(g.kind)
+            lab = None
+            if ax is axq:
+                lab = (rf"on $\sigma^-_{{{g.kind}}}$" if g.kind in CORNER_COLORS else
+                       _WALL_LABELS[_ARC_REGION[g.kind]]) + f": {g.itinerary or g.status.lower()}"
+            # At eps = 0 the segment on sigma_01 leaves the corner along the one on sigma_R0 reversed
+            # (the same |p1| and H2): widths and dashes keep both visible.
+            style = _CORNER_SEGMENT_STYLE.get(g.kind, dict(lw=1.0, ls="-", zorder=2))
+            (ln,) = ax.plot(g.trajectory[:, 1], g.trajectory[:, 3], color=c if g.kind in CORNER_COLORS else
+                            _darker(c), label=lab, **style)
+            ln.set_gid(f"segment:{g.kind}:{i}")
+            (pt,) = ax.plot(g.wall[0], g.wall[2], "o", color=c, ms=6, mec="k", mew=0.6, zorder=4)
+            pt.set_gid(f"dot:{g.kind}:{i}")
+        ax.set_xlabel(r"$q_1$")
+        ax.set_ylabel(r"$q_2$")
+    axq.set_xlim(lo1, allq[:, 0].max() + 0.1)
+    axq.legend(fontsize=6.5, loc="upper right", framealpha=0.85, ncol=2)
+    axq.set_title("(b) trajectory segments through the circle's points (dots: on the wall section)", fontsize=9)
+    axz.set_xlim(result.qw1 - zoom, result.qw1 + zoom)
+    axz.set_ylim(result.qw2 - zoom, result.qw2 + zoom)
+    axz.set_aspect("equal")
+    axz.set_title("(d) the same at the corner", fontsize=9)
+    fig.suptitle(scene.title + _quick(result) + "\n" + _system_text(scene), fontsize=9)
+    return fig
+
+
+#: Line styles of the segments at the corner-singularity crossings (drawn over the others).
+_CORNER_SEGMENT_STYLE = {"R0": dict(lw=3.0, ls="-", zorder=3), "01": dict(lw=1.5, ls=(0, (5, 2)), zorder=4),
+                         "1R": dict(lw=1.5, ls="-", zorder=4)}
+
+
+def _darker(color: str) -> tuple:
+    """A darker shade of a fill colour, for a line drawn in it (the paper's yellow is faint as a line)."""
+    from matplotlib.colors import to_rgb
+
+    return tuple(0.8 * x for x in to_rgb(color))
+
+
 _RENDERERS = {
     OrbitSceneResult: orbit_figure,
     HoveringAreaResult: hovering_area_figure,
@@ -459,6 +783,9 @@ _RENDERERS = {
     FlowHoveringResult: flow_hovering_figure,
     TangentToriResult: tangent_tori_figure,
     SigmaStructureResult: sigma_structure_figure,
+    CornerDirectionsResult: corner_directions_figure,
+    WallTangencyResult: wall_tangency_figure,
+    WallSectionResult: wall_section_figure,
 }
 
 

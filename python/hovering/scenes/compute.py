@@ -18,7 +18,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from .._enums import Region, Status, wrap
+from .._enums import FlowStatus, Region, Status, wrap
 from .._style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
 from ..analysis import rotation_number
@@ -30,11 +30,17 @@ from .._version import __version__
 from ..analysis.hovering import default_depth
 from ..sweeps import Checkpoint, check_row
 from ..truncated.theory import golden_family, hovering_area_theory
-from .results import (FlowHoveringResult, FlowPortraitResult, Geometry, HoveringAreaResult, OrbitPanelResult,
-                      OrbitSceneResult, OrbitSet, SceneResult, SeriesResult, SigmaStructureResult, TangentToriResult,
-                      TorusResult, ZoomPanelResult)
-from .spec import (QUICK_FACTOR, FlowHoveringScene, FlowPortraitScene, HoveringAreaScene, OrbitScene, PanelSpec,
-                   SceneSpec, SigmaStructureScene, TangentToriScene)
+from ..flow.section import Section
+from ..normal.coordinates import TangentialCurve
+from .results import (CornerDirectionsResult, CornerTrajectory, FlowHoveringResult, FlowPortraitResult, Geometry,
+                      HoveringAreaResult, OrbitPanelResult, OrbitSceneResult, OrbitSet, SceneResult, SeriesResult,
+                      SigmaStructureResult, TangentToriResult, TorusResult, WallPoint, WallSectionResult, WallSegment,
+                      WallTangencyResult, ZoomPanelResult)
+from .spec import (QUICK_FACTOR, CornerDirectionsScene, FlowHoveringScene, FlowPortraitScene, HoveringAreaScene,
+                   OrbitScene, PanelSpec, SceneSpec, SigmaStructureScene, TangentToriScene, WallSectionScene,
+                   WallTangencyScene)
+from .wall import (DIRECTIONS, WallFlow, corner_energy, corner_speed, corner_states, rho_w_max, tangent_action, wall_states,
+                   wall_tangency_action)
 
 __all__ = ["compute", "map_geometry", "flow_geometry", "zoom_window_critical", "zoom_window_islands",
            "leading_curve", "special_starts", "hovering_orbits", "scaled", "scene_map"]
@@ -695,6 +701,226 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
         theta1=res.theta[ok, 1], I1=res.I[ok, 1], q21=z[ok, 1, 2], p21=z[ok, 1, 3], tangency=tangency, corners=corners)
 
 
+# ------------------------------------------------------------------------------------------------
+# The corner and the wall section (fig:corner_directions, fig:Sigma_0_wall, fig:wallsection)
+
+
+def _wall_flow(scene, fm=None) -> WallFlow:
+    """The scene's step system and integrator settings (an accuracy target resolved by its FlowMap)."""
+    if scene.integrator.accuracy is not None:
+        opts = (fm if fm is not None else _flowmap(scene)).integrator_options
+    else:
+        opts = scene.integrator.options()
+    return WallFlow(scene.system.build(), opts)
+
+
+def _samples_through(T: float, dt_max: float) -> float:
+    """A spacing <= dt_max that puts a trajectory sample at time T (its ceil(T / dt_max)-th)."""
+    return T / max(1, math.ceil(T / dt_max))
+
+
+def _corner_directions(scene: CornerDirectionsScene, quick: bool, progress, meta: dict) -> CornerDirectionsResult:
+    t = time.perf_counter()
+    fm = _flowmap(scene)  # its tangential curve gives the normal coordinates of the curves
+    flow = _wall_flow(scene, fm)
+    sys, h = flow.sys, scene.h
+    sec = Section(sys, h)
+    meta["timings"]["setup"] = time.perf_counter() - t
+    p1max = corner_speed(sys, h)
+    n = max(scene.n_curve // 4, 8) if quick else scene.n_curve
+    meta["n_curve"] = n
+    # p1w spaced evenly in p1w^2 (K is about linear in it near the tangency, eq:cornersingbordrho).
+    p1w = p1max * np.sqrt((np.arange(n) + 0.5) / n)
+    t = time.perf_counter()
+    curves = {}
+    for ab in DIRECTIONS:
+        z0, T, ok = flow.preimage(corner_states(sys, h, ab, p1w))
+        reached, err = np.zeros(n, dtype=bool), np.full(n, np.nan)
+        if ok.any():  # the step system's flow from each point: does it hit the corner, and how close
+            r = flow.returns(z0[ok])
+            reached[ok] = r["status"] == int(FlowStatus.CORNER)
+            err[ok] = np.where(reached[ok], np.hypot(r["z"][:, 0] - sys.qw1, r["z"][:, 2] - sys.qw2), np.nan)
+        th, I = np.full(n, np.nan), np.full(n, np.nan)
+        c = sec.coordinates(z0[ok])
+        th[ok], I[ok] = c[:, 0], c[:, 1]
+        phi, K = np.full(n, np.nan), np.full(n, np.nan)
+        phi[ok], K[ok] = fm.curve.to_normal(th[ok], I[ok])
+        curves[ab] = dict(p1w=p1w.copy(), theta=th, I=I, phi=phi, K=K, reached=reached, error=err)
+    meta["timings"]["curves"] = time.perf_counter() - t
+    t = time.perf_counter()
+    trajectories = []
+    for ab in DIRECTIONS:
+        pw = p1max * np.asarray(scene.p1w_fractions)
+        z0, T, ok = flow.preimage(corner_states(sys, h, ab, pw))
+        if not ok.all():
+            raise RuntimeError(f"the smooth flow could not be traced back from the corner along p_{ab}")
+        r = flow.returns(z0, trajectory_dt=[_samples_through(x, scene.outputs.trajectory_dt) for x in T])
+        c = sec.coordinates(z0)
+        phi, K = fm.curve.to_normal(c[:, 0], c[:, 1])
+        for i in range(pw.size):
+            tr = r["trajectories"][i]
+            k = int(np.argmin(np.abs(tr[:, 0] - T[i])))  # the sample at T, or where the run stopped
+            trajectories.append(CornerTrajectory(
+                direction=ab, p1w=float(pw[i]), start=z0[i].copy(), theta=float(c[i, 0]), I=float(c[i, 1]),
+                phi=float(phi[i]), K=float(K[i]), flight_time=float(T[i]), trajectory=tr[: k + 1].copy(),
+                status=FlowStatus(int(r["status"][i])).name, arrival=tr[k, 1:].copy()))
+    meta["timings"]["trajectories"] = time.perf_counter() - t
+    meta["work"] = flow.work
+    return CornerDirectionsResult(scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, step_energy=corner_energy(sys),
+                                  p1w_max=p1max, curves=curves, trajectories=trajectories)
+
+
+def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) -> WallTangencyResult:
+    flow = _wall_flow(scene)
+    sys, h = flow.sys, scene.h
+    E2 = h - sys.V1.V(sys.qw1)  # H2 on the unperturbed tangency line
+    line_theta = np.linspace(-np.pi, np.pi, scene.n_points)
+    line = np.array([sys.V2.point_at(float(x), E2) for x in line_theta])
+    outer = np.array([sys.V2.point_at(float(x), h) for x in line_theta])
+    # The seven points of the caption, in increasing wall angle (the sense oscillator 2 turns):
+    # 1 above the corner, 2 at it (p2 < 0), 3-5 below it on the right wall, 6 at it (p2 > 0), 7 above.
+    P = math.sqrt(2.0 * (E2 - sys.V2.V(sys.qw2)))
+    t_1R, t_R0 = sys.V2.angle_of_point(sys.qw2, -P, E2), sys.V2.angle_of_point(sys.qw2, P, E2)
+    up = t_1R - t_R0  # the arc above the step, through theta = 0
+    low = 2 * np.pi - up
+    thetas = wrap(np.array([t_1R - up / 4, t_1R, t_1R + low / 4, t_1R + low / 2, t_1R + 3 * low / 4, t_R0,
+                            t_R0 + up / 4]))
+    t = time.perf_counter()
+    # Each point's segment starts where the tangential curve (traced back from the wall by the core)
+    # puts it on Sigma_h; the smooth flow draws it (it only touches the walls), the step system says
+    # what the touch is: grazing the right wall, hitting the corner, or passing above it.
+    curve = TangentialCurve(Section(sys, h))
+    th0, I0 = curve.at(thetas)
+    z0 = Section(sys, h).point(th0, I0)
+    sm = flow.returns(z0, trajectory_dt=scene.outputs.trajectory_dt, smooth=True)
+    st = flow.returns(z0)
+    points = [WallPoint(number=i + 1, theta=float(thetas[i]), q2=float(q2), p2=float(p2),
+                        trajectory=sm["trajectories"][i], status=FlowStatus(int(st["status"][i])).name,
+                        itinerary=st["itinerary"][i])
+              for i, (q2, p2) in enumerate(sys.V2.point_at(float(x), E2) for x in thetas)]
+    meta["timings"]["points"] = time.perf_counter() - t
+    t = time.perf_counter()
+    n_th, n_rho = scene.grid
+    if quick:
+        n_th, n_rho = max(n_th // 4, 24), max(n_rho // 4, 6)
+    meta["grid"] = [n_th, n_rho]
+    It = tangent_action(sys, h)
+    TH, RHO = np.meshgrid(-np.pi + 2 * np.pi * (np.arange(n_th) + 0.5) / n_th, It * (np.arange(n_rho) + 0.5) / n_rho)
+    zw = wall_states(sys, h, TH.ravel(), RHO.ravel(), I_tan=It)
+    _, region, _ = flow.labels(zw)
+    meta["timings"]["regions"] = time.perf_counter() - t
+    meta["work"] = flow.work
+    return WallTangencyResult(
+        scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, line=dict(theta=line_theta, q2=line[:, 0], p2=line[:, 1]),
+        outer=dict(q2=outer[:, 0], p2=outer[:, 1]), points=points,
+        grid=dict(theta=TH.ravel(), rho_w=RHO.ravel(), q2=zw[:, 2], p2=zw[:, 3], region=region))
+
+
+#: Label changes with increasing wall angle and the corner-singularity curve each one is (lemma:border).
+_CHANGES = {("R", "0"): "R0", ("0", "1"): "01", ("1", "R"): "1R"}
+
+
+def _circle_boundaries(flow: WallFlow, h: float, rho: np.ndarray, n_theta: int, bisections: int) -> tuple:
+    """The corner-singularity angles on circles ``rho_w = rho[k]`` of the wall section.
+
+    Each circle is labelled by the flow at ``n_theta`` angles; every change R -> 0, 0 -> 1, 1 -> R
+    between neighbours is then bisected (all circles' brackets at once) ``bisections`` times.
+    Returns ``(theta, other)``: ``theta[ab]`` one angle per circle (NaN where that change is not
+    found once) and the number of other label changes per circle."""
+    sys = flow.sys
+    th = -np.pi + 2 * np.pi * (np.arange(n_theta) + 0.5) / n_theta
+    TH = np.tile(th, rho.size)
+    R = np.repeat(rho, n_theta)
+    It = wall_tangency_action(sys, h, th)
+    lab, _, _ = flow.labels(wall_states(sys, h, TH, R, I_tan=np.tile(It, rho.size)))
+    lab = lab.reshape(rho.size, n_theta)
+    nxt = np.roll(lab, -1, axis=1)
+    found = {ab: np.full(rho.size, np.nan) for ab in DIRECTIONS}
+    other = np.zeros(rho.size, dtype=int)
+    brackets = []
+    for k in range(rho.size):
+        for i in np.flatnonzero(lab[k] != nxt[k]):
+            ab = _CHANGES.get((lab[k, i], nxt[k, i]))
+            if ab is None or np.isfinite(found[ab][k]):
+                other[k] += 1
+                continue
+            found[ab][k] = 0.0
+            brackets.append((k, ab, th[i], th[i] + 2 * np.pi / n_theta, lab[k, i]))
+    if brackets:
+        lo = np.array([b[2] for b in brackets])
+        hi = np.array([b[3] for b in brackets])
+        rr = rho[[b[0] for b in brackets]]
+        left = np.array([b[4] for b in brackets], dtype=object)
+        for _ in range(bisections):
+            mid = 0.5 * (lo + hi)
+            m = wrap(mid)
+            lm, _, _ = flow.labels(wall_states(sys, h, m, rr))
+            same = lm == left
+            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        for (k, ab, *_), x in zip(brackets, wrap(0.5 * (lo + hi))):
+            found[ab][k] = x
+    return found, other
+
+
+def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) -> WallSectionResult:
+    flow = _wall_flow(scene)
+    sys, h = flow.sys, scene.h
+    rmax = rho_w_max(sys, h)
+    rho = scene.rho_w_fraction * rmax
+    n_theta = max(scene.n_theta // 4, 90) if quick else scene.n_theta
+    n_circles = max(scene.n_circles // 2, 4) if quick else scene.n_circles
+    meta.update(n_theta=n_theta, n_circles=n_circles)
+    t = time.perf_counter()
+    th = -np.pi + 2 * np.pi * (np.arange(n_theta) + 0.5) / n_theta
+    It = wall_tangency_action(sys, h, th)
+    tangency = wall_states(sys, h, th, 0.0, I_tan=It)  # p1 = 0: the tangency line rho_w = 0
+    zc = wall_states(sys, h, th, rho, I_tan=It)
+    _, region, _ = flow.labels(zc)
+    meta["timings"]["circle"] = time.perf_counter() - t
+    t = time.perf_counter()
+    # The circle's own boundaries and the curves' circles, bisected together (rho^2 spacing: the
+    # curve sigma_01 goes as sqrt(rho_w) near the tangency line, Lemma lemma:border).
+    rhos = np.concatenate([[rho], rmax * ((np.arange(n_circles) + 1.0) / n_circles) ** 2])
+    found, other = _circle_boundaries(flow, h, rhos, max(n_theta // 4, 64), scene.bisections)
+    meta["other_changes"] = [int(x) for x in other]
+    meta["timings"]["corner curves"] = time.perf_counter() - t
+    boundaries = {ab: float(found[ab][0]) for ab in DIRECTIONS}
+    curves = {"rho_w": rhos[1:]}
+    for ab in DIRECTIONS:
+        z = wall_states(sys, h, np.nan_to_num(found[ab][1:]), rhos[1:])
+        bad = ~np.isfinite(found[ab][1:])
+        z[bad] = np.nan
+        curves[f"theta_{ab}"] = found[ab][1:]
+        curves[f"q2_{ab}"], curves[f"p2_{ab}"] = z[:, 2], z[:, 3]
+    t = time.perf_counter()
+    # Segments: `segments` per arc, evenly inside it, and one at each of the circle's boundaries.
+    picks = []
+    for a, (lo_ab, hi_ab) in (("R", ("1R", "R0")), ("0", ("R0", "01")), ("1", ("01", "1R"))):
+        lo, hi = boundaries[lo_ab], boundaries[hi_ab]
+        if np.isfinite(lo) and np.isfinite(hi):
+            width = (hi - lo) % (2 * np.pi)
+            picks += [(a, lo + width * (j + 1) / (scene.segments + 1)) for j in range(scene.segments)]
+    picks += [(ab, boundaries[ab]) for ab in DIRECTIONS if np.isfinite(boundaries[ab])]
+    segments = []
+    if picks:
+        angles = wrap(np.array([p[1] for p in picks]))
+        zw = wall_states(sys, h, angles, rho)
+        z0, _, ok = flow.preimage(zw)
+        keep = np.flatnonzero(ok)
+        r = flow.returns(z0[keep], trajectory_dt=scene.outputs.trajectory_dt)
+        for j, i in enumerate(keep):
+            segments.append(WallSegment(kind=picks[i][0], theta=float(angles[i]), wall=zw[i].copy(),
+                                        trajectory=r["trajectories"][j], status=FlowStatus(int(r["status"][j])).name,
+                                        itinerary=r["itinerary"][j]))
+    meta["timings"]["segments"] = time.perf_counter() - t
+    meta["work"] = flow.work
+    return WallSectionResult(
+        scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, rho_w=rho, rho_max=rmax,
+        tangency=dict(theta=th, q2=tangency[:, 2], p2=tangency[:, 3]),
+        circle=dict(theta=th, q2=zc[:, 2], p2=zc[:, 3], p1=zc[:, 1], region=region), boundaries=boundaries,
+        curves=curves, segments=segments, resolution=2 * np.pi / max(n_theta // 4, 64) / 2**scene.bisections)
+
+
 def scene_map(scene: SceneSpec):
     """The map a scene is about: an orbit scene's first panel's, a hovering-area scene's first
     series at its first eps, a flow scene's :class:`~hovering.FlowMap` (its system, section and
@@ -719,7 +945,8 @@ def scene_map(scene: SceneSpec):
         return _flowmap(scene, eps=scene.eps[0])
     if isinstance(scene, TangentToriScene):
         return _flowmap(scene, coordinates="section")
-    if isinstance(scene, (FlowPortraitScene, SigmaStructureScene)):
+    if isinstance(scene, (FlowPortraitScene, SigmaStructureScene, CornerDirectionsScene, WallTangencyScene,
+                          WallSectionScene)):
         return _flowmap(scene)
     raise ValueError(f"scene {scene.name!r} defines no map")
 
@@ -776,6 +1003,12 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
         out = _tangent_tori(scene, quick, progress, meta)
     elif isinstance(scene, SigmaStructureScene):
         out = _sigma_structure(scene, quick, progress, meta)
+    elif isinstance(scene, CornerDirectionsScene):
+        out = _corner_directions(scene, quick, progress, meta)
+    elif isinstance(scene, WallTangencyScene):
+        out = _wall_tangency(scene, quick, progress, meta)
+    elif isinstance(scene, WallSectionScene):
+        out = _wall_section(scene, quick, progress, meta)
     else:
         raise ValueError(f"no computation for scene kind {scene.kind!r}")
     meta["timings"]["total"] = time.perf_counter() - t0

@@ -98,8 +98,33 @@ def format_summary(summary: dict) -> str:
                      f"{t['trajectory_points']} trajectory samples, min q1 = {f(t['q1_min'], '.6f')} "
                      f"(qw1 = {f(summary['qw1'], 'g')}), min q2 = {f(t['q2_min'], '.6f')} "
                      f"(qw2 = {f(summary['qw2'], 'g')})")
-    if "regions" in summary and "flow" not in summary:
+    kind = summary.get("kind")
+    if "regions" in summary and "flow" not in summary and kind == "sigma_structure":
         lines.append(f"  {summary['points']} points of the band, regions {summary['regions']}")
+    if kind == "corner_directions":
+        lines.append(f"  corner {summary['corner']}, h_eps^w = {f(summary['step_energy'], '.6f')}, "
+                     f"p1w_max = {f(summary['p1w_max'], '.6f')}")
+        for d, c in summary["curves"].items():
+            lines.append(f"  sigma_{d}: {c['reached']} of {c['points']} points of Sigma_h reach the corner "
+                         f"(largest miss {f(c['max_error'], '.2g')})")
+        for a in summary["arrivals"]:
+            lines.append(f"    p_{a['direction']}, p1w = {f(a['p1w'], '.4f')}: from (phi, K) = ({f(a['phi'], '+.4f')}, "
+                         f"{f(a['K'], '+.5f')}), {a['status']} after t = {f(a['flight_time'], '.4f')}, "
+                         f"{f(a['error'], '.2g')} from the corner, p = ({f(a['momentum'][0], '+.4f')}, "
+                         f"{f(a['momentum'][1], '+.4f')})")
+    if kind == "wall_tangency":
+        for p in summary["tangency_points"]:
+            lines.append(f"  point {p['number']}: theta = {f(p['theta'], '+.4f')}, q2 = {f(p['q2'], '+.4f')}, "
+                         f"p2 = {f(p['p2'], '+.4f')}: step system {p['status']} {p['itinerary']!r}")
+        lines.append(f"  interior regions {summary['regions']}")
+    if kind == "wall_section":
+        b, a = summary["boundaries"], summary["arcs"]
+        lines.append(f"  circle rho_w = {f(summary['rho_w'], '.5f')} (rho_max {f(summary['rho_max'], '.5f')}): "
+                     f"theta_R0 = {f(b['R0'], '+.6f')}, theta_01 = {f(b['01'], '+.6f')}, theta_1R = {f(b['1R'], '+.6f')} "
+                     f"(+- {f(summary['resolution'], '.1g')}); |J_R| = {f(a['R'], '.4f')}, |J_0| = {f(a['0'], '.4f')}, "
+                     f"|J_1| = {f(a['1'], '.4f')}")
+        lines.append(f"  corner curves measured on {summary['curve_points']} circles; segments "
+                     + ", ".join(f"{g['kind']}: {g['status']} {g['itinerary']!r}" for g in summary["segments"]))
     if "output" in summary:
         files = summary.get("files") or [summary["output"], summary["npz"]]
         lines.append(f"wrote {', '.join(str(x) for x in files)} in {f(summary['runtime_s'], '.2f')} s")

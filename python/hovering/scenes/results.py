@@ -30,7 +30,8 @@ SIDECAR_FORMAT = "hovering-scene-1"
 __all__ = [
     "Geometry", "OrbitSet", "OrbitPanelResult", "ZoomPanelResult", "SeriesResult", "TorusResult",
     "SceneResult", "OrbitSceneResult", "HoveringAreaResult", "FlowPortraitResult", "FlowHoveringResult",
-    "TangentToriResult", "SigmaStructureResult", "load_result", "jsonable",
+    "TangentToriResult", "SigmaStructureResult", "CornerTrajectory", "CornerDirectionsResult", "WallPoint",
+    "WallTangencyResult", "WallSegment", "WallSectionResult", "load_result", "jsonable",
 ]
 
 
@@ -606,6 +607,280 @@ class SigmaStructureResult(SceneResult):
     corners: Geometry = None
 
 
+#: The corner's incoming directions (fig:corner_directions), as :data:`hovering.scenes.wall.DIRECTIONS`.
+_DIRECTIONS = ("R0", "01", "1R")
+
+
+def _status_name(where: str, value) -> None:
+    from .._enums import FlowStatus
+
+    _str(where, value, tuple(s.name for s in FlowStatus))
+
+
+def _same_length(where: str, d: dict, keys, kinds: str = "iuf") -> None:
+    """A dict of 1-D arrays under exactly ``keys``, all of one length."""
+    if not isinstance(d, dict) or set(d) != set(keys):
+        got = sorted(map(str, d)) if isinstance(d, dict) else type(d).__name__
+        raise ValueError(f"{where} must hold the arrays {sorted(keys)}, got {got}")
+    n = None
+    for k in keys:
+        _array(f"{where}.{k}", d[k], 1, "b" if k in ("reached",) else kinds)
+        if n is None:
+            n = d[k].shape
+        elif d[k].shape != n:
+            raise ValueError(f"{where}.{k} has shape {d[k].shape}; it must have shape {n} (as the arrays it goes with)")
+
+
+def _trajectory(where: str, a) -> None:
+    _array(where, a, 2)
+    if a.shape[1] != 5:
+        raise ValueError(f"{where} has shape {a.shape}; it must be (m, 5): t, q1, p1, q2, p2")
+
+
+@dataclass
+class CornerTrajectory:
+    """A trajectory of the step system that arrives at the corner (fig:corner_directions).
+
+    Attributes
+    ----------
+    direction : {"R0", "01", "1R"}
+        Its incoming direction ``p_ab``.
+    p1w : float
+        The horizontal speed at the corner (eq:p2corner).
+    start : ndarray
+        Its point of Sigma_h, ``(q1, p1 = 0, q2, p2)``, found by the time-reversed smooth flow.
+    theta, I, phi, K : float
+        That point in section and normal coordinates.
+    flight_time : float
+        Time from the start to the corner (of the reversed trace).
+    trajectory : ndarray
+        ``(m, 5)`` rows ``t, q1, p1, q2, p2`` of the step system's flow from the start until it
+        stopped (at the corner) or returned, sampled so that a sample falls at ``flight_time``.
+    status : str
+        :class:`~hovering.FlowStatus` name of that forward run (``CORNER`` when it hit the corner).
+    arrival : ndarray
+        The state of the forward run at ``flight_time`` (where it stopped, for a corner hit).
+    """
+
+    direction: str
+    p1w: float
+    start: np.ndarray
+    theta: float
+    I: float
+    phi: float
+    K: float
+    flight_time: float
+    trajectory: np.ndarray
+    status: str
+    arrival: np.ndarray
+
+    def _validate_loaded(self) -> None:
+        _str("direction", self.direction, _DIRECTIONS)
+        _status_name("status", self.status)
+        _array("start", self.start, 1, shape=(4,))
+        _array("arrival", self.arrival, 1, shape=(4,))
+        _trajectory("trajectory", self.trajectory)
+
+
+@dataclass
+class CornerDirectionsResult(SceneResult):
+    """Result of a ``corner_directions`` scene (fig:corner_directions), all from the flow.
+
+    Attributes
+    ----------
+    qw1, qw2 : float
+        The corner.
+    step_energy : float
+        ``h_eps^w`` (def:heps).
+    p1w_max : float
+        ``sqrt(2 (h - h_eps^w))``: the radius of the momentum circle at the corner.
+    curves : dict
+        Direction -> arrays ``p1w``, ``theta``, ``I``, ``phi``, ``K`` (the corner-singularity curve of
+        Sigma_h traced by the reversed flow, parametrized by p1w), ``reached`` (the step system's flow
+        from that point hits the corner) and ``error`` (distance of its arrival from the corner).
+    trajectories : list of CornerTrajectory
+        The drawn trajectories, by direction and p1w.
+    """
+
+    qw1: float = 0.0
+    qw2: float = 0.0
+    step_energy: float = 0.0
+    p1w_max: float = 0.0
+    curves: dict = field(default_factory=dict)
+    trajectories: list = field(default_factory=list)
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        if set(self.curves) != set(_DIRECTIONS):
+            raise ValueError(f"curves must have the keys {list(_DIRECTIONS)}, got {sorted(map(str, self.curves))}")
+        for k, c in self.curves.items():
+            _same_length(f"curves.{k}", c, ("p1w", "theta", "I", "phi", "K", "reached", "error"))
+        for i, t in enumerate(self.trajectories):
+            if not isinstance(t, CornerTrajectory):
+                raise ValueError(f"trajectories[{i}] must be a CornerTrajectory, got {type(t).__name__}")
+
+
+@dataclass
+class WallPoint:
+    """A numbered point of the wall's tangency line and its trajectory (fig:Sigma_0_wall).
+
+    Attributes
+    ----------
+    number : int
+        The caption's number (1 and 7: above the corner; 2 and 6: at the corner; 3-5: below it).
+    theta, q2, p2 : float
+        The point (wall angle and its (q2, p2); p1 = 0 at q1 = qw1).
+    trajectory : ndarray
+        ``(m, 5)`` rows of the smooth flow through it, from Sigma_h to Sigma_h.
+    status : str
+        :class:`~hovering.FlowStatus` name of the step system's return from the same start.
+    itinerary : str
+        That return's itinerary.
+    """
+
+    number: int
+    theta: float
+    q2: float
+    p2: float
+    trajectory: np.ndarray
+    status: str
+    itinerary: str
+
+    def _validate_loaded(self) -> None:
+        if not 1 <= self.number <= 7:
+            raise ValueError(f"number = {self.number!r} is out of range; allowed: 1 to 7")
+        _status_name("status", self.status)
+        _trajectory("trajectory", self.trajectory)
+        if len(self.itinerary) > MAX_TEXT:
+            raise ValueError(f"itinerary: a string of {len(self.itinerary)} characters; allowed: at most {MAX_TEXT}")
+
+
+@dataclass
+class WallTangencyResult(SceneResult):
+    """Result of a ``wall_tangency`` scene (fig:Sigma_0_wall).
+
+    Attributes
+    ----------
+    qw1, qw2 : float
+        The corner.
+    line : dict
+        The tangency line ``Xi^0_wall``: arrays ``theta``, ``q2``, ``p2``.
+    outer : dict
+        The level ``H2 = h`` (outer edge of ``Sigma_h^>``): arrays ``q2``, ``p2``.
+    points : list of WallPoint
+        The seven numbered points.
+    grid : dict
+        Interior points in wall coordinates: arrays ``theta``, ``rho_w``, ``q2``, ``p2`` and
+        ``region`` (the flow's label of the return through each).
+    """
+
+    qw1: float = 0.0
+    qw2: float = 0.0
+    line: dict = field(default_factory=dict)
+    outer: dict = field(default_factory=dict)
+    points: list = field(default_factory=list)
+    grid: dict = field(default_factory=dict)
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        _same_length("line", self.line, ("theta", "q2", "p2"))
+        _same_length("outer", self.outer, ("q2", "p2"))
+        _same_length("grid", self.grid, ("theta", "rho_w", "q2", "p2", "region"))
+        for i, p in enumerate(self.points):
+            if not isinstance(p, WallPoint):
+                raise ValueError(f"points[{i}] must be a WallPoint, got {type(p).__name__}")
+
+
+@dataclass
+class WallSegment:
+    """A trajectory segment through a point of the wall section's fixed circle (fig:wallsection).
+
+    Attributes
+    ----------
+    kind : str
+        The region of the arc it starts on (``"R"``, ``"0"``, ``"1"``) or the corner-singularity
+        curve it starts at (``"R0"``, ``"01"``, ``"1R"``).
+    theta : float
+        Its wall angle.
+    wall : ndarray
+        Its state on the wall section ``(qw1, p1, q2, p2)``.
+    trajectory : ndarray
+        ``(m, 5)`` rows of the step system's flow from its point of Sigma_h until it returned or
+        stopped.
+    status : str
+        :class:`~hovering.FlowStatus` name of that return.
+    itinerary : str
+        Its itinerary.
+    """
+
+    kind: str
+    theta: float
+    wall: np.ndarray
+    trajectory: np.ndarray
+    status: str
+    itinerary: str
+
+    def _validate_loaded(self) -> None:
+        _str("kind", self.kind, ("R", "0", "1") + _DIRECTIONS)
+        _status_name("status", self.status)
+        _array("wall", self.wall, 1, shape=(4,))
+        _trajectory("trajectory", self.trajectory)
+        if len(self.itinerary) > MAX_TEXT:
+            raise ValueError(f"itinerary: a string of {len(self.itinerary)} characters; allowed: at most {MAX_TEXT}")
+
+
+@dataclass
+class WallSectionResult(SceneResult):
+    """Result of a ``wall_section`` scene (fig:wallsection), all from the flow.
+
+    Attributes
+    ----------
+    qw1, qw2 : float
+        The corner.
+    rho_w, rho_max : float
+        The drawn circle and eq:rhomaxh.
+    tangency : dict
+        The tangency line ``rho_w = 0``: arrays ``theta``, ``q2``, ``p2``.
+    circle : dict
+        The circle's samples: arrays ``theta``, ``q2``, ``p2``, ``p1`` and ``region`` (the flow's
+        label of the return through each).
+    boundaries : dict
+        ``"R0"``, ``"01"``, ``"1R"`` -> the bisected wall angle where the circle's label changes
+        (R to 0, 0 to 1, 1 to R with increasing theta; NaN if not found).
+    curves : dict
+        The corner-singularity curves of the wall section: arrays ``rho_w`` (circles) and
+        ``theta_R0``, ``theta_01``, ``theta_1R``, ``q2_R0``, ..., ``p2_1R`` (NaN where not found).
+    segments : list of WallSegment
+        The drawn trajectory segments.
+    resolution : float
+        Bracket width left by the bisections (radians).
+    """
+
+    qw1: float = 0.0
+    qw2: float = 0.0
+    rho_w: float = 0.0
+    rho_max: float = 0.0
+    tangency: dict = field(default_factory=dict)
+    circle: dict = field(default_factory=dict)
+    boundaries: dict = field(default_factory=dict)
+    curves: dict = field(default_factory=dict)
+    segments: list = field(default_factory=list)
+    resolution: float = 0.0
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        _same_length("tangency", self.tangency, ("theta", "q2", "p2"))
+        _same_length("circle", self.circle, ("theta", "q2", "p2", "p1", "region"))
+        if set(self.boundaries) != set(_DIRECTIONS) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.boundaries.values()):
+            raise ValueError(f"boundaries must map {list(_DIRECTIONS)} to numbers")
+        _same_length("curves", self.curves, ("rho_w",) + tuple(f"{c}_{d}" for c in ("theta", "q2", "p2")
+                                                                for d in _DIRECTIONS))
+        for i, p in enumerate(self.segments):
+            if not isinstance(p, WallSegment):
+                raise ValueError(f"segments[{i}] must be a WallSegment, got {type(p).__name__}")
+
+
 def load_result(path: os.PathLike) -> SceneResult:
     """Read a scene result written by :meth:`SceneResult.save`.
 
@@ -667,7 +942,8 @@ def summarize(result) -> dict:
         ``scene``, ``kind``, ``title``, ``quick``, ``n_steps`` (when it has one), ``runtime_s`` and
         per kind: ``panels`` (orbit scenes), ``series`` (hovering_area), ``flow`` / ``model``
         (flow_portrait), ``points`` (flow_hovering_area), ``tori`` (tangent_tori), ``regions``
-        (sigma_structure).
+        (sigma_structure), ``curves`` and ``arrivals`` (corner_directions), ``tangency_points``
+        and ``regions`` (wall_tangency), ``boundaries``, ``arcs`` and ``segments`` (wall_section).
     """
     sc, meta = result.scene, result.meta
     s = dict(scene=sc.name, kind=sc.kind, title=sc.title, quick=bool(meta.get("quick")),
@@ -719,4 +995,30 @@ def summarize(result) -> dict:
     elif isinstance(result, SigmaStructureResult):
         s["regions"] = _region_counts(result.region)
         s["points"] = int(result.phi.size)
+    elif isinstance(result, CornerDirectionsResult):
+        s.update(corner=[result.qw1, result.qw2], step_energy=result.step_energy, p1w_max=result.p1w_max)
+        s["curves"] = {k: dict(points=int(c["p1w"].size), reached=int(np.count_nonzero(c["reached"])),
+                               max_error=float(np.nanmax(c["error"])) if np.isfinite(c["error"]).any() else None,
+                               K_range=[float(np.nanmin(c["K"])), float(np.nanmax(c["K"]))]
+                               if np.isfinite(c["K"]).any() else None)
+                       for k, c in result.curves.items()}
+        s["arrivals"] = [dict(direction=t.direction, p1w=t.p1w, status=t.status, phi=t.phi, K=t.K,
+                              flight_time=t.flight_time,
+                              error=float(np.hypot(t.arrival[0] - result.qw1, t.arrival[2] - result.qw2)),
+                              momentum=[float(t.arrival[1]), float(t.arrival[3])])
+                         for t in result.trajectories]
+    elif isinstance(result, WallTangencyResult):
+        s["tangency_points"] = [dict(number=p.number, theta=p.theta, q2=p.q2, p2=p.p2, status=p.status, itinerary=p.itinerary)
+                       for p in result.points]
+        s["regions"] = _region_counts(result.grid["region"])
+    elif isinstance(result, WallSectionResult):
+        b = result.boundaries
+        two_pi = 2 * math.pi
+        s.update(rho_w=result.rho_w, rho_max=result.rho_max, boundaries=b, resolution=result.resolution,
+                 arcs={"R": (b["R0"] - b["1R"]) % two_pi, "0": (b["01"] - b["R0"]) % two_pi,
+                       "1": (b["1R"] - b["01"]) % two_pi},
+                 circle_regions=_region_counts(result.circle["region"]),
+                 curve_points={k: int(np.count_nonzero(np.isfinite(result.curves[f"theta_{k}"]))) for k in _DIRECTIONS},
+                 segments=[dict(kind=g.kind, theta=g.theta, status=g.status, itinerary=g.itinerary)
+                           for g in result.segments])
     return jsonable(s)

@@ -24,10 +24,11 @@ from ..flow.section import STEPPERS
 from ..truncated.theory import OMEGA_G, golden_family
 from ..interface import register
 from .spec import figure_inches
-from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CriticalSpec, FlowHoveringScene, FlowPortraitScene,
-                   HoveringAreaScene, IntegratorSpec, MapSpec, OrbitScene, OrbitSpec, OutputsSpec, PanelSpec,
-                   PotentialSpec, SceneSpec, SeriesSpec, SigmaStructureScene, SystemSpec, TangentToriScene,
-                   ZoomSpec)
+from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CornerDirectionsScene, CriticalSpec, FlowHoveringScene,
+                   FlowPortraitScene, HoveringAreaScene, IntegratorSpec, MapSpec, OrbitScene, OrbitSpec, OutputsSpec,
+                   PanelSpec, PotentialSpec, SceneSpec, SeriesSpec, SigmaStructureScene, SystemSpec, TangentToriScene,
+                   WallSectionScene, WallTangencyScene, ZoomSpec)
+from .wall import corner_energy, wall_tangency_action
 
 __all__ = ["load_scene", "parse_scene", "check_spec", "scene_table", "MAX_PANELS", "MAX_SERIES_POINTS",
            "MAX_SCENE_BYTES", "MAX_TEXT", "MAX_PATH_CHARS", "MAX_SCENE_STRING", "MAX_SCENE_DEPTH", "MAX_KEY_PARTS", "MAX_CANVAS_PIXELS"]
@@ -292,15 +293,29 @@ _FLOW_KEYS = {
     "flow_hovering_area": _FLOW_COMMON + ("n_steps", "eps", "samples", "seed", "models"),
     "tangent_tori": _FLOW_COMMON + ("n_returns", "n_points"),
     "sigma_structure": _FLOW_COMMON + ("grid", "K_range", "marker_size"),
+    "corner_directions": _FLOW_COMMON + ("p1w_fractions", "n_curve"),
+    "wall_tangency": _FLOW_COMMON + ("grid", "n_points", "marker_size"),
+    "wall_section": _FLOW_COMMON + ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments"),
 }
 _FLOW_REQUIRED = {"flow_portrait": ("n_steps",), "flow_hovering_area": ("n_steps", "eps"), "tangent_tori": (),
-                  "sigma_structure": ()}
+                  "sigma_structure": (), "corner_directions": (), "wall_tangency": (), "wall_section": ()}
+#: The scene's own keys of each kind, as ``scene_table`` writes them back (after the common ones).
+_KIND_KEYS = {"flow_portrait": ("n_steps", "n_orbits", "K0_range", "model", "corner_K", "marker_size"),
+              "flow_hovering_area": ("n_steps", "eps", "samples", "seed", "models"),
+              "tangent_tori": ("n_returns", "n_points"),
+              "sigma_structure": ("grid", "K_range", "marker_size"),
+              "corner_directions": ("p1w_fractions", "n_curve"),
+              "wall_tangency": ("grid", "n_points", "marker_size"),
+              "wall_section": ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments")}
 # (allowed, required) records per kind: a figure's own needs are required, the rest optional.
 _FLOW_RECORDS = {
     "flow_portrait": (("regions",), ()),
     "flow_hovering_area": (("regions",), ("regions",)),
     "tangent_tori": (("trajectory",), ("trajectory",)),
     "sigma_structure": (("regions", "section", "states"), ("regions", "section", "states")),
+    "corner_directions": (("trajectory",), ("trajectory",)),
+    "wall_tangency": (("regions", "trajectory"), ("regions", "trajectory")),
+    "wall_section": (("regions", "trajectory"), ("regions", "trajectory")),
 }
 _SYSTEM_KEYS = ("V1", "V2", "coupling", "eps", "qw1", "qw2", "geometry")
 _POTENTIAL_KEYS = ("kind", "omega", "alpha")
@@ -344,7 +359,8 @@ def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bo
     -------
     SceneSpec
         An :class:`OrbitScene`, :class:`HoveringAreaScene`, :class:`FlowPortraitScene`,
-        :class:`FlowHoveringScene`, :class:`TangentToriScene` or :class:`SigmaStructureScene`.
+        :class:`FlowHoveringScene`, :class:`TangentToriScene`, :class:`SigmaStructureScene`,
+        :class:`CornerDirectionsScene`, :class:`WallTangencyScene` or :class:`WallSectionScene`.
 
     Raises
     ------
@@ -764,7 +780,8 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
 def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneSpec:
     common.update(_flow_common(where, kind, data))
     system = common["system"]
-    if kind in ("flow_portrait", "flow_hovering_area", "sigma_structure") and system.geometry != "step":
+    if kind in ("flow_portrait", "flow_hovering_area", "sigma_structure", "corner_directions", "wall_tangency",
+                "wall_section") and system.geometry != "step":
         raise ValueError(f"{where}.system.geometry = {system.geometry!r}: a {kind} scene draws the regions of "
                          f"the step; allowed: 'step'")
     if kind == "tangent_tori" and (system.eps != 0 or system.geometry != "none"):
@@ -800,6 +817,8 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
             n_returns=_int(f"{where}.n_returns", data["n_returns"], 1, 100) if "n_returns" in data else 3,
             n_points=_int(f"{where}.n_points", data["n_points"], 16, 100_000) if "n_points" in data else 400,
             **common)
+    if kind in ("corner_directions", "wall_tangency", "wall_section"):
+        return _parse_wall_scene(where, kind, data, common)
     grid = (240, 60)
     if "grid" in data:
         gv = data["grid"]
@@ -811,6 +830,58 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
         grid=grid, K_range=kr,
         marker_size=(_real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
                      if "marker_size" in data else 1.0),
+        **common)
+
+
+def _parse_wall_scene(where: str, kind: str, data: dict, common: dict) -> SceneSpec:
+    """The corner and wall-section kinds (fig:corner_directions, fig:Sigma_0_wall, fig:wallsection)."""
+    system, h = common["system"], common["h"]
+    hw = corner_energy(system.build())
+    if not h > hw:
+        raise ValueError(f"{where}.section.h = {h!r} is out of range; allowed: above the energy at rest at the corner "
+                         f"V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = {hw:.6g} (def:heps: below it no orbit reaches the "
+                         f"corner)")
+    if kind == "corner_directions":
+        fr = (0.3, 0.7)
+        if "p1w_fractions" in data:
+            fv = data["p1w_fractions"]
+            if not isinstance(fv, list) or not 1 <= len(fv) <= 12:
+                raise ValueError(f"{where}.p1w_fractions must be a list of 1 to 12 numbers in (0, 1) (p1w / p1w_max), "
+                                 f"got {fv!r}")
+            fr = tuple(_real(f"{where}.p1w_fractions[{i}]", v, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+                       for i, v in enumerate(fv))
+            if len(set(fr)) != len(fr):
+                raise ValueError(f"{where}.p1w_fractions = {fv!r} lists a value twice")
+        return CornerDirectionsScene(
+            p1w_fractions=fr, n_curve=_int(f"{where}.n_curve", data["n_curve"], 4, 2000) if "n_curve" in data else 48,
+            **common)
+    if kind == "wall_tangency":
+        if system.eps != 0:
+            raise ValueError(f"{where}.system.eps = {system.eps!r}: fig:Sigma_0_wall draws the unperturbed tangency "
+                             f"line; allowed: eps = 0 (the wall_section kind takes eps != 0)")
+        grid = (180, 40)
+        if "grid" in data:
+            gv = data["grid"]
+            if not isinstance(gv, list) or len(gv) != 2:
+                raise ValueError(f"{where}.grid must be [n_theta, n_rho], got {gv!r}")
+            grid = (_int(f"{where}.grid[0]", gv[0], 8, 2000), _int(f"{where}.grid[1]", gv[1], 2, 1000))
+        return WallTangencyScene(
+            grid=grid, n_points=_int(f"{where}.n_points", data["n_points"], 16, 100_000) if "n_points" in data else 400,
+            marker_size=(_real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
+                         if "marker_size" in data else 2.0),
+            **common)
+    # wall_section: its coordinates need the tangency line I_tan^{eps,-}(theta) near the unperturbed one
+    try:
+        wall_tangency_action(system.build(), h, [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0])
+    except ValueError as e:
+        raise ValueError(f"{where}.system.eps = {system.eps!r}: {e}") from None
+    return WallSectionScene(
+        rho_w_fraction=(_real(f"{where}.rho_w_fraction", data["rho_w_fraction"], lo=0.0, hi=1.0, lo_open=True)
+                        if "rho_w_fraction" in data else 0.5),
+        n_theta=_int(f"{where}.n_theta", data["n_theta"], 32, 20_000) if "n_theta" in data else 720,
+        n_circles=_int(f"{where}.n_circles", data["n_circles"], 2, 200) if "n_circles" in data else 16,
+        bisections=_int(f"{where}.bisections", data["bisections"], 1, 50) if "bisections" in data else 30,
+        segments=_int(f"{where}.segments", data["segments"], 0, 10) if "segments" in data else 2,
         **common)
 
 
@@ -985,11 +1056,7 @@ def scene_table(spec: SceneSpec) -> dict:
                  {"stepper": ig.stepper, "rtol": ig.rtol, "atol": ig.atol},
                  outputs={"record": list(spec.outputs.record),
                           **({"trajectory_dt": spec.outputs.trajectory_dt} if "trajectory" in allowed else {})})
-        extra = {"flow_portrait": ("n_steps", "n_orbits", "K0_range", "model", "corner_K", "marker_size"),
-                 "flow_hovering_area": ("n_steps", "eps", "samples", "seed", "models"),
-                 "tangent_tori": ("n_returns", "n_points"),
-                 "sigma_structure": ("grid", "K_range", "marker_size")}[spec.kind]
-        t.update(_some(**{k: getattr(spec, k) for k in extra}))
+        t.update(_some(**{k: getattr(spec, k) for k in _KIND_KEYS[spec.kind]}))
     return t
 
 

@@ -22,13 +22,15 @@ __all__ = [
     "MapSpec", "OrbitSpec", "CriticalSpec", "ZoomSpec", "PanelSpec", "SeriesSpec",
     "PotentialSpec", "SystemSpec", "IntegratorSpec", "OutputsSpec",
     "SceneSpec", "OrbitScene", "HoveringAreaScene", "FlowPortraitScene", "FlowHoveringScene",
-    "TangentToriScene", "SigmaStructureScene", "Scene", "figure_inches",
+    "TangentToriScene", "SigmaStructureScene", "CornerDirectionsScene", "WallTangencyScene", "WallSectionScene",
+    "Scene", "figure_inches",
 ]
 
 #: Scene kinds of the truncated map (sec:truncatedmapnum).
 TRUNCATED_KINDS = ("portrait", "critical_orbits", "hovering_area")
 #: Scene kinds of the physical flow.
-FLOW_KINDS = ("flow_portrait", "flow_hovering_area", "tangent_tori", "sigma_structure")
+FLOW_KINDS = ("flow_portrait", "flow_hovering_area", "tangent_tori", "sigma_structure", "corner_directions",
+              "wall_tangency", "wall_section")
 #: Every kind of scene.
 KINDS = TRUNCATED_KINDS + FLOW_KINDS
 
@@ -601,13 +603,88 @@ class SigmaStructureScene(FlowScene):
     marker_size: float = 1.0
 
 
+@dataclass(frozen=True, kw_only=True)
+class CornerDirectionsScene(FlowScene):
+    """``corner_directions`` (fig:corner_directions): the three directions that reach the corner.
+
+    On the energy surface h the corner is reached with momenta ``p_R0 = (-p1w, P2)``,
+    ``p_01 = (p1w, -P2)``, ``p_1R = (-p1w, -P2)``, ``P2 = sqrt(2 (h - h_eps^w) - p1w^2)``
+    (eq:p2corner); each is followed back by the smooth flow to its point of Sigma_h, and forward
+    again by the step system's flow to the corner.
+
+    Attributes
+    ----------
+    p1w_fractions : tuple of float
+        The ``p1w`` of the trajectories drawn, as fractions of ``p1w_max = sqrt(2 (h - h_eps^w))``,
+        each in (0, 1).
+    n_curve : int
+        Values of ``p1w`` on which each corner-singularity curve of Sigma_h is traced.
+    """
+
+    p1w_fractions: tuple = (0.3, 0.7)
+    n_curve: int = 48
+
+
+@dataclass(frozen=True, kw_only=True)
+class WallTangencyScene(FlowScene):
+    """``wall_tangency`` (fig:Sigma_0_wall): the tangency line of the wall section and its trajectories.
+
+    The unperturbed wall section ``Sigma_h^{*,-}`` in the (q2, p2) plane: the tangency line
+    ``Xi^0_wall`` (trajectories that touch q1 = qw1), its seven points of the paper's caption and
+    their trajectories, and the regions of its interior ``Sigma_h^{w,-}`` labelled by the flow.
+
+    Attributes
+    ----------
+    grid : tuple of int
+        ``(n_theta, n_rho)`` points of the interior labelled by the flow (wall coordinates).
+    n_points : int
+        Samples of the tangency line.
+    marker_size : float
+        Scatter marker size of the labelled points.
+    """
+
+    grid: tuple = (180, 40)
+    n_points: int = 400
+    marker_size: float = 2.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class WallSectionScene(FlowScene):
+    """``wall_section`` (fig:wallsection): the wall section's corner-singularity curves and a fixed circle.
+
+    In the wall coordinates ``(theta, rho_w)`` of ``Sigma_h^{w,-}`` (eq:rhow): the curves
+    ``sigma_R0^-, sigma_01^-, sigma_1R^-`` measured on circles ``rho_w = const`` by bisection of the
+    flow's region labels, one circle's arcs J_R, J_0, J_1, and trajectory segments from it.
+
+    Attributes
+    ----------
+    rho_w_fraction : float
+        The drawn circle's ``rho_w`` as a fraction of ``rho_max(h)`` (eq:rhomaxh), in (0, 1].
+    n_theta : int
+        Angles labelled on that circle.
+    n_circles : int
+        Circles on which the corner-singularity curves are measured.
+    bisections : int
+        Bisection steps per boundary (resolution ``2 pi / n / 2^bisections``).
+    segments : int
+        Trajectory segments drawn per region of the circle.
+    """
+
+    rho_w_fraction: float = 0.5
+    n_theta: int = 720
+    n_circles: int = 16
+    bisections: int = 30
+    segments: int = 2
+
+
 #: Old name of the truncated orbit scenes' spec (kept for one release).
 Scene = SceneSpec
 
 
 #: Figure size (inches) of the kinds with a fixed grid of axes, when the scene gives no ``figsize``.
 _FIGSIZE = {"hovering_area": (13.0, 5.2), "flow_portrait": (13.0, 5.6), "flow_hovering_area": (13.0, 5.2),
-            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0)}
+            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0), "corner_directions": (12.0, 10.0),
+            "wall_tangency": (18.0, 6.2), "wall_section": (12.0, 10.0)}
 
 
 def figure_inches(scene, n_panels: int = 1) -> tuple:
