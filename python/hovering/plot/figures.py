@@ -529,7 +529,7 @@ def corner_directions_figure(result: CornerDirectionsResult):
     axa.set_xlim(lo1, hi1)
     axa.set_ylim(lo2 - 0.45 * (hi2 - lo2), hi2)  # room for the legend under the trajectories
     axa.legend(fontsize=6.5, loc="lower right", framealpha=0.85, ncol=2)
-    axa.set_title("(a) trajectories of the step system from $\Sigma_h$ to the corner", fontsize=9)
+    axa.set_title(r"(a) trajectories of the step system from $\Sigma_h$ to the corner", fontsize=9)
     axb.set_xlim(qw1 - zoom, qw1 + zoom)
     axb.set_ylim(qw2 - zoom, qw2 + zoom)
     for d, (dx, dy) in (("R0", (0.25, -0.55)), ("01", (-0.75, 0.45)), ("1R", (0.25, 0.5))):
@@ -570,7 +570,7 @@ def corner_directions_figure(result: CornerDirectionsResult):
     axd.set_xlabel(r"$\phi$")
     axd.set_ylabel(r"$K$")
     axd.legend(fontsize=7, loc="lower right", framealpha=0.85)
-    axd.set_title("(d) corner-singularity curves of $\Sigma_h$, traced back from the corner", fontsize=9)
+    axd.set_title(r"(d) corner-singularity curves of $\Sigma_h$, traced back from the corner", fontsize=9)
     fig.suptitle(scene.title + _quick(result) + "\n" + _system_text(scene), fontsize=9)
     return fig
 

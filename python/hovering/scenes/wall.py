@@ -227,8 +227,9 @@ def wall_states(sys: StepSystem, h: float, theta, rho_w, I_tan=None) -> np.ndarr
         e2 = sys.V2.energy(float(I))
         q2, p2 = sys.V2.point_at(float(t), e2)
         ups = E - e2 - (sys.eps * sys.coupling(sys.qw1, q2) if sys.eps != 0 and sys.coupling is not None else 0.0)
-        if ups >= 0:
-            z.reshape(-1, 4)[k] = (sys.qw1, -math.sqrt(2.0 * ups), q2, p2)
+        # On the tangency line (rho_w = 0) Upsilon is 0 up to the rounding of I_tan^{eps,-}.
+        if ups >= -1e-12 * max(1.0, abs(E)):
+            z.reshape(-1, 4)[k] = (sys.qw1, -math.sqrt(2.0 * max(ups, 0.0)), q2, p2)
     return z.reshape(-1, 4)
 
 
