@@ -168,7 +168,7 @@ def _closed_form_start(sys, ab: str, p1w: float) -> tuple:
     H1 = V1.V(sys.qw1) + 0.5 * p1w**2
     H2 = H - H1
     a = V1.angle_of(sys.qw1, H1)
-    t = (a if ab == "01" else 2 * np.pi - a) / V1.frequency(H1)
+    t = (2 * np.pi - a if ab == "01" else a) / V1.frequency(H1)
     z = corner_states(sys, H, ab, [p1w])[0]
     theta = V2.angle_of_point(sys.qw2, z[3], H2) - V2.frequency(H2) * t
     return float(wrap(theta)), float(V2.action(H2)), t
