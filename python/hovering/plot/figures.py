@@ -476,7 +476,11 @@ def _draw_step(ax, qw1: float, qw2: float, lo1: float, lo2: float) -> None:
 
 
 def _segment_color(kind: str) -> str:
-    return CORNER_COLORS[kind] if kind in CORNER_COLORS else WALL_REGION_COLORS[_ARC_REGION[kind]]
+    """Colour of a wall segment: its arc's region colour, or at a corner crossing the caption's
+    red, blue, black (fig:wallsection draws the sigma_1R^- curve green but its segment black)."""
+    if kind in CORNER_COLORS:
+        return "k" if kind == "1R" else CORNER_COLORS[kind]
+    return WALL_REGION_COLORS[_ARC_REGION[kind]]
 
 
 def corner_directions_figure(result: CornerDirectionsResult):
@@ -507,8 +511,9 @@ def corner_directions_figure(result: CornerDirectionsResult):
     zoom = 0.12 * max(hi1 - lo1, hi2 - lo2)
     styles = ("-", "--", "-.", ":")
     fr = sorted({t.p1w for t in result.trajectories})
+    bottom = lo2 - 0.45 * (hi2 - lo2)  # room for panel (a)'s legend under the trajectories
     for ax in (axa, axb):
-        _draw_step(ax, qw1, qw2, lo1, lo2)
+        _draw_step(ax, qw1, qw2, lo1, bottom)
         for i, t in enumerate(result.trajectories):
             c = CORNER_COLORS[t.direction]
             ls = styles[fr.index(t.p1w) % len(styles)]
@@ -527,7 +532,7 @@ def corner_directions_figure(result: CornerDirectionsResult):
         ax.set_ylabel(r"$q_2$")
         ax.set_aspect("equal", adjustable="box")
     axa.set_xlim(lo1, hi1)
-    axa.set_ylim(lo2 - 0.45 * (hi2 - lo2), hi2)  # room for the legend under the trajectories
+    axa.set_ylim(bottom, hi2)
     axa.legend(fontsize=6.5, loc="lower right", framealpha=0.85, ncol=2)
     axa.set_title(r"(a) trajectories of the step system from $\Sigma_h$ to the corner", fontsize=9)
     axb.set_xlim(qw1 - zoom, qw1 + zoom)
@@ -656,6 +661,7 @@ def wall_tangency_figure(result: WallTangencyResult):
         axz.annotate(nums, (result.qw1, q2), xytext=(-8, 0), textcoords="offset points", fontsize=9, weight="bold",
                      va="center", ha="right")
     axq.set_xlim(lo1, allq[:, 0].max() + 0.1)
+    axq.set_ylim(lo2, allq[:, 1].max() + 0.1)
     axq.legend(fontsize=6.5, loc="lower right", framealpha=0.9)
     axq.set_title("(b) their trajectories (smooth flow), one return; pairs 1-7, 2-6, 3-5 share one curve", fontsize=9)
     span = max(p.q2 for p in result.points) - min(p.q2 for p in result.points)
@@ -675,7 +681,7 @@ def wall_section_figure(result: WallSectionResult):
     ``rho_w = const`` coloured by the flow's label of each point (J_R yellow, J_0 gray, J_1 cyan).
     Right column: the trajectory segments through chosen points of the circle in configuration
     space (top: one return; bottom: at the corner), those at the circle's corner crossings in the
-    curves' colours; solid dots where each crosses the wall section, in both columns.
+    caption's red, blue and black; solid dots where each crosses the wall section, in both columns.
 
     Parameters
     ----------
@@ -737,14 +743,17 @@ def wall_section_figure(result: WallSectionResult):
     for ax in (axq, axz):
         _draw_step(ax, result.qw1, result.qw2, lo1, lo2)
         ax.axvline(result.qw1, color="k", lw=0.6, ls=":")
+        labelled = set()
         for i, g in enumerate(result.segments):
             c = _segment_color(g.kind)
             lab = None
-            if ax is axq:
+            if ax is axq and (g.kind, g.itinerary, g.status) not in labelled:
+                labelled.add((g.kind, g.itinerary, g.status))
                 lab = (rf"on $\sigma^-_{{{g.kind}}}$" if g.kind in CORNER_COLORS else
                        _WALL_LABELS[_ARC_REGION[g.kind]]) + f": {g.itinerary or g.status.lower()}"
-            # At eps = 0 the segment on sigma_01 leaves the corner along the one on sigma_R0 reversed
-            # (the same |p1| and H2): widths and dashes keep both visible.
+            # At eps = 0 the segment on sigma_1R leaves the corner (after the upper wall) along the one
+            # on sigma_01 reversed, and the one on sigma_R0 (after the right wall) along the one on
+            # sigma_1R reversed (the same |p1| and H2): widths, dashes and order keep all visible.
             style = _CORNER_SEGMENT_STYLE.get(g.kind, dict(lw=1.0, ls="-", zorder=2))
             (ln,) = ax.plot(g.trajectory[:, 1], g.trajectory[:, 3], color=c if g.kind in CORNER_COLORS else
                             _darker(c), label=lab, **style)
@@ -753,8 +762,10 @@ def wall_section_figure(result: WallSectionResult):
             pt.set_gid(f"dot:{g.kind}:{i}")
         ax.set_xlabel(r"$q_1$")
         ax.set_ylabel(r"$q_2$")
+    hi2 = allq[:, 1].max() + 0.05
     axq.set_xlim(lo1, allq[:, 0].max() + 0.1)
-    axq.legend(fontsize=6.5, loc="upper right", framealpha=0.85, ncol=2)
+    axq.set_ylim(lo2, hi2 + 0.3 * (hi2 - lo2))  # room for the legend above the segments
+    axq.legend(fontsize=6.5, loc="upper right", framealpha=0.85, ncol=3)
     axq.set_title("(b) trajectory segments through the circle's points (dots: on the wall section)", fontsize=9)
     axz.set_xlim(result.qw1 - zoom, result.qw1 + zoom)
     axz.set_ylim(result.qw2 - zoom, result.qw2 + zoom)
@@ -765,8 +776,8 @@ def wall_section_figure(result: WallSectionResult):
 
 
 #: Line styles of the segments at the corner-singularity crossings (drawn over the others).
-_CORNER_SEGMENT_STYLE = {"R0": dict(lw=3.0, ls="-", zorder=3), "01": dict(lw=1.5, ls=(0, (5, 2)), zorder=4),
-                         "1R": dict(lw=1.5, ls="-", zorder=4)}
+_CORNER_SEGMENT_STYLE = {"R0": dict(lw=3.5, ls="-", zorder=3), "1R": dict(lw=1.8, ls="-", zorder=3.5),
+                         "01": dict(lw=1.4, ls=(0, (4, 2)), zorder=3.8)}
 
 
 def _darker(color: str) -> tuple:
