@@ -26,6 +26,7 @@ import tomllib
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+from matplotlib.colors import to_rgb
 import numpy as np
 import pytest
 
@@ -461,6 +462,60 @@ def test_wall_section_result_arcs_curves_and_segments(results):
             assert g.status == "OK" and g.itinerary == g.kind
         assert g.wall[0] == sys.qw1 and g.wall[1] < 0
         assert _crossing_q2(g.trajectory, sys.qw1) == pytest.approx(g.wall[2], abs=1e-4), g.kind
+    _check_corner_segments(res, sys)
+
+
+def _distance_to_polyline(q: np.ndarray, c) -> float:
+    """Distance from the point c to the broken line through the rows of q (n, 2)."""
+    a, b = q[:-1], q[1:]
+    ab = b - a
+    s = np.clip(np.einsum("ij,ij->i", np.asarray(c) - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0, 1)
+    return float(np.hypot(*(a + s[:, None] * ab - c).T).min())
+
+
+def _check_corner_segments(res, sys) -> None:
+    """The segments through the circle's corner crossings run through the corner itself; the others
+    keep away from it.
+
+    The recorded trajectory is sampled every dt = 0.01 (impacts and corner hits exactly); between
+    samples the chord leaves the curve by at most |q''| dt^2 / 8 = 2e-5 (|q''| = |grad V| <= 1.6
+    near the corner): 3e-5. A boundary angle off by 1e-4 would miss the corner by ~1e-4.
+    R0 and 1R cross the wall section at the corner (q2 = qw2, within the bisection's 1e-9); 01
+    crosses above the step and reaches the corner after its passage over it.
+    """
+    for g in res.segments:
+        d = _distance_to_polyline(g.trajectory[:, [1, 3]], (sys.qw1, sys.qw2))
+        if g.kind in DIRECTIONS:
+            assert d < 3e-5, (g.kind, d)
+            assert (g.wall[2] > sys.qw2 + 0.1) if g.kind == "01" else (abs(g.wall[2] - sys.qw2) < 1e-9), g.kind
+        else:
+            assert d > 1e-2, (g.kind, d)
+
+
+def test_wall_section_at_small_eps_keeps_the_order_symmetry_and_corner_segments():
+    # fig:wallsection at eps = 0.05 (the paper draws eps = 0; no closed form here): the circle's
+    # boundaries keep lemma:border's order and the symmetry theta_1R = -theta_R0 (eq:q2starsym;
+    # 1e-8 as in the bisection test), every sample of the circle carries its arc's label, the
+    # circle's points have energy h on q1 = qw1 at distance rho_w from the tangency line, and the
+    # corner-crossing segments run through the corner.
+    d = _small("fig_wallsection")
+    d["system"].update(coupling="bilinear", eps=0.05)
+    res = compute(parse_scene(d, "w.toml"), quick=True)
+    sys = res.scene.system.build()
+    b, ci = res.boundaries, res.circle
+    assert b["R0"] < 0 < b["01"] < b["1R"] and b["1R"] == pytest.approx(-b["R0"], abs=1e-8)
+    th = ci["theta"]
+    want = np.where((th > b["R0"]) & (th < b["01"]), int(Region.ABOVE),
+                    np.where((th > b["01"]) & (th < b["1R"]), int(Region.UPPER), int(Region.RIGHT)))
+    np.testing.assert_array_equal(ci["region"], want)
+    z = np.column_stack([np.full(th.size, sys.qw1), ci["p1"], ci["q2"], ci["p2"]])
+    np.testing.assert_allclose(sys.core.energy(z), H, atol=1e-13)
+    I = np.array([sys.V2.action(0.5 * p**2 + sys.V2.V(q)) for q, p in zip(ci["q2"], ci["p2"])])
+    np.testing.assert_allclose(wall_tangency_action(sys, H, th) - I, res.rho_w, atol=1e-12)  # eq:rhow
+    # the eps = 0 boundaries are not these: the test sees the coupling (they moved by ~0.03)
+    want0 = _closed_form_wall_angles(_system(0.0), res.rho_w)
+    assert all(abs(wrap(b[ab] - want0[ab])) > 0.01 for ab in DIRECTIONS)
+    _check_corner_segments(res, sys)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -514,6 +569,29 @@ def test_a_quick_run_writes_png_npz_json(runs, name):
         assert {"arc:R", "arc:0", "arc:1", "segment:R0:6", "segment:01:7", "segment:1R:8"} <= gids
         arcs = doc["summary"]["arcs"]
         assert arcs["R"] + arcs["0"] + arcs["1"] == pytest.approx(2 * np.pi, abs=1e-12)
+        # the caption's colours, by name: curves red, blue, green; arcs yellow (J_R), gray (J_0),
+        # cyan (J_1); the corner-crossing segments red, blue, black
+        by_gid = {}
+        for ax in fig.axes:
+            for a in list(ax.lines) + list(ax.collections):
+                by_gid.setdefault(a.get_gid(), a)
+
+        def rgb(gid):
+            a = by_gid[gid]
+            c = a.get_color() if hasattr(a, "get_xdata") else a.get_facecolor()[0]
+            return np.array(to_rgb(c))
+
+        named = {"red": lambda r, g, b: r > 0.6 and g < 0.3 and b < 0.3,
+                 "blue": lambda r, g, b: b > 0.6 and r < 0.3 and g < 0.3,
+                 "green": lambda r, g, b: g > 0.35 and r < 0.35 and b < 0.2,
+                 "black": lambda r, g, b: max(r, g, b) < 0.1,
+                 "yellow": lambda r, g, b: r > 0.8 and g > 0.6 and b < 0.3,
+                 "gray": lambda r, g, b: 0.4 < r < 0.8 and abs(r - g) < 0.05 and abs(r - b) < 0.05,
+                 "cyan": lambda r, g, b: r < 0.3 and g > 0.7 and b > 0.7}
+        want = {"curve:R0": "red", "curve:01": "blue", "curve:1R": "green", "arc:R": "yellow", "arc:0": "gray",
+                "arc:1": "cyan", "segment:R0:6": "red", "segment:01:7": "blue", "segment:1R:8": "black"}
+        for gid, name in want.items():
+            assert named[name](*rgb(gid)), (gid, name, rgb(gid))
 
 
 @pytest.mark.e2e
