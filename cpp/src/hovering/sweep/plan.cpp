@@ -235,7 +235,7 @@ std::vector<std::string> steppers() { return std::vector<std::string>(kSteppers.
 IntegratorSpec read_integrator(Table& t) {
     IntegratorSpec it;
     it.stepper = t.string("stepper", steppers());
-    it.rtol = t.real("rtol", 0, 1, true, true);
+    it.rtol = t.real("rtol", 0, 1, true, true, true);
     it.atol = t.real("atol", 0, kInf);
     t.done();
     return it;

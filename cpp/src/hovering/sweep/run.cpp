@@ -133,14 +133,18 @@ std::string sys_error(const std::string& what, int err) { return what + ": " + s
 /// Why a complete line is not a record of a checkpoint ("" if it is one); `header`: the first line.
 std::string check_line(const std::string& line, bool header, std::string& key) {
     const json j = json::parse(line, nullptr, false);
+    const std::string not_header = "the first line is not the header {\"format\": \"hovering-checkpoint\", \"version\": " +
+                                   std::to_string(kCheckpointVersion) + "}: ";
+    if (header && (j.is_discarded() || !j.is_object())) return not_header + "another program's file";
     if (j.is_discarded()) return "not a line of JSON";
     if (!j.is_object()) return "not a JSON object";
     if (header) {
         const auto f = j.find("format");
         const auto v = j.find("version");
         if (j.size() != 2 || f == j.end() || v == j.end() || *f != "hovering-checkpoint")
-            return "the first line is not the header {\"format\": \"hovering-checkpoint\", \"version\": " +
-                   std::to_string(kCheckpointVersion) + "}: another program's file";
+            return not_header + (j.contains("key") && j.contains("row")
+                                     ? "a checkpoint of an older hovering, whose points were keyed otherwise"
+                                     : "another program's file");
         if (!v->is_number_integer() || *v != kCheckpointVersion)
             return "a checkpoint of version " + v->dump() + "; this program reads version " +
                    std::to_string(kCheckpointVersion);
@@ -173,6 +177,9 @@ private:
 }  // namespace
 
 Checkpoint::Checkpoint(const std::string& path) : path_(path) {
+    struct stat pre;
+    if (::stat(path.c_str(), &pre) == 0 && !S_ISREG(pre.st_mode))  // a FIFO or a device would be read forever
+        throw std::invalid_argument(path + " is not a regular file (a checkpoint)");
     fd_ = ::open(path.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
     if (fd_ < 0 && (errno == EACCES || errno == EROFS)) {
         read_only_ = errno;
