@@ -324,25 +324,6 @@ def test_full_tmpfs_keeps_the_previous_outputs(tmp_path):
 # ------------------------------------------------------------------------------------------------
 # hovering_sweep: one run per CSV at a time, provenance in the header, a full disk
 
-@pytest.fixture(scope="module")
-def sweep_exe():
-    """This checkout's hovering_sweep, brought up to date in build/ctest (the directory the README's
-    ctest command builds; a no-op after scripts/test.sh), or the executable $HOVERING_SWEEP names."""
-    if os.environ.get("HOVERING_SWEEP"):
-        return os.environ["HOVERING_SWEEP"]
-    cmake = shutil.which("cmake")
-    assert cmake, "cmake is needed to build hovering_sweep (scripts/setup.sh installs it)"
-    build = ROOT / "build" / "ctest"
-    if not (build / "CMakeCache.txt").exists():
-        gen = ["-G", "Ninja"] if shutil.which("ninja") else []
-        subprocess.run([cmake, "-S", str(ROOT), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release",
-                        "-DHOVERING_BUILD_TESTS=ON"], check=True, capture_output=True, timeout=600)
-    r = subprocess.run([cmake, "--build", str(build), "--target", "hovering_sweep"], capture_output=True, text=True,
-                       timeout=3600)
-    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    return str(build / "hovering_sweep")
-
-
 def csv_parts(path: Path):
     """(provenance records, header lines, rows) of a hovering_sweep CSV."""
     lines = path.read_text().splitlines()

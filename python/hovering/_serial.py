@@ -197,7 +197,6 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
                     "dataclass or hovering object)")
 
 
-@functools.lru_cache(maxsize=None)
 def record_key(obj: Any) -> Any:
     """The canonical record of ``obj`` as plain JSON values: what a checkpoint keys it by.
 
@@ -238,6 +237,7 @@ def record_key(obj: Any) -> Any:
     return inline(tree)
 
 
+@functools.lru_cache(maxsize=None)
 def _field_types(cls) -> dict:
     try:
         return typing.get_type_hints(cls)

@@ -11,6 +11,7 @@ from .. import _core
 from .._common import (MAX_TRAJECTORY_POINTS, FlowStatus, integer, is_choice, real_array, real_number, status_code,
                        thread_count, trajectory_arguments, trajectory_rows)
 from .._progress import check_progress, progress_bar
+from .._pickle import reduce_record
 from .._serial import Saveable
 from .system import StepSystem
 
@@ -172,6 +173,10 @@ class Section:
     def _from_record(cls, record: dict) -> "Section":
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls(record["sys"], record["h"])
+
+    def __reduce__(self):
+        """Pickle as the record (and any other instance attribute)."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h")})
 
     def point(self, theta, I) -> np.ndarray:
         """States (q1, 0, q2, p2) of Sigma_h at section coordinates (theta, I).

@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import _core
 from .._common import MAX_MODES, integer, real_array, require_angles, require_finite, require_type, wrap
+from .._pickle import reduce_record
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 
@@ -134,6 +135,14 @@ class TangentialCurve(Saveable):
     def _from_record(cls, record: dict) -> "TangentialCurve":
         """Inverse of :meth:`_to_record` (the interpolants are rebuilt bit for bit, the flow is not traced)."""
         return cls._from_samples(record["sec"], record["samples"])
+
+    #: What the record rebuilds (the rest of the instance dict is pickled as it is).
+    _OWN = frozenset({"sec", "_c", "s", "theta", "values", "interpolation_error", "interpolation_error_theta",
+                      "is_graph", "min_slope"})
+
+    def __reduce__(self):
+        """Pickle as the record: the section and the measured samples."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in self._OWN})
 
     def __repr__(self) -> str:
         return (f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "

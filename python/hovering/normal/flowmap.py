@@ -17,6 +17,7 @@ import numpy as np
 from .. import _core
 from .._common import (MAX_MODES, MAX_TRAJECTORY_POINTS, Region, check_memory, flag, forcing_array, integer,
                        is_choice, iterate_arguments, point_pair, trajectory_arguments, wrap)
+from .._pickle import reduce_record
 from .._progress import check_progress, progress_bar
 from .._protocols import MapAnalyses
 from .._serial import Saveable
@@ -190,10 +191,9 @@ class FlowMap(MapAnalyses):
                       "curve", "_core"})
 
     def __reduce__(self):
-        """Pickle as the constructor arguments, the measured curve and the other instance attributes."""
-        extra = {k: v for k, v in self.__dict__.items() if k not in self._OWN}
-        return _restore_flowmap, (type(self), self.sys, self.h, self.coordinates, dict(self.integrator_options),
-                                  self.curve, extra)
+        """Pickle as the record (system, h, coordinates, integrator options, the curve's samples, the
+        forcing cache) and the other instance attributes."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in self._OWN | {"_forcing"}})
 
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: system, h, coordinates, integrator options, the curve's samples
