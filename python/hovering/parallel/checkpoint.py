@@ -171,16 +171,21 @@ class Checkpoint:
         finally:
             os.close(fd)
 
+    def _check_size(self, nbytes: int, need: int) -> None:
+        budget = _untrusted.memory_budget()
+        if need > budget:
+            raise ValueError(f"{self.path}: a checkpoint of {nbytes} bytes, whose rows would take up to "
+                             f"{need / 2**30:.3g} GiB, more than half of this machine's memory "
+                             f"({2 * budget / 2**30:.3g} GiB)")
+
     def _scan(self, fd: int, cut: bool) -> None:
         size = os.fstat(fd).st_size
-        budget = _untrusted.memory_budget()
-        if 6 * size > budget:
-            raise ValueError(f"{self.path}: a checkpoint of {size} bytes, whose rows would take up to "
-                             f"{6 * size / 2**30:.3g} GiB, more than half of this machine's memory "
-                             f"({2 * budget / 2**30:.3g} GiB)")
+        # Checked before the text is read, then before it is parsed (see _untrusted.json_cost).
+        self._check_size(size, _untrusted.json_cost(b"") + 6 * size)
         if size <= self._offset:
             return
         data = os.pread(fd, size - self._offset, self._offset)
+        self._check_size(size, _untrusted.json_cost(data))
         end = data.rfind(b"\n") + 1
         if end < len(data) and cut:
             # Killed mid-write: the last line is incomplete. Cut it off, or the next line would be

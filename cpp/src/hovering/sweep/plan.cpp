@@ -236,7 +236,7 @@ IntegratorSpec read_integrator(Table& t) {
     IntegratorSpec it;
     it.stepper = t.string("stepper", steppers());
     it.rtol = t.real("rtol", 0, 1, true, true, true);
-    it.atol = t.real("atol", 0, kInf);
+    it.atol = t.real("atol", 0, kInf, true, true);
     t.done();
     return it;
 }
