@@ -40,7 +40,7 @@ BAD = {
     "area samples=2.5": (lambda: M.hovering_area(samples=2.5), r"samples must be an integer in \[1, \d+\], got 2.5"),
     "area seed=-1": (lambda: M.hovering_area(seed=-1), r"seed must be an integer in \[0, \d+\], got -1"),
     "area n_steps='100'": (lambda: M.hovering_area(n_steps="100"), r"n_steps must be an integer in \[4, \d+\], got '100'"),
-    "return_map stepper=None": (lambda: SEC.return_map([0.1], [0.3], stepper=None), r"stepper must be one of \('rk8pd'"),
+    "return_map stepper=3": (lambda: SEC.return_map([0.1], [0.3], stepper=3), r"stepper must be one of \('rk8pd'"),
     "return_map max_steps=2**70": (lambda: SEC.return_map([0.1], [0.3], max_steps=2**70),
                                    r"max_steps must be an integer in \[1, 4611686018427387904\], got 1180591620717411303424"),
     "return_map max_steps=1.5": (lambda: SEC.return_map([0.1], [0.3], max_steps=1.5), r"max_steps must be an integer in \[1, "),

@@ -28,7 +28,7 @@ using json = nlohmann::json;
 
 constexpr std::int64_t kMaxCount = std::int64_t(1) << 53;  // counts exact in a double
 constexpr std::size_t kMaxPoints = 1000000;
-constexpr std::size_t kMaxTable = 1000000;  // entries of a model's table
+constexpr std::size_t kMaxTable = 100000;  // entries of a model's table (its key stays a checkpoint line)
 constexpr std::uintmax_t kMaxPlanBytes = std::uintmax_t(256) << 20;
 
 std::string num(double x) {
