@@ -237,6 +237,11 @@ def test_near_the_step_energy_the_answer_is_accurate_or_an_error(method):
         p, e = onset_parameters(SYS, HW + 1e-12, method, rtol=1e-3, errors=True)
         check_against_reference_rtol(p, e, ref_sys(HW + 1e-12), 1e-3)
         assert abs(p.tau0 - 3.0787608005179976) < 1e-12
+    # README: the smallest accepted h - h_w is ~7.3e-10 for the definitions (the default method).
+    if method == "definitions":
+        onset_parameters(SYS, HW + 1e-9)
+        with pytest.raises(ValueError, match="below the resolution of the step energy"):
+            onset_parameters(SYS, HW + 5e-10)
     # Further up every method succeeds and is within its stated error.
     dhs = (1e-8, 1e-6, 1.0) if method != "quadrature" else (1e-6, 1.0)
     for dh in dhs:

@@ -9,51 +9,7 @@ import subprocess
 import sys
 import textwrap
 
-
-
-DAEMON_AT_EXIT = textwrap.dedent(
-    """
-    import sys, threading, time
-    import numpy as np
-    import hovering as hv
-    m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
-    n = int(sys.argv[1])
-    threading.Thread(target=lambda: m.iterate(np.zeros(n), np.full(n, 0.1), 1000, record=()), daemon=True).start()
-    time.sleep(0.05)  # the main thread ends while the daemon thread is in C++
-    """
-)
-
-
-def test_iterate_in_a_daemon_thread_at_interpreter_exit_does_not_abort():
-    # The daemon thread's computation ends while the interpreter finalises: taking the GIL back
-    # then made CPython end the thread by forced unwinding through a noexcept destructor
-    # (std::terminate, exit 134; measured 1 of 3 runs at n = 40000). It now parks until exit.
-    # Durations around the finalisation window, several times.
-    for n in (20_000, 30_000, 40_000, 50_000, 60_000) * 2:
-        r = subprocess.run([sys.executable, "-c", DAEMON_AT_EXIT, str(n)], capture_output=True, text=True, timeout=60)
-        assert r.returncode == 0, (n, r.returncode, r.stderr[-500:])
-
-
-CTRL_C_IN_JOIN = textwrap.dedent(
-    """
-    import _thread, threading
-    import numpy as np
-    import hovering as hv
-    m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
-    t = threading.Thread(target=lambda: m.iterate(np.zeros(4000), np.full(4000, 0.1), 100_000, record=()))
-    t.start()
-    threading.Timer(0.2, _thread.interrupt_main).start()
-    t.join()
-    """
-)
-
-
-def test_ctrl_c_while_the_main_thread_waits_in_join():
-    # KeyboardInterrupt in the main thread while another thread iterates: the interpreter ends with
-    # the interrupt (exit 1, 130 or by SIGINT), never an abort (134).
-    r = subprocess.run([sys.executable, "-c", CTRL_C_IN_JOIN], capture_output=True, text=True, timeout=120)
-    assert r.returncode in (1, 130, -2), (r.returncode, r.stderr[-500:])  # -2: Python re-raises SIGINT at exit
-    assert "KeyboardInterrupt" in r.stderr and "terminate called" not in r.stderr
+# A long call at interpreter exit (a daemon thread, Ctrl-C in join()): tests/test_exit_race.py.
 
 
 SIGINT_IN_ITERATE = textwrap.dedent(

@@ -178,6 +178,12 @@ TEST_CASE("section coordinates at the bottom of well 2; section points next to t
         const auto c = section_coordinates(s, rest.data());
         CHECKF(c[0] == 0.0 && c[1] == 0.0, "%s: (theta, I) = (%g, %g) at H2 = 0", V2->name().c_str(), c[0], c[1]);
     }
+    // A finite state whose H2 overflows (a runaway orbit's last state, NON_FINITE) has no
+    // coordinates: NaN, not an action error (it made Section.return_map raise for the batch).
+    s.V2 = std::make_shared<Harmonic>(0.2);
+    const std::array<double, 4> runaway{1.8e307, 1.2e307, 1.8e307, 1.2e307};
+    const auto nc = section_coordinates(s, runaway.data());
+    CHECKF(std::isnan(nc[0]) && std::isnan(nc[1]), "(theta, I) = (%g, %g) at H2 = inf", nc[0], nc[1]);
     // A V2 below its minimum V2(0) = 0 is not a single well: named, not an action error.
     struct Negative final : Potential {
         double V(double q) const override { return -0.5 * q * q; }

@@ -4,19 +4,20 @@
 // (through the trampoline PyPotential) or two callables (CallablePotential, behind
 // hovering.CustomPotential). The base class Potential answers every energy question from V and dV
 // alone, so nothing else is needed from Python. The core may call them from the return map's worker
-// threads with the GIL released: every call into Python takes the GIL itself, and a Python
-// exception travels up through the core (and GSL's frames) as pybind11::error_already_set, which
-// the flow's thread pool hands to the calling thread.
+// threads with the GIL released: every call into Python takes the GIL itself (through the gate of
+// gil.hpp), and a Python exception travels up through the core (and GSL's frames) as
+// pybind11::error_already_set, which the flow's thread pool hands to the calling thread.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <string>
 
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/system.hpp"
+#include "gil.hpp"
 #include "pybind.hpp"
-#include "signals.hpp"
 
 using namespace hovering;
 
@@ -26,42 +27,42 @@ using hovering::detail::kInf;
 
 using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
 
-/// Holds the GIL for one call into Python from any thread. On a thread Python does not know (the
-/// return map's workers), the first call creates a Python thread state; it is kept, with one extra
-/// reference, until the thread ends, instead of being created and destroyed on every call (which
-/// made a two-thread return map with Python potentials 16x slower: 21 ms instead of 1.3 ms per
-/// return). Threads Python created are left alone: Python deletes their states itself.
-class CallbackGil {
+/// A Python exception of a Python-defined potential on its way through the core (GSL's frames, the
+/// worker threads) to the caller, where the module's translator raises it again unchanged. Its
+/// Python part is dropped through the gate (gil.hpp): a second worker's exception is discarded on
+/// that worker, without the GIL, and pybind11's own exception would take the GIL for it there
+/// unconditionally (PyGILState_Ensure), also while the interpreter exits.
+class PotentialError : public std::exception {
 public:
-    CallbackGil() : fresh_(park_if_finalizing() && PyGILState_GetThisThreadState() == nullptr), gil_() {
-        if (fresh_) {
-            gil_.inc_ref();
-            keeper().kept = true;
-        }
-    }
+    /// Takes over e (GIL held).
+    explicit PotentialError(py::error_already_set&& e)
+        : what_(e.what()), error_(new py::error_already_set(std::move(e)), drop) {}
+    const char* what() const noexcept override { return what_.c_str(); }
+    /// Set the potential's exception as the Python error (GIL held).
+    void restore() const { error_->restore(); }
 
 private:
-    // Taking the GIL while the interpreter finalises would end this thread by forced unwinding
-    // through C++ frames (std::terminate): park it until the process ends (see GilRelease).
-    static bool park_if_finalizing() {
-        while (hovering_py::GilRelease::finalizing()) std::this_thread::sleep_for(std::chrono::seconds(1));
-        return true;
+    static void drop(py::error_already_set* e) {
+        const hovering_py::Gil gil;
+        if (gil) delete e;  // else the interpreter is exiting: leak it
     }
-    struct Keeper {
-        bool kept = false;
-        ~Keeper() {
-            if (!kept || !Py_IsInitialized()) return;
-            py::gil_scoped_acquire gil;
-            gil.dec_ref();  // the extra reference: the state is deleted when `gil` ends
-        }
-    };
-    static Keeper& keeper() {
-        thread_local Keeper k;
-        return k;
-    }
-    bool fresh_;
-    py::gil_scoped_acquire gil_;
+    std::string what_;
+    std::shared_ptr<py::error_already_set> error_;
 };
+
+/// f() with the GIL, taken on any thread through the gate (gil.hpp); a Python exception leaves it
+/// as PotentialError. Once the interpreter exits the thread parks instead (its computation's
+/// result would never be seen).
+template <class F>
+auto in_python(F&& f) -> decltype(f()) {
+    const hovering_py::Gil gil;
+    if (!gil) hovering_py::GilGate::refused();
+    try {
+        return f();
+    } catch (py::error_already_set& e) {
+        throw PotentialError(std::move(e));
+    }
+}
 
 /// hovering.Potential.ReturnError, set by register_potential (leaked, like the module).
 PyObject* potential_return_error = nullptr;
@@ -127,7 +128,15 @@ public:
     double dV(double q) const override { return call("dV", q); }
 
     std::string name() const override {
-        CallbackGil gil;
+        return in_python([&] { return name_of_class(); });
+    }
+
+    double q_limit() const override {  // asked once per orbit, on the worker threads too
+        return in_python([&] { return limit_of_class(); });
+    }
+
+private:
+    std::string name_of_class() const {
         const py::handle self = python_self(this);
         if (!self) return "Potential(<Python object released>)";
         const std::string fallback = py::type::handle_of(self).attr("__name__").cast<std::string>() + "()";
@@ -147,8 +156,7 @@ public:
         return v.cast<std::string>();
     }
 
-    double q_limit() const override {  // asked once per orbit, on the worker threads too
-        CallbackGil gil;
+    double limit_of_class() const {
         const py::handle self = python_self(this);
         if (!self) return kInf;
         bool called = false;
@@ -161,18 +169,19 @@ public:
         return lim;
     }
 
-private:
     double call(const char* fn, double q) const {
-        CallbackGil gil;
-        const py::function f = py::get_override(static_cast<const Potential*>(this), fn);
-        if (!f) {
-            if (!python_self(this))
-                throw std::runtime_error(std::string("Potential.") + fn + ": the Python object of this potential was released");
-            throw py::type_error(name() + " does not define " + fn +
-                                 "(self, q): subclass hovering.Potential and define V(self, q) and dV(self, q), "
-                                 "or use hovering.CustomPotential(V, dV)");
-        }
-        return checked_value(f(q), *this, fn, q);
+        return in_python([&] {
+            const py::function f = py::get_override(static_cast<const Potential*>(this), fn);
+            if (!f) {
+                if (!python_self(this))
+                    throw std::runtime_error(std::string("Potential.") + fn +
+                                             ": the Python object of this potential was released");
+                throw py::type_error(name() + " does not define " + fn +
+                                     "(self, q): subclass hovering.Potential and define V(self, q) and dV(self, q), "
+                                     "or use hovering.CustomPotential(V, dV)");
+            }
+            return checked_value(f(q), *this, fn, q);
+        });
     }
 };
 
@@ -188,12 +197,12 @@ public:
     /// The last reference may go from a thread without the GIL (a core object holding the
     /// potential): dropping the callables needs it.
     ~CallablePotential() override {
-        if (!Py_IsInitialized()) {  // interpreter gone: leak rather than touch freed state
+        const hovering_py::Gil gil;
+        if (!gil) {  // the interpreter is exiting: leak rather than touch it
             V_.release();
             dV_.release();
             return;
         }
-        py::gil_scoped_acquire gil;
         V_ = py::object();
         dV_ = py::object();
     }
@@ -208,8 +217,7 @@ public:
 
 private:
     double call(const py::object& f, const char* fn, double q) const {
-        CallbackGil gil;
-        return checked_value(f(q), *this, fn, q);
+        return in_python([&] { return checked_value(f(q), *this, fn, q); });
     }
     py::object V_, dV_;
     double q_limit_;
@@ -227,12 +235,8 @@ std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
                              py::repr(obj).cast<std::string>());
     const Potential* cpp = obj.cast<const Potential*>();
     std::shared_ptr<py::object> owner(new py::object(obj), [](py::object* o) {
-        if (!Py_IsInitialized()) {
-            o->release();
-            delete o;
-            return;
-        }
-        py::gil_scoped_acquire gil;
+        const hovering_py::Gil gil;
+        if (!gil) o->release();  // the interpreter is exiting: leak the reference rather than touch it
         delete o;
     });
     return std::shared_ptr<const Potential>(owner, cpp);
@@ -398,6 +402,14 @@ void register_potential(py::module_& m) {
                    ", lam=" + g(p.lam) + ", theta_w=" + g(p.theta_w) + ", I_tan=" + g(p.I_tan) + ")";
         });
     register_potential_pickles(m);
+    // A Python-defined potential's exception reaches the caller as the exception it raised.
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const PotentialError& e) {
+            e.restore();
+        }
+    });
     m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"),
           py::arg("rtol") = 1e-6);
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),

@@ -2,9 +2,11 @@
 // (truncated, flow, normal), each registering itself; the shared enums live at the top.
 #include "hovering/build_info.hpp"
 #include "pybind.hpp"
+#include "gil.hpp"
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";
+    hovering_py::register_gil_gate();  // before anything can take the GIL from another thread
     register_enums(m);
     auto truncated = m.def_submodule("truncated", "The truncated near-tangency family F_{eps1,eps2}.");
     register_truncated(truncated);

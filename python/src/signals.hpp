@@ -5,6 +5,7 @@
 // set; the core then ends every orbit promptly with an Interrupted status and keeps what it
 // computed, and the Python wrapper raises KeyboardInterrupt with that partial result attached.
 // The same waiting thread reports progress to a Python callable (ProgressReport) when asked to.
+// Every GIL acquisition here goes through the gate of gil.hpp (none once the interpreter exits).
 
 #include <Python.h>
 
@@ -18,37 +19,10 @@
 #include <system_error>
 #include <thread>
 
+#include "gil.hpp"
 #include "pybind.hpp"
 
 namespace hovering_py {
-
-/// Releases the GIL for a pure C++ computation and takes it back at the end, like
-/// py::gil_scoped_release, except when the interpreter is finalising by then (the call ran on a
-/// daemon thread, or on a thread the main thread stopped waiting for): taking the GIL would make
-/// CPython exit the thread by forced unwinding, which through this (noexcept) destructor ends in
-/// std::terminate ("terminate called without an active exception", exit 134). The thread then
-/// parks until the process ends instead, as CPython 3.14 itself does with daemon threads.
-class GilRelease {
-public:
-    GilRelease() : state_(PyEval_SaveThread()) {}
-    ~GilRelease() {
-        while (finalizing()) std::this_thread::sleep_for(std::chrono::seconds(1));
-        PyEval_RestoreThread(state_);
-    }
-    GilRelease(const GilRelease&) = delete;
-    GilRelease& operator=(const GilRelease&) = delete;
-    /// Whether the interpreter is shutting down (taking the GIL would end the calling thread).
-    static bool finalizing() {
-#if PY_VERSION_HEX >= 0x030D0000
-        return Py_IsFinalizing() != 0;
-#else
-        return _Py_IsFinalizing() != 0;
-#endif
-    }
-
-private:
-    PyThreadState* state_;
-};
 
 /// Whether the calling thread (GIL held) is Python's main thread.
 inline bool on_main_thread() {
@@ -128,8 +102,8 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const Progr
                 while (!cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
                     lock.unlock();
                     if (!cancel.load()) {
-                        py::gil_scoped_acquire acquire;
-                        if (signals && PyErr_CheckSignals() != 0) {
+                        const Gil gil;  // false once the interpreter exits: no signal, no report then
+                        if (gil && signals && PyErr_CheckSignals() != 0) {
                             cancel.store(true);
                             if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
                                 PyErr_Clear();  // re-raised by the Python wrapper, with the partial result
@@ -138,7 +112,7 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const Progr
                                 handler_error = std::make_unique<py::error_already_set>();
                             }
                         }
-                        if (report && !cancel.load()) call_progress();
+                        if (gil && report && !cancel.load()) call_progress();
                     }
                     lock.lock();
                 }
@@ -148,7 +122,10 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const Progr
             }
         }
     }
-    if (report && !handler_error) call_progress();  // once at the end (GIL held again)
+    if (report && !handler_error) {  // once at the end (GIL held again), unless the interpreter exits
+        const Gil gil;
+        if (gil) call_progress();
+    }
     if (handler_error) throw std::move(*handler_error);  // what a signal handler raised, unchanged
     return interrupted;
 }

@@ -71,7 +71,7 @@ class ReturnMapResult(Saveable):
     Attributes
     ----------
     theta, I : ndarray
-        Section coordinates of the image (unperturbed S2 of (q2, p2)).
+        Section coordinates of the image (unperturbed S2 of (q2, p2)); NaN where the status is not OK.
     z : ndarray
         Image states (q1, p1, q2, p2), shape (n, 4).
     time : ndarray
@@ -217,12 +217,13 @@ class Section:
         Parameters
         ----------
         z : array_like
-            States (rows with a non-finite entry give NaN).
+            States (q1, p1, q2, p2).
 
         Returns
         -------
         ndarray
-            Shape (n, 2): theta in [-pi, pi), I.
+            Shape (n, 2): theta in [-pi, pi), I; NaN rows where a state has no coordinates (a
+            non-finite entry, or an H2 that overflows: the last state of a runaway orbit).
         """
         z = np.atleast_2d(real_array("z", z))
         if z.ndim != 2 or z.shape[1] != 4:
@@ -310,7 +311,11 @@ class Section:
                                                                                       z0.shape[0])
         with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
             d = _core.flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
-        c = self.coordinates(d["z"])
+        # The image's coordinates where there is an image: a stopped orbit's z is its last state,
+        # which need not have coordinates (a runaway's H2 overflows), and its records are NaN.
+        c = np.full((z0.shape[0], 2), np.nan)
+        ok = d["status"] == FlowStatus.OK
+        c[ok] = self.coordinates(d["z"][ok])
         res = ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
                               status=d["status"], energy_error=d["energy_error"], steps=d["steps"], region=d["region"],
                               work=d["work"], trajectory=d.get("trajectory"), trajectory_index=d.get("trajectory_index"),

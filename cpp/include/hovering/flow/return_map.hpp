@@ -67,7 +67,8 @@ std::array<double, 4> section_point(const FlowSystem& s, double h, double theta,
 bool try_section_point(const FlowSystem& s, double h, double theta, double I, std::array<double, 4>& z,
                        std::string* why = nullptr);
 
-/// (theta, I) = S2(q2, p2) of a state (unperturbed H2; theta in [-pi, pi), sign(theta) = -sign(p2)).
+/// (theta, I) = S2(q2, p2) of a state (unperturbed H2; theta in [-pi, pi), sign(theta) = -sign(p2));
+/// NaN where H2 overflows (a runaway orbit's last state has no coordinates).
 std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z);
 
 /// Result of one return.

@@ -23,6 +23,18 @@ inline constexpr double kTwoPi = 2.0 * kPi;
 inline constexpr double kInvTwoPi = 1.0 / kTwoPi;
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// Wrap to [-pi, pi): the one definition (hovering::wrap_angle, the truncated map, the flow map,
+/// the tangential curve, the exact flow); idempotent on [-pi, pi).
+inline double wrap(double x) {
+    double y = x - kTwoPi * std::floor((x + kPi) * kInvTwoPi);
+    // For |x| < 1e15 the line above lands within one turn of [-pi, pi); these corrections are
+    // exact (Sterbenz: y -/+ 2 pi for |y| in [pi, 4 pi]). Without the second, x one ulp below pi
+    // (x + pi rounds up to 2 pi) became one ulp below -pi.
+    if (y >= kPi) y -= kTwoPi;
+    if (y < -kPi) y += kTwoPi;
+    return y;
+}
+
 /// A double in its shortest round-trip form (1e+200, not 9.9999999999999997e+199), for error
 /// messages that name the offending value exactly as the user typed it.
 inline std::string fmt(double v) {

@@ -120,11 +120,7 @@ void LinearFlow::propagate(const double* y0, double t, double* y1) const {
 // ------------------------------------------------------------------------------- angle flow
 
 double wrap_angle(double th) {
-    if (th >= -kPi && th < kPi) return th;  // most calls: no floor
-    double y = th - kTwoPi * std::floor((th + kPi) * kInvTwoPi);
-    if (y >= kPi) y -= kTwoPi;
-    if (y < -kPi) y += kTwoPi;
-    return y;
+    return th >= -kPi && th < kPi ? th : wrap(th);  // most calls: no floor
 }
 
 bool AngleOscillator::set(double q, double p) {

@@ -12,6 +12,8 @@ namespace hovering {
 
 using detail::bad;
 using detail::fmt;
+using detail::kInf;
+using detail::kNaN;
 using detail::kPi;
 
 void FlowOptions::validate() const {
@@ -119,6 +121,9 @@ std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z) 
         if (e2 == 0) return {0.0, 0.0};
         negative_h2(z, e2);
     }
+    // A finite state whose H2 overflows (the last state of an orbit that ran away, NON_FINITE) has
+    // no action in double precision: no coordinates, as for a non-finite state, not an error.
+    if (e2 == kInf) return {kNaN, kNaN};
     double th = s.V2->angle_on_level(z[2], z[3], e2);
     if (th >= kPi) th -= 2 * kPi;  // [-pi, pi)
     return {th, s.V2->action(e2)};

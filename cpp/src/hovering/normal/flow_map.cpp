@@ -18,16 +18,7 @@ using detail::fmt;
 using detail::kNaN;
 using detail::kPi;
 using detail::kTwoPi;
-
-namespace {
-
-double wrap(double x) {
-    double y = x - kTwoPi * std::floor((x + kPi) / kTwoPi);
-    if (y >= kPi) y -= kTwoPi;
-    return y;
-}
-
-}  // namespace
+using detail::wrap;
 
 FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const TangentialCurve> curve,
                  std::shared_ptr<const AnalyticArcs> lift)

@@ -15,12 +15,7 @@ using detail::bad;
 using detail::fmt;
 using detail::kPi;
 using detail::kTwoPi;
-
-namespace {
-
-double wrap(double x) { return x - kTwoPi * std::floor((x + kPi) / kTwoPi); }
-
-}  // namespace
+using detail::wrap;
 
 // ------------------------------------------------------------------ trigonometric interpolation
 

@@ -27,16 +27,6 @@ struct Classified {
     double omega;
 };
 
-/// Wrap to [-pi, pi): the definition behind hovering::wrap_angle; idempotent on [-pi, pi).
-inline double wrap(double x) {
-    double y = x - kTwoPi * std::floor((x + kPi) * kInvTwoPi);
-    // For |x| < 1e15 the line above lands within one turn of [-pi, pi); these corrections are
-    // exact (Sterbenz: y -/+ 2 pi for |y| in [pi, 4 pi]).
-    if (y >= kPi) y -= kTwoPi;
-    if (y < -kPi) y += kTwoPi;
-    return y;
-}
-
 /// Wrap u in [-pi, 3 pi) to [-pi, pi), exactly (u - 2 pi is exact for u in [pi, 4 pi]).
 inline double wrap_once(double u) { return u >= kPi ? u - kTwoPi : u; }
 
