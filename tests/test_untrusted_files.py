@@ -1,5 +1,5 @@
 """Files from elsewhere stay harmless: each line of docs/threat-model.md is kept here by files the
-tests craft themselves (the hovering_sweep CSV lines by the C++ test test_sweep_untrusted).
+tests craft themselves (the plan and checkpoint lines hovering_sweep reads by the C++ tests test_plan, test_sweep_plan).
 
 Every crafted file is refused with one ValueError naming the file and the field (the CLI: exit
 status 2 and one ``error:`` line), and what reading it cost is bounded: the peak of the memory

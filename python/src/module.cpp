@@ -1,5 +1,5 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
-// (truncated, flow, normal), each registering itself; the shared enums live at the top.
+// (truncated, flow, normal, analysis), each registering itself; the shared enums live at the top.
 #include "hovering/build_info.hpp"
 #include "pybind.hpp"
 #include "gil.hpp"
