@@ -31,6 +31,7 @@ import math
 import os
 import re
 import typing
+import zipfile
 from pathlib import Path, PurePath
 from typing import Any, Optional
 
@@ -517,8 +518,18 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     except ValueError as e:
         raise ValueError(f"cannot save: the file would not read back: {e}") from None
     with replacing(path) as fh:
-        np.savez_compressed(fh, **{_META_KEY: np.array(text)}, **arrays)
+        _write_npz(fh, {_META_KEY: np.array(text), **arrays})
     return path
+
+
+def _write_npz(fh, members: dict) -> None:
+    """The archive ``np.savez_compressed`` writes (one deflated ``NAME.npy`` per array), closed on
+    every path: numpy < 1.25 left its ZipFile open when a write failed (a full disk), and the
+    finaliser then printed a second traceback after the one clear error."""
+    with zipfile.ZipFile(fh, mode="w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as zf:
+        for name, a in members.items():
+            with zf.open(f"{name}.npy", mode="w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(a), allow_pickle=False)
 
 
 #: Largest ``__meta__`` member :func:`is_result_file` reads to recognise a result file.
