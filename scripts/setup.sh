@@ -17,7 +17,7 @@ for arg in "$@"; do
   esac
 done
 
-APT_PACKAGES=(g++ pkg-config libgsl-dev libeigen3-dev libsleef-dev catch2 libtomlplusplus-dev libcli11-dev)
+APT_PACKAGES=(g++ pkg-config libgsl-dev libeigen3-dev libsleef-dev catch2 libtomlplusplus-dev libcli11-dev nlohmann-json3-dev)
 PY=${PYTHON:-python3}
 VENV=.venv
 [ -n "${PYTHON:-}" ] && VENV=".venv-$(basename "$PY")"

@@ -162,3 +162,27 @@ class CtrlCOnceStarted:
 #: machine measures ~0.1-0.2 s; the bound only has to separate "promptly" from "at the end of a
 #: run of minutes", so it is generous.
 PROMPT = 10.0
+
+
+@pytest.fixture(scope="session")
+def sweep_exe():
+    """This checkout's hovering_sweep, brought up to date in build/ctest (the directory the README's
+    ctest command builds; a no-op after scripts/test.sh), or the executable $HOVERING_SWEEP names."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    if os.environ.get("HOVERING_SWEEP"):
+        return os.environ["HOVERING_SWEEP"]
+    root = Path(HERE).parent
+    cmake = shutil.which("cmake")
+    assert cmake, "cmake is needed to build hovering_sweep (scripts/setup.sh installs it)"
+    build = root / "build" / "ctest"
+    if not (build / "CMakeCache.txt").exists():
+        gen = ["-G", "Ninja"] if shutil.which("ninja") else []
+        subprocess.run([cmake, "-S", str(root), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release",
+                        "-DHOVERING_BUILD_TESTS=ON"], check=True, capture_output=True, timeout=600)
+    r = subprocess.run([cmake, "--build", str(build), "--target", "hovering_sweep"], capture_output=True, text=True,
+                       timeout=3600)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    return str(build / "hovering_sweep")

@@ -10,7 +10,6 @@ import pytest
 
 import hovering
 import numpy_reference as ref
-from hovering import Status
 from hovering.analysis import birkhoff_average, birkhoff_weights, regularity, rotation_number
 
 PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)

@@ -17,7 +17,6 @@ from __future__ import annotations
 import errno
 import fcntl
 import json
-import math
 import os
 import platform
 import re
@@ -42,7 +41,7 @@ import hovering  # noqa: E402
 from hovering import _core, pipeline, scenes  # noqa: E402
 from hovering._output import WriteError  # noqa: E402
 from hovering._provenance import provenance  # noqa: E402
-from hovering.sweeps import Checkpoint  # noqa: E402
+from hovering.parallel.checkpoint import Checkpoint  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -254,7 +253,7 @@ FULL_API = r"""
 import os, sys
 import numpy as np
 import hovering
-from hovering.sweeps import Checkpoint
+from hovering.parallel.checkpoint import Checkpoint
 d = sys.argv[1]
 out = []
 try:
@@ -322,139 +321,98 @@ def test_full_tmpfs_keeps_the_previous_outputs(tmp_path):
 
 
 # ------------------------------------------------------------------------------------------------
-# hovering_sweep: one run per CSV at a time, provenance in the header, a full disk
+# hovering_sweep: runs sharing a checkpoint, provenance lines, a full disk
 
-@pytest.fixture(scope="module")
-def sweep_exe():
-    """This checkout's hovering_sweep, brought up to date in build/ctest (the directory the README's
-    ctest command builds; a no-op after scripts/test.sh), or the executable $HOVERING_SWEEP names."""
-    if os.environ.get("HOVERING_SWEEP"):
-        return os.environ["HOVERING_SWEEP"]
-    cmake = shutil.which("cmake")
-    assert cmake, "cmake is needed to build hovering_sweep (scripts/setup.sh installs it)"
-    build = ROOT / "build" / "ctest"
-    if not (build / "CMakeCache.txt").exists():
-        gen = ["-G", "Ninja"] if shutil.which("ninja") else []
-        subprocess.run([cmake, "-S", str(ROOT), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release",
-                        "-DHOVERING_BUILD_TESTS=ON"], check=True, capture_output=True, timeout=600)
-    r = subprocess.run([cmake, "--build", str(build), "--target", "hovering_sweep"], capture_output=True, text=True,
-                       timeout=3600)
-    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    return str(build / "hovering_sweep")
+def sweep_plan(tmp_path: Path, n_steps: int = 2000, eps=(0.2,)) -> Path:
+    """The plan of the one-series sweep scene at ``eps``, written by python -m hovering plan."""
+    (tmp_path / "s.toml").write_text(sweep_scene(n_steps=n_steps, eps=eps))
+    r = cli("plan", "s.toml", "-o", "s.plan.toml", "--force", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    return tmp_path / "s.plan.toml"
 
 
-def csv_parts(path: Path):
-    """(provenance records, header lines, rows) of a hovering_sweep CSV."""
-    lines = path.read_text().splitlines()
-    prov = [json.loads(x[len("# provenance: "):]) for x in lines if x.startswith("# provenance: ")]
-    data = [x for x in lines if not x.startswith("#")]
-    heads = [x for x in data if x.startswith("area,")]
-    return prov, heads, [x for x in data if not x.startswith("area,")]
+def ckpt_parts(path: Path):
+    """(provenance records, header lines, point lines) of a checkpoint."""
+    recs = [json.loads(x) for x in path.read_text().splitlines()]
+    return ([r["provenance"] for r in recs if "provenance" in r], [r for r in recs if "format" in r],
+            [r for r in recs if "key" in r])
 
 
-def test_two_sweeps_started_together_never_both_write_the_header(tmp_path, sweep_exe):
-    scene = tmp_path / "s.toml"
-    scene.write_text(sweep_scene(n_steps=20_000))
-    refused = 0
-    for trial in range(50):
-        csv = tmp_path / f"c{trial}.csv"
-        runs = [subprocess.Popen([sweep_exe, "--scene", str(scene), "--out", str(csv), "--threads", "1"],
+def test_two_sweeps_started_together_never_write_a_point_twice(tmp_path, sweep_exe):
+    plan = sweep_plan(tmp_path, n_steps=20_000)
+    for trial in range(20):
+        out = tmp_path / f"c{trial}.jsonl"
+        runs = [subprocess.Popen([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"],
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)]
         results = [(p.wait(timeout=300), p.communicate()[1]) for p in runs]
-        for rc, err in results:
-            # the second either found the point done (it waited for nothing) or was refused at once
-            assert rc == 0 or (rc == 2 and "is being written by another hovering_sweep run" in err), (trial, rc, err)
-        refused += sum(rc == 2 for rc, _ in results)
-        assert sum(rc == 0 for rc, _ in results) >= 1
-        prov, heads, rows = csv_parts(csv)
-        assert len(heads) == 1 and len(rows) == 1 and len(prov) == 1, (trial, csv.read_text())
-        # and the file is accepted afterwards: a rerun finds its point
-        again = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
+        assert all(rc == 0 for rc, _ in results), (trial, results)
+        prov, heads, points = ckpt_parts(out)
+        # one header, one point; a provenance line per run that wrote a point (one here)
+        assert len(heads) == 1 and len(points) == 1 and len(prov) == 1, (trial, out.read_text())
+        again = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True,
                                timeout=300)
         assert again.returncode == 0 and "1 already in" in again.stderr, (trial, again.stderr)
-    print(f"{refused} of 50 second runs were refused while the first held the lock")
 
 
-def test_a_sweep_refuses_a_csv_another_run_holds(tmp_path, sweep_exe):
-    scene = tmp_path / "s.toml"
-    scene.write_text(sweep_scene())
-    csv = tmp_path / "c.csv"
-    with open(csv, "a") as held:
+def test_a_sweep_waits_for_a_writer_holding_the_checkpoint(tmp_path, sweep_exe):
+    plan = sweep_plan(tmp_path)
+    out = tmp_path / "c.jsonl"
+    with open(out, "a") as held:
         fcntl.flock(held.fileno(), fcntl.LOCK_EX)
-        r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
-                           timeout=300)
-        assert r.returncode == 2 and "is being written by another hovering_sweep run" in r.stderr, r.stderr
-        assert "give another --out" in r.stderr and csv.read_bytes() == b""
-    r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
-                       timeout=300)
-    assert r.returncode == 0, r.stderr
-    assert len(csv_parts(csv)[2]) == 1
+        p = subprocess.Popen([sweep_exe, "--plan", str(plan), "--out", str(out)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+        time.sleep(0.5)
+        assert p.poll() is None and out.read_bytes() == b""  # nothing read or written under another's lock
+    _, err = p.communicate(timeout=300)
+    assert p.returncode == 0, err
+    assert len(ckpt_parts(out)[2]) == 1
 
 
-def test_a_sweep_on_a_full_disk_keeps_its_rows(tmp_path, sweep_exe):
-    scene = tmp_path / "s.toml"
-    scene.write_text(sweep_scene())
-    csv = tmp_path / "c.csv"
-    assert subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], timeout=300,
+def test_a_sweep_on_a_full_disk_keeps_its_points(tmp_path, sweep_exe):
+    plan = sweep_plan(tmp_path)
+    out = tmp_path / "c.jsonl"
+    assert subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], timeout=300,
                           capture_output=True).returncode == 0
-    before = csv.read_bytes()
-    scene.write_text(sweep_scene(eps=(0.2, 0.3)))
-    argv = [sweep_exe, "--scene", str(scene), "--out", str(csv)]
+    before = out.read_bytes()
+    plan = sweep_plan(tmp_path, eps=(0.2, 0.3))
+    argv = [sweep_exe, "--plan", str(plan), "--out", str(out)]
     launch = fsize_limit(len(before) + 40) + f"import os\nos.execv({sweep_exe!r}, {argv!r})"
     r = subprocess.run([sys.executable, "-c", launch], capture_output=True, text=True, timeout=300)
     assert r.returncode == 2, r.stderr
-    assert "writing a row to " in r.stderr and "failed: no space left" in r.stderr
-    assert csv.read_bytes() == before  # the half row was cut back off
-    ok = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
+    assert "writing a point to " in r.stderr and "failed: no space left" in r.stderr
+    assert out.read_bytes() == before  # the half line was cut back off
+    ok = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True,
                         timeout=300)
-    assert ok.returncode == 0 and "1 already in" in ok.stderr and len(csv_parts(csv)[2]) == 2
+    assert ok.returncode == 0 and "1 already in" in ok.stderr and len(ckpt_parts(out)[2]) == 2
 
 
-def test_sweep_csv_header_records_the_cores_provenance(tmp_path, sweep_exe):
-    scene = tmp_path / "s.toml"
-    scene.write_text(sweep_scene())
-    csv = tmp_path / "c.csv"
-    r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv), "--threads", "1"], capture_output=True,
+def test_sweep_checkpoint_records_the_cores_provenance(tmp_path, sweep_exe):
+    plan = sweep_plan(tmp_path)
+    out = tmp_path / "c.jsonl"
+    r = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"], capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 0, r.stderr
-    lines = csv.read_text().splitlines()
-    assert lines[0].startswith("# provenance: ") and lines[1].startswith("area,")
-    prov = json.loads(lines[0][len("# provenance: "):])
+    lines = out.read_text().splitlines()
+    assert lines[0] == '{"format":"hovering-checkpoint","version":1}' and lines[1].startswith('{"provenance":')
+    prov = json.loads(lines[1])["provenance"]
     core = dict(_core.build_info())
-    assert list(prov) == list(core) + ["threads", "seed"]
+    assert set(prov) == set(core) | {"program", "threads"} and prov["program"] == "hovering_sweep"
     py = provenance()
     # the build's facts come from the one core function both programs call
     for k in ("hovering", "compiler", "gsl", "eigen", "sleef", "simd_width", "platform", "hardware_threads"):
         assert prov[k] == py[k], k
     check_commit(prov["git"])
-    assert prov["threads"] == 1 and prov["seed"] == 7
-    # Another build or setting later appends its own line before its rows; the same one does not.
-    scene.write_text(sweep_scene(eps=(0.2, 0.3)))
-    subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv), "--threads", "1"], check=True,
+    assert prov["threads"] == 1
+    # A later run writes its own line before its first point; a run that writes nothing writes none.
+    subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"], check=True,
                    capture_output=True, timeout=300)
-    assert len(csv_parts(csv)[0]) == 1
-    scene.write_text(sweep_scene(eps=(0.2, 0.3, 0.4)))
-    subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv), "--threads", "2"], check=True,
+    assert len(ckpt_parts(out)[0]) == 1
+    plan = sweep_plan(tmp_path, eps=(0.2, 0.3))
+    subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"], check=True,
                    capture_output=True, timeout=300)
-    prov, heads, rows = csv_parts(csv)
-    assert [p["threads"] for p in prov] == [1, 2] and len(heads) == 1 and len(rows) == 3
-    assert csv.read_text().splitlines()[-2].startswith("# provenance: ")
-
-
-def test_a_sweep_resumes_a_csv_written_before_provenance(tmp_path, sweep_exe):
-    scene = tmp_path / "s.toml"
-    scene.write_text(sweep_scene())
-    csv = tmp_path / "c.csv"
-    subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], check=True, capture_output=True, timeout=300)
-    old = "".join(x + "\n" for x in csv.read_text().splitlines() if not x.startswith("#"))
-    csv.write_text(old)
-    r = subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], capture_output=True, text=True,
-                       timeout=300)
-    assert r.returncode == 0 and "1 already in" in r.stderr and csv.read_text() == old
-    scene.write_text(sweep_scene(eps=(0.2, 0.3)))
-    subprocess.run([sweep_exe, "--scene", str(scene), "--out", str(csv)], check=True, capture_output=True, timeout=300)
-    lines = csv.read_text().splitlines()
-    assert csv.read_text().startswith(old) and lines[-2].startswith("# provenance: ") and len(lines) == 4
+    prov, heads, points = ckpt_parts(out)
+    assert [p["threads"] for p in prov] == [1, 2] and len(heads) == 1 and len(points) == 2
+    assert out.read_text().splitlines()[-2].startswith('{"provenance":')
 
 
 # ------------------------------------------------------------------------------------------------
@@ -605,7 +563,7 @@ def test_checkpoint_row_with_nan_area_prints_as_nan(tmp_path):
     assert cli("scene", "s.toml", "--quick", cwd=tmp_path).returncode == 0
     ck = tmp_path / "s.sweep.jsonl"
     recs = [json.loads(x) for x in ck.read_text().splitlines()]
-    recs[0]["row"]["area"] = math.nan
+    recs[2]["row"]["area"] = "NaN"  # a checkpoint writes a non-finite number as its name
     ck.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in recs))
     r = cli("scene", "s.toml", "--quick", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -738,8 +696,11 @@ def test_saved_results_checkpoints_and_sidecars_record_provenance(tmp_path):
     side = json.loads((tmp_path / "s.json").read_text())
     assert list(side)[:2] == ["format", "provenance"] and side["format"] == "hovering-scene-1"
     assert side["provenance"] == want
-    line = json.loads((tmp_path / "s.sweep.jsonl").read_text().splitlines()[0])
-    assert line["provenance"] == want and list(line) == ["key", "provenance", "row"]
+    # The checkpoint: its header, then the provenance line of the run before its points (the seed is
+    # in each point's key).
+    lines = [json.loads(x) for x in (tmp_path / "s.sweep.jsonl").read_text().splitlines()]
+    assert lines[0] == {"format": "hovering-checkpoint", "version": 1}
+    assert lines[1]["provenance"] == dict(provenance(), program="python") and list(lines[2]) == ["key", "row"]
 
 
 def test_files_written_before_provenance_still_load(tmp_path):
@@ -752,10 +713,12 @@ def test_files_written_before_provenance_still_load(tmp_path):
     np.savez_compressed(tmp_path / "old.npz", __meta__=np.array(json.dumps(doc)), **arrays)
     back = hovering.load(tmp_path / "old.npz")
     assert np.array_equal(back["x"], np.arange(4)) and back["t"] == "old"
-    # a checkpoint record without provenance
+    # a checkpoint of the format before its header (its keys are not today's): hovering's own file,
+    # refused with the reason, untouched
     (tmp_path / "c.jsonl").write_text('{"key": {"eps": 0.1}, "row": {"area": 0.5}}\n')
-    c = Checkpoint(tmp_path / "c.jsonl")
-    assert c.get({"eps": 0.1}) == {"area": 0.5} and c.dropped == 0
+    with pytest.raises(ValueError, match=r"c\.jsonl line 1: a checkpoint of an older hovering \(no format header\)"):
+        Checkpoint(tmp_path / "c.jsonl")
+    assert (tmp_path / "c.jsonl").read_text() == '{"key": {"eps": 0.1}, "row": {"area": 0.5}}\n'
     # an old scene result is still recognised as hovering's, so a rerun may replace it
     from hovering._output import is_ours
 
@@ -770,7 +733,7 @@ def test_files_written_before_provenance_still_load(tmp_path):
 def test_concurrent_checkpoint_writers_never_mix_lines(tmp_path):
     # Four processes append 200 records each to one checkpoint, each record longer than a file
     # buffer (so an unlocked writer would issue several writes that interleave): every line is whole.
-    code = ("import sys\nfrom hovering.sweeps import Checkpoint\nc = Checkpoint(sys.argv[1])\n"
+    code = ("import sys\nfrom hovering.parallel.checkpoint import Checkpoint\nc = Checkpoint(sys.argv[1])\n"
             "for i in range(200):\n    c.put({'w': int(sys.argv[2]), 'i': i}, {'pad': 'x' * 20_000})\n")
     ck = tmp_path / "c.jsonl"
     procs = [subprocess.Popen([sys.executable, "-c", code, str(ck), str(w)]) for w in range(4)]

@@ -57,26 +57,35 @@ def test_flow_map_pieces_give_the_single_process_answer():
     same(hovering_area(fm, **kw), hovering_area(fm, **kw, workers=2, pieces=3))
 
 
+def _points(path) -> list:
+    """The point records of a checkpoint (its header and provenance lines left out)."""
+    return [json.loads(x) for x in path.read_text().splitlines() if x.startswith('{"key":')]
+
+
 def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_path):
     ck = tmp_path / "hov.jsonl"
     seen = []
     first = hovering_area(M, **KW, workers=2, pieces=4, checkpoint=ck)
     same(single, first)
-    assert len(ck.read_text().splitlines()) == 4
+    assert len(_points(ck)) == 4
+    # The key is the canonical record: the map's parameters, the counts, the box, the seed, the range.
+    key = _points(ck)[0]["key"]["hovering_area_piece"]
+    assert key["map"]["data"]["__dict__"]["eps"] == M.eps and key["n_steps"] == KW["n_steps"]
+    assert sorted(p["key"]["hovering_area_piece"]["lo"] for p in _points(ck))[0] == 0
     # a rerun reads all four pieces back: the progress callback sees every unit done, no new line
     again = hovering_area(M, **KW, workers=2, pieces=4, checkpoint=ck, progress=lambda d, t: seen.append((d, t)))
     same(single, again)
-    assert len(ck.read_text().splitlines()) == 4 and seen[-1][0] == seen[-1][1]
+    assert len(_points(ck)) == 4 and seen[-1][0] == seen[-1][1]
     # another parameter (n_steps) is another key: four new pieces
     hovering_area(M, **{**KW, "n_steps": 400}, workers=2, pieces=4, checkpoint=ck)
-    assert len(ck.read_text().splitlines()) == 8
+    assert len(_points(ck)) == 8
     # a torn last line (a killed run) is dropped and that piece alone recomputed
-    lines = ck.read_text().splitlines()
+    text = ck.read_text()
+    lines = text.splitlines()
     ck.write_text("\n".join(lines[:-1]) + "\n" + lines[-1][: len(lines[-1]) // 2])
     redo = hovering_area(M, **{**KW, "n_steps": 400}, workers=2, pieces=4, checkpoint=ck)
-    assert len(ck.read_text().splitlines()) == 8
+    assert len(_points(ck)) == 8
     assert redo.area == hovering_area(M, **{**KW, "n_steps": 400}).area
-    assert all("key" in json.loads(x) for x in ck.read_text().splitlines())
 
 
 def test_bad_distribution_arguments_are_named():

@@ -22,9 +22,8 @@ import pytest
 
 import hovering
 from hovering import Region, pipeline, scenes
-from hovering.plot import render
 from hovering.plot.style import REGION_COLORS
-from hovering.scenes import load_result, parse_scene
+from hovering.scenes import parse_scene
 from hovering.pipeline import run_scene
 
 SCENE_DIR = Path(__file__).resolve().parents[1] / "examples" / "scenes"

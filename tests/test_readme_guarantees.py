@@ -21,7 +21,7 @@
   (a real SIGINT; a system that refuses threads), test_exit_race.py (a long call at exit parks), and
   here ::test_ctrl_c_stops_hovering_area, ::test_ctrl_c_stops_critical_curve, ::test_ctrl_c_stops_a_scene.
 * Nothing computed is lost: test_sweeps.py, test_bad_input.py::test_checkpoint_cuts_a_torn_last_line_
-  and_appends_cleanly, cpp/tests/test_sweep_app.cmake (hovering_sweep).
+  and_appends_cleanly, test_plan.py (resumes across programs), cpp/tests/test_sweep_plan.sh (hovering_sweep).
 * Scenes and the CLI: test_bad_input.py (::test_scene_cli_refuses_a_bad_out_path,
   ::test_output_path_names_the_file_savefig_writes, ::test_demo_cli_refuses_bad_options_before_
   computing), test_scenes.py (colours and expressions when the file is read).

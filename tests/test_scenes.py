@@ -9,7 +9,6 @@ content (axes, labels, artists, legend text), never by pixels.
 
 from __future__ import annotations
 
-import copy
 import json
 import re
 import tomllib

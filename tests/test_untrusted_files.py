@@ -1,5 +1,5 @@
 """Files from elsewhere stay harmless: each line of docs/threat-model.md is kept here by files the
-tests craft themselves (the hovering_sweep CSV lines by the C++ test test_sweep_untrusted).
+tests craft themselves (the plan and checkpoint lines hovering_sweep reads by the C++ tests test_plan, test_sweep_plan).
 
 Every crafted file is refused with one ValueError naming the file and the field (the CLI: exit
 status 2 and one ``error:`` line), and what reading it cost is bounded: the peak of the memory
@@ -11,7 +11,6 @@ memory except through that generous guard.
 
 from __future__ import annotations
 
-import copy
 import io
 import json
 import os
@@ -34,7 +33,7 @@ from hovering.scenes import load_result, load_scene
 from hovering.pipeline import redraw, run_scene
 from hovering.scenes.schema import (MAX_CANVAS_PIXELS, MAX_KEY_PARTS, MAX_SCENE_DEPTH, MAX_TEXT, check_spec,
                                     scene_table)
-from hovering.sweeps import Checkpoint
+from hovering.parallel.checkpoint import Checkpoint
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "examples" / "scenes"
 HANG_GUARD = 30.0  # seconds: only a guard against a hang or a long computation, never a speed test
@@ -549,28 +548,30 @@ def checkpoint(tmp_path_factory):
 
 
 def _edited(src: Path, dst_dir: Path, edit) -> Path:
-    """The sweep's output path whose checkpoint is ``src`` with its first row edited."""
+    """The sweep's output path whose checkpoint is ``src`` with its first point's row edited (line 3,
+    after the header and the provenance line)."""
     lines = src.read_text().splitlines()
-    rec = json.loads(lines[0])
+    rec = json.loads(lines[2])
     edit(rec["row"])
-    lines[0] = json.dumps(rec)
+    lines[2] = json.dumps(rec)
     (dst_dir / "hov.sweep.jsonl").write_text("\n".join(lines) + "\n")
     return dst_dir / "hov.png"
 
 
-@pytest.mark.parametrize("case", ["area_text", "area_missing", "flag_number", "eps_other", "row_list"])
+@pytest.mark.parametrize("case", ["area_text", "area_missing", "flag_number", "box_other", "row_list", "count_float"])
 def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monkeypatch):
     edit, msg = {
         "area_text": (lambda r: r.update(area="x"), r"row\.area must be a number \(within the range of a double\), got 'x'"),
         "area_missing": (lambda r: r.pop("area"), r"row\.area is missing"),
         "flag_number": (lambda r: r.update(floor_touched=0), r"row\.floor_touched must be true or false, got 0"),
-        "eps_other": (lambda r: r.update(eps=0.5), r"row\.eps = 0\.5 is not the point's eps = -?0\.\d+"),
-        "row_list": (lambda r: (r.clear(), r.update(area=[1.0] * 10)), r"row\.eps is missing"),
+        "box_other": (lambda r: r.update(K_low=-0.5), r"row\.K_low = -0\.5 is not the point's K_low = -?0\.\d+"),
+        "row_list": (lambda r: (r.clear(), r.update(area=[1.0] * 10)), r"row\.area must be a number .*, got \[1\.0, .*\]"),
+        "count_float": (lambda r: r.update(n_samples=2.5), r"row\.n_samples must be an integer, got 2\.5"),
     }[case]
     out = _edited(checkpoint[0], tmp_path, edit)
     computed = []
     monkeypatch.setattr(hv.TruncatedMap, "hovering_area", lambda *a, **k: computed.append(a))
-    _refused(run_scene, load_scene(HOV_SCENE), out, True, match=rf"hov\.sweep\.jsonl line 1: {msg} \(the file was "
+    _refused(run_scene, load_scene(HOV_SCENE), out, True, match=rf"hov\.sweep\.jsonl line 3: {msg} \(the file was "
                                                                 r"edited or damaged")
     assert computed == [] and not out.exists()
 
@@ -585,22 +586,26 @@ def test_checkpoint_genuine_rows_are_reused(checkpoint, tmp_path, monkeypatch):
 
 
 def test_checkpoint_files_within_limits(tmp_path, monkeypatch):
-    good = json.dumps({"key": {"eps": 0.1}, "row": {"area": 1.0}})
-    # A line nested 100,000 deep (before: a RecursionError traceback) counts as damaged; a line of
-    # invalid UTF-8 is read with replacement characters (its key then matches no point's).
+    head = '{"format":"hovering-checkpoint","version":1}\n'
+    good = '{"key":{"eps":0.1},"row":{"area":1.0}}\n'
+    # A line nested 100,000 deep (before: a RecursionError traceback) is a damaged line, refused
+    # without recursing; so is a line of invalid UTF-8. Memory stays bounded while reading.
     path = tmp_path / "c.jsonl"
-    path.write_bytes((good + "\n" + '{"key": ' + "[" * 100_000 + "]" * 100_000 + ', "row": 1}\n').encode()
-                     + b'{"key": {"eps": "\xff\xfe"}, "row": 2}\n')
-    tracemalloc.start()
-    c = Checkpoint(path)
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    assert len(c) == 2 and c.dropped == 1 and c.get({"eps": 0.1}) == {"area": 1.0} and peak < 16 * MiB
-    assert c.get({"eps": "\ufffd\ufffd"}) == 2
+    for bad in ('{"key": ' + "[" * 100_000 + "]" * 100_000 + ', "row": {}}\n', '{"key": {"eps": "\xff"}}\n'):
+        data = (head + good).encode() + (bad.encode("latin-1") if "\xff" in bad else bad.encode())
+        path.write_bytes(data)
+        tracemalloc.start()
+        with pytest.raises(ValueError, match=r"c\.jsonl line 3: not a line of JSON"):
+            Checkpoint(path)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert peak < 16 * MiB and path.read_bytes() == data
+    path.write_text(head + good)
+    assert Checkpoint(path).get({"eps": 0.1}) == {"area": 1.0}
     os.mkfifo(tmp_path / "fifo.jsonl")
     _refused(Checkpoint, tmp_path / "fifo.jsonl", match=r"fifo\.jsonl: not a regular file")
     # 10,000 rows of empty lists: ~2 MB of text, ~50 MB of Python objects by the estimate.
-    (tmp_path / "big.jsonl").write_text((json.dumps({"key": 1, "row": [[]] * 10_000}) + "\n") * 10)
+    (tmp_path / "big.jsonl").write_text(head + (json.dumps({"key": {"a": 1}, "row": {"r": [[]] * 10_000}}) + "\n") * 10)
     monkeypatch.setattr(_untrusted, "memory_budget", lambda: 4 * MiB)
     _refused(Checkpoint, tmp_path / "big.jsonl", match=r"big\.jsonl: a checkpoint of \d+ bytes, whose rows would take "
                                                        r"up to [\d.e-]+ GiB, more than half of this machine's memory")

@@ -18,7 +18,8 @@ recognised by their content, never by their name alone:
 * a JSON file whose first key is ``"format"`` with a value starting ``hovering-`` (scene sidecars,
   accuracy tables), or a scene sidecar of a version before that key (starts with the scene's typed
   tree);
-* a checkpoint (``.jsonl``) that is empty or starts with a record ``{"key": ...``;
+* a checkpoint (``.jsonl``) that is empty, starts with its header ``{"format":"hovering-checkpoint",...``
+  or (written before the header) with a record ``{"key": ...``;
 * any other file (a figure) whose JSON or NPZ of the same name beside it is hovering's.
 """
 
@@ -274,7 +275,8 @@ def is_ours(path: os.PathLike) -> bool:
             return is_result_file(p)
         if p.suffix.lower() == ".jsonl":
             head = _head(p)
-            return head == b"" or head.startswith(b'{"key": ')
+            # a checkpoint (its format header; before it, a first record {"key": ...})
+            return head == b"" or head.startswith(b'{"key": ') or bool(_JSON_MARK.match(head))
         if p.suffix.lower() == ".json":
             head = _head(p)
             return bool(_JSON_MARK.match(head) or _OLD_SIDECAR.match(head))

@@ -1,11 +1,14 @@
-"""Pickling helpers shared by the Python classes built on compiled ones (maps, potentials).
+"""Pickling helpers: every class with parameters pickles as its one record.
 
-A Python subclass of a compiled class (``hovering.TruncatedMap`` of ``_core.truncated.TruncatedMap``)
-pickles as its class, the compiled part's state (the compiled class's ``__getstate__``: its
-constructor arguments) and its instance dict; unpickling creates the instance, rebuilds the
-compiled part with the compiled ``__setstate__`` (the constructor's checks run again) and restores
-the dict. Nothing is recomputed beyond what the compiled constructor does, so the rebuilt object
-computes bit for bit what the original did.
+A map, system, potential, section or curve has one representation of its parameters, its
+``_to_record`` / ``_from_record`` pair, which :func:`hovering.save` (NPZ), checkpoint keys
+(:func:`hovering._serial.record_key`) and pickle all use: :func:`reduce_record` pickles an object
+as its class, its record and the instance attributes the record does not hold; unpickling runs
+``_from_record`` (the constructor's checks, nothing measured), so the rebuilt object computes bit
+for bit what the original did.
+
+:func:`restore_compiled` reads the pickles written before (a compiled class's ``__setstate__``
+state tuple), which stay loadable.
 """
 
 from __future__ import annotations
@@ -13,11 +16,52 @@ from __future__ import annotations
 import pickle
 import sys
 
-__all__ = ["pickler_stores_code", "reduce_compiled", "restore_compiled"]
+__all__ = ["pickler_stores_code", "reduce_compiled", "reduce_record", "restore_compiled", "restore_record"]
+
+
+def reduce_record(obj, extra: dict | None = None) -> tuple:
+    """``__reduce__`` value of ``obj`` by its record.
+
+    Parameters
+    ----------
+    obj : object
+        An instance of a class with ``_to_record`` and the classmethod ``_from_record``.
+    extra : dict, optional
+        Instance attributes the record does not hold (a subclass's own, caches), restored as they were.
+
+    Returns
+    -------
+    tuple
+        ``(restore_record, (type(obj), record, extra))``.
+    """
+    return restore_record, (type(obj), obj._to_record(), dict(extra or {}))
+
+
+def restore_record(cls: type, record: dict, attrs: dict):
+    """Inverse of :func:`reduce_record`: ``cls._from_record(record)`` with the attributes ``attrs``.
+
+    Parameters
+    ----------
+    cls : type
+        The class to rebuild.
+    record : dict
+        Its record.
+    attrs : dict
+        Instance attributes to set afterwards.
+
+    Returns
+    -------
+    object
+    """
+    obj = cls._from_record(record)
+    if attrs:
+        obj.__dict__.update(attrs)
+    return obj
 
 
 def reduce_compiled(obj, base: type) -> tuple:
-    """``__reduce__`` value of ``obj``, an instance of a Python subclass of the compiled class ``base``.
+    """``__reduce__`` value of ``obj``, an instance of a Python subclass of the compiled class ``base``
+    (how maps pickled before they pickled by their records; kept for :func:`restore_compiled`'s tests).
 
     Parameters
     ----------
@@ -35,7 +79,8 @@ def reduce_compiled(obj, base: type) -> tuple:
 
 
 def restore_compiled(cls: type, base: type, state, attrs: dict):
-    """Inverse of :func:`reduce_compiled`: a ``cls`` instance with ``base``'s state and the attributes ``attrs``.
+    """Inverse of :func:`reduce_compiled`: a ``cls`` instance with ``base``'s state and the attributes ``attrs``
+    (what pickles of maps written before records were their pickles load through).
 
     Parameters
     ----------

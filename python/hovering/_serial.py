@@ -43,7 +43,7 @@ from ._provenance import provenance
 from ._version import __version__
 from ._untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
 
-__all__ = ["FORMAT", "Saveable", "from_tree", "load", "save", "to_tree"]
+__all__ = ["FORMAT", "Saveable", "from_tree", "load", "record_key", "save", "to_tree"]
 
 _MAX_INT_BITS = _untrusted.MAX_INT_BITS
 
@@ -198,6 +198,46 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
         return {tag: [to_tree(v, arrays, f"{key}[{i}]") for i, v in enumerate(obj)]}
     raise TypeError(f"{key}: cannot save a {type(obj).__name__} to NPZ (not an array, number, string, "
                     "dataclass or hovering object)")
+
+
+def record_key(obj: Any) -> Any:
+    """The canonical record of ``obj`` as plain JSON values: what a checkpoint keys it by.
+
+    The tree :func:`to_tree` writes to NPZ (each class by its one record, ``_to_record``), with
+    every array inline (its dtype, shape and values) and a record's caches left out: a class names
+    in ``_RECORD_CACHE`` the entries of its record that are derived from the others (kept in a
+    file only to spare the work), which must not make two equal objects two keys.
+
+    Parameters
+    ----------
+    obj : object
+        Anything :func:`to_tree` takes.
+
+    Returns
+    -------
+    object
+        JSON-able (floats may be non-finite: a checkpoint writes those as strings).
+    """
+    arrays: dict = {}
+    tree = to_tree(obj, arrays)
+
+    def inline(t):
+        if isinstance(t, list):
+            return [inline(v) for v in t]
+        if not isinstance(t, dict):
+            return t
+        if "__array__" in t and set(t) == {"__array__", "object"}:
+            a = arrays[t["__array__"]]
+            return {"__array__": str(a.dtype), "shape": list(a.shape), "values": a.ravel().tolist()}
+        if "__record__" in t:
+            cache = getattr(_resolve(t["__record__"], "record"), "_RECORD_CACHE", ())
+            data = t["data"]
+            if cache and isinstance(data, dict) and "__dict__" in data:
+                data = {"__dict__": {k: v for k, v in data["__dict__"].items() if k not in cache}}
+            return {"__record__": t["__record__"], "data": inline(data)}
+        return {k: inline(v) for k, v in t.items()}
+
+    return inline(tree)
 
 
 @functools.lru_cache(maxsize=None)

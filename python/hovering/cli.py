@@ -6,6 +6,9 @@
     One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
     and the PNG, prints the numbers shown. Sweep scenes run their points on N local processes, a
     Dask LocalCluster or a running Dask scheduler, each point checkpointed as it arrives.
+``plan SCENE.toml [-o PLAN.toml] [--quick] [--force]``
+    The resolved sweep plan of a sweep scene (docs/sweep-plan.md): every point's numbers
+    explicit, for ``hovering_sweep --plan PLAN.toml``, which needs no Python at run time.
 ``redraw RESULT.npz [--out PNG]``
     Redraws a saved result's figure without computing.
 ``accuracy SCENE.toml [--quick] [--out PNG]``
@@ -117,6 +120,31 @@ def _demo(args) -> int:
     if rc == 0:
         print(f"demo done in {time.perf_counter() - t0:.2f} s")
     return rc
+
+
+def _plan(args) -> int:
+    from pathlib import Path
+
+    from ._output import refuse_foreign
+    from .scenes import load_scene
+    from .scenes.plan import write_plan
+
+    try:
+        scene = load_scene(args.path, check_output=False)
+        out = Path(args.out if args.out is not None else Path(args.path).with_suffix(".plan.toml").name)
+        if out.suffix.lower() != ".toml":
+            raise ValueError(f"-o {str(out)!r}: a plan is a TOML file, give a name ending in .toml")
+        if not out.parent.is_dir():
+            raise ValueError(f"-o {str(out)!r}: the directory {str(out.parent)!r} does not exist")
+        if out.exists() and not args.force and not out.read_bytes()[:4096].startswith(b"# The resolved sweep plan"):
+            refuse_foreign([out])  # a plan hovering wrote may be replaced; any other file is refused
+        t0 = time.perf_counter()
+        path = write_plan(scene, out, quick=args.quick)
+    except (OSError, ValueError) as e:
+        return _error(e)
+    print(f"wrote {path} ({scene.kind}, {len(scene.eps) * len(getattr(scene, 'series', [None]))} points) in "
+          f"{time.perf_counter() - t0:.2f} s; run it with: hovering_sweep --plan {path}")
+    return 0
 
 
 def _redraw(args) -> int:
@@ -242,6 +270,11 @@ def main(argv=None) -> int:
     sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
     force_flag(sc)
+    pl = sub.add_parser("plan", help="the resolved sweep plan of a sweep scene, for hovering_sweep --plan")
+    pl.add_argument("path", help="scene file (TOML) of kind hovering_area or flow_hovering_area")
+    pl.add_argument("-o", "--out", default=None, help="plan file (default: SCENE.plan.toml in the working directory)")
+    pl.add_argument("--quick", action="store_true", help="the counts of a --quick run (divided by 50)")
+    force_flag(pl)
     rd = sub.add_parser("redraw", help="redraw a saved result (RESULT.npz) without computing")
     rd.add_argument("path", help="result file written by 'scene' (NPZ)")
     rd.add_argument("--out", default=None, help="output PNG (default: RESULT.png)")
@@ -255,5 +288,5 @@ def main(argv=None) -> int:
     ex.add_argument("path", help="scene file (TOML)")
     ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")
     args = p.parse_args(argv)
-    return {"demo": _demo, "scene": _scene, "redraw": _redraw, "accuracy": _accuracy,
+    return {"demo": _demo, "scene": _scene, "plan": _plan, "redraw": _redraw, "accuracy": _accuracy,
             "explore": _explore}[args.cmd](args)

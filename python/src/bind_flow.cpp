@@ -52,6 +52,10 @@ void register_flow(py::module_& m) {
              },
              py::arg("z"), "H of states z (shape (n, 4)).");
 
+    py::tuple steppers(kSteppers.size());
+    for (std::size_t i = 0; i < kSteppers.size(); ++i) steppers[i] = kSteppers[i];
+    m.attr("STEPPERS") = steppers;  // the names FlowOptions.stepper takes, its default first
+
     py::class_<FlowOptions>(m, "FlowOptions", "Integrator settings of the return map (validated on use).")
         .def(py::init([](std::string stepper, double rtol, double atol, double event_tol, std::int64_t max_steps,
                          int max_impacts, double grazing_tol, double corner_tol) {
@@ -67,9 +71,11 @@ void register_flow(py::module_& m) {
                  o.validate();
                  return o;
              }),
-             py::arg("stepper") = "rk8pd", py::arg("rtol") = 1e-10, py::arg("atol") = 1e-12, py::arg("event_tol") = 1e-15,
-             py::arg("max_steps") = 1000000, py::arg("max_impacts") = 100, py::arg("grazing_tol") = 1e-12,
-             py::arg("corner_tol") = 1e-10)
+             // The core's defaults (FlowOptions{}), the one place they are written.
+             py::arg("stepper") = FlowOptions{}.stepper, py::arg("rtol") = FlowOptions{}.rtol,
+             py::arg("atol") = FlowOptions{}.atol, py::arg("event_tol") = FlowOptions{}.event_tol,
+             py::arg("max_steps") = FlowOptions{}.max_steps, py::arg("max_impacts") = FlowOptions{}.max_impacts,
+             py::arg("grazing_tol") = FlowOptions{}.grazing_tol, py::arg("corner_tol") = FlowOptions{}.corner_tol)
         .def_readonly("stepper", &FlowOptions::stepper)
         .def_readonly("rtol", &FlowOptions::rtol)
         .def_readonly("atol", &FlowOptions::atol)

@@ -219,7 +219,42 @@ void register_normal(py::module_& m) {
         .def_property_readonly("h", &TangentialCurve::h)
         .def_property_readonly("s", [](const TangentialCurve& c) { return darray(c.s().size(), c.s().data()); })
         .def_property_readonly("theta", [](const TangentialCurve& c) { return darray(c.theta().size(), c.theta().data()); })
-        .def_property_readonly("I", [](const TangentialCurve& c) { return darray(c.I().size(), c.I().data()); });
+        .def_property_readonly("I", [](const TangentialCurve& c) { return darray(c.I().size(), c.I().data()); })
+        .def_static(
+            "measure_refined",
+            [](const FlowSystem& s, double h, const FlowOptions& o, int n_check) {
+                hovering_py::GilRelease release;  // pure C++ (a Python-defined potential takes the GIL back)
+                return std::make_shared<TangentialCurve>(TangentialCurve::measure_refined(s, h, o, n_check));
+            },
+            py::arg("system"), py::arg("h"), py::arg("options"), py::arg("n_check") = 4,
+            "The curve from 64 wall points, doubled (up to 1024) until its measured interpolation error is below 1e-12.")
+        .def(
+            "forcing_coefficients",
+            [](const TangentialCurve& c, int n_modes, int n_phi) {
+                const auto b = c.forcing_coefficients(n_modes, n_phi);
+                return darray(py::ssize_t(b.size()), b.data());
+            },
+            py::arg("n_modes") = TangentialCurve::kForcingModes, py::arg("n_phi") = TangentialCurve::kForcingSamples,
+            "Sine coefficients b_1..b_n_modes of the measured forcing f (eq:defoff), f sampled at forcing_angles(n_phi).");
+    m.attr("FORCING_MODES") = TangentialCurve::kForcingModes;
+    m.attr("FORCING_SAMPLES") = TangentialCurve::kForcingSamples;
+    m.def(
+        "forcing_angles",
+        [](int n_phi) {
+            const auto ph = forcing_angles(n_phi);
+            return darray(py::ssize_t(ph.size()), ph.data());
+        },
+        py::arg("n_phi") = TangentialCurve::kForcingSamples,
+        "The midpoint angles -pi + 2 pi (j + 1/2) / n_phi at which a forcing is sampled.");
+    m.def(
+        "sine_coefficients",
+        [](const darray& f, int n_modes) {
+            if (f.ndim() != 1) throw py::value_error("f must be a 1-D array of values at forcing_angles(n_phi)");
+            const auto b = sine_coefficients(std::vector<double>(f.data(), f.data() + f.size()), n_modes);
+            return darray(py::ssize_t(b.size()), b.data());
+        },
+        py::arg("f"), py::arg("n_modes") = TangentialCurve::kForcingModes,
+        "Sine coefficients of f from its values at forcing_angles(len(f)) (the discrete sine transform).");
 
     py::class_<FlowMap>(m, "FlowMap", "The flow's return map as an iterable map (use hovering.FlowMap).")
         .def(py::init([](const FlowSystem& s, double h, const FlowOptions& o, std::shared_ptr<TangentialCurve> curve,

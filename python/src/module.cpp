@@ -1,5 +1,5 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
-// (truncated, flow, normal), each registering itself; the shared enums live at the top.
+// (truncated, flow, normal, analysis), each registering itself; the shared enums live at the top.
 #include "hovering/build_info.hpp"
 #include "pybind.hpp"
 #include "gil.hpp"
@@ -15,8 +15,8 @@ PYBIND11_MODULE(_core, m) {
     register_flow(flow);
     auto normal = m.def_submodule("normal", "The tangential curve (normal coordinates) and the flow map.");
     register_normal(normal);
-    auto scene = m.def_submodule("scene", "The sweep executable's reading of scene files and its point runner.");
-    register_scene(scene);
+    auto analysis = m.def_submodule("analysis", "The hovering area's samples, outcomes, estimate and default box.");
+    register_analysis(analysis);
     m.def(
         "build_info",
         [] {
@@ -33,5 +33,5 @@ PYBIND11_MODULE(_core, m) {
     // `from hovering._core.flow import X` needs the submodules in sys.modules (def_submodule only
     // sets them as attributes).
     auto modules = py::module_::import("sys").attr("modules");
-    for (auto sub : {truncated, flow, normal, scene}) modules[sub.attr("__name__")] = sub;
+    for (auto sub : {truncated, flow, normal, analysis}) modules[sub.attr("__name__")] = sub;
 }

@@ -64,8 +64,8 @@ void register_flow(py::module_& m);
 
 /// Register the bridge: TangentialCurve and FlowMap.
 void register_normal(py::module_& m);
-/// hovering._core.scene: the C++ reading of sweep scenes and its point runner.
-void register_scene(py::module_& m);
+/// hovering._core.analysis: the hovering area's samples, outcomes, estimate and default box.
+void register_analysis(py::module_& m);
 
 /// Add pickling to the truncated maps, FlowSystem, FlowOptions and TangentialCurve (after they are registered).
 void register_pickles(py::module_& core);

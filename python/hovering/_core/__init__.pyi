@@ -2,6 +2,7 @@
 
 import enum
 
+from . import analysis as analysis
 from . import flow as flow
 from . import normal as normal
 from . import truncated as truncated

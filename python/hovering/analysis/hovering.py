@@ -15,8 +15,8 @@ from typing import Optional
 
 import numpy as np
 
+from .. import _core
 from .._checks import check_memory, flag, integer, real_number, thread_count
-from .._enums import Region, Status
 from ..interface import require_map
 from .._serial import Saveable
 from .._progress import check_progress, progress_bar
@@ -85,75 +85,84 @@ class HoveringArea(Saveable):
 
 
 
-def _stratified(samples: int, K_low: float, rng) -> tuple:
-    """One uniform point in each cell of a near-square grid over [-pi, pi) x [K_low, 0).
+def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: Optional[int] = None) -> tuple:
+    """Samples lo..hi-1 ``(phi, K)`` of the box ``[-pi, pi) x [K_low, 0)``: one uniform point per cell
+    of a near-square grid, jittered by ``numpy.random.default_rng(seed)`` (the core draws that
+    stream: ``hovering._core.analysis.stratified_samples``).
 
     The grid has at most ``samples + n_phi`` cells whatever the box's aspect ratio (a thin box
     gets one row, not millions of columns).
     """
-    H = -K_low
-    n_phi = int(min(max(1, round(math.sqrt(samples * 2 * math.pi / H))), samples))
-    n_K = max(1, int(math.ceil(samples / n_phi)))
-    i, j = np.meshgrid(np.arange(n_phi), np.arange(n_K), indexing="ij")
-    phi = -math.pi + (i.ravel() + rng.random(i.size)) * (2 * math.pi / n_phi)
-    K = K_low + (j.ravel() + rng.random(j.size)) * (H / n_K)
-    K = np.minimum(K, -1e-300)  # the box is K < 0 (HOV lies in J_0)
-    return phi, K
+    return _core.analysis.stratified_samples(int(samples), float(K_low), int(seed), int(lo), hi)
 
 
 def default_depth(m) -> float:
     """Depth of the default box below K = 0: twice the deepest leading-order curve through L1.
 
-    ``2 |eps| max_psi |G(psi)|`` (:class:`hovering.Theory`), i.e. ``2 |eps| / |sin(Omega0/2)|`` for
-    ``f = sin``; the band's depth when that is not finite (resonant Omega0).
+    ``2 |eps| max_psi |G(psi)|`` (:class:`hovering.Theory`, the map's own Omega0 and forcing), i.e.
+    ``2 |eps| / |sin(Omega0/2)|`` for ``f = sin``; infinite when that is not finite (resonant
+    Omega0), then the band's depth is used. Computed by the core
+    (``hovering._core.analysis.default_depth``), which the sweep plans use too.
     """
     th = m.theory()
-    psi = np.linspace(-math.pi, math.pi, 4001)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        d = 2.0 * abs(m.eps) * float(np.max(np.abs(th.G(psi)))) if th.forcing else float("nan")
-    return d if math.isfinite(d) and d > 0 else float("inf")
+    return float(_core.analysis.default_depth(float(m.eps), float(th.Omega0), [float(b) for b in th.forcing]))
 
 
-def _piece(m, phi, K, n_steps: int, n_threads: int):
-    """The per-sample outcome of hovering_area for some samples (a piece of a distributed run)."""
-    no_impact = ("0u", "0")
-    r0 = m.with_eps(0.0).iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
-                                 n_threads=n_threads)
-    r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True, n_threads=n_threads)
-    return r0.status, r.status, r.steps_done, r.visited
+def _outcomes(m, phi, K, n_steps: int, n_threads: int, progress=False) -> tuple:
+    """Per-sample outcomes (status under F_0, status, steps done, regions visited) of F_0 then F_eps
+    with early exit from {J_0u, J_0}, by the core; KeyboardInterrupt on Ctrl-C."""
+    if hasattr(m, "_core") and not isinstance(m, (_core.truncated.TruncatedMap, _core.truncated.TruncatedFamily)):
+        m0 = m.with_eps(0.0)  # the flow's F_0: the eps = 0 flow on its own normal coordinates
+        d = _core.analysis.hovering_outcomes(m._core, m0._core, phi, K, int(n_steps), _flow_threads(m, n_threads),
+                                             progress or None)
+    else:
+        d = _core.analysis.hovering_outcomes(m, phi, K, int(n_steps), int(n_threads), progress or None)
+    if d["interrupted"]:
+        raise KeyboardInterrupt("hovering_area interrupted")
+    return d["status_F0"], d["status"], d["steps_done"], d["visited"]
 
 
-def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> str:
-    # Everything that changes a piece's samples or their orbits: the map (its pickle: parameters,
-    # integrator options, measured curve), the counts, the box, the seed and the piece's range.
-    import hashlib
-    import pickle
+def _flow_threads(m, n_threads: int) -> int:
+    # A potential defined in Python takes the GIL at every call: one thread (as FlowMap.iterate).
+    return 1 if n_threads == 0 and m.sys.python_defined else int(n_threads)
 
-    blob = pickle.dumps((m, int(n_steps), float(K_low), int(seed), int(samples), int(lo), int(hi)), protocol=4)
-    return hashlib.sha256(blob).hexdigest()
+
+def _piece(m, samples, K_low, seed, lo, hi, n_steps: int, n_threads: int):
+    """The outcomes of samples lo..hi-1 (a piece of a distributed run: it draws its own samples)."""
+    phi, K = _stratified(samples, K_low, seed, lo, hi)
+    return _outcomes(m, phi, K, n_steps, n_threads)
+
+
+def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> dict:
+    """Everything that changes a piece's outcomes: the map's record (its parameters, integrator
+    options, measured curve), the counts, the box, the seed and the piece's range."""
+    from .._serial import record_key
+
+    return {"hovering_area_piece": {"map": record_key(m), "n_steps": int(n_steps), "K_low": float(K_low),
+                                    "seed": int(seed), "samples": int(samples), "lo": int(lo), "hi": int(hi)}}
 
 
 def _piece_arrays(row, n: int) -> tuple:
     """A checkpointed piece (untrusted): four lists of n integers, each within its array's dtype."""
     names, dtypes = ("status_F0", "status", "steps_done", "visited"), (np.int8, np.int8, np.int64, np.int8)
-    if not isinstance(row, list) or len(row) != 4:
-        raise ValueError("row must be a list of 4 lists (statuses under F_0 and F_eps, steps done, regions visited)")
+    if not isinstance(row, dict) or not isinstance(row.get("outcomes"), list) or len(row["outcomes"]) != 4:
+        raise ValueError("row.outcomes must be a list of 4 lists (statuses under F_0 and F_eps, steps done, regions "
+                         "visited)")
     out = []
-    for name, a, dt in zip(names, row, dtypes):
+    for name, a, dt in zip(names, row["outcomes"], dtypes):
         arr = np.asarray(a) if isinstance(a, list) else np.zeros(0, dtype=object)
         if arr.shape != (n,) or arr.dtype.kind not in "iu" or (n and not (np.iinfo(dt).min <= arr.min() and
                                                                            arr.max() <= np.iinfo(dt).max)):
-            raise ValueError(f"row.{name} must be {n} integers within {np.dtype(dt).name}")
+            raise ValueError(f"row.outcomes.{name} must be {n} integers within {np.dtype(dt).name}")
         out.append(arr.astype(dt))
     return tuple(out)
 
 
-def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, workers, client, scheduler, dask,
+def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, workers, client, scheduler, dask,
                  pieces, checkpoint):
     from ..distribute import executor, run_pieces
-    from ..sweeps import Checkpoint
+    from ..parallel.checkpoint import Checkpoint
 
-    n = phi.size
     with executor(workers, client, scheduler, dask) as ex:
         threads = n_threads if n_threads != 0 else ex.threads_per_piece
         k = integer("pieces", pieces if pieces is not None else 4 * ex.workers, 1, max(1, n))
@@ -175,11 +184,12 @@ def _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar, worke
             lo, hi = bounds[i]
             out[i] = res
             if store is not None:
-                store.put(_piece_key(m, n_steps, K_low, seed, samples, lo, hi), [np.asarray(a).tolist() for a in res])
+                store.put(_piece_key(m, n_steps, K_low, seed, samples, lo, hi),
+                          {"outcomes": [np.asarray(a).tolist() for a in res]})
             bar.advance(2 * (hi - lo) * n_steps)
 
-        for _ in run_pieces(ex, _piece, [(m, phi[bounds[i][0]:bounds[i][1]], K[bounds[i][0]:bounds[i][1]], n_steps,
-                                          threads) for i in todo], on_result=done):
+        for _ in run_pieces(ex, _piece, [(m, samples, K_low, seed, *bounds[i], n_steps, threads) for i in todo],
+                            on_result=done):
             pass
     return tuple(np.concatenate([o[j] for o in out]) for j in range(4))
 
@@ -222,8 +232,8 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     workers : int, optional
         Split the samples into ``pieces`` and run them on this many local worker processes (a
         process pool; with ``dask=True`` a Dask LocalCluster). The result is identical to the
-        single-process one for the same seed: the samples are drawn once, here, and each piece
-        iterates a contiguous slice of them.
+        single-process one for the same seed: each piece draws its own contiguous range of the
+        samples (the core jumps the random stream ahead to it), and the estimate only counts.
     client : distributed.Client, optional
         Run the pieces on an existing Dask cluster.
     scheduler : str, optional
@@ -233,9 +243,9 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     pieces : int, optional
         Number of pieces (default 4 per worker).
     checkpoint : path-like, optional
-        A :class:`hovering.sweeps.Checkpoint` file: each finished piece is written as it arrives,
-        keyed by every parameter that changes it (map, counts, box, seed, range); a rerun computes
-        only the missing pieces (distributed runs only).
+        A checkpoint file (:mod:`hovering.parallel.checkpoint`): each finished piece is written as
+        it arrives, keyed by every parameter that changes it (the map's record, counts, box, seed,
+        range); a rerun computes only the missing pieces (distributed runs only).
 
     Returns
     -------
@@ -264,61 +274,34 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     K_low = real_number("K_low", K_low)
     if not (lo < K_low < 0):
         raise ValueError(f"K_low must lie in the band below 0, ({lo}, 0), got {K_low}")
-    rng = np.random.default_rng(seed)
-    phi, K = _stratified(samples, K_low, rng)
+    phi, K = _stratified(samples, K_low, seed)
     n = phi.size
-    no_impact = ("0u", "0")
-
-    m0 = m.with_eps(0.0)
     unit = getattr(m, "_progress_unit", "step")
     distributed = workers is not None or client is not None or scheduler is not None
     if checkpoint is not None and not distributed:
         raise ValueError("checkpoint applies to distributed runs (give workers, client or scheduler)")
     with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
         if distributed:
-            s0, s1, steps_done, visited = _distributed(m, phi, K, n_steps, K_low, seed, samples, n_threads, bar,
+            s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar,
                                                        workers, client, scheduler, dask, pieces, checkpoint)
         else:
-            # Part 1 of the definition: the point impacts under F_0 (checked, not assumed).
-            r0 = m0.iterate(phi, K, n_steps, record=(), exit_regions=no_impact, stop_on_exit=True,
-                            n_threads=n_threads, progress=bar.part(0))
-            # Part 2: it never impacts under F_eps (for N/4, N/2, N steps: exit_step beyond each count).
-            r = m.iterate(phi, K, n_steps, record=("visited",), exit_regions=no_impact, stop_on_exit=True,
-                          n_threads=n_threads, progress=bar.part(n * n_steps))
-            s0, s1, steps_done, visited = r0.status, r.status, r.steps_done, r.visited
-    impacts0 = np.isin(s0, [int(Status.EXITED), int(Status.CORNER), int(Status.GRAZING)])
-    stayed = s1 == Status.OK
-    box_area = 2 * math.pi * (-K_low)
-    areas = {}
-    for N in (n_steps // 4, n_steps // 2, n_steps):
-        # Stopped at or after N steps for any reason (exit, escape, the flow's corner hits): survived N.
-        survive = stayed | (steps_done >= N)
-        areas[N] = box_area * np.count_nonzero(impacts0 & survive) / n
-    hov = impacts0 & stayed
-    both = (1 << int(Region.BESIDE)) | (1 << int(Region.ABOVE))
-    hov_both = hov & ((visited & both) == both)
-    p = np.count_nonzero(hov) / n
-    sampling = box_area * math.sqrt(max(p * (1 - p), 1.0 / n) / n)
-    iteration = areas[n_steps // 2] - areas[n_steps]
-    theory = m.theory().area
-    floor_touched = bool(np.any(hov & (K < 0.9 * K_low)))
-    unresolved = int(np.count_nonzero(~np.isin(s1, [int(Status.OK), int(Status.EXITED), int(Status.ESCAPED)])))
+            s0, s1, steps_done, visited = _outcomes(m, phi, K, n_steps, n_threads, bar.part(0))
+    e = _core.analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), keep_points)
     return HoveringArea(
-        area=areas[n_steps],
-        error=2 * sampling + iteration,
-        sampling_error=sampling,
-        iteration_error=iteration,
-        theory=float(theory),
-        areas=areas,
-        n_samples=n,
+        area=e["area"],
+        error=e["error"],
+        sampling_error=e["sampling_error"],
+        iteration_error=e["iteration_error"],
+        theory=float(m.theory().area),
+        areas={n_steps // 4: e["area_N4"], n_steps // 2: e["area_N2"], n_steps: e["area"]},
+        n_samples=int(e["n_samples"]),
         box=(-math.pi, math.pi, K_low, 0.0),
-        impact_fraction_F0=float(np.count_nonzero(impacts0) / n),
-        floor_touched=floor_touched,
-        area_both_sides=box_area * np.count_nonzero(hov_both) / n,
-        unresolved=unresolved,
+        impact_fraction_F0=e["impact_fraction_F0"],
+        floor_touched=bool(e["floor_touched"]),
+        area_both_sides=e["area_both_sides"],
+        unresolved=int(e["unresolved"]),
         phi=phi if keep_points else None,
         K=K if keep_points else None,
-        hovering=hov if keep_points else None,
-        both_sides=hov_both if keep_points else None,
+        hovering=e["hovering"] if keep_points else None,
+        both_sides=e["both_sides"] if keep_points else None,
     )
-

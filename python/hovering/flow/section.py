@@ -13,39 +13,51 @@ from .._enums import status_code
 from .._enums import FlowStatus
 from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .._progress import check_progress, progress_bar
+from .._pickle import reduce_record
 from .._serial import Saveable
 from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
 
-#: Steppers the flow offers: GSL's explicit Runge-Kutta methods and Adams multistep method, and
-#: ``"exact"``, the flow in closed form where the system has one (see :meth:`Section.return_map`).
-STEPPERS = ("rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "exact")
+#: Steppers the flow offers, its default first: GSL's explicit Runge-Kutta methods, Adams multistep
+#: method and implicit Gauss-Legendre methods, and ``"exact"``, the flow in closed form where the
+#: system has one (see :meth:`Section.return_map`). The core's list (``hovering._core.flow.STEPPERS``).
+STEPPERS = tuple(_core.flow.STEPPERS)
 
 
-def flow_options(rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd", event_tol: float = 1e-15,
-                 max_steps: int = 1_000_000, max_impacts: int = 100, grazing_tol: float = 1e-12,
-                 corner_tol: float = 1e-10) -> "_core.flow.FlowOptions":
+def flow_options(rtol: Optional[float] = None, atol: Optional[float] = None, stepper: Optional[str] = None,
+                 event_tol: Optional[float] = None, max_steps: Optional[int] = None, max_impacts: Optional[int] = None,
+                 grazing_tol: Optional[float] = None, corner_tol: Optional[float] = None) -> "_core.flow.FlowOptions":
     """Integrator settings of the flow, validated with errors that name the value and its range.
 
     Parameters
     ----------
     rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol
         See :meth:`Section.return_map` (``"exact"`` ignores rtol and atol; whether it applies
-        depends on the system: ``FlowOptions.validate_for(system)``).
+        depends on the system: ``FlowOptions.validate_for(system)``). None: the core's default
+        (``hovering._core.flow.FlowOptions()``: rk8pd, rtol 1e-10, atol 1e-12, event_tol 1e-15,
+        max_steps 1e6, max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10).
 
     Returns
     -------
     hovering._core.flow.FlowOptions
     """
-    if not is_choice(stepper, STEPPERS):
-        raise ValueError(f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
-                         f"solvers, and this flow is not stiff), got {stepper!r}")
-    return _core.flow.FlowOptions(
-        stepper=stepper, rtol=real_number("rtol", rtol, 1e-16, False, 1, True), atol=real_number("atol", atol, 0),
-        event_tol=real_number("event_tol", event_tol, 0), max_steps=integer("max_steps", max_steps, 1, 2**62),
-        max_impacts=integer("max_impacts", max_impacts, 1, 1_000_000),
-        grazing_tol=real_number("grazing_tol", grazing_tol, 0, False), corner_tol=real_number("corner_tol", corner_tol, 0, False))
+    kw = {}
+    if stepper is not None:
+        if not is_choice(stepper, STEPPERS):
+            raise ValueError(f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
+                             f"solvers, and this flow is not stiff), got {stepper!r}")
+        kw["stepper"] = stepper
+    checks = dict(rtol=lambda v: real_number("rtol", v, 1e-16, False, 1, True), atol=lambda v: real_number("atol", v, 0),
+                  event_tol=lambda v: real_number("event_tol", v, 0),
+                  max_steps=lambda v: integer("max_steps", v, 1, 2**62),
+                  max_impacts=lambda v: integer("max_impacts", v, 1, 1_000_000),
+                  grazing_tol=lambda v: real_number("grazing_tol", v, 0, False),
+                  corner_tol=lambda v: real_number("corner_tol", v, 0, False))
+    given = dict(rtol=rtol, atol=atol, event_tol=event_tol, max_steps=max_steps, max_impacts=max_impacts,
+                 grazing_tol=grazing_tol, corner_tol=corner_tol)
+    kw.update({k: checks[k](v) for k, v in given.items() if v is not None})
+    return _core.flow.FlowOptions(**kw)
 
 
 def _threads(n_threads, python_defined: bool) -> int:
@@ -164,6 +176,10 @@ class Section:
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls(record["sys"], record["h"])
 
+    def __reduce__(self):
+        """Pickle as the record (and any other instance attribute)."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h")})
+
     def point(self, theta, I) -> np.ndarray:
         """States (q1, 0, q2, p2) of Sigma_h at section coordinates (theta, I).
 
@@ -216,9 +232,10 @@ class Section:
             raise ValueError(f"z must be states (q1, p1, q2, p2) of shape (n, 4), got shape {np.shape(z)}")
         return _core.flow.section_coordinates(self.sys.core, np.ascontiguousarray(z))
 
-    def return_map(self, theta, I, rtol: float = 1e-10, atol: float = 1e-12, stepper: str = "rk8pd",
-                   event_tol: float = 1e-15, max_steps: int = 1_000_000, max_impacts: int = 100,
-                   grazing_tol: float = 1e-12, corner_tol: float = 1e-10, n_threads: int = 0,
+    def return_map(self, theta, I, rtol: Optional[float] = None, atol: Optional[float] = None,
+                   stepper: Optional[str] = None, event_tol: Optional[float] = None, max_steps: Optional[int] = None,
+                   max_impacts: Optional[int] = None, grazing_tol: Optional[float] = None,
+                   corner_tol: Optional[float] = None, n_threads: int = 0,
                    trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
                    progress=False) -> ReturnMapResult:
         """Return map of many points of Sigma_h (multi-threaded, GIL released).
@@ -228,9 +245,10 @@ class Section:
         theta, I : array_like
             Section coordinates of the starting points.
         rtol, atol : float, optional
-            Tolerances of GSL's step-size control (not read by ``"exact"``).
+            Tolerances of GSL's step-size control (not read by ``"exact"``; default 1e-10, 1e-12).
+            Every integrator setting left None takes the core's default (:func:`flow_options`).
         stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "exact"}, optional
-            GSL stepper: an explicit Runge-Kutta method, or the variable-order Adams multistep
+            GSL stepper (default rk8pd): an explicit Runge-Kutta method, or the variable-order Adams multistep
             method (its events are located on an rk8pd extension of each step; on this smooth,
             oscillatory flow it is ~7x slower than rk8pd at matched accuracy), or an implicit
             Gauss-Legendre method (``rk4imp``, ``rk2imp``: symplectic at a fixed step, with the

@@ -14,6 +14,7 @@ from .. import _core
 from .._checks import is_choice, real_number
 from .._enums import Geometry
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
+from .._pickle import reduce_record
 
 __all__ = [
     "Harmonic",
@@ -61,6 +62,8 @@ def _record_fields(*names):
 for _cls, _names in ((Harmonic, ("omega",)), (Tan, ("omega", "alpha")), (Numerical, ("base",))):
     _cls.__eq__, _cls.__hash__ = _potential_eq, _potential_hash
     _cls._to_record, _cls._from_record = _record_fields(*_names)
+    # Pickled by the record too (the compiled __setstate__ stays, to read the pickles written before).
+    _cls.__reduce__ = reduce_record
 
 _ONSET_FIELDS = ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
 
@@ -85,6 +88,7 @@ def _onset_eq(self, other):
 
 
 OnsetParameters._to_record, OnsetParameters._from_record = _onset_to_record, classmethod(_onset_from_record)
+OnsetParameters.__reduce__ = reduce_record
 OnsetParameters.__eq__, OnsetParameters.__hash__ = _onset_eq, _potential_hash
 
 
@@ -114,6 +118,10 @@ class Bilinear:
     def _from_record(cls, record: dict) -> "Bilinear":
         """Inverse of :meth:`_to_record`."""
         return cls()
+
+    def __reduce__(self):
+        """Pickle as the record."""
+        return reduce_record(self)
 
 
 @dataclass(frozen=True)
@@ -162,6 +170,10 @@ class Polynomial:
     def _from_record(cls, record: dict) -> "Polynomial":
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls({(i, j): c for i, j, c in record["terms"]})
+
+    def __reduce__(self):
+        """Pickle as the record."""
+        return reduce_record(self)
 
 
 def _terms(coupling) -> list:
@@ -276,8 +288,9 @@ class StepSystem:
         return StepSystem(**fields)
 
     def __reduce__(self):
-        """Pickle as the constructor arguments (the core's copy is rebuilt, and validated, on unpickling)."""
-        return type(self), tuple(getattr(self, f.name) for f in dataclasses.fields(self) if f.init)
+        """Pickle as the record (the constructor arguments; the core's copy is rebuilt, and validated, on
+        unpickling)."""
+        return reduce_record(self)
 
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: the fields (potentials and coupling as their own records)."""

@@ -13,12 +13,14 @@
 from __future__ import annotations
 
 import operator
+from typing import Optional
 
 import numpy as np
 
 from .. import _core
 from .._checks import integer, MAX_MODES, real_array, require_angles, require_finite, require_type
 from .._enums import wrap
+from .._pickle import reduce_record
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 
@@ -86,9 +88,9 @@ class TangentialCurve(Saveable):
         if not 0 <= n_check <= n:
             raise ValueError(f"n_check must be in [0, n], got {n_check!r}")
         opts = flow_options(rtol=rtol, atol=rtol * 1e-2)
-        c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
-        while auto and n_check and n < 1024 and not c.interpolation_error[1] < 1e-12:
-            n *= 2
+        if auto:  # the core's rule (64 wall points, doubled up to 1024 for an error below 1e-12)
+            c = _core.normal.TangentialCurve.measure_refined(sec.sys.core, sec.h, opts, n_check)
+        else:
             c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
         self._adopt(sec, c, checked=bool(n_check))
 
@@ -134,6 +136,14 @@ class TangentialCurve(Saveable):
     def _from_record(cls, record: dict) -> "TangentialCurve":
         """Inverse of :meth:`_to_record` (the interpolants are rebuilt bit for bit, the flow is not traced)."""
         return cls._from_samples(record["sec"], record["samples"])
+
+    #: What the record rebuilds (the rest of the instance dict is pickled as it is).
+    _OWN = frozenset({"sec", "_c", "s", "theta", "values", "interpolation_error", "interpolation_error_theta",
+                      "is_graph", "min_slope"})
+
+    def __reduce__(self):
+        """Pickle as the record: the section and the measured samples."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in self._OWN})
 
     def __repr__(self) -> str:
         return (f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "
@@ -200,31 +210,42 @@ class TangentialCurve(Saveable):
         require_angles("phi", ph)
         return (self(-ph) - self(ph)) / eps
 
-    def forcing_coefficients(self, n_modes: int = 8, n_phi: int = 256) -> np.ndarray:
-        """Sine coefficients ``b_1 .. b_n_modes`` of f (eq:defoff), by least squares on n_phi angles.
+    def forcing_coefficients(self, n_modes: Optional[int] = None, n_phi: Optional[int] = None) -> np.ndarray:
+        """Sine coefficients ``b_1 .. b_n_modes`` of f (eq:defoff), fitted on n_phi angles.
+
+        The core's one fit of the measured forcing (``hovering._core.normal``): f sampled at the
+        midpoint angles ``-pi + 2 pi (j + 1/2) / n_phi``, where the sine modes are orthogonal and
+        the least-squares fit is the discrete sine transform (spectrally accurate for the smooth f).
 
         Parameters
         ----------
         n_modes : int, optional
-            Number of sine modes.
+            Number of sine modes (default ``FORCING_MODES``, 8).
         n_phi : int, optional
-            Sample angles (equispaced): with n_phi > 2 n_modes the fit is the discrete sine
-            transform's (spectrally accurate for the smooth f).
+            Sample angles, > 2 n_modes (default ``FORCING_SAMPLES``, 256).
 
         Returns
         -------
         ndarray
+
+        Raises
+        ------
+        ValueError
+            At eps = 0 (f divides by eps), if the curve is not a graph, or for bad counts.
         """
         n_modes, n_phi = _mode_counts(n_modes, n_phi)
-        ph = -np.pi + _TWO_PI * (np.arange(n_phi) + 0.5) / n_phi
-        A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
-        return np.linalg.lstsq(A, self.forcing(ph), rcond=None)[0]
+        if self.sec.sys.eps == 0:
+            raise ValueError("f(phi) is defined for eps != 0 (eq:defoff divides by eps)")
+        self._require_graph()
+        return self._c.forcing_coefficients(n_modes, n_phi)
 
 
 def _mode_counts(n_modes, n_phi) -> tuple:
     """(n_modes, n_phi) of a sine fit: 1 <= n_modes <= MAX_MODES, 2 n_modes < n_phi <= 65536 (beyond,
-    each sample is a flow trace and the fit gains nothing)."""
-    n_modes = integer("n_modes", n_modes, 1, MAX_MODES)
+    each sample is a flow trace and the fit gains nothing); None: the core's defaults."""
+    n_modes = integer("n_modes", _core.normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
+    if n_phi is None:
+        n_phi = _core.normal.FORCING_SAMPLES
     return n_modes, integer("n_phi (> 2 n_modes, so the fit is determined)", n_phi, 2 * n_modes + 1, 65536)
 
 
@@ -370,17 +391,21 @@ def forcing_function(sec: Section, phi, **kwargs) -> np.ndarray:
     return (both[: p.size] - both[p.size :]) / sec.sys.eps
 
 
-def forcing_coefficients(sec: Section, n_modes: int = 6, n_phi: int = 64, **kwargs) -> np.ndarray:
-    """Sine coefficients ``b_k`` of the measured forcing f (eq:defoff), least squares on n_phi angles.
+def forcing_coefficients(sec: Section, n_modes: Optional[int] = None, n_phi: Optional[int] = None,
+                         **kwargs) -> np.ndarray:
+    """Sine coefficients ``b_k`` of the measured forcing f (eq:defoff), f by :func:`forcing_function`.
+
+    The same fit as :meth:`TangentialCurve.forcing_coefficients` (the core's, on the same midpoint
+    angles), of f found point by point by bisection: an independent check of the curve's.
 
     Parameters
     ----------
     sec : Section
         Section of a system with eps != 0.
     n_modes : int, optional
-        Number of sine modes.
+        Number of sine modes (default ``FORCING_MODES``, 8).
     n_phi : int, optional
-        Sample angles in (-pi, pi).
+        Sample angles in (-pi, pi), > 2 n_modes (default ``FORCING_SAMPLES``, 256).
     **kwargs
         Passed to :func:`forcing_function`.
 
@@ -391,10 +416,8 @@ def forcing_coefficients(sec: Section, n_modes: int = 6, n_phi: int = 64, **kwar
     """
     _section("sec", sec)
     n_modes, n_phi = _mode_counts(n_modes, n_phi)
-    ph = np.linspace(-np.pi, np.pi, n_phi + 2)[1:-1]
-    f = forcing_function(sec, ph, **kwargs)
-    A = np.stack([np.sin((k + 1) * ph) for k in range(n_modes)], 1)
-    return np.linalg.lstsq(A, f, rcond=None)[0]
+    f = forcing_function(sec, _core.normal.forcing_angles(n_phi), **kwargs)
+    return _core.normal.sine_coefficients(np.ascontiguousarray(f, dtype=float), n_modes)
 
 
 def to_normal(sec: Section, theta, I, **kwargs):

@@ -20,6 +20,7 @@ from .._enums import Region, wrap
 from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, trajectory_arguments
 from .._progress import check_progress, progress_bar
 from ..interface import IterateResult, MapAnalyses, hook
+from .._pickle import reduce_record
 from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
@@ -85,13 +86,13 @@ class FlowMap(MapAnalyses):
         tangential curve, which must be a graph over theta (else a ValueError says so; use
         ``"section"``). ``"section"``: ``(theta, I)`` of the unperturbed H2.
     rtol : float, optional
-        Relative tolerance of the integrator (GSL step control).
+        Relative tolerance of the integrator (GSL step control; default the core's, 1e-10).
     atol : float, optional
         Absolute tolerance (default ``rtol``: the flow's variables are O(1) here, and an atol
         below rtol only tightens the steps where a momentum crosses zero: at rtol 1e-10,
         atol 1e-12 costs 17% more steps for a 2.5x smaller error per return).
     stepper : str, optional
-        GSL stepper, or ``"exact"`` for the closed-form flow (see :data:`hovering.flow.STEPPERS`
+        GSL stepper (default the core's, ``"rk8pd"``), or ``"exact"`` for the closed-form flow (see :data:`hovering.flow.STEPPERS`
         and :meth:`hovering.Section.return_map`; it ignores rtol and atol).
     curve : TangentialCurve, optional
         The tangential curve of this section (measured at rtol 1e-13 if not given, with as many
@@ -129,8 +130,8 @@ class FlowMap(MapAnalyses):
     #: rotation averages): the integration error of each return caps invariant curves at 7-9.
     regularity_digits = 6.0
 
-    def __init__(self, sys: StepSystem, h: float = 1.0, coordinates: str = "normal", rtol: float = 1e-10,
-                 atol: Optional[float] = None, stepper: str = "rk8pd", curve: Optional[TangentialCurve] = None,
+    def __init__(self, sys: StepSystem, h: float = 1.0, coordinates: str = "normal", rtol: Optional[float] = None,
+                 atol: Optional[float] = None, stepper: Optional[str] = None, curve: Optional[TangentialCurve] = None,
                  accuracy: Optional[float] = None, accuracy_returns: int = 1, **options):
         if not isinstance(sys, StepSystem):
             raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
@@ -150,6 +151,9 @@ class FlowMap(MapAnalyses):
             self.accuracy_choice = hook("choose_setting")(self.section, accuracy, accuracy_returns)
             stepper, rtol = self.accuracy_choice["method"], self.accuracy_choice["tolerance"]
             atol = rtol
+        default = _core.flow.FlowOptions()  # the core's defaults, for what is not given
+        stepper = default.stepper if stepper is None else stepper
+        rtol = default.rtol if rtol is None else rtol
         atol = rtol if atol is None else atol
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
         self._options.validate_for(sys.core)  # before the tangential curve is measured
@@ -188,16 +192,19 @@ class FlowMap(MapAnalyses):
                       "curve", "_core"})
 
     def __reduce__(self):
-        """Pickle as the constructor arguments, the measured curve and the other instance attributes."""
-        extra = {k: v for k, v in self.__dict__.items() if k not in self._OWN}
-        return _restore_flowmap, (type(self), self.sys, self.h, self.coordinates, dict(self.integrator_options),
-                                  self.curve, extra)
+        """Pickle as the record (system, h, coordinates, integrator options, the curve's samples, the
+        forcing cache) and the other instance attributes."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in self._OWN | {"_forcing"}})
 
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: system, h, coordinates, integrator options, the curve's samples
         (not its system again: it is this map's) and the forcing cache."""
         return {"sys": self.sys, "h": self.h, "coordinates": self.coordinates, "options": dict(self.integrator_options),
                 "curve": None if self.curve is None else self.curve._samples(), "forcing": self._forcing}
+
+    #: Entries of the record derived from the others (the forcing fit of the curve): not part of
+    #: the map's identity in a checkpoint key (:func:`hovering._serial.record_key`).
+    _RECORD_CACHE = ("forcing",)
 
     #: The integrator options a saved FlowMap holds (:attr:`integrator_options`): a file's options
     #: are these or nothing, never an ``accuracy`` target (that would measure, i.e. compute, on load).
@@ -459,13 +466,14 @@ class FlowMap(MapAnalyses):
         if self.coordinates != "normal":
             raise ValueError("the theory and the model live in normal coordinates: use coordinates='normal'")
 
-    def forcing_coefficients(self, n_modes: int = 8) -> np.ndarray:
+    def forcing_coefficients(self, n_modes: Optional[int] = None) -> np.ndarray:
         """Sine coefficients of the measured forcing f (eq:defoff) of this section (cached).
 
-        At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit is used there,
-        measured on the system at eps = 1e-6 (zeros without a coupling).
+        The core's one fit (:meth:`TangentialCurve.forcing_coefficients`, ``n_modes`` default
+        ``FORCING_MODES``). At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit
+        is used there, measured on the system at eps = 1e-6 (zeros without a coupling).
         """
-        n_modes = integer("n_modes", n_modes, 1, MAX_MODES)
+        n_modes = integer("n_modes", _core.normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
         if self._forcing is None or self._forcing.size != n_modes:
             if self.curve is None:
                 raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
@@ -504,7 +512,7 @@ class FlowMap(MapAnalyses):
         self._require_onset()
         return _theory.L2(K, self.onset.Omega0, self.onset.tau0)
 
-    def truncated(self, forcing: str = "measured", n_modes: int = 8):
+    def truncated(self, forcing: str = "measured", n_modes: Optional[int] = None):
         """The truncated model of this system (eq:trunceps1eps2), with no hand scaling.
 
         The arcs are the onset parameters' (eq:omegaofalead); the forcing is the measured f of
@@ -518,7 +526,7 @@ class FlowMap(MapAnalyses):
         forcing : {"measured", "first_mode"}, optional
             Which forcing.
         n_modes : int, optional
-            Sine modes kept for ``"measured"``.
+            Sine modes kept for ``"measured"`` (default ``FORCING_MODES``, 8).
 
         Returns
         -------

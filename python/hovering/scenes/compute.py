@@ -10,10 +10,8 @@ eps = 0 no coupling, no "regions" no crossing bookkeeping, no "trajectory" no de
 
 from __future__ import annotations
 
-import math
 import os
 import time
-from dataclasses import asdict, replace
 from typing import Callable, Optional
 
 import numpy as np
@@ -21,17 +19,17 @@ import numpy as np
 from .._enums import FlowStatus, Region, Status, wrap
 from .._style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
+from .._version import __version__
 from ..analysis import rotation_number
 from ..diagnostics.work_precision import _reverse
-from ..normal.compare import truncated_from_flow
 from ..normal.corners import corner_curves
 from ..normal.flowmap import FlowMap
-from .._version import __version__
-from ..analysis.hovering import default_depth
-from ..sweeps import Checkpoint, check_row
+from ..parallel.checkpoint import Checkpoint, check_row
+from ..truncated.maps import TruncatedFamily, TruncatedMap
 from ..truncated.theory import golden_family, hovering_area_theory
 from ..flow.section import Section
 from ..normal.coordinates import TangentialCurve
+from .plan import build_system, plan_points, point_key
 from .results import (CornerDirectionsResult, CornerTrajectory, FlowHoveringResult, FlowPortraitResult, Geometry,
                       HoveringAreaResult, OrbitPanelResult, OrbitSceneResult, OrbitSet, SceneResult, SeriesResult,
                       SigmaStructureResult, TangentToriResult, TorusResult, WallPoint, WallSectionResult, WallSegment,
@@ -395,47 +393,96 @@ def _theory_line(spec, eps_all: np.ndarray) -> tuple:
     return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
 
 
-def _truncated_point(ms, n_steps: int, samples: int, seed: int, kw: dict, n_threads: int = 0) -> dict:
-    """One point of a truncated-map |HOV| sweep (a piece: runs in any process)."""
+def run_point(kind: str, point: dict, n_threads: int = 0) -> dict:
+    """Measure one point of a resolved sweep plan (:func:`hovering.scenes.plan.plan_points`).
+
+    The same core functions, on the same numbers, as ``hovering_sweep`` (cpp/src/hovering/sweep/
+    run.cpp): the rows of the two programs are the same doubles (but ``seconds``), and each
+    resumes the other's checkpoint. A piece: it runs in any process.
+
+    Parameters
+    ----------
+    kind : {"hovering_area", "flow_hovering_area"}
+        The plan's kind.
+    point : dict
+        A plan point.
+    n_threads : int, optional
+        Core threads (0 = all cores).
+
+    Returns
+    -------
+    dict
+        The row: the estimate's fields (``area``, ``error``, ``sampling_error``,
+        ``iteration_error``, ``area_N4``, ``area_N2``, ``area_both_sides``, ``impact_fraction_F0``,
+        ``floor_touched``, ``unresolved``, ``n_samples``, ``K_low``), ``theory`` (carried),
+        ``seconds``; a flow point also ``b1`` (carried) and ``models`` (per model: ``area``,
+        ``error``, ``agree``, ``K_low``).
+    """
     t = time.perf_counter()
-    h = ms.build().hovering_area(n_steps=n_steps, samples=samples, seed=seed, n_threads=n_threads, **kw)
-    return dict(eps=ms.eps, area=float(h.area), error=float(h.error), theory=float(h.theory),
-                floor_touched=bool(h.floor_touched), K_low=float(h.box[2]), Omega0=ms.Omega0, theta_w=ms.theta_w,
-                seconds=time.perf_counter() - t)
+    kw = dict(n_steps=point["n_steps"], samples=point["samples"], seed=point["seed"], n_threads=n_threads)
+    if kind == "hovering_area":
+        h = TruncatedMap(**point["map"]).hovering_area(K_low=point["K_low"], **kw)
+        row = _area_row(h)
+    else:
+        fm = FlowMap(build_system(point["system"]), h=point["h"], **point["integrator"])
+        h = fm.hovering_area(K_low=point["K_low"], keep_points=bool(point["models"]), **kw)
+        row = _area_row(h)
+        row["b1"] = point["b1"]
+        row["models"] = {}
+        for m in point["models"]:
+            tm = TruncatedFamily._from_record({k: m[k] for k in ("eps", "K", "Omega", "JR", "J1", "forcing", "K_max")})
+            mh = tm.hovering_area(K_low=m["K_low"], keep_points=True, **kw)
+            # A model sampling another box (its band is shallower) classifies other points: no agreement.
+            agree = float(np.mean(mh.hovering == h.hovering)) if m["K_low"] == point["K_low"] else float("nan")
+            row["models"][m["name"]] = dict(area=mh.area, error=mh.error, agree=agree, K_low=m["K_low"])
+    row["theory"] = point["theory"]
+    row["seconds"] = time.perf_counter() - t
+    return row
 
 
-#: The fields of a truncated-map sweep point (what _hovering_scene reads of a checkpointed row).
-_TRUNCATED_ROW = dict(eps=float, area=float, error=float, theory=float, floor_touched=bool, K_low=float, Omega0=float,
-                      theta_w=float)
-#: The fields of a flow sweep point (_flow_hovering), its models' fields under "models".
-_FLOW_ROW = dict(eps=float, flow=float, flow_err=float, flow_both=float, K_low=float, theory=float, b1=float,
-                 seconds=float, unresolved=float)
+def _area_row(h) -> dict:
+    N = sorted(h.areas)
+    return dict(area=h.area, error=h.error, sampling_error=h.sampling_error, iteration_error=h.iteration_error,
+                area_N4=h.areas[N[0]], area_N2=h.areas[N[1]], area_both_sides=h.area_both_sides,
+                impact_fraction_F0=h.impact_fraction_F0, floor_touched=bool(h.floor_touched), unresolved=int(h.unresolved),
+                n_samples=int(h.n_samples), K_low=float(h.box[2]))
+
+
+#: The fields of a point's row that the sweeps read (what a checkpointed row must have).
+_ROW = dict(area=float, error=float, sampling_error=float, iteration_error=float, area_N4=float, area_N2=float,
+            area_both_sides=float, impact_fraction_F0=float, floor_touched=bool, unresolved=int, n_samples=int,
+            K_low=float, theory=float, seconds=float)
 _MODEL_ROW = dict(area=float, error=float, agree=float, K_low=float)
 
 
-def _row_check(fields: dict, eps: float) -> Callable:
-    """A check of a checkpointed row (untrusted): the fields its reader takes, and the point's own eps."""
+def _row_check(kind: str, point: dict) -> Callable:
+    """A check of a checkpointed row (untrusted): the fields its reader takes, and the point's own box."""
+    fields = dict(_ROW)
+    if kind == "flow_hovering_area":
+        fields.update(b1=float, models=(tuple(m["name"] for m in point["models"]), _MODEL_ROW))
+
     def check(row):
         check_row(row, fields)
-        if row["eps"] != eps:
-            raise ValueError(f"row.eps = {row['eps']!r} is not the point's eps = {eps!r}")
+        if row["K_low"] != point["K_low"]:
+            raise ValueError(f"row.K_low = {row['K_low']!r} is not the point's K_low = {point['K_low']!r}")
     return check
 
 
-def _sweep(points, ckpt, bar, where) -> tuple:
-    """Rows of a sweep's points ``[(key, fn, args, check)]`` in order: from the checkpoint (each row
-    checked first: the file is untrusted), or computed (here, or as pieces on ``where``: a dict of
-    executor arguments) and checkpointed as each arrives. Returns (rows, reused: one bool per
-    point, True where the checkpoint had it)."""
-    rows = [ckpt.get(key, check) for key, _, _, check in points]
+def _sweep(kind: str, points: list, ckpt, bar, where) -> tuple:
+    """Rows of a plan's points in order: from the checkpoint (each row checked first: the file is
+    untrusted), or computed (here, or as pieces on ``where``: a dict of executor arguments) and
+    checkpointed as each arrives (a point another process wrote meanwhile is not written again).
+    Returns (rows, reused: one bool per point, True where the checkpoint had it)."""
+    keys = [point_key(kind, p) for p in points]
+    rows = [ckpt.get(k, _row_check(kind, p)) for k, p in zip(keys, points)]
     reused = [r is not None for r in rows]
     bar.advance(sum(reused))
     todo = [i for i, r in enumerate(rows) if r is None]
 
     def done(j, row):
         i = todo[j]
-        ckpt.put(points[i][0], row)
-        rows[i] = row
+        ckpt.put(keys[i], row)
+        rows[i] = ckpt.get(keys[i]) if keys[i] in ckpt else row  # another process's row, if it was first
         bar.advance(1)
 
     if where:
@@ -445,11 +492,17 @@ def _sweep(points, ckpt, bar, where) -> tuple:
             # Each point keeps the core's threads (all cores): sweep points differ in cost (1-25 s per
             # eps of the flow scene), and one thread per point on a shared machine left the costliest
             # point alone at the end (66 s vs 50 s for flow_hov_vs_eps on 2 workers here).
-            for _ in run_pieces(ex, _call, [(points[i][1], points[i][2]) for i in todo], on_result=done):
+            for _ in run_pieces(ex, _call, [(run_point, (kind, points[i])) for i in todo], on_result=done):
                 pass
     else:
         for j, i in enumerate(todo):
-            done(j, points[i][1](*points[i][2]))
+            ckpt.refresh()
+            if keys[i] in ckpt:  # finished by another process meanwhile (hovering_sweep on the same file)
+                rows[i] = ckpt.get(keys[i], _row_check(kind, points[i]))
+                reused[i] = True
+                bar.advance(1)
+                continue
+            done(j, run_point(kind, points[i]))
     return rows, reused
 
 
@@ -459,36 +512,30 @@ def _call(fn, args):
 
 def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint,
                     where=None) -> HoveringAreaResult:
-    n_steps = scaled(scene.n_steps, quick)
-    samples = max(scene.samples // QUICK_FACTOR, 400) if quick else scene.samples
-    meta.update(n_steps=n_steps, samples=samples)
+    points = plan_points(scene, quick)
+    meta.update(n_steps=points[0]["n_steps"], samples=points[0]["samples"])
     # Each measured point is on disk at once; a rerun resumes where an interrupted one stopped and
     # recomputes nothing already measured (keys hold every parameter that changes a point).
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
     eps_all = np.array(scene.eps)
-    points = []
-    for s in scene.series:
-        for e in scene.eps:
-            ms = s.map_at(e)
-            kw = {} if s.K_low is None else {"K_low": s.K_low}
-            key = dict(map=ms.as_dict(), n_steps=n_steps, samples=samples, seed=scene.seed, **kw)
-            points.append((key, _truncated_point, (ms, n_steps, samples, scene.seed, kw), _row_check(_TRUNCATED_ROW, e)))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="point") as bar:
-        all_rows, from_ckpt = _sweep(points, ckpt, bar, where)
+        all_rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where)
     drawn = set()
     out = []
     ne = len(scene.eps)
     for k, s in enumerate(scene.series):
         rows = all_rows[k * ne:(k + 1) * ne]
+        pts = points[k * ne:(k + 1) * ne]
         reused = sum(from_ckpt[k * ne:(k + 1) * ne])
         fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
         te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
         drawn.add(fam)
         col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
-        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=col("eps"), area=col("area"),
+        par = lambda c: np.array([p["map"][c] for p in pts], dtype=float)  # noqa: E731
+        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=par("eps"), area=col("area"),
                                 error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
-                                K_low=col("K_low"), Omega0=col("Omega0"), theta_w=col("theta_w"), theory_eps=te,
+                                K_low=col("K_low"), Omega0=par("Omega0"), theta_w=par("theta_w"), theory_eps=te,
                                 theory_curve=tc, golden_c=s.golden_c, reused=reused))
     meta["points_reused"] = sum(from_ckpt)
     return HoveringAreaResult(scene=scene, meta=meta, series=out)
@@ -562,85 +609,23 @@ def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
     return out
 
 
-def _measured_model(fm, K_low: float):
-    """The truncated family with arcs measured on the flow's corner curves (and measured forcing).
-
-    Circles below the flow's impact zone (eps > 0: under the deformed torus tangent to the upper
-    wall, ``FlowMap.impact_zone_floor``) hold no J_1 / J_R arcs: the family then stops at the
-    lowest circle that has them, and its band is shallower than the box asked for.
-    """
-    depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
-    s = np.linspace(math.sqrt(depth), 0.0, 17)[:-1]
-    K = np.concatenate([-s**2, [0.01, 0.03, 0.05]])
-    cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=1e-12)
-    ok = (K > 0) | (np.isfinite(cc.JR) & np.isfinite(cc.J1) & np.isfinite(cc.Omega))
-    first = int(np.argmax(np.cumprod(ok[::-1])[::-1])) if not ok.all() else 0
-    keep = np.zeros(K.size, bool)
-    keep[first:] = True
-    keep &= ok
-    if not keep.all():
-        cc = replace(cc, **{f: getattr(cc, f)[keep] for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1",
-                                                              "Omega", "Omega_spread", "other")})
-    return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
-
-
 def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint,
                    where=None) -> FlowHoveringResult:
-    n = scaled(scene.n_steps, quick, floor=50)
-    samples = max(scene.samples // QUICK_FACTOR, 100) if quick else scene.samples
-    meta.update(n_steps=n, samples=samples)
+    points = plan_points(scene, quick)
+    meta.update(n_steps=points[0]["n_steps"], samples=points[0]["samples"])
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
-    points = []
-    for e in scene.eps:
-        sysd = _serial_dict(scene.system)
-        sysd["eps"] = e
-        key = dict(system=sysd, h=scene.h, integrator=_serial_dict(scene.integrator), n_steps=n, samples=samples,
-                   seed=scene.seed, models=list(scene.models), rows=2)  # rows: the row layout's version
-        models = (tuple(scene.models), _MODEL_ROW)
-        points.append((key, _flow_point, (scene, e, n, samples), _row_check(dict(_FLOW_ROW, models=models), e)))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="eps") as bar:
-        rows, from_ckpt = _sweep(points, ckpt, bar, where)
+        rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where)
     reused = sum(from_ckpt)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
     models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")}
               for name in scene.models}
     meta["points_reused"] = reused
-    return FlowHoveringResult(scene=scene, meta=meta, eps=col("eps"), flow_area=col("flow"), flow_error=col("flow_err"),
-                              flow_both_sides=col("flow_both"), models=models, theory=col("theory"), K_low=col("K_low"),
-                              b1=col("b1"), seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
-
-
-def _flow_point(scene, e, n, samples, n_threads: int = 0) -> dict:
-    """One eps of a flow |HOV| sweep (a piece: runs in any process)."""
-    t = time.perf_counter()
-    fm = _flowmap(scene, eps=e)
-    # One box for flow and models, so the same points are classified by each: the default
-    # depth (the critical band of eq:hovsetsize), cut to the band every model is defined on.
-    depth = default_depth(fm) if e != 0 else 0.1
-    tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
-    K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
-    if "onset" in tms:
-        K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
-    flow = fm.hovering_area(n_steps=n, samples=samples, K_low=K_low, seed=scene.seed, keep_points=True,
-                            n_threads=n_threads)
-    th = fm.theory()
-    row = dict(eps=e, flow=flow.area, flow_err=flow.error, flow_both=flow.area_both_sides, K_low=flow.box[2],
-               theory=th.area, b1=float(th.forcing[0]), unresolved=flow.unresolved,
-               seconds=time.perf_counter() - t, models={})
-    for name, tm in tms.items():
-        # A model whose band is shallower than the box (measured arcs stop at the impact zone's
-        # floor) samples its own box: its points are not the flow's, so no verdict agreement.
-        K_m = max(K_low, tm.valid_band()[0] * (1 - 1e-9))
-        mh = tm.hovering_area(n_steps=n, samples=samples, K_low=K_m, seed=scene.seed, keep_points=True,
-                              n_threads=n_threads)
-        agree = float(np.mean(mh.hovering == flow.hovering)) if K_m == K_low else float("nan")
-        row["models"][name] = dict(area=mh.area, error=mh.error, agree=agree, K_low=K_m)
-    return row
-
-
-def _serial_dict(spec) -> dict:
-    return asdict(spec)
+    return FlowHoveringResult(scene=scene, meta=meta, eps=np.array([p["system"]["eps"] for p in points], dtype=float),
+                              flow_area=col("area"), flow_error=col("error"), flow_both_sides=col("area_both_sides"),
+                              models=models, theory=col("theory"), K_low=col("K_low"), b1=col("b1"),
+                              seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
 
 
 def _circle(V, e: float, n: int) -> tuple:

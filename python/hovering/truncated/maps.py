@@ -18,7 +18,7 @@ from .._checks import (check_memory, forcing_array, is_choice, point_pair, real_
 from .._enums import Region, wrap
 from ..interface import iterate_arguments
 from .._progress import check_progress, progress_bar
-from .._pickle import reduce_compiled
+from .._pickle import reduce_record
 from ..interface import IterateResult, MapAnalyses
 from . import theory as _geo
 
@@ -431,8 +431,8 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         return TruncatedMap(**p, K_max=self.valid_band()[1])
 
     def __reduce__(self):
-        """Pickle as the compiled map's parameters (K_max: the band's upper end) and the instance dict."""
-        return reduce_compiled(self, _core.truncated.TruncatedMap)
+        """Pickle as the record (the parameters, K_max: the band's upper end) and the instance dict."""
+        return reduce_record(self, self.__dict__)
 
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: the six parameters and ``K_max`` (the band's upper end)."""
@@ -440,8 +440,11 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
 
     @classmethod
     def _from_record(cls, record: dict) -> "TruncatedMap":
-        """Inverse of :meth:`_to_record` (validated again; the same doubles give the same map bit for bit)."""
-        return cls(**record)
+        """Inverse of :meth:`_to_record` (validated again; the same doubles give the same map bit for bit).
+        A subclass is rebuilt through this class's constructor (its own may take other arguments)."""
+        obj = cls.__new__(cls)
+        TruncatedMap.__init__(obj, **record)
+        return obj
 
 
 def _angles(name: str, phi):
@@ -556,8 +559,8 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         return TruncatedFamily(eps, K, Om, JR, J1, forcing=tuple(self.forcing), K_max=self._K_max)
 
     def __reduce__(self):
-        """Pickle as the compiled family's tables, forcing and band, and the instance dict (the tables as given)."""
-        return reduce_compiled(self, _core.truncated.TruncatedFamily)
+        """Pickle as the record (the tables as given, forcing, K_max) and the rest of the instance dict."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("_tables", "_K_max")})
 
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: eps, the tables as given, the forcing and K_max."""
@@ -569,8 +572,10 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
     def _from_record(cls, record: dict) -> "TruncatedFamily":
         """Inverse of :meth:`_to_record` (validated again; the same tables give the same map bit for bit)."""
         r = dict(record)
-        return cls(r.pop("eps"), r.pop("K"), r.pop("Omega"), r.pop("JR"), r.pop("J1"), forcing=tuple(r.pop("forcing")),
-                   **r)
+        obj = cls.__new__(cls)
+        TruncatedFamily.__init__(obj, r.pop("eps"), r.pop("K"), r.pop("Omega"), r.pop("JR"), r.pop("J1"),
+                                 forcing=tuple(r.pop("forcing")), **r)
+        return obj
 
     @classmethod
     def from_map(cls, m: TruncatedMap, K, forcing=(1.0,)) -> "TruncatedFamily":

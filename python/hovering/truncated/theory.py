@@ -17,6 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .. import _core
 from .._checks import forcing_array, integer, real_array, real_number, require_angles, require_finite
 from .._enums import wrap
 from .._serial import Saveable
@@ -401,8 +402,8 @@ class Theory(Saveable):
     def G(self, psi):
         """The first-order shape ``G(psi)``, ``psi = phi + Omega0/2``, of the curves through L1."""
         psi = np.asarray(psi, dtype=float)
-        return sum(b * (1 - np.cos((k + 1) * psi)) / (2 * math.sin(0.5 * (k + 1) * self.Omega0))
-                   for k, b in enumerate(self.forcing) if b != 0)
+        g = _core.analysis.first_order_shape(list(self.forcing), self.Omega0, np.ascontiguousarray(psi.ravel()))
+        return g.reshape(psi.shape) if psi.ndim else float(g[0])
 
     def curve(self, phi):
         """The lowest curve avoiding the impacting arcs (critical curve if hovering, else k^{u0}) at phi."""

@@ -1,10 +1,15 @@
 #pragma once
 // The hovering set HOV(eps) by its definition (sec:truncinvcurves), measured on any map of the
-// core: points that impact under F_0 and never impact under F_eps within N iterates. The C++ twin of
-// python/hovering/analysis/hovering_area: the same stratified samples to the bit (numpy's
-// default_rng(seed) stream is reproduced), the same early exit from {J_0u, J_0}, the same
-// estimates at N/4, N/2, N and the same error bar (2 sampling sigma + the change over the last
-// doubling of N). On the truncated maps the result is Python's bit for bit.
+// core: points that impact under F_0 and never impact under F_eps within N iterates. The one
+// implementation of its numerics: the stratified samples (numpy's default_rng(seed) stream, so the
+// points are the doubles numpy draws), the per-sample outcomes (F_0, then F_eps, each with early
+// exit from {J_0u, J_0}), the estimates at N/4, N/2, N with their error bar, and the default box.
+// Python's hovering.hovering_area and the sweep executable both call these.
+//
+// Pieces: the samples of an index range [lo, hi) are drawn on their own (the stream is jumped
+// ahead, not replayed), their outcomes computed anywhere, and the outcomes of all pieces,
+// concatenated in index order, give hovering_estimate the single-process answer bit for bit (the
+// estimate only counts).
 
 #include <atomic>
 #include <cstdint>
@@ -15,25 +20,24 @@
 
 namespace hovering {
 
-/// Unsigned 128-bit integers (a GCC/Clang extension; PCG64's state).
-__extension__ typedef unsigned __int128 uint128;
-
-/// numpy.random.default_rng(seed).random(): PCG64 seeded through SeedSequence, 53-bit doubles.
-class NumpyRandom {
-public:
-    /// The generator numpy.random.default_rng(seed) starts as (seed >= 0).
-    explicit NumpyRandom(std::uint64_t seed);
-    /// The next raw 64-bit output (PCG64 XSL-RR).
-    std::uint64_t next_u64();
-    /// The next double in [0, 1), as Generator.random().
-    double random() { return double(next_u64() >> 11) * (1.0 / 9007199254740992.0); }
-
-private:
-    uint128 state_ = 0, inc_ = 0;
+/// The near-square grid of the box [-pi, pi) x [K_low, 0): n_phi columns, n_K rows, one sample per cell.
+struct SampleGrid {
+    std::int64_t n_phi = 0;  ///< round(sqrt(samples 2 pi / -K_low)) clipped to [1, samples]
+    std::int64_t n_K = 0;    ///< ceil(samples / n_phi)
+    /// Number of samples (cells), at most samples + n_phi.
+    std::int64_t size() const { return n_phi * n_K; }
 };
 
-/// One uniform point per cell of a near-square grid over [-pi, pi) x [K_low, 0) (as Python's
-/// _stratified: n_phi = round(sqrt(samples 2 pi / -K_low)) columns, ceil(samples / n_phi) rows).
+/// The grid for `samples` points asked for (>= 1) over the box of bottom K_low (finite, < 0).
+SampleGrid sample_grid(std::int64_t samples, double K_low);
+
+/// Samples lo..hi-1 (0 <= lo <= hi <= grid size) of the box: sample i lies in column i / n_K, row
+/// i % n_K, jittered by numpy's default_rng(seed).random(): the phi jitters are its outputs 0..n-1,
+/// the K jitters n..2n-1 (n the grid size). K is capped at -1e-300 (the box is K < 0).
+void stratified_samples(std::int64_t samples, double K_low, std::uint64_t seed, std::int64_t lo, std::int64_t hi,
+                        double* phi, double* K);
+
+/// All samples of the box (lo = 0, hi = grid size).
 void stratified_samples(std::int64_t samples, double K_low, std::uint64_t seed, std::vector<double>& phi,
                         std::vector<double>& K);
 
@@ -47,6 +51,15 @@ struct HoveringAreaOptions {
     const std::atomic<bool>* cancel = nullptr;      ///< set to stop early (then interrupted)
     std::atomic<std::int64_t>* progress = nullptr;  ///< steps / returns done, 2 N n in all
     bool keep_points = false;      ///< keep each sample's membership (HoveringAreaResult::hovering)
+};
+
+/// Per-sample outcomes of the two iterations: the Status under F_0 and under F_eps, the steps
+/// F_eps took before it stopped, and the regions its orbit visited (bit r: Region r).
+struct HoveringOutcomes {
+    std::vector<std::int8_t> status_F0, status;
+    std::vector<std::int64_t> steps_done;
+    std::vector<std::int8_t> visited;
+    bool interrupted = false;  ///< cancelled: the outcomes are not a result
 };
 
 /// The measured area; the fields of Python's HoveringArea that do not need the theory.
@@ -63,14 +76,39 @@ struct HoveringAreaResult {
     double area_both_sides = 0;   ///< part whose orbits visit both J_0 and J_0u
     std::int64_t unresolved = 0;  ///< orbits of F_eps ending otherwise (corner, grazing, limits)
     bool interrupted = false;     ///< cancelled: the numbers are not a result
-    std::vector<std::int8_t> hovering;  ///< per sample (keep_points): 1 if it hovers
+    std::vector<std::int8_t> hovering;    ///< per sample (keep_points): 1 if it hovers
+    std::vector<std::int8_t> both_sides;  ///< per sample (keep_points): 1 if it hovers visiting J_0 and J_0u
 };
 
-/// HOV of the truncated map m (F_0 = m at eps = 0).
+/// Outcomes of the n points (phi, K) under F_0 (the same arcs at eps = 0) and the truncated map m.
+/// Uses opt.n_steps, n_threads, cancel, progress (2 n N in all).
+HoveringOutcomes hovering_outcomes(const TruncatedMap& m, const double* phi, const double* K, std::int64_t n,
+                                   const HoveringAreaOptions& opt);
+/// The same for the truncated family m.
+HoveringOutcomes hovering_outcomes(const TruncatedFamily& m, const double* phi, const double* K, std::int64_t n,
+                                   const HoveringAreaOptions& opt);
+/// The same for the flow map m, with F_0 = m0 (the eps = 0 flow on its own normal coordinates).
+HoveringOutcomes hovering_outcomes(const FlowMap& m, const FlowMap& m0, const double* phi, const double* K,
+                                   std::int64_t n, const HoveringAreaOptions& opt);
+
+/// The estimates from the outcomes of the samples (their heights K, n of them) of a box of bottom
+/// K_low after N = n_steps iterates: counts only, so pieces concatenated give the whole answer.
+HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K, std::int64_t n, std::int64_t n_steps,
+                                     double K_low, bool keep_points);
+
+/// HOV of the truncated map m: checks, samples, outcomes and estimate in one call.
 HoveringAreaResult hovering_area(const TruncatedMap& m, const HoveringAreaOptions& opt);
-/// HOV of the truncated family m (F_0 = the same arcs at eps = 0).
+/// HOV of the truncated family m.
 HoveringAreaResult hovering_area(const TruncatedFamily& m, const HoveringAreaOptions& opt);
-/// HOV of the flow map m with F_0 = m0, the eps = 0 flow on its own normal coordinates.
+/// HOV of the flow map m with F_0 = m0.
 HoveringAreaResult hovering_area(const FlowMap& m, const FlowMap& m0, const HoveringAreaOptions& opt);
+
+/// First-order shape G(psi) = sum_k b_k (1 - cos(k psi)) / (2 sin(k Omega0 / 2)) of the invariant
+/// curves through L1 (psi = phi + Omega0 / 2); b[0] multiplies sin(phi). hovering.Theory.G.
+double first_order_shape(const std::vector<double>& b, double Omega0, double psi);
+
+/// Depth of the default box below K = 0: 2 |eps| max |G| over 4001 angles in [-pi, pi]
+/// (2 |eps| / |sin(Omega0 / 2)| for f = sin); +inf when that is not finite and positive (or b is empty).
+double default_depth(double eps, double Omega0, const std::vector<double>& b);
 
 }  // namespace hovering

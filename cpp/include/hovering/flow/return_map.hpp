@@ -32,6 +32,10 @@ enum class FlowStatus : std::int8_t {
 /// The orbit outcome (Status) of a return that ended with this FlowStatus.
 Status orbit_status(FlowStatus s);
 
+/// The names FlowOptions::stepper takes, its default first (bound as hovering.flow.STEPPERS).
+inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd", "rkck",   "rkf45",  "rk4",  "rk2",
+                                                         "msadams", "rk4imp", "rk2imp", "exact"};
+
 /// Integrator settings.
 /// Stepper "exact" is the flow in closed form where the system has one (eps = 0 with Harmonic or
 /// Tan potentials: event to event on the action-angle variables; Harmonic + Harmonic with a

@@ -40,6 +40,15 @@ private:
     std::vector<double> a_, b_;  // cos and sin coefficients in (s + pi), a_[0] the mean
 };
 
+/// The n_phi midpoint angles phi_j = -pi + 2 pi (j + 1/2) / n_phi at which a forcing is sampled.
+std::vector<double> forcing_angles(int n_phi);
+
+/// Sine coefficients b_1..b_n_modes of f from its values at forcing_angles(f.size()): the least-squares
+/// fit, which on these angles is the discrete sine transform b_k = (2 / n) sum_j f_j sin(k phi_j)
+/// (the modes are orthogonal there). Throws std::invalid_argument unless 1 <= n_modes and
+/// 2 n_modes < f.size().
+std::vector<double> sine_coefficients(const std::vector<double>& f, int n_modes);
+
 /// I_tan^eps of a system at energy h; see the file comment.
 class TangentialCurve {
 public:
@@ -48,6 +57,12 @@ public:
     /// interpolation error. Throws std::invalid_argument, saying why, when the wall tangency curve
     /// does not exist or is not a graph over the wall angle (eps too large), or a trace fails.
     static TangentialCurve measure(const FlowSystem& s, double h, int n, const FlowOptions& opt, int n_check = 4);
+    /// measure() with as many wall points as the curve needs: 64, doubled (up to 1024) until the
+    /// interpolation error in I measured at n_check points is below 1e-12 (64 when n_check = 0).
+    static TangentialCurve measure_refined(const FlowSystem& s, double h, const FlowOptions& opt, int n_check = 4);
+    /// The curve a flow map on normal coordinates uses unless given one: measure_refined with the
+    /// traces at rtol 1e-13 (atol 1e-15) and the other options' defaults.
+    static TangentialCurve measure_default(const FlowSystem& s, double h);
     /// The curve of measure() from its samples (theta_k, I_k at s_k = -pi + 2 pi k / n), its
     /// energy h, the system's eps, I_tan0 and the measured interpolation errors: bit for bit the
     /// curve measure() built from them (what a saved or pickled curve is rebuilt from).
@@ -81,6 +96,15 @@ public:
     double eps() const { return eps_; }
     /// A one-line explanation of why the curve is not a graph (empty if it is).
     std::string not_graph_reason() const;
+    /// Sine coefficients b_1..b_n_modes of the measured forcing f(phi) = (I_tan(-phi) - I_tan(phi)) / eps
+    /// (eq:defoff): f sampled at forcing_angles(n_phi) and fitted by sine_coefficients. Throws
+    /// std::invalid_argument at eps = 0 (f divides by eps) or if the curve is not a graph.
+    std::vector<double> forcing_coefficients(int n_modes = kForcingModes, int n_phi = kForcingSamples) const;
+
+    /// Sine modes of the measured forcing fitted by default.
+    static constexpr int kForcingModes = 8;
+    /// Angles the measured forcing is sampled at by default.
+    static constexpr int kForcingSamples = 256;
 
 private:
     /// Build the interpolants, min_slope and I_tan(theta) from s_, theta_, I_ (throws if theta(s) winds).

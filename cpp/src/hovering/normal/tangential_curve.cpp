@@ -272,4 +272,49 @@ double TangentialCurve::I_tan(double theta) const {
     return Itheta_(theta);
 }
 
+TangentialCurve TangentialCurve::measure_refined(const FlowSystem& s, double h, const FlowOptions& opt, int n_check) {
+    int n = 64;
+    TangentialCurve c = measure(s, h, n, opt, n_check);
+    while (n_check > 0 && n < 1024 && !(c.err_I_ < 1e-12)) {
+        n *= 2;
+        c = measure(s, h, n, opt, n_check);
+    }
+    return c;
+}
+
+TangentialCurve TangentialCurve::measure_default(const FlowSystem& s, double h) {
+    FlowOptions o;
+    o.rtol = 1e-13;
+    o.atol = 1e-13 * 1e-2;
+    return measure_refined(s, h, o, 4);
+}
+
+std::vector<double> forcing_angles(int n_phi) {
+    if (n_phi < 1 || n_phi > 65536) bad("n_phi must be an integer in [1, 65536], got " + std::to_string(n_phi));
+    std::vector<double> ph(static_cast<std::size_t>(n_phi));
+    for (int j = 0; j < n_phi; ++j) ph[std::size_t(j)] = -kPi + 2 * kPi * (double(j) + 0.5) / n_phi;
+    return ph;
+}
+
+std::vector<double> sine_coefficients(const std::vector<double>& f, int n_modes) {
+    const int n_phi = int(f.size());
+    if (n_modes < 1 || 2 * n_modes >= n_phi)
+        bad("a sine fit of " + std::to_string(n_modes) + " modes needs more than " + std::to_string(2 * n_modes) +
+            " samples (n_modes >= 1, n_phi > 2 n_modes), got " + std::to_string(n_phi));
+    const std::vector<double> ph = forcing_angles(n_phi);
+    std::vector<double> b(std::size_t(n_modes), 0.0);
+    for (int j = 0; j < n_phi; ++j)
+        for (int k = 0; k < n_modes; ++k) b[std::size_t(k)] += f[std::size_t(j)] * std::sin(double(k + 1) * ph[std::size_t(j)]);
+    for (auto& x : b) x *= 2.0 / n_phi;
+    return b;
+}
+
+std::vector<double> TangentialCurve::forcing_coefficients(int n_modes, int n_phi) const {
+    if (eps_ == 0) bad("the forcing f(phi) is defined for eps != 0 (eq:defoff divides by eps)");
+    const std::vector<double> ph = forcing_angles(n_phi);
+    std::vector<double> f(ph.size());
+    for (std::size_t j = 0; j < ph.size(); ++j) f[j] = (I_tan(-ph[j]) - I_tan(ph[j])) / eps_;
+    return sine_coefficients(f, n_modes);
+}
+
 }  // namespace hovering

@@ -1,0 +1,233 @@
+// The sweep plan reader (type and range checks, version, exact numbers, keys) and the checkpoint
+// file (header, torn and damaged lines, keys compared as values, no duplicates), the parts of
+// hovering_sweep that are not the core's numerics.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "testing.hpp"
+#include "hovering/sweep/plan.hpp"
+#include "hovering/sweep/run.hpp"
+
+using namespace hovering::sweep;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kHead = "format = \"hovering-sweep-plan\"\nversion = 1\nkind = \"hovering_area\"\n";
+const std::string kPoint =
+    "[[points]]\nn_steps = 400\nsamples = 2000\nseed = 0\nK_low = -0.2145848093800635\ntheory = 0.1\n"
+    "map = { eps = 0.1, Omega0 = 3.883222077450933, theta_w = 2.356194490192345, tau0 = 1.0, tau1 = 0.5, lam = 0.5 }\n";
+
+/// kPoint with one line replaced (the line starting with `key =`), or a line added.
+std::string point_with(const std::string& key, const std::string& line) {
+    std::istringstream in(kPoint);
+    std::string out, l;
+    bool done = false;
+    while (std::getline(in, l)) {
+        if (!done && l.compare(0, key.size() + 3, key + " = ") == 0) {
+            if (!line.empty()) out += line + "\n";
+            done = true;
+        } else {
+            out += l + "\n";
+        }
+    }
+    if (!done) out += line + "\n";
+    return out;
+}
+
+const std::string kFlow = R"(format = "hovering-sweep-plan"
+version = 1
+kind = "flow_hovering_area"
+[[points]]
+n_steps = 50
+samples = 100
+seed = 0
+K_low = -0.1
+theory = 0.2
+b1 = 0.5
+h = 1.0
+system = { V1 = { kind = "harmonic", omega = 1.0 }, V2 = { kind = "tan", omega = 1.4, alpha = 0.7 }, coupling = [[1.0, 1, 1]], eps = -0.1, qw1 = -1.0, qw2 = -0.5, geometry = "step" }
+integrator = { stepper = "rk8pd", rtol = 1e-10, atol = 1e-10 }
+)";
+
+std::string tmp(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("hovering_test_plan_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return (d / name).string();
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void spit(const std::string& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+}
+
+}  // namespace
+
+TEST_CASE("a hand-written plan is read with its numbers exact and its key canonical", "[plan]") {
+    const Plan p = parse_plan(kHead + kPoint, "p.toml");
+    REQUIRE(p.points.size() == 1);
+    const PlanPoint& q = p.points[0];
+    CHECK(p.kind == "hovering_area");
+    CHECK(q.n_steps == 400);
+    CHECK(q.K_low == -0.2145848093800635);
+    CHECK(q.map.Omega0 == 3.883222077450933);
+    CHECK(q.theory == 0.1);
+    // Sorted keys, shortest round-trip numbers, the kind; label and theory are not parameters.
+    CHECK(q.key ==
+          "{\"K_low\":-0.2145848093800635,\"kind\":\"hovering_area\",\"map\":{\"Omega0\":3.883222077450933,\"eps\":0.1,"
+          "\"lam\":0.5,\"tau0\":1.0,\"tau1\":0.5,\"theta_w\":2.356194490192345},\"n_steps\":400,\"samples\":2000,\"seed\":0}");
+    const Plan labelled = parse_plan(kHead + point_with("theory", "theory = 0.7\nlabel = \"x\""), "p.toml");
+    CHECK(labelled.points[0].key == q.key);
+    // An integer where a number is asked is that number (a person may write tau0 = 1).
+    CHECK(parse_plan(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.883222077450933, theta_w = "
+                                               "2.356194490192345, tau0 = 1, tau1 = 0.5, lam = 0.5 }"),
+                     "p.toml")
+              .points[0]
+              .key == q.key);
+}
+
+TEST_CASE("every double a plan holds reads back bit for bit", "[plan]") {
+    // Python writes repr(float), the shortest text that reads back as that double; the reader must
+    // give the same double, or the two programs would sample other boxes. Doubles over the whole
+    // range, printed the same way (std::to_chars shortest), read by the plan reader.
+    std::mt19937_64 rng(7);
+    std::string text = kHead;
+    std::vector<double> xs;
+    for (int i = 0; i < 2000; ++i) {
+        double x;
+        do {
+            std::uint64_t bits = rng();
+            std::memcpy(&x, &bits, sizeof x);
+        } while (!std::isfinite(x));
+        xs.push_back(x);
+    }
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        char buf[64];
+        const auto r = std::to_chars(buf, buf + sizeof buf, xs[i]);
+        std::string s(buf, r.ptr);
+        if (s.find_first_of(".eE") == std::string::npos) s += ".0";  // TOML floats need a dot or exponent
+        text += "[[points]]\nn_steps = 400\nsamples = 2000\nseed = " + std::to_string(i) +
+                "\nK_low = -0.1\ntheory = " + s +
+                "\nmap = { eps = 0.1, Omega0 = 3.9, theta_w = 2.3, tau0 = 1.0, tau1 = 0.5, lam = 0.5 }\n";
+    }
+    const Plan p = parse_plan(text, "p.toml");
+    REQUIRE(p.points.size() == xs.size());
+    for (std::size_t i = 0; i < xs.size(); ++i) REQUIRE(std::memcmp(&p.points[i].theory, &xs[i], sizeof(double)) == 0);
+}
+
+TEST_CASE("bad plans: one message naming the file, the key, the value and what is allowed", "[plan]") {
+    const auto bad = [](const std::string& text, const std::string& needle) {
+        INFO(text);
+        CHECK_INVALID(parse_plan(text, "p.toml"), needle);
+    };
+    bad(kHead + point_with("n_steps", "n_steps = 2"),
+        "p.toml: points[0].n_steps = 2: allowed: an integer in [4, 9007199254740992]");
+    bad(kHead + point_with("samples", "samples = \"many\""), "points[0].samples = 'many': allowed: an integer");
+    bad(kHead + point_with("seed", "seed = -1"), "points[0].seed = -1: allowed: an integer in [0, 9223372036854775807]");
+    bad(kHead + point_with("K_low", "K_low = 0.5"), "points[0].K_low = 0.5: allowed: a finite number < 0");
+    bad(kHead + point_with("K_low", "K_low = nan"), "points[0].K_low = nan");
+    bad(kHead + point_with("K_low", ""), "points[0].K_low is missing (a finite number < 0)");
+    bad(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.9, theta_w = 4.0, tau0 = 1.0, tau1 = 0.5, lam = 0.5 }"),
+        "points[0].map.theta_w = 4: allowed: a finite number in (0, 3.141592653589793)");
+    bad(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.9, theta_w = 2.0, tau0 = 1.0, tau1 = 0.5 }"),
+        "points[0].map.lam is missing");
+    bad(kHead + point_with("seed", "seed = 0\nsed = 1"), "points[0].sed is not a key of this table");
+    bad(kHead + kPoint + kPoint, "p.toml: points[1] has the parameters of an earlier point");
+    // The core refuses what the reader let through: named with the point.
+    bad(kHead + point_with("K_low", "K_low = -50.0"), "p.toml: points[0]: K_low = ");
+    bad("format = \"hovering-sweep-plan\"\nversion = 2\nkind = \"hovering_area\"\n" + kPoint,
+        "p.toml: version = 2: this hovering_sweep reads plan version 1");
+    bad("format = \"a-scene\"\nversion = 1\nkind = \"hovering_area\"\n" + kPoint,
+        "p.toml: format = 'a-scene': allowed: one of 'hovering-sweep-plan'");
+    bad("format = \"hovering-sweep-plan\"\nversion = 1\nkind = \"portrait\"\n" + kPoint,
+        "kind = 'portrait': allowed: one of 'hovering_area' 'flow_hovering_area'");
+    bad(kHead, "p.toml: points is missing");
+    bad(kHead + "points = []\n", "p.toml: points = an array of 0: allowed: an array of 1 to");
+    bad("kind = [\n", "p.toml line ");
+    // Flow points: system, integrator and models.
+    const auto flow = [&](const std::string& from, const std::string& to, const std::string& needle) {
+        std::string t = kFlow;
+        const auto at = t.find(from);
+        REQUIRE(at != std::string::npos);
+        bad(t.replace(at, from.size(), to), needle);
+    };
+    CHECK(parse_plan(kFlow, "f.toml").points[0].system.coupling.size() == 1);
+    flow("stepper = \"rk8pd\"", "stepper = \"euler\"", "points[0].integrator.stepper = 'euler': allowed: one of 'rk8pd'");
+    flow("rtol = 1e-10", "rtol = 2.0", "points[0].integrator.rtol = 2: allowed: a finite number in (0, 1)");
+    flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 21]]", "points[0].system.coupling[0] = an array of 3");
+    flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 1], [2.0, 1, 1]]", "each (i, j) once");
+    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1.4",
+         "points[0].system.V2.alpha is missing");
+    flow("qw2 = -0.5", "qw2 = 0.5", "points[0].system.qw2 = 0.5: allowed: a finite number < 0");
+    flow("geometry = \"step\"", "geometry = \"box\"", "geometry = 'box': allowed: one of 'none' 'wall' 'step'");
+    flow("integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n",
+         "integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n[[points.models]]\nname = \"m\"\nK_low = -0.1\n"
+         "eps = 0.1\nK = [-1.0, -0.5, 0.0, 0.5]\nOmega = [1.0, 1.0, 1.0]\nJR = [1.0, 1.0, 1.0, 0.0]\n"
+         "J1 = [1.0, 0.5, 0.0, 0.0]\nforcing = [1.0]\nK_max = inf\n",
+         "points[0].models[0].Omega = an array of 3: allowed: an array of 4 to 4 entries");
+}
+
+TEST_CASE("checkpoint: header, points by key, torn and damaged lines", "[checkpoint]") {
+    const std::string path = tmp("c.jsonl");
+    fs::remove(path);
+    const std::string key = "{\"kind\":\"hovering_area\",\"n_steps\":400,\"x\":0.1}";
+    {
+        Checkpoint c(path);
+        CHECK(c.size() == 0);
+        CHECK(!c.done(key));
+        CHECK(c.append(key, "{\"area\":1.5}", "{\"program\":\"test\"}"));
+        CHECK(c.done(key));
+        CHECK(!c.append(key, "{\"area\":2.5}", "{\"program\":\"test\"}"));  // never twice
+    }
+    CHECK(slurp(path) ==
+          "{\"format\":\"hovering-checkpoint\",\"version\":1}\n{\"provenance\":{\"program\":\"test\"}}\n" +
+              std::string("{\"key\":") + key + ",\"row\":{\"area\":1.5}}\n");
+    // Keys are compared as values: another program's spacing, key order and number spelling match.
+    spit(path, slurp(path) + "{\"row\": {}, \"key\": {\"x\": 1.0e-1, \"n_steps\": 4e2, \"kind\": \"b\"}}\n");
+    {
+        Checkpoint c(path);
+        CHECK(c.size() == 2);
+        CHECK(c.done("{\"kind\":\"b\",\"n_steps\":400.0,\"x\":0.1}"));
+    }
+    // A last line without its newline (a run killed mid-write) is cut off.
+    const std::string good = slurp(path);
+    spit(path, good + "{\"key\":{\"x\":0.2},\"ro");
+    {
+        Checkpoint c(path);
+        CHECK(!c.torn().empty());
+        CHECK(c.size() == 2);
+    }
+    CHECK(slurp(path) == good);
+    // A damaged line with lines after it, or any complete line that is not a record: refused, untouched.
+    for (const std::string& broken : {std::string("{\"key\":{\"x\":0.2},\"ro\n"), std::string("[1, 2]\n"),
+                                      std::string("{\"key\":{\"x\":NaN},\"row\":{}}\n"),
+                                      std::string("{\"key\":{},\"row\":{},\"extra\":1}\n")}) {
+        const std::string text = good + broken + "{\"key\":{\"x\":0.3},\"row\":{}}\n";
+        spit(path, text);
+        CHECK_INVALID(Checkpoint{path}, "line 5: ");
+        CHECK(slurp(path) == text);
+    }
+    // Another program's file, or another version of this one: refused, untouched.
+    for (const std::string& first : {std::string("area,error\n"), std::string("{\"key\":{},\"row\":{}}\n"),
+                                     std::string("{\"format\":\"hovering-checkpoint\",\"version\":2}\n")}) {
+        spit(path, first);
+        CHECK_INVALID(Checkpoint{path}, "line 1: ");
+        CHECK(slurp(path) == first);
+    }
+    CHECK_INVALID(Checkpoint{fs::temp_directory_path().string()}, "is not a regular file");
+    fs::remove_all(fs::path(path).parent_path());
+}
