@@ -10,6 +10,7 @@ eps = 0 no coupling, no "regions" no crossing bookkeeping, no "trajectory" no de
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from typing import Callable, Optional
