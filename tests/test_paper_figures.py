@@ -519,6 +519,56 @@ def test_wall_section_at_small_eps_keeps_the_order_symmetry_and_corner_segments(
 
 
 # ------------------------------------------------------------------------------------------------
+# A saved result is untrusted input: a tampered field is one ValueError naming the file and field
+
+
+def _seg(d, i=0):
+    return d["tree"]["fields"]["segments"]["__list__"][i]["fields"]
+
+
+TAMPERED = [
+    ("fig_wallsection", "segment_kind", lambda d: _seg(d).update(kind="R2"),
+     r"root\.segments\[0\]: kind = 'R2' is not allowed; allowed: 'R', '0', '1', 'R0', '01', '1R'"),
+    ("fig_wallsection", "segment_status", lambda d: _seg(d).update(status="FINE"), r"root\.segments\[0\]: status"),
+    ("fig_wallsection", "boundaries", lambda d: d["tree"]["fields"]["boundaries"]["__dict__"].pop("01"),
+     r"root: boundaries must map \['R0', '01', '1R'\] to numbers"),
+    ("fig_wallsection", "circle_keys", lambda d: d["tree"]["fields"]["circle"]["__dict__"].pop("p1"),
+     r"root: circle must hold the arrays \['p1', 'p2', 'q2', 'region', 'theta'\]"),
+    ("fig_sigma0_wall", "point_number", lambda d: d["tree"]["fields"]["points"]["__list__"][0]["fields"].update(number=9),
+     r"root\.points\[0\]: number = 9 is out of range; allowed: 1 to 7"),
+    ("fig_corner_directions", "direction", lambda d: d["tree"]["fields"]["trajectories"]["__list__"][0]["fields"].update(
+        direction="10"), r"root\.trajectories\[0\]: direction = '10' is not allowed"),
+    ("fig_corner_directions", "curves", lambda d: d["tree"]["fields"]["curves"]["__dict__"].pop("1R"),
+     r"root: curves must have the keys \['R0', '01', '1R'\]"),
+]
+
+
+@pytest.mark.parametrize("name,what,edit,msg", TAMPERED, ids=[t[1] for t in TAMPERED])
+def test_a_tampered_result_is_refused_naming_the_field(results, tmp_path, name, what, edit, msg):
+    import io
+    import zipfile
+
+    from hovering.scenes import load_result
+
+    src, _ = results[name].save(tmp_path / "genuine.npz")
+    assert type(load_result(src)) is type(results[name])  # the genuine file loads
+    with zipfile.ZipFile(src) as z:
+        members = {n: z.read(n) for n in z.namelist()}
+    doc = json.loads(str(np.load(io.BytesIO(members.pop("__meta__.npy")))))
+    edit(doc)
+    dst = tmp_path / f"{what}.npz"
+    with zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as z:
+        buf = io.BytesIO()
+        np.lib.format.write_array(buf, np.array(json.dumps(doc)))
+        z.writestr("__meta__.npy", buf.getvalue())
+        for n, b in members.items():
+            z.writestr(n, b)
+    with pytest.raises(ValueError, match=msg) as e:
+        load_result(dst)
+    assert str(e.value).startswith(f"{dst}: "), str(e.value)
+
+
+# ------------------------------------------------------------------------------------------------
 # End to end: a quick run writes PNG, NPZ and JSON; the saved result redraws the same figure
 
 
