@@ -50,6 +50,20 @@ def test_dask_local_cluster_and_an_existing_client_give_the_same_answer(single, 
     same(single, hovering_area(M, **KW, executor=Executor(scheduler=cluster.scheduler.address, pieces=3)))
 
 
+def test_the_callers_own_pools_give_the_same_answer_and_stay_open(single):
+    # A thread pool works too (the core releases the GIL); a process pool of the caller's is used,
+    # not shut down: it takes more work afterwards.
+    import concurrent.futures as cf
+    import multiprocessing
+
+    with cf.ThreadPoolExecutor(2) as pool:
+        same(single, hovering_area(M, **KW, executor=pool))
+        assert pool.submit(abs, -1).result() == 1
+    with cf.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        same(single, hovering_area(M, **KW, executor=Executor(pool=pool, pieces=3)))
+        assert pool.submit(abs, -2).result() == 2
+
+
 def test_flow_map_pieces_give_the_single_process_answer():
     sys = hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
                               eps=-0.1, qw1=-1.0, qw2=-0.5, geometry="step")
@@ -98,6 +112,10 @@ def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_p
     (dict(workers=2, pieces=0), "pieces must be an integer"),
     (dict(client=None, scheduler="tcp://a:1", dask=True), "dask=True makes a LocalCluster"),
     (dict(workers=2, dask="yes"), "dask must be True or False, got 'yes'"),
+    (dict(pool="threads"), "pool must be a concurrent.futures.Executor, got 'threads'"),
+    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), workers=2), "brings its own workers"),
+    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), scheduler="tcp://a:1"),
+     "at most one of client, scheduler and pool"),
 ])
 def test_bad_executors_are_named_before_any_work(bad, match):
     with pytest.raises(ValueError, match=match):

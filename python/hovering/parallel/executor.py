@@ -4,7 +4,8 @@ existing Dask cluster, behind one small interface.
 
 ``executor=`` takes what scipy's ``workers=`` would, and a little more: ``None`` (this process,
 the core's threads), an ``int`` (that many local worker processes), a scheduler address (``str``),
-a ``distributed.Client``, or an :class:`Executor` for the rest (a Dask ``LocalCluster``, the number
+a ``distributed.Client``, a :class:`concurrent.futures.Executor` of the caller's (not shut down
+here), or an :class:`Executor` for the rest (a Dask ``LocalCluster``, the number
 of pieces, a checkpoint file that keeps finished pieces).
 
 A *piece* is a picklable function call (maps, systems and results pickle: tests/test_pickle.py).
@@ -50,13 +51,16 @@ class Executor:
     checkpoint : path-like, optional
         A checkpoint file (:mod:`hovering.parallel.checkpoint`): each finished piece is written as it
         arrives, keyed by every parameter that changes it; a rerun computes only the missing pieces.
+    pool : concurrent.futures.Executor, optional
+        The caller's own pool (a ``ProcessPoolExecutor``, or a ``ThreadPoolExecutor``: the core
+        releases the GIL); it is used, not shut down.
 
     Raises
     ------
     ValueError
-        For a worker or piece count out of range, a client that is not a ``distributed.Client``, an
-        empty scheduler address, both ``client`` and ``scheduler``, or ``dask`` with a client or
-        scheduler.
+        For a worker or piece count out of range, a client that is not a ``distributed.Client``, a
+        pool that is not a ``concurrent.futures.Executor``, an empty scheduler address, more than one
+        of ``client``, ``scheduler`` and ``pool``, or ``dask`` with one of them.
     """
 
     workers: Optional[int] = None
@@ -65,10 +69,15 @@ class Executor:
     scheduler: Optional[str] = None
     pieces: Optional[int] = None
     checkpoint: object = None
+    pool: object = None
 
     def __post_init__(self):
-        if self.client is not None and self.scheduler is not None:
-            raise ValueError("give at most one of client and scheduler")
+        if sum(x is not None for x in (self.client, self.scheduler, self.pool)) > 1:
+            raise ValueError("give at most one of client, scheduler and pool")
+        if self.pool is not None and not isinstance(self.pool, cf.Executor):
+            raise ValueError(f"pool must be a concurrent.futures.Executor, got {self.pool!r}")
+        if self.pool is not None and (self.workers is not None or self.dask):
+            raise ValueError("a pool brings its own workers: give pool without workers and dask")
         if not isinstance(self.dask, bool):
             raise ValueError(f"dask must be True or False, got {self.dask!r}")
         if self.dask and (self.client is not None or self.scheduler is not None):
@@ -89,7 +98,7 @@ class Executor:
 
     def where(self) -> dict:
         """The arguments of :func:`executor` (where the pieces run)."""
-        return dict(workers=self.workers, client=self.client, scheduler=self.scheduler, dask=self.dask)
+        return dict(workers=self.workers, client=self.client, scheduler=self.scheduler, dask=self.dask, pool=self.pool)
 
 
 def as_executor(value) -> Optional[Executor]:
@@ -97,9 +106,9 @@ def as_executor(value) -> Optional[Executor]:
 
     Parameters
     ----------
-    value : None, int, str, distributed.Client or Executor
+    value : None, int, str, distributed.Client, concurrent.futures.Executor or Executor
         ``None`` (this process), a number of local worker processes, a Dask scheduler address, a
-        Dask client, or an :class:`Executor`.
+        Dask client, the caller's pool, or an :class:`Executor`.
 
     Returns
     -------
@@ -113,16 +122,18 @@ def as_executor(value) -> Optional[Executor]:
     if value is None or isinstance(value, Executor):
         return value
     if isinstance(value, bool):
-        raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client or "
-                         f"a hovering.parallel.Executor, got {value!r}")
+        raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
+                         f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
     if isinstance(value, int):
         return Executor(workers=value)
     if isinstance(value, str):
         return Executor(scheduler=value)
+    if isinstance(value, cf.Executor):
+        return Executor(pool=value)
     if type(value).__name__ == "Client" and type(value).__module__.startswith("distributed"):
         return Executor(client=value)
-    raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client or "
-                     f"a hovering.parallel.Executor, got {value!r}")
+    raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
+                     f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
 
 
 #: The "where it runs" arguments an ``executor=`` replaced (deprecated in 0.3.0).
@@ -189,6 +200,19 @@ class _Local:
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 
+class _Given(_Local):
+    """The caller's concurrent.futures pool: used, never shut down here."""
+
+    def __init__(self, pool):
+        self.pool = pool
+        # concurrent.futures keeps the size private; 4 pieces per worker only sets the default piece count.
+        self.workers = max(1, int(getattr(pool, "_max_workers", 0) or (os.cpu_count() or 1)))
+        self.threads_per_piece = _share(self.workers)
+
+    def close(self):
+        pass
+
+
 class _Dask:
     """A distributed.Client (given, or on a LocalCluster / scheduler address made here)."""
 
@@ -225,7 +249,8 @@ def _share(workers: int) -> int:
 
 
 @contextmanager
-def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False):
+def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False,
+             pool=None):
     """Where pieces run.
 
     Parameters
@@ -239,6 +264,8 @@ def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str
         Address of a running Dask scheduler (``tcp://host:8786``).
     dask : bool, optional
         With ``workers``: a Dask LocalCluster instead of a process pool.
+    pool : concurrent.futures.Executor, optional
+        The caller's pool (used, not shut down).
 
     Yields
     ------
@@ -252,8 +279,10 @@ def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str
     ValueError
         For a bad worker count, or more than one of client / scheduler / workers-with-dask.
     """
-    spec = Executor(workers=workers, client=client, scheduler=scheduler, dask=dask)  # the checks
-    if client is not None or scheduler is not None or dask:
+    spec = Executor(workers=workers, client=client, scheduler=scheduler, dask=dask, pool=pool)  # the checks
+    if pool is not None:
+        ex = _Given(pool)
+    elif client is not None or scheduler is not None or dask:
         import distributed
 
         if client is not None:
