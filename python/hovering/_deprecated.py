@@ -14,6 +14,7 @@ import importlib
 import os
 import sys
 import warnings
+from types import FrameType
 from typing import Callable, Optional
 
 __all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
@@ -29,7 +30,8 @@ def _user_stacklevel() -> int:
     """The stacklevel of the first frame outside this package: a warning is attributed to the user's
     line (Python shows DeprecationWarnings of ``__main__`` by default), however many of our own
     frames lie between (``m.hovering_area`` -> hook -> ``hovering_area`` -> here)."""
-    level, f = 1, sys._getframe(1)
+    level = 1
+    f: Optional[FrameType] = sys._getframe(1)
     while f is not None and os.path.abspath(f.f_code.co_filename).startswith(_PACKAGE):
         level, f = level + 1, f.f_back
     return level
