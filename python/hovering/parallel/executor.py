@@ -101,6 +101,11 @@ class Executor:
         return dict(workers=self.workers, client=self.client, scheduler=self.scheduler, dask=self.dask, pool=self.pool)
 
 
+def _not_an_executor(value) -> ValueError:
+    return ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
+                      f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
+
+
 def as_executor(value) -> Optional[Executor]:
     """The :class:`Executor` an ``executor=`` argument stands for (``None``: this process).
 
@@ -122,8 +127,7 @@ def as_executor(value) -> Optional[Executor]:
     if value is None or isinstance(value, Executor):
         return value
     if isinstance(value, bool):
-        raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
-                         f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
+        raise _not_an_executor(value)
     if isinstance(value, int):
         return Executor(workers=value)
     if isinstance(value, str):
@@ -132,8 +136,7 @@ def as_executor(value) -> Optional[Executor]:
         return Executor(pool=value)
     if type(value).__name__ == "Client" and type(value).__module__.startswith("distributed"):
         return Executor(client=value)
-    raise ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
-                     f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
+    raise _not_an_executor(value)
 
 
 #: The "where it runs" arguments an ``executor=`` replaced (deprecated in 0.3.0).
