@@ -19,7 +19,8 @@ import numpy as np
 
 import hovering
 from hovering.analysis.hovering import hovering_area
-from hovering.distribute import executor, run_pieces
+from hovering.parallel import Executor
+from hovering.parallel.executor import executor, run_pieces
 
 
 def _noop(x):
@@ -51,7 +52,7 @@ def main():
         print(f"one process, core threads = all: {t1:8.2f} s  ({work / t1:.3g} {unit}s/s)")
         base = None
         for w in (1, 2):
-            t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, workers=w, pieces=pieces))
+            t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, executor=Executor(workers=w, pieces=pieces)))
             assert r.area == ref.area
             base = base or t
             print(f"process pool, {w} worker(s):      {t:8.2f} s  speed-up vs 1 worker {base / t:.2f}x")
@@ -60,7 +61,7 @@ def main():
             cluster = distributed.LocalCluster(n_workers=w, threads_per_worker=1, dashboard_address=":0")
             client = distributed.Client(cluster)
             start = time.perf_counter() - ts
-            t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, client=client, pieces=pieces))
+            t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, executor=Executor(client=client, pieces=pieces)))
             assert r.area == ref.area
             print(f"Dask LocalCluster, {w} worker(s): {t:8.2f} s  speed-up vs pool 1 worker {base / t:.2f}x "
                   f"(cluster start {start:.1f} s, not included)")

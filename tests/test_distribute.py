@@ -12,6 +12,7 @@ import pytest
 
 import hovering
 from hovering.analysis.hovering import hovering_area
+from hovering.parallel import Executor
 
 M = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
 KW = dict(n_steps=800, samples=6000, seed=7)
@@ -40,13 +41,27 @@ def cluster():
 
 @pytest.mark.parametrize("pieces", [1, 3, 8])
 def test_process_pool_gives_the_single_process_answer(single, pieces):
-    same(single, hovering_area(M, **KW, workers=2, pieces=pieces))
+    same(single, hovering_area(M, **KW, executor=Executor(workers=2, pieces=pieces)))
 
 
 def test_dask_local_cluster_and_an_existing_client_give_the_same_answer(single, cluster):
-    same(single, hovering_area(M, **KW, workers=2, dask=True, pieces=5))
-    same(single, hovering_area(M, **KW, client=cluster, pieces=4))
-    same(single, hovering_area(M, **KW, scheduler=cluster.scheduler.address, pieces=3))
+    same(single, hovering_area(M, **KW, executor=Executor(workers=2, dask=True, pieces=5)))
+    same(single, hovering_area(M, **KW, executor=Executor(client=cluster, pieces=4)))
+    same(single, hovering_area(M, **KW, executor=Executor(scheduler=cluster.scheduler.address, pieces=3)))
+
+
+def test_the_callers_own_pools_give_the_same_answer_and_stay_open(single):
+    # A thread pool works too (the core releases the GIL); a process pool of the caller's is used,
+    # not shut down: it takes more work afterwards.
+    import concurrent.futures as cf
+    import multiprocessing
+
+    with cf.ThreadPoolExecutor(2) as pool:
+        same(single, hovering_area(M, **KW, executor=pool))
+        assert pool.submit(abs, -1).result() == 1
+    with cf.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        same(single, hovering_area(M, **KW, executor=Executor(pool=pool, pieces=3)))
+        assert pool.submit(abs, -2).result() == 2
 
 
 def test_flow_map_pieces_give_the_single_process_answer():
@@ -54,7 +69,7 @@ def test_flow_map_pieces_give_the_single_process_answer():
                               eps=-0.1, qw1=-1.0, qw2=-0.5, geometry="step")
     fm = hovering.FlowMap(sys, 1.0)
     kw = dict(n_steps=40, samples=64, seed=1)
-    same(hovering_area(fm, **kw), hovering_area(fm, **kw, workers=2, pieces=3))
+    same(hovering_area(fm, **kw), hovering_area(fm, **kw, executor=Executor(workers=2, pieces=3)))
 
 
 def _points(path) -> list:
@@ -65,7 +80,7 @@ def _points(path) -> list:
 def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_path):
     ck = tmp_path / "hov.jsonl"
     seen = []
-    first = hovering_area(M, **KW, workers=2, pieces=4, checkpoint=ck)
+    first = hovering_area(M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     same(single, first)
     assert len(_points(ck)) == 4
     # The key is the canonical record: the map's parameters, the counts, the box, the seed, the range.
@@ -73,30 +88,64 @@ def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_p
     assert key["map"]["data"]["__dict__"]["eps"] == M.eps and key["n_steps"] == KW["n_steps"]
     assert sorted(p["key"]["hovering_area_piece"]["lo"] for p in _points(ck))[0] == 0
     # a rerun reads all four pieces back: the progress callback sees every unit done, no new line
-    again = hovering_area(M, **KW, workers=2, pieces=4, checkpoint=ck, progress=lambda d, t: seen.append((d, t)))
+    again = hovering_area(M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck), progress=lambda d, t: seen.append((d, t)))
     same(single, again)
     assert len(_points(ck)) == 4 and seen[-1][0] == seen[-1][1]
     # another parameter (n_steps) is another key: four new pieces
-    hovering_area(M, **{**KW, "n_steps": 400}, workers=2, pieces=4, checkpoint=ck)
+    hovering_area(M, **{**KW, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     assert len(_points(ck)) == 8
     # a torn last line (a killed run) is dropped and that piece alone recomputed
     text = ck.read_text()
     lines = text.splitlines()
     ck.write_text("\n".join(lines[:-1]) + "\n" + lines[-1][: len(lines[-1]) // 2])
-    redo = hovering_area(M, **{**KW, "n_steps": 400}, workers=2, pieces=4, checkpoint=ck)
+    redo = hovering_area(M, **{**KW, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     assert len(_points(ck)) == 8
     assert redo.area == hovering_area(M, **{**KW, "n_steps": 400}).area
 
 
-def test_bad_distribution_arguments_are_named():
-    with pytest.raises(ValueError, match="workers"):
-        hovering_area(M, **KW, workers=0)
-    with pytest.raises(ValueError, match="client"):
-        hovering_area(M, **KW, client="tcp://nowhere")
-    with pytest.raises(ValueError, match="checkpoint applies"):
+@pytest.mark.parametrize("bad, match", [
+    (0, r"workers must be an integer in \[1, 4096\], got 0"),
+    (True, "executor must be None, a worker count, .* got True"),
+    (2.0, "executor must be None, a worker count, .* got 2.0"),
+    ("", "scheduler must be an address"),
+    (dict(client="tcp://nowhere"), "client must be a distributed.Client, got 'tcp://nowhere'"),
+    (dict(workers=2, pieces=0), "pieces must be an integer"),
+    (dict(client=None, scheduler="tcp://a:1", dask=True), "dask=True makes a LocalCluster"),
+    (dict(workers=2, dask="yes"), "dask must be True or False, got 'yes'"),
+    (dict(pool="threads"), "pool must be a concurrent.futures.Executor, got 'threads'"),
+    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), workers=2), "brings its own workers"),
+    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), scheduler="tcp://a:1"),
+     "at most one of client, scheduler and pool"),
+])
+def test_bad_executors_are_named_before_any_work(bad, match):
+    with pytest.raises(ValueError, match=match):
+        hovering_area(M, **KW, executor=Executor(**bad) if isinstance(bad, dict) else bad)
+
+
+def test_the_six_old_arguments_still_work_and_warn_naming_executor_and_the_release(single, tmp_path):
+    # Every old argument: the same answer as its executor=, one DeprecationWarning each, pointing at
+    # this file (the user's line, not the package's), naming executor= and hovering 0.4.0.
+    with pytest.warns(DeprecationWarning) as w:
+        old = hovering_area(M, **KW, workers=2, pieces=3, checkpoint=tmp_path / "old.jsonl")
+    same(single, old)
+    msgs = [str(x.message) for x in w]
+    assert len(msgs) == 3 and all("executor=hovering.parallel.Executor(" in m and "0.4.0" in m for m in msgs)
+    assert {x.filename for x in w} == {__file__}
+    # through the map's method (one more frame of ours between): still attributed to this file
+    with pytest.warns(DeprecationWarning) as w:
+        same(single, M.hovering_area(**KW, workers=2))
+    assert [x.filename for x in w] == [__file__]
+    with pytest.raises(ValueError, match="not both"):
+        hovering_area(M, **KW, executor=2, workers=2)
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="checkpoint apply to runs on workers"):
         hovering_area(M, **KW, checkpoint="x.jsonl")
-    with pytest.raises(ValueError, match="pieces"):
-        hovering_area(M, **KW, workers=2, pieces=0)
+
+
+def test_an_int_executor_is_a_local_pool_and_a_string_a_scheduler():
+    from hovering.parallel import as_executor
+
+    assert as_executor(3) == Executor(workers=3) and as_executor("tcp://h:1") == Executor(scheduler="tcp://h:1")
+    assert as_executor(None) is None
 
 
 def _scene_copy(tmp_path, name, **changes):
@@ -117,11 +166,11 @@ def test_sweep_scenes_on_workers_give_the_one_process_rows(tmp_path):
 
     sc = _scene_copy(tmp_path, "fig_hov_vs_eps.toml")
     one = compute(sc, quick=True, checkpoint=tmp_path / "one.jsonl")
-    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2)
+    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", executor=2)
     for a, b in zip(one.series, pool.series):
         assert np.array_equal(a.area, b.area) and np.array_equal(a.error, b.error) and np.array_equal(a.eps, b.eps)
     # every point is in the checkpoint, and a rerun (on a Dask LocalCluster) computes none
-    again = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2, dask=True)
+    again = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", executor=Executor(workers=2, dask=True))
     assert again.meta["points_reused"] == sum(len(s.eps) for s in again.series)
 
 
@@ -130,7 +179,7 @@ def test_flow_sweep_scene_on_workers(tmp_path):
 
     sc = _scene_copy(tmp_path, "flow_hov_vs_eps.toml", eps=[-0.1, 0.1])
     one = compute(sc, quick=True, checkpoint=tmp_path / "one.jsonl")
-    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", workers=2)
+    pool = compute(sc, quick=True, checkpoint=tmp_path / "pool.jsonl", executor=2)
     assert np.array_equal(one.flow_area, pool.flow_area) and np.array_equal(one.eps, pool.eps)
     for name in one.models:
         assert np.array_equal(one.models[name]["area"], pool.models[name]["area"])

@@ -173,7 +173,8 @@ __all__ = [
 # the scene pipeline, the figures and the module that joins them; and the old module paths
 # (hovering.geometry, hovering.fullmap, ...), which warn on use (hovering._deprecated).
 _LAZY_MODULES = ("pipeline", "scenes", "plot")
-_OLD_MODULES = ("accuracy", "references", "fullmap", "geometry", "maps", "potentials", "system", "plotting", "figures")
+_OLD_MODULES = ("accuracy", "references", "fullmap", "geometry", "maps", "potentials", "system", "plotting", "figures",
+                "distribute", "sweeps")
 
 
 def __getattr__(name: str):

@@ -11,7 +11,10 @@ lazily keeps ``import hovering`` from loading what the old path points to.
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 import warnings
+from types import FrameType
 from typing import Callable, Optional
 
 __all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
@@ -20,7 +23,21 @@ __all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
 REMOVED_IN = "0.4.0"
 
 
-def warn(old: str, new: str, stacklevel: int = 3) -> None:
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _user_stacklevel() -> int:
+    """The stacklevel of the first frame outside this package: a warning is attributed to the user's
+    line (Python shows DeprecationWarnings of ``__main__`` by default), however many of our own
+    frames lie between (``m.hovering_area`` -> hook -> ``hovering_area`` -> here)."""
+    level = 1
+    f: Optional[FrameType] = sys._getframe(1)
+    while f is not None and os.path.abspath(f.f_code.co_filename).startswith(_PACKAGE):
+        level, f = level + 1, f.f_back
+    return level
+
+
+def warn(old: str, new: str, stacklevel: Optional[int] = None) -> None:
     """Warn that ``old`` is deprecated in favour of ``new``.
 
     Parameters
@@ -28,10 +45,10 @@ def warn(old: str, new: str, stacklevel: int = 3) -> None:
     old, new : str
         What the caller used, and what to use instead.
     stacklevel : int, optional
-        Passed to :func:`warnings.warn` (3: the caller of the function that calls this).
+        Passed to :func:`warnings.warn`; default: the first frame outside the package (the user's line).
     """
     warnings.warn(f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead",
-                  DeprecationWarning, stacklevel=stacklevel)
+                  DeprecationWarning, stacklevel=stacklevel if stacklevel is not None else _user_stacklevel())
 
 
 def moved_module(old: str, new: str, names: Optional[dict] = None) -> Callable[[str], object]:
@@ -65,7 +82,7 @@ def moved_module(old: str, new: str, names: Optional[dict] = None) -> Callable[[
     return __getattr__
 
 
-def renamed_argument(func: str, old: str, new: str, stacklevel: int = 4) -> None:
+def renamed_argument(func: str, old: str, new: str, stacklevel: Optional[int] = None) -> None:
     """Warn that argument ``old`` of ``func`` is deprecated in favour of ``new``.
 
     Parameters
@@ -75,6 +92,6 @@ def renamed_argument(func: str, old: str, new: str, stacklevel: int = 4) -> None
     old, new : str
         The argument used, and what to use instead (may be a short phrase).
     stacklevel : int, optional
-        Passed to :func:`warnings.warn`.
+        Passed to :func:`warnings.warn`; default: the user's line (see :func:`warn`).
     """
     warn(f"{func}({old}=...)", f"{func}({new})", stacklevel=stacklevel)

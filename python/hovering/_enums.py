@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._checks import MAX_ANGLE, _short, real_array
+from . import _core
 from ._core import FlowStatus, Geometry, Kernel, Region, Status, TrajectoryPoint
 
 __all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "TrajectoryPoint", "REGION_LABELS", "region_mask",
@@ -114,9 +115,7 @@ def wrap(x):
             bad = x[np.abs(x) > MAX_ANGLE] if x.ndim else x
             raise ValueError(f"angles to wrap must satisfy |x| <= 1e6 (beyond, 2 pi floor(x / 2 pi) loses accuracy), "
                              f"got {np.ravel(bad)[0]}")
-    y = x - 2 * np.pi * np.floor((x + np.pi) / (2 * np.pi))
-    y = np.where(y >= np.pi, y - 2 * np.pi, y)
-    y = np.where(y < -np.pi, y + 2 * np.pi, y)
+    y = _core.wrap(x)  # the core's one definition: every entry point wraps alike
     return y if np.ndim(y) else float(y)
 
 

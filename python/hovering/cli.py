@@ -66,7 +66,7 @@ def _run(scene, out, quick: bool, progress: bool, where=None, force: bool = Fals
     from .scenes import format_summary
 
     try:
-        summary = run_scene(scene, out=out, quick=quick, progress=progress, force=force, **(where or {}))
+        summary = run_scene(scene, out=out, quick=quick, progress=progress, force=force, executor=where)
     except (OSError, ValueError) as e:
         # a value only the computation can check (e.g. a K beyond the band's top), a file in the
         # way, or a write that failed (a full disk): one line, the previous files intact
@@ -88,9 +88,14 @@ def _scene(args) -> int:
         out = output_path("--out", args.out) if args.out is not None else None
     except (OSError, ValueError) as e:
         return _error(e)
-    where = {}
+    where = None
     if args.workers is not None or args.scheduler is not None:
-        where = dict(workers=args.workers, scheduler=args.scheduler, dask=args.dask)
+        from .parallel import Executor
+
+        try:
+            where = Executor(workers=args.workers, scheduler=args.scheduler, dask=args.dask)
+        except ValueError as e:
+            return _error(e)
     elif args.dask:
         return _error("--dask needs --workers N (a LocalCluster of N workers)")
     return _run(scene, out, args.quick, _progress(args), where, args.force)

@@ -28,7 +28,7 @@ __all__ = ["run_scene", "redraw", "phase_portrait", "draw_geometry"]
 
 
 def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool = False, keep_figure: bool = False,
-              progress=False, force: bool = False, **where) -> dict:
+              progress=False, force: bool = False, executor=None, **where) -> dict:
     """Compute a scene, save its result (NPZ + JSON), draw its figure and write the PNG.
 
     Where it writes: ``out`` if given, else the scene's ``output``, which must lie under the scene
@@ -53,9 +53,10 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
         Progress bars on stderr for the long computations.
     force : bool, optional
         Replace existing files that hovering did not write.
+    executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
+        Where a sweep scene's points run (see :func:`hovering.scenes.compute`).
     **where
-        ``workers``, ``client``, ``scheduler``, ``dask``: where a sweep scene's points run (see
-        :func:`hovering.scenes.compute`).
+        Deprecated (removed in 0.4.0): ``workers``, ``client``, ``scheduler``, ``dask``; each warns.
 
     Returns
     -------
@@ -81,7 +82,7 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
             ckpt.unlink()  # replaced by this run's checkpoint (it is appended to, not rewritten)
     except OSError as e:
         raise write_error(png.parent, e, previous=False) from None
-    result = compute(scene, quick=quick, progress=progress, checkpoint=ckpt, **where)
+    result = compute(scene, quick=quick, progress=progress, checkpoint=ckpt, executor=executor, **where)
     result.meta["output"] = str(png)
     t = time.perf_counter()
     fig = render(result)

@@ -1,5 +1,5 @@
-"""Old home of the checkpoints: :mod:`hovering.parallel.checkpoint` (the one checkpoint format)."""
+"""Old path of :mod:`hovering.parallel.checkpoint` (deprecated; removed in 0.4.0)."""
 
-from .parallel.checkpoint import Checkpoint, check_row  # noqa: F401
+from ._deprecated import moved_module
 
-__all__ = ["Checkpoint", "check_row"]
+__getattr__ = moved_module(__name__, "hovering.parallel.checkpoint")

@@ -3,6 +3,7 @@
 #include <pybind11/native_enum.h>
 
 #include "hovering/flow/return_map.hpp"
+#include "hovering/truncated/map.hpp"
 #include "hovering/types.hpp"
 #include "pybind.hpp"
 
@@ -58,4 +59,7 @@ void register_enums(py::module_& m) {
         .value("SIMD", Kernel::Simd, "Eigen packets + SLEEF vector sin over chunks of orbits")
         .value("SCALAR", Kernel::Scalar, "one orbit at a time with libm sin (the reference)")
         .finalize();
+    // The core's one wrap, for Python too (hovering._enums.wrap checks the range first).
+    m.def("wrap", py::vectorize(&hovering::wrap_angle), py::arg("x"),
+          "Angles wrapped to [-pi, pi) by the core's one definition (NaN stays NaN).");
 }

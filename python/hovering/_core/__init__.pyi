@@ -2,12 +2,15 @@
 
 import enum
 
+import numpy as np
+
 from . import analysis as analysis
 from . import flow as flow
 from . import normal as normal
 from . import truncated as truncated
 
 def build_info() -> list[tuple[str, str | int]]: ...
+def wrap(x: np.ndarray | float) -> np.ndarray | float: ...
 
 class Region(enum.IntEnum):
     NONE = -1

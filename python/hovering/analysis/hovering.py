@@ -19,6 +19,9 @@ from .. import _core
 from .._checks import check_memory, flag, integer, real_number, thread_count
 from ..interface import require_map
 from .._serial import Saveable
+from ..parallel.checkpoint import Checkpoint
+from ..parallel.executor import Executor, from_old_arguments, run_pieces
+from ..parallel.executor import executor as open_executor
 from .._progress import check_progress, progress_bar
 
 __all__ = ["HoveringArea", "hovering_area"]
@@ -158,16 +161,12 @@ def _piece_arrays(row, n: int) -> tuple:
     return tuple(out)
 
 
-def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, workers, client, scheduler, dask,
-                 pieces, checkpoint):
-    from ..distribute import executor, run_pieces
-    from ..parallel.checkpoint import Checkpoint
-
-    with executor(workers, client, scheduler, dask) as ex:
+def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Executor):
+    with open_executor(**spec.where()) as ex:
         threads = n_threads if n_threads != 0 else ex.threads_per_piece
-        k = integer("pieces", pieces if pieces is not None else 4 * ex.workers, 1, max(1, n))
+        k = integer("pieces", spec.pieces if spec.pieces is not None else 4 * ex.workers, 1, max(1, n))
         bounds = [(n * i // k, n * (i + 1) // k) for i in range(k)]
-        store = Checkpoint(checkpoint) if checkpoint is not None else None
+        store = Checkpoint(spec.checkpoint) if spec.checkpoint is not None else None
         out = [None] * k
         todo = []
         for i, (lo, hi) in enumerate(bounds):
@@ -195,9 +194,9 @@ def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, workers, c
 
 
 def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optional[float] = None, seed: int = 0,
-                  n_threads: int = 0, keep_points: bool = False, progress=False, *, workers: Optional[int] = None,
-                  client=None, scheduler: Optional[str] = None, dask: bool = False, pieces: Optional[int] = None,
-                  checkpoint=None) -> HoveringArea:
+                  n_threads: int = 0, keep_points: bool = False, progress=False, *, executor=None,
+                  workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False,
+                  pieces: Optional[int] = None, checkpoint=None) -> HoveringArea:
     """Area of the hovering set HOV(eps) of a map, by its definition.
 
     HOV(eps) is the set of points that impact under F_0 (some iterate leaves J_0 u J_0u) and never
@@ -229,23 +228,17 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
         One report for the whole call (both iterations, ``2 * n_samples * n_steps`` steps or
         returns): ``True`` a tqdm bar on stderr, a callable ``progress(done, total)``, ``False``
         (default) none. See :mod:`hovering._progress`.
-    workers : int, optional
-        Split the samples into ``pieces`` and run them on this many local worker processes (a
-        process pool; with ``dask=True`` a Dask LocalCluster). The result is identical to the
-        single-process one for the same seed: each piece draws its own contiguous range of the
-        samples (the core jumps the random stream ahead to it), and the estimate only counts.
-    client : distributed.Client, optional
-        Run the pieces on an existing Dask cluster.
-    scheduler : str, optional
-        Address of a running Dask scheduler to run the pieces on.
-    dask : bool, optional
-        With ``workers``: a Dask LocalCluster instead of a process pool.
-    pieces : int, optional
-        Number of pieces (default 4 per worker).
-    checkpoint : path-like, optional
-        A checkpoint file (:mod:`hovering.parallel.checkpoint`): each finished piece is written as
-        it arrives, keyed by every parameter that changes it (the map's record, counts, box, seed,
-        range); a rerun computes only the missing pieces (distributed runs only).
+    executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
+        Where it runs (:func:`hovering.parallel.executor.as_executor`): ``None`` in this process on
+        ``n_threads`` core threads; otherwise the samples are cut into pieces run on that many local
+        worker processes (``int``), a Dask scheduler (address), a Dask client, or as an
+        :class:`~hovering.parallel.Executor` says (a Dask LocalCluster, the number of pieces, a
+        checkpoint file that keeps finished pieces, keyed by every parameter that changes them). The
+        result is identical to the single-process one for the same seed: each piece draws its own
+        contiguous range of the samples (the core jumps the random stream ahead to it), and the
+        estimate only counts.
+    workers, client, scheduler, dask, pieces, checkpoint : optional
+        Deprecated (removed in 0.4.0): the fields of ``executor=Executor(...)``; each warns.
 
     Returns
     -------
@@ -277,13 +270,11 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     phi, K = _stratified(samples, K_low, seed)
     n = phi.size
     unit = getattr(m, "_progress_unit", "step")
-    distributed = workers is not None or client is not None or scheduler is not None
-    if checkpoint is not None and not distributed:
-        raise ValueError("checkpoint applies to distributed runs (give workers, client or scheduler)")
+    spec = from_old_arguments("hovering_area", executor, dict(workers=workers, client=client, scheduler=scheduler,
+                                                              dask=dask, pieces=pieces, checkpoint=checkpoint))
     with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
-        if distributed:
-            s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar,
-                                                       workers, client, scheduler, dask, pieces, checkpoint)
+        if spec is not None:
+            s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec)
         else:
             s0, s1, steps_done, visited = _outcomes(m, phi, K, n_steps, n_threads, bar.part(0))
     e = _core.analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), keep_points)

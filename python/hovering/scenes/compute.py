@@ -26,6 +26,8 @@ from ..diagnostics.work_precision import _reverse
 from ..normal.corners import corner_curves
 from ..normal.flowmap import FlowMap
 from ..parallel.checkpoint import Checkpoint, check_row
+from ..parallel.executor import Executor, from_old_arguments, run_pieces
+from ..parallel.executor import executor as open_executor
 from ..truncated.maps import TruncatedFamily, TruncatedMap
 from ..truncated.theory import golden_family, hovering_area_theory
 from ..flow.section import Section
@@ -469,9 +471,9 @@ def _row_check(kind: str, point: dict) -> Callable:
     return check
 
 
-def _sweep(kind: str, points: list, ckpt, bar, where) -> tuple:
+def _sweep(kind: str, points: list, ckpt, bar, where: Optional[Executor]) -> tuple:
     """Rows of a plan's points in order: from the checkpoint (each row checked first: the file is
-    untrusted), or computed (here, or as pieces on ``where``: a dict of executor arguments) and
+    untrusted), or computed (here, or as pieces on the executor ``where``) and
     checkpointed as each arrives (a point another process wrote meanwhile is not written again).
     Returns (rows, reused: one bool per point, True where the checkpoint had it)."""
     keys = [point_key(kind, p) for p in points]
@@ -486,10 +488,8 @@ def _sweep(kind: str, points: list, ckpt, bar, where) -> tuple:
         rows[i] = ckpt.get(keys[i]) if keys[i] in ckpt else row  # another process's row, if it was first
         bar.advance(1)
 
-    if where:
-        from ..distribute import executor, run_pieces
-
-        with executor(**where) as ex:
+    if where is not None:
+        with open_executor(**where.where()) as ex:
             # Each point keeps the core's threads (all cores): sweep points differ in cost (1-25 s per
             # eps of the flow scene), and one thread per point on a shared machine left the costliest
             # point alone at the end (66 s vs 50 s for flow_hov_vs_eps on 2 workers here).
@@ -941,8 +941,8 @@ def scene_map(scene: SceneSpec):
 
 
 def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: Optional[os.PathLike] = None,
-            workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False
-            ) -> SceneResult:
+            workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False, *,
+            executor=None) -> SceneResult:
     """Run a scene's simulation and return its typed result (nothing is drawn or written).
 
     Parameters
@@ -957,10 +957,13 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
         Sweep scenes (``hovering_area``, ``flow_hovering_area``): the JSON-lines file every
         finished point is written to at once (default: next to the scene's output).
     workers, client, scheduler, dask : optional
-        Sweep scenes: run the points as pieces on ``workers`` local processes (with ``dask`` a
-        Dask LocalCluster), an existing Dask ``client`` or a ``scheduler`` address
-        (:func:`hovering.distribute.executor`); each point is checkpointed as it arrives and the
-        result is the one-process result. Other scenes: ignored (they are one computation).
+        Deprecated (removed in 0.4.0): the fields of ``executor=Executor(...)``; each warns.
+    executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
+        Sweep scenes: run the points as pieces on local worker processes (``int``), a Dask
+        scheduler (address), a Dask client, or as a :class:`~hovering.parallel.Executor` says (a Dask
+        LocalCluster); each point is checkpointed as it arrives and the result is the one-process
+        result. Other scenes: ignored (they are one computation). A scene's pieces are its points and
+        its checkpoint is ``checkpoint``: an Executor's ``pieces`` and ``checkpoint`` are refused.
 
     Returns
     -------
@@ -974,9 +977,11 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
     meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
     t0 = time.perf_counter()
     ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
-    where = None
-    if workers is not None or client is not None or scheduler is not None:
-        where = dict(workers=workers, client=client, scheduler=scheduler, dask=bool(dask))
+    where = from_old_arguments("compute", executor, dict(workers=workers, client=client, scheduler=scheduler,
+                                                         dask=dask), allowed=("workers", "client", "scheduler", "dask"))
+    if where is not None and (where.pieces is not None or where.checkpoint is not None):
+        raise ValueError("compute: a scene's points are its pieces and checkpoint= its checkpoint; give an Executor "
+                         "without pieces and checkpoint")
     if isinstance(scene, OrbitScene):
         out = _orbit_scene(scene, quick, progress, meta)
     elif isinstance(scene, HoveringAreaScene):
