@@ -309,8 +309,10 @@ def _closed_form_wall_angles(sys, rho: float) -> dict:
 
 def test_wall_corner_angles_match_the_uncoupled_closed_form_and_slope_as_tau1():
     # The flow's region labels, bisected on circles rho_w = const, against lemma:border's closed
-    # forms at eps = 0. 1e-8: the bisection leaves 2 pi / 128 / 2^30 = 5e-11, and the corner band
-    # of the core's corner test (1e-10 in q) is ~1e-9 wide in theta here.
+    # forms at eps = 0. 1.5e-8: the bisection leaves 2 pi / 128 / 2^30 = 5e-11, but it stops at the
+    # edge of the core's corner band (an impact within 1e-10 of the corner counts as a corner hit),
+    # which is wider in theta the slower the arrival: measured offsets 2e-10 to 7.2e-9, the largest
+    # for 01 and 1R at rho = 0.002 rho_max (growing as rho^-1/2: there |p1| ~ sqrt(2 omega2 rho)).
     sys = _system(0.0)
     flow = _flow(sys)
     rmax = rho_w_max(sys, H)
@@ -320,10 +322,10 @@ def test_wall_corner_angles_match_the_uncoupled_closed_form_and_slope_as_tau1():
     for k, r in enumerate(rho):
         want = _closed_form_wall_angles(sys, r)
         for ab in DIRECTIONS:
-            assert abs(wrap(found[ab][k] - want[ab])) < 1e-8, (r, ab, found[ab][k], want[ab])
+            assert abs(wrap(found[ab][k] - want[ab])) < 1.5e-8, (r, ab, found[ab][k], want[ab])
         # lemma:border's order on the circle: theta_R0 < 0 < theta_01 < theta_1R = -theta_R0
         assert found["R0"][k] < 0 < found["01"][k] < found["1R"][k]
-        assert found["1R"][k] == pytest.approx(-found["R0"][k], abs=1e-8)
+        assert found["1R"][k] == pytest.approx(-found["R0"][k], abs=1.5e-8)  # the same band
     # At eps = 0, theta_1R(rho) = theta_w(I_tan - rho): its slope at rho -> 0 is tau1 / 2 with tau1
     # = -2 dtheta_w/dI from its definition (eq:deftau1, FlowMap.onset), as eq:thetar0expan says of
     # theta_1R; theta_R0 = -theta_1R then has slope -tau1 / 2 (eq:dthetadrhor0 prints the opposite
