@@ -193,9 +193,10 @@ OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw
         // 2 sqrt(8 ulps) (acos(-1 + x) = pi - sqrt(2 x)); and the level's.
         {"theta_w", theta, std::fabs(dth.value) * 2 * in.Ed,
          a2 * kPi + std::min(8 * kEps / std::fabs(std::sin(theta)), 2 * std::sqrt(8 * kEps)) + 2 * kEps * theta, 0},
-        // The action's quadrature: up to 4e-12 relative measured on Tan levels 1e21 .. 1e35 (turning points
-        // ulps from the wall), above the tolerance that bounds the periods and angles: 10x.
-        {"I_tan", I_tan, in.Eh2 / w2, (10 * a2 + 2 * kEps) * I_tan, 0},
+        // The action's quadrature: up to 3.9e-11 relative measured on 40,000 random Tan levels 1e-3 .. 1e45
+        // (omega 0.1 .. 10, alpha 1e-6 .. 10; turning points ulps from the wall), above the tolerance that
+        // bounds the periods and angles: 100x (a closed form keeps its 10 x 8 eps).
+        {"I_tan", I_tan, in.Eh2 / w2, ((a2 > 1e-14 ? 100 : 10) * a2 + 2 * kEps) * I_tan, 0},
     };
     const std::string how = "the potentials' " + std::string(a1 > 1e-14 || a2 > 1e-14 ? "quadratures (relative accuracy " +
                                                                                             fmt(std::max(a1, a2)) + ") and their difference quotients"

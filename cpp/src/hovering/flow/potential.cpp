@@ -265,9 +265,34 @@ double Potential::period(double h) const {
 double Potential::action(double h) const {
     const Level L(*this, h, "action");
     const double a = L.a, b = L.b, mid = 0.5 * (a + b);
-    return L.qaws([&](double q) {
-        return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) / (q - a)) : std::sqrt(2 * L.slope(q - a, -1) / (b - q));
-    }, a, b, 0.5, 0.5, "action") / kPi;
+    const auto whole = [&] {
+        return L.qaws([&](double q) {
+            return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) / (q - a)) : std::sqrt(2 * L.slope(q - a, -1) / (b - q));
+        }, a, b, 0.5, 0.5, "action") / kPi;
+    };
+    // Near a steep wall p = sqrt(2 (h - V)) climbs from 0 to ~sqrt(2 h) within l = h / |V'| of the
+    // turning point; on a high level of a Tan well l is 1e-10 of the width, and one QAWS over the
+    // level returned "converged" 8.4e-9 off (Tan(2.6, 0.13) at h = 1.3e20). So each end's layer,
+    // 1e3 l wide (p is smooth on the scale l there), is its own QAWS with the end's square root
+    // as the weight, and the rest between them, where p is smooth on the scale of the width, a
+    // third (without weights). A layer within ~1e6 doubles of its end is not resolved by V's
+    // doubles (V jumps from one to the next) and its share of the action is below ~1e-10: there,
+    // and where the layers do not converge, the single quadrature is the answer (as before).
+    const double la = 1e3 * h / std::fabs(dV(a)), lb = 1e3 * h / std::fabs(dV(b));
+    const double ulp = std::nextafter(std::max(-a, b), kInf) - std::max(-a, b);
+    if (!(la < 0.25 * (b - a) && lb < 0.25 * (b - a)) || !std::isfinite(la + lb) || !(std::min(la, lb) >= 1e6 * ulp))
+        return whole();
+    try {
+        // In the layers' local distance d from their turning point (exact near it): p = sqrt(2 d slope(d)).
+        const double left = L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, -1)); }, 0.0, la, 0.5, 0.0, "action");
+        const double right = L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, 1)); }, 0.0, lb, 0.5, 0.0, "action");
+        const double inner = L.qaws([&](double q) {
+            return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) * (b - q)) : std::sqrt(2 * L.slope(q - a, -1) * (q - a));
+        }, a + la, b - lb, 0.0, 0.0, "action");
+        return (left + inner + right) / kPi;
+    } catch (const std::invalid_argument&) {
+        return whole();
+    }
 }
 
 double Potential::energy(double I) const {
