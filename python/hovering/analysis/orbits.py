@@ -13,14 +13,15 @@ over phi preserves under any orientation-preserving map, smooth or not.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Optional
 
 import numpy as np
 
 from .._checks import integer, real_number
 from .._enums import Region
 from ..interface import IterateResult
+from ..truncated import TruncatedMap
 
 __all__ = ["OrbitClasses", "classify_orbits", "cyclic_order_violations", "rank_rotation", "ConeCrossing",
            "cone_crossing", "converse_kam"]
@@ -428,7 +429,7 @@ class ConeCrossing:
 
 
 def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twist: float = 1.0,
-                  in_domain: Optional[Callable] = None, tol: float = 1e-9) -> ConeCrossing:
+                  in_domain: Callable | None = None, tol: float = 1e-9) -> ConeCrossing:
     """MacKay-Percival cone crossing for any map that is smooth and twist on a domain.
 
     Push the vertical vector (0, 1) forward along the orbit by the Jacobian. On a rotational
@@ -540,8 +541,6 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
         for tau0 = 0 (no twist), or for a start point in an impacting region (J_1, J_R: the map
         is not smooth twist there) or outside the band.
     """
-    from ..truncated import TruncatedMap
-
     if not isinstance(m, TruncatedMap):
         raise ValueError(f"converse_kam needs a TruncatedMap (smooth twist map with a closed-form Jacobian on its "
                          f"no-impact regions), got {type(m).__name__}; for other maps call cone_crossing with "
@@ -558,8 +557,9 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
     reg = np.asarray(m.region(p.ravel(), k.ravel()))
     if not np.all(np.isin(reg, smooth)):
         j = int(np.argmax(~np.isin(reg, smooth)))
-        raise ValueError(f"start point (phi, K) = ({p.ravel()[j]}, {k.ravel()[j]}) lies in region {Region(int(reg[j])).name}, "
-                         f"where the map impacts and is not a smooth twist map; converse_kam applies on J_0u and J_0 only")
+        raise ValueError(f"start point (phi, K) = ({p.ravel()[j]}, {k.ravel()[j]}) lies in region "
+                         f"{Region(int(reg[j])).name}, where the map impacts and is not a smooth twist map; "
+                         f"converse_kam applies on J_0u and J_0 only")
     eps, Om, t0 = float(m.eps), float(m.Omega0), float(m.tau0)
 
     def jac(ph, kk):
