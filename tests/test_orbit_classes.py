@@ -282,6 +282,18 @@ def test_converse_kam_truncated_map():
         hovering.converse_kam(hovering.TruncatedMap(eps=0.3, Omega0=1.0, theta_w=1.0, tau0=0.0), 0.0, 0.1, 10)
 
 
+def test_critical_curve_is_the_lowest_circle_on_L1():
+    """eps = 0.3: critical_curve() (an independent search by Birkhoff regularity in the no-impact
+    regions) puts the lowest no-impact circle at K_min on L1. Starts at and above it are circles;
+    starts up to 0.02 below it are not (within the 0.004 spacing of the starts)."""
+    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * math.pi / 4)
+    K_min = m.critical_curve(n_steps=20_000).K_min
+    K0 = K_min + 0.004 * np.arange(-5, 6)
+    c = hovering.classify_orbits(m.iterate(m.L1(K0), K0, 20_000, record=("orbit",)))
+    assert np.all(c.kind[5:] == "circle"), c.kind
+    assert not np.any(c.kind[:5] == "circle"), c.kind
+
+
 def test_flow_map_agrees_with_its_model():
     """README system at eps = -0.05 (hovers; its critical curve lies near K = -0.025): starts on L1
     well above it are circles for the flow and for its truncated model alike, and the start at
