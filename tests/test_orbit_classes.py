@@ -368,3 +368,49 @@ def test_not_twist_is_a_status():
     r = hovering.cone_crossing(step, jac_bad, [0.0, 0.0], [1.0, 3.5], 50)
     assert r.status[1] == "not_twist" and r.step[1] == 0
     assert r.status[0] != "not_twist"
+
+
+def test_ctrl_c_keeps_what_was_found():
+    """Ctrl-C (a KeyboardInterrupt from inside the step) stops cone_crossing and keeps the crossings
+    found so far in .partial; classify_orbits keeps the orbits done before it."""
+    step, jac = standard_map_step_jacobian(1.2)
+    calls = [0]
+
+    def step_interrupted(x, p):
+        calls[0] += 1
+        if calls[0] > 10:
+            raise KeyboardInterrupt
+        return step(x, p)
+
+    rng = np.random.default_rng(3)
+    x0, y0 = rng.uniform(-math.pi, math.pi, 50), rng.uniform(0.0, TWO_PI, 50)
+    with pytest.raises(KeyboardInterrupt) as info:
+        hovering.cone_crossing(step_interrupted, jac, x0, y0, 1000)
+    part = info.value.partial
+    assert 10 <= part.crossed.sum() < 50  # median crossing step 7 measured: about half within 10
+    assert np.all(part.step[part.crossed] <= 10) and np.all(part.status[~part.crossed] == "none")
+    full = hovering.cone_crossing(step, jac, x0, y0, 1000)
+    assert np.array_equal(full.step[part.crossed], part.step[part.crossed])
+
+    phi, K, _ = standard_map_orbits(0.5, 0.0, [1.0, 2.0, 3.0], 300)
+    rows = [0]
+
+    def isfinite_once(a, _real=np.isfinite):
+        if np.ndim(a) == 1 and np.size(a) == 301:  # a row: classify_orbits checks phi and K of each
+            rows[0] += 1
+            if rows[0] > 4:  # after two orbits
+                raise KeyboardInterrupt
+        return _real(a)
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(np, "isfinite", isfinite_once)
+    try:
+        with pytest.raises(KeyboardInterrupt) as info:
+            hovering.classify_orbits(phi, K, pieces=1)
+    finally:
+        mp.undo()
+    part = info.value.partial
+    i0 = int(np.argmax(part.decided_by == "interrupted"))
+    assert 1 <= i0 < 3 and np.all(part.decided_by[i0:] == "interrupted")
+    done = hovering.classify_orbits(phi, K, pieces=1)
+    assert list(part.kind[:i0]) == list(done.kind[:i0])

@@ -316,6 +316,9 @@ def classify_orbits(phi, K=None, *, pieces: int = 3, tol: float = 1e-9, min_poin
     ------
     ValueError
         For mismatched shapes or out-of-range options.
+    KeyboardInterrupt
+        On Ctrl-C; its ``partial`` attribute holds the OrbitClasses with the orbits done so far
+        (the others ``"undecided"``, decided_by ``"interrupted"``).
     """
     if isinstance(phi, IterateResult):
         if K is not None:
@@ -348,17 +351,24 @@ def classify_orbits(phi, K=None, *, pieces: int = 3, tol: float = 1e-9, min_poin
         graph_exponent=np.full(n_orbits, np.nan),
         dimension=np.full(n_orbits, np.nan),
     )
-    for i in range(n_orbits):
-        bad = ~(np.isfinite(P[i]) & np.isfinite(Q[i]))
-        n = int(np.argmax(bad)) if bad.any() else P.shape[1]
-        p, k = P[i, :n], Q[i, :n]
-        out.n_points[i] = n
-        if n == 0:
-            continue
-        out.K_min[i], out.K_max[i] = k.min(), k.max()
-        if n < min_points:
-            continue
-        _classify_one(out, i, p, k, _allowed(pieces), tol, max_period, graph_max, chaos_dimension)
+    i = 0
+    try:
+        for i in range(n_orbits):
+            bad = ~(np.isfinite(P[i]) & np.isfinite(Q[i]))
+            n = int(np.argmax(bad)) if bad.any() else P.shape[1]
+            p, k = P[i, :n], Q[i, :n]
+            out.n_points[i] = n
+            if n == 0:
+                continue
+            out.K_min[i], out.K_max[i] = k.min(), k.max()
+            if n < min_points:
+                continue
+            _classify_one(out, i, p, k, _allowed(pieces), tol, max_period, graph_max, chaos_dimension)
+    except KeyboardInterrupt as exc:
+        out.kind[i:], out.decided_by[i:], out.period[i:], out.rotation[i:] = "undecided", "interrupted", 0, np.nan
+        out.kind, out.decided_by = out.kind.astype(str), out.decided_by.astype(str)
+        exc.partial = out  # the orbits classified before Ctrl-C keep their verdicts
+        raise
     out.kind = out.kind.astype(str)
     out.decided_by = out.decided_by.astype(str)
     return out
@@ -462,6 +472,13 @@ def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twis
     Returns
     -------
     ConeCrossing
+
+    Raises
+    ------
+    ValueError
+        For non-finite starts, n_steps < 1, a twist other than +-1 or tol outside [0, 0.1].
+    KeyboardInterrupt
+        On Ctrl-C; its ``partial`` attribute holds the ConeCrossing found so far.
     """
     n_steps = integer("n_steps", n_steps, 1, 10**9)
     tw = real_number("twist", twist)
@@ -478,6 +495,17 @@ def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twis
     when = np.full(m, -1, dtype=np.int64)
     vp, vk = np.zeros(m), np.ones(m)
     alive = np.arange(m)
+    try:
+        _push_cone(step, jacobian, in_domain, tw, tol, n_steps, p, k, vp, vk, alive, status, when)
+    except KeyboardInterrupt as exc:
+        # what was found so far stands; the rest is inconclusive ("none")
+        exc.partial = ConeCrossing(status=status.astype(str), step=when, phi=phi0, K=K0, n_steps=n_steps)
+        raise
+    return ConeCrossing(status=status.astype(str), step=when, phi=phi0, K=K0, n_steps=n_steps)
+
+
+def _push_cone(step, jacobian, in_domain, tw, tol, n_steps, p, k, vp, vk, alive, status, when):
+    """The loop of cone_crossing, filling status and when in place."""
     for n in range(n_steps):
         if alive.size == 0:
             break
@@ -487,12 +515,16 @@ def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twis
             if out.any():
                 status[alive[out]], when[alive[out]] = "left_domain", n
                 alive, pa, ka = alive[~out], pa[~out], ka[~out]
-        a, b, c, d = (np.asarray(t, dtype=float) for t in jacobian(pa, ka))
+        if alive.size == 0:
+            break
+        a, b, c, d = (np.broadcast_to(np.asarray(t, dtype=float), pa.shape) for t in jacobian(pa, ka))
         bad = ~(tw * b > 0)
         if bad.any():
             status[alive[bad]], when[alive[bad]] = "not_twist", n
             keep = ~bad
             alive, pa, ka, a, b, c, d = alive[keep], pa[keep], ka[keep], a[keep], b[keep], c[keep], d[keep]
+            if alive.size == 0:
+                break
         x, y = vp[alive], vk[alive]
         x, y = a * x + b * y, c * x + d * y
         r = np.hypot(x, y)
@@ -502,7 +534,6 @@ def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twis
         if hit.any():
             status[alive[hit]], when[alive[hit]] = "crossing", n + 1
             alive = alive[~hit]
-    return ConeCrossing(status=status.astype(str), step=when, phi=phi0, K=K0, n_steps=n_steps)
 
 
 def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
