@@ -187,7 +187,8 @@ def test_converse_kam_agrees_with_classes_at_k05():
 def test_brute_force_box_counting_agrees():
     """Brute force on a fixed grid: a circle's covered fraction halves when the grid is refined
     (ratio ~1/2), a chaotic layer's does not (~1). Every circle verdict of the order test has
-    ratio < 0.7, every chaotic verdict > 0.7 (measured: circles 0.50-0.51, chaotic 0.76-0.84)."""
+    ratio < 0.7, every chaotic verdict > 0.7 (measured: circles 0.50-0.51, chaotic 0.76-0.84), on the
+    standard map and on eps = 0 circles of the truncated map."""
     n = 20_000
     p0 = np.linspace(0.2, TWO_PI - 0.2, 12)
     for k in (0.5, 1.2):
@@ -200,6 +201,15 @@ def test_brute_force_box_counting_agrees():
             ratio = covered_fraction(phi[i], K[i], lo, hi, 64) / covered_fraction(phi[i], K[i], lo, hi, 32)
             assert (ratio < 0.7) == (c.kind[i] == "circle"), (k, p0[i], c.kind[i], ratio)
     assert (c.kind == "chaotic").sum() >= 5  # k = 1.2 gave chaotic verdicts to check
+    # eps = 0 truncated circles (impacting and not), on a fixed box K +- 0.1 around each
+    m = hovering.TruncatedMap(eps=0.0, Omega0=hovering.OMEGA_G, theta_w=3 * math.pi / 4)
+    K0 = np.array([-0.3, 0.2])
+    res = m.iterate(m.L1(K0), K0, n, record=("orbit",))
+    c = hovering.classify_orbits(res)
+    for i, k in enumerate(K0):
+        ratio = (covered_fraction(res.phi[i], res.K[i], k - 0.1, k + 0.1, 64)
+                 / covered_fraction(res.phi[i], res.K[i], k - 0.1, k + 0.1, 32))
+        assert c.kind[i] == "circle" and ratio < 0.7, (k, c.kind[i], ratio)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -27,6 +27,7 @@ __all__ = ["OrbitClasses", "classify_orbits", "cyclic_order_violations", "rank_r
            "cone_crossing", "converse_kam"]
 
 _TWO_PI = 2.0 * math.pi
+#: The classes :func:`classify_orbits` gives, in the order its tests try them.
 KINDS = ("circle", "islands", "chaotic", "undecided")
 
 
