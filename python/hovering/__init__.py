@@ -35,6 +35,7 @@ from .analysis import (
     regularity,
     rotation_number,
 )
+from .analysis import ConeCrossing, OrbitClasses, classify_orbits, cone_crossing, converse_kam
 from .flow import (
     Bilinear,
     CustomPotential,
@@ -167,6 +168,11 @@ __all__ = [
     "save",
     "load",
     "show_versions",
+    "OrbitClasses",
+    "classify_orbits",
+    "ConeCrossing",
+    "cone_crossing",
+    "converse_kam",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):

@@ -4,6 +4,8 @@ and regularity, the hovering set HOV(eps), and the critical invariant curve."""
 from ..interface import register
 from .critical import CriticalCurve, critical_curve, max_angular_gap
 from .hovering import HoveringArea, hovering_area
+from .orbits import (ConeCrossing, OrbitClasses, classify_orbits, cone_crossing, converse_kam, cyclic_order_violations,
+                     rank_rotation)
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
 
 __all__ = [
@@ -16,6 +18,13 @@ __all__ = [
     "CriticalCurve",
     "critical_curve",
     "max_angular_gap",
+    "OrbitClasses",
+    "classify_orbits",
+    "cyclic_order_violations",
+    "rank_rotation",
+    "ConeCrossing",
+    "cone_crossing",
+    "converse_kam",
 ]
 
 # The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the
