@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import hovering
-import numpy_reference as ref
+from helpers import numpy_reference as ref
 from hovering.analysis import birkhoff_average, birkhoff_weights, regularity, rotation_number
 
-PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+from conftest import PAPER  # hovering.paper.FIGURE
 
 
 def paper_map(eps):

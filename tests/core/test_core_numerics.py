@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 from hovering import _core
 from hovering.analysis.hovering import _outcomes, _stratified, default_depth
 
-PAPER = dict(Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+from conftest import PAPER  # hovering.paper.FIGURE
 
 
 def numpy_samples(samples, K_low, seed):
@@ -48,9 +49,7 @@ def maps():
     m = hv.TruncatedMap(eps=0.15, **PAPER)
     fam = hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1, 0, 30) ** 2, [0.5, 1.0]]),
                                       forcing=(1.0, 0.3, -0.1))
-    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=-0.1, qw1=-1.0,
-                        qw2=-0.5)
-    return {"truncated": (m, 400), "family": (fam, 400), "flow": (hv.FlowMap(sys, h=1.0), 60)}
+    return {"truncated": (m, 400), "family": (fam, 400), "flow": (paper.flow_map(-0.1), 60)}
 
 
 @pytest.mark.parametrize("name", ["truncated", "family", "flow"])
@@ -102,9 +101,7 @@ def test_default_box_is_twice_the_deepest_first_order_curve():
 
 
 def test_the_measured_forcing_has_one_fit():
-    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0,
-                        qw2=-0.5)
-    fm = hv.FlowMap(sys, h=1.0)
+    fm = paper.flow_map(0.05)
     b = fm.forcing_coefficients()
     assert b.size == _core.normal.FORCING_MODES == 8
     # The least-squares fit of the same samples (what NumPy computed before): the modes are
@@ -131,9 +128,7 @@ def test_integrator_defaults_and_steppers_are_the_cores():
     o = hv.flow.flow_options()
     assert (o.stepper, o.rtol, o.atol, o.max_steps) == (d.stepper, d.rtol, d.atol, d.max_steps)
     assert hv.flow.flow_options(rtol=1e-8).rtol == 1e-8 and hv.flow.flow_options(rtol=1e-8).atol == d.atol
-    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0,
-                        qw2=-0.5)
-    fm = hv.FlowMap(sys, h=1.0, coordinates="section")
+    fm = paper.flow_map(0.05, coordinates="section")
     # A FlowMap's atol defaults to its rtol (the map's documented rule), the rest is the core's.
     assert fm.integrator_options == dict(rtol=d.rtol, atol=d.rtol, stepper=d.stepper)
     with pytest.raises(ValueError, match=r"stepper must be one of \('rk8pd', 'rkck'"):

@@ -18,16 +18,12 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import Bilinear, FlowMap, Harmonic, Section, StepSystem, Tan
+from hovering import FlowMap, Section, paper
 from hovering.diagnostics import choose_setting
 from hovering.diagnostics.work_precision import _reference_run
+from hovering.paper import V2, system
 
-ROOT = Path(__file__).resolve().parents[1]
-V1, V2 = Harmonic(1.0), Tan(1.4, 0.7)
-
-
-def system(eps=0.0, geometry="step"):
-    return StepSystem(V1=V1, V2=V2, coupling=Bilinear(), eps=eps, qw1=-1.0, qw2=-0.5, geometry=geometry)
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +146,7 @@ def test_scene_accuracy_key(tmp_path):
 
 
 def test_truncated_rotation_diagram():
-    m = hovering.TruncatedMap(eps=0.05, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    m = paper.truncated_map(0.05)
     wp = hovering.work_precision(m, tolerances=(1000, 10_000), n_points=3, repeat=1)
     rows = {(r["method"], r["tolerance"]): r["error"] for r in wp.table}
     # the plain mean converges as 1/n (10x per decade, within 3x), the weighted Birkhoff average
@@ -230,7 +226,7 @@ def test_hovering_area_diagram_against_its_largest_setting():
     # The largest (samples, n_steps) is the reference; each smaller setting's |area - reference|
     # must lie within 4x the two stated error bars combined (each bar is ~2 sigma of the
     # stratified sampling plus the iteration-count part: a 4x margin keeps this from flaking)
-    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    m = paper.truncated_map(0.3)
     wp = hovering.work_precision(m, quantity="hovering_area", tolerances=[(400, 250), (1600, 500), (6400, 1000)],
                                  repeat=1)
     assert wp.kind == "hovering_area" and [r["tolerance"] for r in wp.table] == ["400x250", "1600x500"]

@@ -476,7 +476,7 @@ def test_flow_scene_runs_with_the_exact_stepper(tmp_path):
     from hovering.pipeline import run_scene
     from hovering.scenes import parse_scene
 
-    d = tomllib.loads((Path(__file__).resolve().parents[1] / "examples" / "scenes" / "flow_portrait.toml").read_text())
+    d = tomllib.loads((Path(__file__).resolve().parents[2] / "examples" / "scenes" / "flow_portrait.toml").read_text())
     d.update(n_orbits=3, n_steps=300, corner_K=0)
     d["system"]["eps"] = 0.0
     runs = {}

@@ -6,13 +6,11 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import Bilinear, FlowStatus, Harmonic, Polynomial, Section, StepSystem, Tan
+from hovering import Bilinear, FlowStatus, Harmonic, Polynomial, StepSystem, Tan, paper
 
 
 def section(eps=0.0, V1=None, V2=None, coupling=None, geometry="none", h=1.0):
-    sys = StepSystem(V1=V1 or Harmonic(1.0), V2=V2 or Tan(1.4, 0.7), coupling=coupling or Bilinear(), eps=eps,
-                     qw1=-1.0, qw2=-0.5, geometry=geometry)
-    return Section(sys, h)
+    return paper.section(eps, geometry, h, V1=V1, V2=V2, coupling=coupling)
 
 
 @pytest.mark.parametrize("V1,V2", [(Harmonic(1.0), Tan(1.4, 0.7)), (Tan(1.2, 0.5), Harmonic(1.3)), (Tan(1.0, 0.6), Tan(1.4, 0.7))])
@@ -144,7 +142,7 @@ def test_msadams_agrees_with_rk8pd_on_the_coupled_step_system():
     # with events on its own steps) on the coupled step system, eps = 0.05: same itineraries
     # (all three regions present) and images within msadams' accuracy at rtol = atol = 1e-12
     # (its global error runs ~400x the local tolerance: measured 2.7e-10 here), bound 5e-9.
-    sec = Section(StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), coupling=Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5), 1.0)
+    sec = paper.section(0.05)
     th, I = np.linspace(-3, 3, 50), np.full(50, 0.3)
     a = sec.return_map(th, I, rtol=1e-12, atol=1e-12)
     b = sec.return_map(th, I, rtol=1e-12, atol=1e-12, stepper="msadams")

@@ -28,19 +28,14 @@ reference only.
 from __future__ import annotations
 
 import math
-import os
-import sys
 from collections import Counter
 
 import numpy as np
 import pytest
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-if HERE not in sys.path:
-    sys.path.insert(0, HERE)
-
-import flow_reference as ref
 import hovering as hv
+from hovering import paper
+from helpers import flow_reference as ref
 
 H = 1.0
 EPS_VALUES = (0.05, -0.1)
@@ -73,8 +68,7 @@ def _points():
 
 
 def _system(eps):
-    return hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(),
-                         eps=eps, qw1=-1.0, qw2=-0.5, geometry="step")
+    return paper.system(eps)
 
 
 @pytest.fixture(scope="module", params=EPS_VALUES, ids=lambda e: f"eps={e:+g}")

@@ -14,10 +14,9 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import FlowStatus, Harmonic, Section, StepSystem, Tan
+from hovering import FlowStatus, Harmonic, Section, StepSystem, paper
+from hovering.paper import H, QW1, QW2, V1, V2
 
-V1, V2 = Harmonic(1.0), Tan(1.4, 0.7)
-QW1, QW2, H = -1.0, -0.5, 1.0
 RTOL = 1e-12
 
 
@@ -115,7 +114,7 @@ def test_corner_hits_exactly_and_near(sec, delta):
 
 @pytest.mark.parametrize("dh", [-1e-12, 0.0, 1e-12])
 def test_energies_at_the_step_energy(dh):
-    sys = StepSystem(V1=V1, V2=V2, coupling=hovering.Bilinear(), eps=0.0, qw1=QW1, qw2=QW2, geometry="step")
+    sys = paper.system(0.0)
     h = sys.step_energy + dh
     s = Section(sys, h)
     th = np.linspace(-3.1, 3.1, 40)

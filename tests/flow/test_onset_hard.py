@@ -24,7 +24,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from hovering import Bilinear, Harmonic, StepSystem, Tan, onset_parameters
+from hovering import Bilinear, Harmonic, StepSystem, Tan, onset_parameters, paper
 
 FIELDS = ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
 EPS = 2.0**-52
@@ -213,7 +213,7 @@ def test_every_returned_parameter_is_within_its_error_of_the_definitions(args):
 
 # ---------------------------------------------------------------- the cases of the brief
 
-SYS = system(Harmonic(1.0), Tan(1.4, 0.7), -1.0, -0.5)
+SYS = paper.system(0.0)  # the physical system (hovering.paper) at eps = 0
 HW = SYS.step_energy
 
 

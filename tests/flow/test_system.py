@@ -7,7 +7,7 @@ import math
 import pytest
 
 import hovering
-from hovering import Bilinear, Harmonic, StepSystem, Tan, onset_parameters
+from hovering import Bilinear, Harmonic, StepSystem, Tan, onset_parameters, paper
 
 FIELDS = ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
 
@@ -19,7 +19,7 @@ def system(V1, V2, qw1=-1.0, qw2=-0.5):
 @pytest.mark.parametrize(
     "V1,V2,qw1,qw2,h",
     [
-        (Harmonic(1.0), Tan(1.4, 0.7), -1.0, -0.5, 1.0),  # the example
+        (paper.V1, paper.V2, paper.QW1, paper.QW2, paper.H),  # the example (hovering.paper's system)
         (Tan(1.0, 0.6), Tan(1.4, 0.7), -0.8, -0.4, 1.2),
         (Tan(1.2, 0.9), Harmonic(1.0), -0.7, -0.6, 1.5),
         (Harmonic(1.0), Harmonic(1.3), -1.0, -0.5, 2.0),
@@ -67,17 +67,17 @@ def test_printed_tau0_disagrees_with_the_definition():
 
 def test_bad_input_is_named():
     with pytest.raises(ValueError, match="h must exceed the step energy"):
-        onset_parameters(system(Harmonic(1.0), Tan(1.4, 0.7)), h=0.6)
+        onset_parameters(system(paper.V1, paper.V2), h=0.6)
     with pytest.raises(ValueError, match="geometry must be one of"):
-        StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), geometry="steps")
+        StepSystem(V1=paper.V1, V2=paper.V2, geometry="steps")
     with pytest.raises(ValueError, match=r"qw2 = -3.0 lies outside the well"):
-        StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), qw2=-3.0)
+        StepSystem(V1=paper.V1, V2=paper.V2, qw2=-3.0)
     with pytest.raises(ValueError, match="qw1 must be finite and < 0"):
-        StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), qw1=0.5)
+        StepSystem(V1=paper.V1, V2=paper.V2, qw1=0.5)
     with pytest.raises(ValueError, match="eps != 0 needs a coupling"):
-        StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), eps=0.1)
+        StepSystem(V1=paper.V1, V2=paper.V2, eps=0.1)
     with pytest.raises(ValueError, match=r"omega must lie in \[1e-100, 1e100\], got 0"):
         Harmonic(0.0)
     with pytest.raises(ValueError, match="method must be"):
-        onset_parameters(system(Harmonic(1.0), Tan(1.4, 0.7)), 1.0, method="guess")
-    assert system(Harmonic(1.0), Tan(1.4, 0.7)).step_energy == pytest.approx(0.5 + hovering.Tan(1.4, 0.7).V(-0.5))
+        onset_parameters(system(paper.V1, paper.V2), 1.0, method="guess")
+    assert system(paper.V1, paper.V2).step_energy == pytest.approx(0.5 + hovering.Tan(1.4, 0.7).V(-0.5))

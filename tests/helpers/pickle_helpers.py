@@ -13,6 +13,7 @@ import functools
 import numpy as np
 
 import hovering as hv
+from hovering import paper
 
 
 def quartic_V(q):
@@ -71,13 +72,12 @@ def step_chunk(args):
 
 # ------------------------------------------------------------------ shared objects of both test files
 
-PAPER = dict(Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+PAPER = paper.FIGURE
 
 
 def issue_system(eps=-0.05, V1=None, V2=None, geometry="step"):
     """The oscillators-step system of the flow tests (harmonic V1, Tan V2, bilinear coupling)."""
-    return hv.StepSystem(V1=V1 or hv.Harmonic(1.0), V2=V2 or hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=eps,
-                         qw1=-1.0, qw2=-0.5, geometry=geometry)
+    return paper.system(eps, geometry, V1=V1, V2=V2)
 
 
 @functools.cache

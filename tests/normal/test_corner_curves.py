@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import hovering
+from hovering import paper
 
 
 def _measure_arcs(sec, I, n=720):
@@ -36,8 +37,7 @@ def test_arc_lengths_from_the_flow_fix_the_sign_of_tau1():
     # Measured on circles K = I - I_tan < 0 of the eps = 0 step flow: + holds, to O(K^2)
     # (measured deviation ~10 K^2), while - is off by 2 tau1 |K|. |J_1| = 2 lam sqrt(-K) to
     # relative O(|K|) (measured 1.4 |K|). Both use onset parameters from the definitions.
-    sys = hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
-                              eps=0.0, qw1=-1.0, qw2=-0.5, geometry="step")
+    sys = paper.system(0.0)
     sec = hovering.Section(sys, 1.0)
     p = hovering.onset_parameters(sys, 1.0)
     for K in (-4e-4, -4e-3, -1e-2):

@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 from hovering import FlowStatus, Region, Status
 from conftest import PROMPT, CtrlCOnceStarted
 
 
 def system(eps=0.0, geometry="step", V1=None, V2=None):
-    return hv.StepSystem(V1=V1 or hv.Harmonic(1.0), V2=V2 or hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=eps,
-                         qw1=-1.0, qw2=-0.5, geometry=geometry)
+    return paper.system(eps, geometry, V1=V1, V2=V2)
 
 
 @pytest.fixture(scope="module")

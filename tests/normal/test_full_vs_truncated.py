@@ -1,14 +1,33 @@
-"""The full return map against the truncated map (thm:returnmap's remainders), measured."""
+"""The full return map against the truncated map (thm:returnmap's remainders), measured.
+
+Built from the package's public API only (the script examples/compare_full_truncated.py prints the
+same comparison for more eps and K; no test imports an example): the physical system of
+:mod:`hovering.paper`, its onset parameters, the measured forcing's sine fit, the truncated family
+on those and :func:`hovering.compare_maps`.
+"""
 
 from __future__ import annotations
 
-import importlib.util
-import pathlib
+import numpy as np
 
-SPEC = importlib.util.spec_from_file_location(
-    "compare_full_truncated", pathlib.Path(__file__).resolve().parents[1] / "examples" / "compare_full_truncated.py")
-cmp = importlib.util.module_from_spec(SPEC)
-SPEC.loader.exec_module(cmp)
+import hovering
+from hovering import paper
+
+
+def compare(eps, K, n_phi=12, n_modes=6):
+    """Largest |dphi|, |dK| between the full and the truncated map on the circle K, over the points
+    whose regions agree; ``same`` counts those points, ``b`` are the forcing's sine coefficients."""
+    sec = paper.section(eps)
+    p = hovering.onset_parameters(paper.system(0.0), paper.H)
+    b = hovering.forcing_coefficients(sec, n_modes=n_modes, n_phi=64)
+    m = hovering.TruncatedMap(eps=eps, Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
+    grid = np.concatenate([-np.linspace(0.3, 0.0, 31) ** 2 * 10 / 9, np.linspace(0.01, 0.3, 10)])
+    fam = hovering.TruncatedFamily.from_map(m, grid, forcing=tuple(b))
+    phi = np.linspace(-3.0, 3.0, n_phi)
+    c = hovering.compare_maps(sec, None, fam, phi, np.full_like(phi, K))
+    same = c.agree & (c.region_full != "?")
+    return dict(same=int(same.sum()), dphi=float(np.abs(c.dphi[same]).max()), dK=float(np.abs(c.dK[same]).max()),
+                b=b)
 
 
 def test_remainders_scale_as_thm_returnmap():
@@ -17,8 +36,8 @@ def test_remainders_scale_as_thm_returnmap():
     # measured x5.9 (K = 0.01) and x6.8 (K = -0.01), accepted in [3, 16].
     # G_phi = O(eps) near the tangency: at |K| = 0.01 the phi-difference grows ~linearly in eps.
     # The regions of the two maps agree at every tested point away from the arc ends.
-    lo = {K: cmp.compare(0.005, K, n_phi=12) for K in (-0.01, 0.01)}
-    hi = {K: cmp.compare(0.02, K, n_phi=12) for K in (-0.01, 0.01)}
+    lo = {K: compare(0.005, K) for K in (-0.01, 0.01)}
+    hi = {K: compare(0.02, K) for K in (-0.01, 0.01)}
     for K in (-0.01, 0.01):
         for r, eps in ((lo[K], 0.005), (hi[K], 0.02)):
             assert r["same"] >= 11

@@ -7,13 +7,8 @@ import pytest
 
 import hovering
 from hovering import normal as fm
+from hovering.paper import V1, V2, section
 
-V1, V2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7)
-
-
-def section(eps):
-    sys = hovering.StepSystem(V1=V1, V2=V2, coupling=hovering.Bilinear(), eps=eps, qw1=-1.0, qw2=-0.5, geometry="step")
-    return hovering.Section(sys, 1.0)
 
 
 @pytest.fixture(scope="module")

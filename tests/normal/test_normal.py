@@ -6,21 +6,16 @@ import numpy as np
 import pytest
 
 from hovering import (
-    Bilinear,
-    Harmonic,
-    Section,
-    StepSystem,
-    Tan,
     forcing_function,
     from_normal,
     tangential_curve,
+    paper,
     to_normal,
 )
 
 
 def sec(eps, geometry="step"):
-    return Section(StepSystem(V1=Harmonic(1.0), V2=Tan(1.4, 0.7), coupling=Bilinear(), eps=eps, qw1=-1.0, qw2=-0.5,
-                              geometry=geometry), 1.0)
+    return paper.section(eps, geometry)
 
 
 def test_uncoupled_tangential_curve_is_the_tangent_circle():

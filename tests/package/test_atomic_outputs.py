@@ -43,7 +43,7 @@ from hovering._output import WriteError  # noqa: E402
 from hovering._provenance import provenance  # noqa: E402
 from hovering.parallel.checkpoint import Checkpoint  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 # A portrait that computes in well under a second (TITLE makes two runs' files differ).
 PORTRAIT = """

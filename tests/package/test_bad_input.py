@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 from hovering.parallel.checkpoint import Checkpoint
 
 M = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
 FAM = hv.TruncatedFamily.from_map(M, np.concatenate([-np.linspace(1.0, 0.0, 41) ** 2, np.linspace(0.02, 1.0, 10)]))
-SYS = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5)
+SYS = paper.system(0.05)
 SEC = hv.Section(SYS, 1.0)
 NAN = float("nan")
 
@@ -258,7 +259,7 @@ def test_demo_cli_refuses_bad_options_before_computing(argv, text, capsys):
 def test_scene_cli_refuses_a_bad_out_path(tmp_path, capsys):
     from hovering.__main__ import main
 
-    scene = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_smalleps.toml"
+    scene = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "fig_smalleps.toml"
     assert main(["scene", str(scene), "--out", str(tmp_path / "x.nope")]) == 2
     assert "matplotlib cannot write '.nope' files" in capsys.readouterr().err
 
@@ -284,7 +285,7 @@ def test_scene_cli_reports_values_only_the_run_can_check_in_one_line(tmp_path, c
     # refuses it; the CLI used to print a traceback (exit 1) instead of one line (exit 2).
     from hovering.__main__ import main
 
-    src = (Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_smalleps.toml").read_text()
+    src = (Path(__file__).resolve().parents[2] / "examples" / "scenes" / "fig_smalleps.toml").read_text()
     assert "eps = 0.3" in src
     bad = tmp_path / "bad.toml"
     bad.write_text(src.replace("eps = 0.3", "eps = 1e6", 1))

@@ -31,6 +31,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import hovering as hv
+from hovering import paper
 
 # Derandomised by default so CI is reproducible; HOVERING_FUZZ=N runs N random examples per test
 # (a deeper local search: HOVERING_FUZZ=2000 python -m pytest tests/test_hypothesis_api.py).
@@ -39,7 +40,7 @@ SETTINGS = settings(max_examples=_DEEP or 60, deadline=None, derandomize=not _DE
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
 M = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
-SYS = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5)
+SYS = paper.system(0.05)
 SEC = hv.Section(SYS, 1.0)
 FM = hv.FlowMap(SYS, 1.0)
 
@@ -305,7 +306,7 @@ SYSTEM = dict(eps=ANY, qw1=ANY, qw2=ANY, geometry=ANY, coupling=ANY)
 @SETTINGS
 @given(data=st.data())
 def test_step_system_parameters(param, data):
-    kw = dict(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5)
+    kw = dict(V1=paper.V1, V2=paper.V2, coupling=hv.Bilinear(), eps=0.05, qw1=paper.QW1, qw2=paper.QW2)
     kw[param] = data.draw(SYSTEM[param])
     s = outcome(lambda: hv.StepSystem(**kw), param)
     if s is not None:

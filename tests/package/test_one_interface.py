@@ -4,21 +4,19 @@ alike, and the enums are the core's own."""
 from __future__ import annotations
 
 import enum
-import math
 
 import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import Region, Status
+from hovering import Region, Status, paper
 
 
 @pytest.fixture(scope="module")
 def maps():
-    m = hv.TruncatedMap(eps=0.1, Omega0=hv.OMEGA_G, theta_w=3 * math.pi / 4)
+    m = paper.truncated_map(0.1)
     fam = hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1.0, 0.0, 81) ** 2, np.linspace(0.02, 1.0, 30)]))
-    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=-0.05, qw1=-1.0, qw2=-0.5)
-    return {"TruncatedMap": m, "TruncatedFamily": fam, "FlowMap": hv.FlowMap(sys, h=1.0)}
+    return {"TruncatedMap": m, "TruncatedFamily": fam, "FlowMap": paper.flow_map(-0.05)}
 
 
 @pytest.mark.parametrize("kind", ["TruncatedMap", "TruncatedFamily", "FlowMap"])

@@ -19,7 +19,7 @@ import pytest
 
 import hovering as hv
 from hovering import _core
-from pickle_helpers import (
+from helpers.pickle_helpers import (
     Cosh,
     issue_system,
     maps,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import Status
+from hovering import Status, paper
 from hovering._progress import Progress, check_progress, progress_bar
 from conftest import CtrlCOnceStarted
 
@@ -45,7 +45,7 @@ def fm():
 
 @pytest.fixture(scope="module")
 def tm():
-    return hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4)
+    return paper.truncated_map(0.3)
 
 
 @pytest.mark.parametrize("kernel", ["simd", "scalar"])

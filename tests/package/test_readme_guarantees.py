@@ -41,7 +41,7 @@ import pytest
 import hovering as hv
 from hovering import Status
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_the_bullets_example_messages_are_the_apis():

@@ -13,17 +13,17 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 from hovering import _pickle, _serial
 from hovering.parallel.checkpoint import canonical
 
-LEGACY = Path(__file__).resolve().parent / "data" / "legacy"
+LEGACY = Path(__file__).resolve().parents[1] / "data" / "legacy"
 MAPS = ("truncated", "truncated_capped", "family", "flow_normal", "flow_section")
 
 
 def objects() -> dict:
     """One object of each class with a record."""
-    sys = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=-0.05, qw1=-1.0,
-                        qw2=-0.5)
+    sys = paper.system(-0.05)
     fm = hv.FlowMap(sys, h=1.0)
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
     return {

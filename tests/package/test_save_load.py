@@ -16,7 +16,7 @@ import pytest
 
 import hovering as hv
 from hovering import FlowStatus, Region, Status, _serial
-from pickle_helpers import Cosh, issue_system, maps, quartic, results, same, same_steps
+from helpers.pickle_helpers import Cosh, issue_system, maps, quartic, results, same, same_steps
 
 # ------------------------------------------------------------------ results
 

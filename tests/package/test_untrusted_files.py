@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 from hovering import _serial, _untrusted, scenes
 from hovering.cli import main
 from hovering.scenes import load_result, load_scene
@@ -35,7 +36,7 @@ from hovering.scenes.schema import (MAX_CANVAS_PIXELS, MAX_KEY_PARTS, MAX_SCENE_
                                     scene_table)
 from hovering.parallel.checkpoint import Checkpoint
 
-SCENE_DIR = Path(__file__).resolve().parent.parent / "examples" / "scenes"
+SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 HANG_GUARD = 30.0  # seconds: only a guard against a hang or a long computation, never a speed test
 MiB = 1 << 20
 
@@ -151,9 +152,7 @@ def genuine(tmp_path_factory):
     d = tmp_path_factory.mktemp("genuine")
     (d / "tiny.toml").write_text(TINY_SCENE)
     summary = run_scene(load_scene(d / "tiny.toml"), out=d / "tiny.png")
-    sys_ = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=-0.05, qw1=-1.0,
-                         qw2=-0.5)
-    fm = hv.save(hv.FlowMap(sys_, 1.0, coordinates="section"), d / "flowmap")
+    fm = hv.save(paper.flow_map(-0.05, coordinates="section"), d / "flowmap")
     return {"result": Path(summary["npz"]), "flowmap": Path(fm), "dir": d}
 
 
@@ -645,7 +644,7 @@ def _differs(a, b) -> bool:
 
 def test_every_result_type_round_trips_its_checks(tmp_path):
     # The field-type checks accept everything hovering writes (results of every type, maps).
-    from pickle_helpers import maps, results
+    from helpers.pickle_helpers import maps, results
 
     for name, r in {**{k: v for k, v in results().items() if k != "iterate_custom"},
                     **{f"map_{k}": v[0] for k, v in maps().items() if k != "flow_custom"}}.items():

@@ -10,11 +10,11 @@ import json
 import numpy as np
 import pytest
 
-import hovering
+from hovering import paper
 from hovering.analysis.hovering import hovering_area
 from hovering.parallel import Executor
 
-M = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+M = paper.truncated_map(0.3)
 KW = dict(n_steps=800, samples=6000, seed=7)
 
 
@@ -51,9 +51,7 @@ def test_dask_local_cluster_and_an_existing_client_give_the_same_answer(single, 
 
 
 def test_flow_map_pieces_give_the_single_process_answer():
-    sys = hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
-                              eps=-0.1, qw1=-1.0, qw2=-0.5, geometry="step")
-    fm = hovering.FlowMap(sys, 1.0)
+    fm = paper.flow_map(-0.1)
     kw = dict(n_steps=40, samples=64, seed=1)
     same(hovering_area(fm, **kw), hovering_area(fm, **kw, executor=Executor(workers=2, pieces=3)))
 
@@ -135,7 +133,7 @@ def _scene_copy(tmp_path, name, **changes):
 
     from hovering.scenes import parse_scene
 
-    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    root = __import__("pathlib").Path(__file__).resolve().parents[2]
     path = root / "examples" / "scenes" / name
     data = tomllib.loads(path.read_text())
     data.update(changes)
@@ -171,7 +169,7 @@ def test_cli_workers_flags(tmp_path):
     import subprocess
     import sys
 
-    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    root = __import__("pathlib").Path(__file__).resolve().parents[2]
     scene = root / "examples" / "scenes" / "fig_hov_vs_eps.toml"
     p = subprocess.run([sys.executable, "-m", "hovering", "scene", str(scene), "--quick", "--workers", "2", "--out",
                         str(tmp_path / "h.png")], capture_output=True, text=True, timeout=300)

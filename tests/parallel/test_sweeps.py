@@ -12,7 +12,7 @@ import hovering
 from hovering import pipeline, scenes
 from hovering.parallel.checkpoint import Checkpoint, canonical
 
-SCENE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "scenes" / "fig_hov_vs_eps.toml"
+SCENE = pathlib.Path(__file__).resolve().parents[2] / "examples" / "scenes" / "fig_hov_vs_eps.toml"
 
 
 def test_checkpoint_roundtrip_and_torn_line(tmp_path):

@@ -22,7 +22,7 @@ from hovering import Region, Status
 from hovering.explore import COLORS, DEFAULT_N_STEPS, Explorer, default_K_range, main
 from hovering.plot.style import REGION_COLORS
 
-PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+from conftest import PAPER  # hovering.paper.FIGURE
 
 
 @pytest.fixture(autouse=True)

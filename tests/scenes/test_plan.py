@@ -21,7 +21,7 @@ from hovering.scenes import load_scene
 from hovering.scenes.compute import compute, run_point
 from hovering.scenes.plan import FORMAT, VERSION, plan_points, plan_text, point_key, sweep_counts, write_plan
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TRUNC = ROOT / "examples" / "scenes" / "fig_hov_vs_eps.toml"
 FLOW = ROOT / "examples" / "scenes" / "flow_hov_vs_eps.toml"
 

@@ -24,7 +24,7 @@ from hovering.scenes.compute import zoom_window_critical, zoom_window_islands
 from hovering.scenes import load_scene, parse_scene
 from hovering.pipeline import run_scene
 
-SCENE_DIR = Path(__file__).resolve().parent.parent / "examples" / "scenes"
+SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "fig_hov_vs_eps"}
 FLOW = {"flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma"}  # tests/test_flow_scenes.py
 SCENE_FILES = [SCENE_DIR / f"{n}.toml" for n in sorted(EXPECTED)]

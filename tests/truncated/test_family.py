@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import hovering
-import numpy_reference as ref
+from helpers import numpy_reference as ref
 from conftest import PAPER, PARAM_SETS, cdiff, make_map
 from hovering import TruncatedFamily
 

@@ -7,13 +7,12 @@ import time
 import numpy as np
 import pytest
 
-import hovering
-from hovering import Status
+from hovering import Status, paper
 from conftest import PROMPT, CtrlCOnceStarted
 
 
 def test_interrupt_keeps_every_orbit_state():
-    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    m = paper.truncated_map(0.3)
     rng = np.random.default_rng(5)
     n = 20_000
     phi0, K0 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.5, 0.5, n)
@@ -49,7 +48,7 @@ def test_interrupt_keeps_every_orbit_state():
 
 def test_interrupt_reports_unstarted_out_of_band_orbits_as_escaped():
     # Orbits that start outside the band are ESCAPED after 0 steps, interrupted run or not.
-    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, K_max=1.0)
+    m = paper.truncated_map(0.3, K_max=1.0)
     n = 20_000
     phi0 = np.linspace(-3, 3, n)
     K0 = np.where(np.arange(n) % 2 == 0, 0.1, 5.0)
@@ -66,7 +65,7 @@ def test_exception_from_a_signal_handler_propagates_unchanged():
     # Only Ctrl-C becomes KeyboardInterrupt-with-partial; what another handler raises passes through.
     import signal
 
-    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    m = paper.truncated_map(0.3)
 
     def on_alarm(signum, frame):
         raise TimeoutError("budget exceeded")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import numpy_reference as ref
+from helpers import numpy_reference as ref
 from conftest import (
     LOCAL_ROUNDOFF,
     PARAM_SETS,

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from hovering import paper
 
 OMEGA_IN = hv.OMEGA_G  # 3.883: sin(Omega0/2) > 0
 OMEGA_OUT = hv.OMEGA_G + 2 * math.pi  # 10.17: sin(Omega0/2) < 0
@@ -54,7 +55,7 @@ def test_symmetry_behind_it():
 
 
 def test_critical_curve_on_the_sign_that_does_not_hover_says_so():
-    m = hv.TruncatedMap(eps=-0.3, Omega0=hv.OMEGA_G, theta_w=3 * math.pi / 4)
+    m = paper.truncated_map(-0.3)
     cc = m.critical_curve(n_steps=4000)
     # The lowest curve avoiding the impacts is k^{u0}: minimum ~0 on L2 (thm:minmaxinvriantcurves).
     assert not cc.hovers and cc.line == "L2" and "no hovering set" in cc.note

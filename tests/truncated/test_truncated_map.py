@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import hovering
-import numpy_reference as ref
+from helpers import numpy_reference as ref
 from conftest import (
     LOCAL_ROUNDOFF,
     PARAM_SETS,
