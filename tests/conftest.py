@@ -168,6 +168,16 @@ class CtrlCOnceStarted:
 PROMPT = 10.0
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Every test that runs the C++ executable (it asks for ``sweep_exe``) is end-to-end: the
+    default run leaves it out (``-m "not slow and not e2e"`` in pyproject), so a plain
+    ``python -m pytest tests`` never builds hovering_sweep; CI and scripts/test.sh run it."""
+    for item in items:
+        if "sweep_exe" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.e2e)
+
+
 @pytest.fixture(scope="session")
 def sweep_exe():
     """This checkout's hovering_sweep, brought up to date in build/ctest (the directory the README's

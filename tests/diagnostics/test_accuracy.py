@@ -172,6 +172,7 @@ def test_bad_arguments_are_named():
                                 steppers=(2.0,))
 
 
+@pytest.mark.e2e
 def test_cli_accuracy_writes_the_diagram_and_table(tmp_path):
     out = tmp_path / "acc.png"
     p = subprocess.run([sys.executable, "-m", "hovering", "accuracy", str(ROOT / "examples/scenes/flow_portrait.toml"),

@@ -467,6 +467,7 @@ def test_flowmap_exact_iterates_the_interval_exchange():
     assert np.max(np.abs(p0 - phi)) < 1e-12 and np.max(np.abs(k0 - K)) < 1e-12
 
 
+@pytest.mark.e2e
 def test_flow_scene_runs_with_the_exact_stepper(tmp_path):
     import tomllib
     from pathlib import Path

@@ -1,6 +1,6 @@
 """Cross-check of hovering's flow return map against an independent pure-NumPy reference.
 
-The reference (``tests/flow_reference.py``) was written from the problem statement alone: fixed-
+The reference (``tests/helpers/flow_reference.py``) was written from the problem statement alone: fixed-
 step RK4 (DT = 1e-3) with bisection-located events.  It is validated here on its own (angle-action
 conversion, exact answers at eps = 0, step halving, detection of wall dips inside one step) and
 then compared with ``hovering.Section.return_map`` and ``hovering.FlowMap.iterate`` at h = 1,

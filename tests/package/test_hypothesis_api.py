@@ -34,7 +34,7 @@ import hovering as hv
 from hovering import paper
 
 # Derandomised by default so CI is reproducible; HOVERING_FUZZ=N runs N random examples per test
-# (a deeper local search: HOVERING_FUZZ=2000 python -m pytest tests/test_hypothesis_api.py).
+# (a deeper local search: HOVERING_FUZZ=2000 python -m pytest tests/package/test_hypothesis_api.py).
 _DEEP = int(os.environ.get("HOVERING_FUZZ", "0"))
 SETTINGS = settings(max_examples=_DEEP or 60, deadline=None, derandomize=not _DEEP, database=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

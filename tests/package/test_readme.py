@@ -50,7 +50,7 @@ def test_readme_examples_run_and_agree_with_the_text():
 def test_readme_fullmap_block():
     # The hovering.fullmap block: measured-arc truncation at eps = 0.05 on the circle K = -0.015.
     # All three regions are hit and agree with the flow; G_K = O(eps K) with the constant 0.4-0.7
-    # measured in tests/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
+    # measured in tests/normal/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
     ns: dict = {}
     for code in _python_blocks():
         exec(compile(code, str(README), "exec"), ns)

@@ -9,7 +9,7 @@ import subprocess
 import sys
 import textwrap
 
-# A long call at interpreter exit (a daemon thread, Ctrl-C in join()): tests/test_exit_race.py.
+# A long call at interpreter exit (a daemon thread, Ctrl-C in join()): tests/package/test_exit_race.py.
 
 
 SIGINT_IN_ITERATE = textwrap.dedent(

@@ -141,6 +141,7 @@ def _scene_copy(tmp_path, name, **changes):
     return parse_scene(data, tmp_path / path.name)  # a scene in tmp_path may write there
 
 
+@pytest.mark.e2e
 def test_sweep_scenes_on_workers_give_the_one_process_rows(tmp_path):
     from hovering.scenes.compute import compute
 
@@ -154,6 +155,7 @@ def test_sweep_scenes_on_workers_give_the_one_process_rows(tmp_path):
     assert again.meta["points_reused"] == sum(len(s.eps) for s in again.series)
 
 
+@pytest.mark.e2e
 def test_flow_sweep_scene_on_workers(tmp_path):
     from hovering.scenes.compute import compute
 
@@ -165,6 +167,7 @@ def test_flow_sweep_scene_on_workers(tmp_path):
         assert np.array_equal(one.models[name]["area"], pool.models[name]["area"])
 
 
+@pytest.mark.e2e
 def test_cli_workers_flags(tmp_path):
     import subprocess
     import sys

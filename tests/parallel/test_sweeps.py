@@ -69,6 +69,7 @@ def test_two_writers_never_duplicate_a_point(tmp_path):
     assert len(points) == 2 and path.read_text().count('"format"') == 1
 
 
+@pytest.mark.e2e
 def test_interrupted_sweep_resumes(tmp_path, monkeypatch):
     scene = scenes.load_scene(SCENE)
     out = tmp_path / "hov.png"

@@ -82,6 +82,7 @@ def test_every_flow_scene_file_loads_and_names_its_effects():
     assert tori.outputs.record == ("trajectory",)
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize("name", FLOW_FILES)
 def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, monkeypatch):
     s = runs[name]
@@ -112,6 +113,7 @@ def _region_colls(ax):
     return {c.get_gid(): c for c in ax.collections if (c.get_gid() or "").startswith("region:")}
 
 
+@pytest.mark.e2e
 def test_flow_portrait_side_by_side_same_starts_region_colours(runs):
     s = runs["flow_portrait"]
     res, fig = s["result"], s["figure"]
@@ -163,6 +165,7 @@ def test_flow_portrait_without_regions_records_none_and_colours_by_orbit(tmp_pat
         plt.close(s["figure"])
 
 
+@pytest.mark.e2e
 def test_flow_hovering_area_scene_both_signs_models_and_theory(runs):
     s = runs["flow_hov_vs_eps"]
     res, fig = s["result"], s["figure"]
@@ -191,6 +194,7 @@ def test_flow_hovering_area_scene_both_signs_models_and_theory(runs):
     assert len(fig.axes[1].lines) == 2  # agreement curves of both models
 
 
+@pytest.mark.e2e
 def test_sigma_structure_regions_and_images(runs):
     s = runs["fig_structure_sigma"]
     res, fig = s["result"], s["figure"]
@@ -225,6 +229,7 @@ def test_sigma_structure_regions_and_images(runs):
         assert np.sign(m0) == -np.sign(m1)
 
 
+@pytest.mark.e2e
 def test_tangent_tori_figure(runs):
     s = runs["fig_two_tang"]
     res, fig = s["result"], s["figure"]
@@ -299,6 +304,7 @@ def test_flow_schema_errors_name_the_key(name, path, value, text):
     assert text in str(e.value), str(e.value)
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize("case,text", [
     ("unwritable", "is not a directory"),
     ("format", "matplotlib cannot write '.xyz' files"),
@@ -341,6 +347,7 @@ def test_bad_flow_scene_fails_in_the_cli_before_computing(tmp_path, case, text):
     assert not list(tmp_path.glob("**/*.npz"))
 
 
+@pytest.mark.e2e
 def test_cli_redraw(tmp_path, runs, capsys):
     from hovering.cli import main
 

@@ -26,7 +26,7 @@ from hovering.pipeline import run_scene
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "fig_hov_vs_eps"}
-FLOW = {"flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma"}  # tests/test_flow_scenes.py
+FLOW = {"flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma"}  # tests/scenes/test_flow_scenes.py
 SCENE_FILES = [SCENE_DIR / f"{n}.toml" for n in sorted(EXPECTED)]
 
 
@@ -222,6 +222,7 @@ def runs(tmp_path_factory):
         plt.close(summary["figure"])
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_quick_run_writes_png_and_npz(runs, name):
     s = runs[name]
@@ -251,6 +252,7 @@ def _orbit_axes(fig):
     return [ax for ax in fig.axes if ax.get_xlabel() == r"$\phi$"]
 
 
+@pytest.mark.e2e
 def test_smallepsmany_two_panels_of_thirty_orbits(runs):
     s = runs["fig_smallepsmany"]
     fig = s["figure"]
@@ -268,6 +270,7 @@ def test_smallepsmany_two_panels_of_thirty_orbits(runs):
         np.testing.assert_allclose(phi0, m.L1(K0), atol=1e-12)
 
 
+@pytest.mark.e2e
 def test_smalleps_special_orbits_legends_and_curves(runs):
     s = runs["fig_smalleps"]
     fig = s["figure"]
@@ -321,6 +324,7 @@ def test_smalleps_special_orbits_legends_and_curves(runs):
         assert any(np.all(np.asarray(ln.get_ydata()) == 0) for ln in ax.lines)  # K = 0
 
 
+@pytest.mark.e2e
 def test_smalleps_hovering_only_for_positive_eps(runs):
     # fig:smalleps a: blue and orange lie on invariant curves in J_0 u J_0u dipping below K = 0;
     # b: no L1 orbit hovers (the hovering set is destroyed); red stays on K >= 0 curve.
@@ -332,6 +336,7 @@ def test_smalleps_hovering_only_for_positive_eps(runs):
     assert ob["red"]["impacts"] == 0 and ob["red"]["K_min"] >= -1e-12
 
 
+@pytest.mark.e2e
 def test_hoverinnc_zoom_shows_the_dip_of_the_critical_curve(runs):
     s = runs["fig_hoverinnc"]
     fig = s["figure"]
@@ -354,6 +359,7 @@ def test_hoverinnc_zoom_shows_the_dip_of_the_critical_curve(runs):
     assert zax.get_xlabel() == r"$\phi$" and "zoom of (b)" in zax.get_title()
 
 
+@pytest.mark.e2e
 def test_epsbig_panels_islands_zoom_and_flipped_eps(runs):
     s = runs["fig_epsbig"]
     fig = s["figure"]
@@ -384,6 +390,7 @@ def test_epsbig_panels_islands_zoom_and_flipped_eps(runs):
         assert r"k_{\varepsilon,2}" in lead.get_label()
 
 
+@pytest.mark.e2e
 def test_hov_vs_eps_errorbars_and_theory(runs):
     s = runs["fig_hov_vs_eps"]
     fig = s["figure"]
@@ -437,6 +444,7 @@ def test_zoom_window_rules_on_synthetic_orbits():
     assert w["xlim"] == [pytest.approx(3.1), np.pi]  # the box (3.1, 3.1 + 0.083) is clipped at pi
 
 
+@pytest.mark.e2e
 def test_cli_scene_prints_summary_and_path(tmp_path, capsys):
     from hovering.__main__ import main
 

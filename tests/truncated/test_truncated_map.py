@@ -2,7 +2,7 @@
 
 Oracles: the reversibility lemma (lem:truncreturnmap), area preservation, the symmetries and the
 rescaling of sec:truncatedmapnum, exact solutions (standard map for K >= 0, interval exchange for
-eps = 0) and the independent NumPy implementation tests/numpy_reference.py.
+eps = 0) and the independent NumPy implementation tests/helpers/numpy_reference.py.
 """
 
 from __future__ import annotations
