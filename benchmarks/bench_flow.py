@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 import hovering
 from hovering import paper
 from hovering.diagnostics.work_precision import _best_time
-from hovering.paper import H, QW1, V1, V2
+from hovering.paper import QW1, V1, V2, H
 
 SEC = paper.section(0.0, "wall")
 

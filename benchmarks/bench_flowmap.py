@@ -20,7 +20,7 @@ import numpy as np
 
 import hovering as hv
 from hovering import paper
-from hovering.paper import H, QW1, QW2
+from hovering.paper import QW1, QW2, H
 
 EPS = -0.05
 SYS = paper.system(EPS)

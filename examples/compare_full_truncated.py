@@ -17,7 +17,7 @@ import numpy as np
 
 import hovering
 from hovering import StepSystem, TruncatedFamily, TruncatedMap, paper
-from hovering.paper import H, QW1, QW2, V1, V2
+from hovering.paper import QW1, QW2, V1, V2, H
 
 CODE = {"1": int(hovering.Region.UPPER), "R": int(hovering.Region.RIGHT), "0": int(hovering.Region.ABOVE), "u": int(hovering.Region.BESIDE)}
 

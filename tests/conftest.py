@@ -29,8 +29,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import hovering  # noqa: E402
-from hovering import paper  # noqa: E402
 from helpers import numpy_reference as ref  # noqa: E402
+from hovering import paper  # noqa: E402
 
 #: Figure parameters of the paper (fig:smalleps) without eps: hovering.paper's, the one copy.
 PAPER = dict(paper.FIGURE)

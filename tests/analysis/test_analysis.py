@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 
 import hovering
+from conftest import PAPER  # hovering.paper.FIGURE
 from helpers import numpy_reference as ref
 from hovering.analysis import birkhoff_average, birkhoff_weights, regularity, rotation_number
-
-from conftest import PAPER  # hovering.paper.FIGURE
 
 
 def paper_map(eps):

@@ -12,11 +12,9 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import paper
-from hovering import _core
-from hovering.analysis.hovering import _outcomes, _stratified, default_depth
-
 from conftest import PAPER  # hovering.paper.FIGURE
+from hovering import _core, paper
+from hovering.analysis.hovering import _outcomes, _stratified, default_depth
 
 
 def numpy_samples(samples, K_low, seed):

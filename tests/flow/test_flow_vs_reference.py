@@ -34,8 +34,8 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import paper
 from helpers import flow_reference as ref
+from hovering import paper
 
 H = 1.0
 EPS_VALUES = (0.05, -0.1)

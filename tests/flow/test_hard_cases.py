@@ -15,7 +15,7 @@ import pytest
 
 import hovering
 from hovering import FlowStatus, Harmonic, Section, StepSystem, paper
-from hovering.paper import H, QW1, QW2, V1, V2
+from hovering.paper import QW1, QW2, V1, V2, H
 
 RTOL = 1e-12
 

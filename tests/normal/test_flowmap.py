@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import paper
-from hovering import FlowStatus, Region, Status
 from conftest import PROMPT, CtrlCOnceStarted
+from hovering import FlowStatus, Region, Status, paper
 
 
 def system(eps=0.0, geometry="step", V1=None, V2=None):

@@ -10,7 +10,6 @@ from hovering import normal as fm
 from hovering.paper import V1, V2, section
 
 
-
 @pytest.fixture(scope="module")
 def sec0():
     return section(0.0)

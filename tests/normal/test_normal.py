@@ -8,8 +8,8 @@ import pytest
 from hovering import (
     forcing_function,
     from_normal,
-    tangential_curve,
     paper,
+    tangential_curve,
     to_normal,
 )
 

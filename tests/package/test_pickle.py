@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import _core
 from helpers.pickle_helpers import (
     Cosh,
     issue_system,
@@ -31,6 +30,7 @@ from helpers.pickle_helpers import (
     same_steps,
     scaled,
 )
+from hovering import _core
 
 PROTOCOLS = list(range(2, pickle.HIGHEST_PROTOCOL + 1))
 COPIES = {

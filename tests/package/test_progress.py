@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from conftest import CtrlCOnceStarted
 from hovering import Status, paper
 from hovering._progress import Progress, check_progress, progress_bar
-from conftest import CtrlCOnceStarted
 
 
 class Recorder:

@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import paper
-from hovering import _pickle, _serial
+from hovering import _pickle, _serial, paper
 from hovering.parallel.checkpoint import canonical
 
 LEGACY = Path(__file__).resolve().parents[1] / "data" / "legacy"

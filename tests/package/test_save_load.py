@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import FlowStatus, Region, Status, _serial
 from helpers.pickle_helpers import Cosh, issue_system, maps, quartic, results, same, same_steps
+from hovering import FlowStatus, Region, Status, _serial
 
 # ------------------------------------------------------------------ results
 

@@ -27,14 +27,12 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import paper
-from hovering import _serial, _untrusted, scenes
+from hovering import _serial, _untrusted, paper, scenes
 from hovering.cli import main
-from hovering.scenes import load_result, load_scene
-from hovering.pipeline import redraw, run_scene
-from hovering.scenes.schema import (MAX_CANVAS_PIXELS, MAX_KEY_PARTS, MAX_SCENE_DEPTH, MAX_TEXT, check_spec,
-                                    scene_table)
 from hovering.parallel.checkpoint import Checkpoint
+from hovering.pipeline import redraw, run_scene
+from hovering.scenes import load_result, load_scene
+from hovering.scenes.schema import MAX_CANVAS_PIXELS, MAX_KEY_PARTS, MAX_SCENE_DEPTH, MAX_TEXT, check_spec, scene_table
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 HANG_GUARD = 30.0  # seconds: only a guard against a hang or a long computation, never a speed test

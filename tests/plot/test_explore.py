@@ -18,11 +18,10 @@ from matplotlib.backend_bases import KeyEvent, MouseEvent, NavigationToolbar2
 from matplotlib.colors import to_rgba_array
 
 import hovering
+from conftest import PAPER  # hovering.paper.FIGURE
 from hovering import Region, Status
 from hovering.explore import COLORS, DEFAULT_N_STEPS, Explorer, default_K_range, main
 from hovering.plot.style import REGION_COLORS
-
-from conftest import PAPER  # hovering.paper.FIGURE
 
 
 @pytest.fixture(autouse=True)

@@ -22,9 +22,9 @@ import pytest
 
 import hovering
 from hovering import Region, pipeline, scenes
+from hovering.pipeline import run_scene
 from hovering.plot.style import REGION_COLORS
 from hovering.scenes import parse_scene
-from hovering.pipeline import run_scene
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 FLOW_FILES = ("flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma")

@@ -20,9 +20,9 @@ import pytest
 
 import hovering
 from hovering import Region, Status, scenes
-from hovering.scenes.compute import zoom_window_critical, zoom_window_islands
-from hovering.scenes import load_scene, parse_scene
 from hovering.pipeline import run_scene
+from hovering.scenes import load_scene, parse_scene
+from hovering.scenes.compute import zoom_window_critical, zoom_window_islands
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "fig_hov_vs_eps"}

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import hovering
-from helpers import numpy_reference as ref
 from conftest import PAPER, PARAM_SETS, cdiff, make_map
+from helpers import numpy_reference as ref
 from hovering import TruncatedFamily
 
 BOUNDARY = 1e-9  # distance to arc ends / K = 0 below which points are not compared (round-off)

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import hovering
-from helpers import numpy_reference as ref
 from conftest import PARAM_SETS, cdiff, make_map
+from helpers import numpy_reference as ref
 
 OMEGA_G = 2 * np.pi * (np.sqrt(5.0) - 1.0) / 2  # written out independently of the package
 

@@ -7,8 +7,8 @@ import time
 import numpy as np
 import pytest
 
-from hovering import Status, paper
 from conftest import PROMPT, CtrlCOnceStarted
+from hovering import Status, paper
 
 
 def test_interrupt_keeps_every_orbit_state():

@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers import numpy_reference as ref
 from conftest import (
     LOCAL_ROUNDOFF,
     PARAM_SETS,
@@ -20,6 +19,7 @@ from conftest import (
     omega_prime,
     safe_mask,
 )
+from helpers import numpy_reference as ref
 from hovering import Region, Status
 
 KERNELS = ("simd", "scalar")

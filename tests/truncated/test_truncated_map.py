@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 import hovering
-from helpers import numpy_reference as ref
 from conftest import (
     LOCAL_ROUNDOFF,
     PARAM_SETS,
@@ -23,6 +22,7 @@ from conftest import (
     make_map,
     safe_mask,
 )
+from helpers import numpy_reference as ref
 
 N_POINTS = 100_000
 #: Points closer than this to an arc end (or to K = 0, or to the band floor) are excluded: there
