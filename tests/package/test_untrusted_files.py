@@ -443,6 +443,7 @@ def test_redraw_refuses_what_the_scene_schema_refuses(case, genuine, tmp_path, c
     assert peak < 32 * MiB and not (tmp_path / "out.png").exists()
 
 
+@pytest.mark.e2e
 def test_redraw_command_line_is_one_error_line_and_bounded(genuine, tmp_path):
     path = _craft(genuine["result"], tmp_path / "dpi.npz", lambda d: _scene_fields(d).update(dpi=8000))
     t0 = time.perf_counter()
