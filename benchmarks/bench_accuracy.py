@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 import hovering  # noqa: E402
+from hovering import paper  # noqa: E402
 from hovering._output import savefig  # noqa: E402  (atomic: a killed run leaves the old docs PNG)
 from hovering.diagnostics import exact_available  # noqa: E402
 
@@ -27,8 +28,7 @@ DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 
 def system(eps, geometry):
-    return hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
-                               eps=eps, qw1=-1.0, qw2=-0.5, geometry=geometry)
+    return paper.system(eps, geometry)
 
 
 def matched(wp, a, b, error):
@@ -88,7 +88,7 @@ def main():
             print(f"  exact: {1e6 * te:.2f} us per return; rk8pd at rtol 1e-13: {1e6 * tr:.2f} us; "
                   f"ratio {tr / te:.0f}x; max distance {d:.2g}")
         savefig(wp.plot(), DOCS / f"accuracy_{geometry}_eps{eps:g}.png", dpi=90)
-    m = hovering.TruncatedMap(eps=0.05, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    m = paper.truncated_map(0.05)
     wp = hovering.work_precision(m, quick=args.quick)
     print("\n## truncated map (rotation number)\n")
     print(wp.format())

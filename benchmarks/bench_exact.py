@@ -15,15 +15,14 @@ import time
 import numpy as np
 
 import hovering
-from hovering import _core
+from hovering import _core, paper
 from hovering.flow import flow_options
 
 N, REPEATS, H = 20000, 3, 1.0
 
 
 def case(V2, eps, geometry):
-    return hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=V2, coupling=hovering.Bilinear(), eps=eps, qw1=-1.0,
-                               qw2=-0.5, geometry=geometry)
+    return paper.system(eps, geometry, V2=V2)
 
 
 def timed(sys, z, opts):
@@ -36,8 +35,8 @@ def timed(sys, z, opts):
 
 
 def main():
-    cases = [("eps=0 wall", case(hovering.Tan(1.4, 0.7), 0.0, "wall")),
-             ("eps=0 step", case(hovering.Tan(1.4, 0.7), 0.0, "step")),
+    cases = [("eps=0 wall", case(paper.V2, 0.0, "wall")),
+             ("eps=0 step", case(paper.V2, 0.0, "step")),
              ("linear eps=0.1 step", case(hovering.Harmonic(1.3), 0.1, "step"))]
     rng = np.random.default_rng(0)
     print(f"{'system':22s} {'method':16s} {'us/return':>10s} {'ratio':>7s} {'error':>9s} {'steps':>7s}")

@@ -21,12 +21,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import hovering
+from hovering import paper
 from hovering.diagnostics.work_precision import _best_time
+from hovering.paper import QW1, V1, V2, H
 
-V1, V2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7)
-QW1, H = -1.0, 1.0
-SYS = hovering.StepSystem(V1=V1, V2=V2, coupling=hovering.Bilinear(), eps=0.0, qw1=QW1, qw2=-0.5, geometry="wall")
-SEC = hovering.Section(SYS, H)
+SEC = paper.section(0.0, "wall")
 
 
 def exact_angle(I):

@@ -19,9 +19,11 @@ import time
 import numpy as np
 
 import hovering as hv
+from hovering import paper
+from hovering.paper import QW1, QW2, H
 
-EPS, H, QW1, QW2 = -0.05, 1.0, -1.0, -0.5
-SYS = hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=EPS, qw1=QW1, qw2=QW2)
+EPS = -0.05
+SYS = paper.system(EPS)
 
 
 def best(fn, repeat=3):

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import hovering
-from hovering import Status
+from hovering import Status, paper
 
 TWO_PI = 2 * np.pi
 
@@ -57,7 +57,7 @@ def main(argv=None):
     ap.add_argument("--numpy-fraction", type=float, default=0.05, help="share of the points NumPy is timed on")
     args = ap.parse_args(argv)
 
-    p = dict(eps=args.eps, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    p = dict(eps=args.eps, **paper.FIGURE)
     m = hovering.TruncatedMap(**p)
     K_low = -2 * args.eps / math.sin(p["Omega0"] / 2)
 

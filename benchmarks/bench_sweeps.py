@@ -15,9 +15,7 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
-
-import hovering
+from hovering import paper
 from hovering.analysis.hovering import hovering_area
 from hovering.parallel import Executor
 from hovering.parallel.executor import executor, run_pieces
@@ -34,10 +32,8 @@ def timed(fn):
 
 
 def main():
-    tm = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
-    sys = hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
-                              eps=-0.1, qw1=-1.0, qw2=-0.5, geometry="step")
-    fm = hovering.FlowMap(sys, 1.0)
+    tm = paper.truncated_map(0.3)
+    fm = paper.flow_map(-0.1)
     cases = [("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, samples=200_000), 16, "step"),
              ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, samples=1600), 8, "return")]
     with executor(workers=2) as ex:  # what a pool's start costs (spawn + import hovering), for reference

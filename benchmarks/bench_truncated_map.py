@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 import hovering
+from hovering import paper
 
 TWO_PI = 2 * np.pi
 
@@ -106,7 +107,7 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
 
-    p = dict(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+    p = dict(eps=0.3, **paper.FIGURE)
     m = hovering.TruncatedMap(**p)
     rng = np.random.default_rng(1)
     phi0 = rng.uniform(-np.pi, np.pi, args.orbits)

@@ -16,16 +16,16 @@ from __future__ import annotations
 import numpy as np
 
 import hovering
-from hovering import Bilinear, Harmonic, Section, StepSystem, Tan, TruncatedFamily, TruncatedMap
+from hovering import StepSystem, TruncatedFamily, TruncatedMap, paper
+from hovering.paper import QW1, QW2, V1, V2, H
 
-V1, V2, H, QW1, QW2 = Harmonic(1.0), Tan(1.4, 0.7), 1.0, -1.0, -0.5
 CODE = {"1": int(hovering.Region.UPPER), "R": int(hovering.Region.RIGHT), "0": int(hovering.Region.ABOVE), "u": int(hovering.Region.BESIDE)}
 
 
 def compare(eps, K, n_phi=24, n_modes=6):
     """Largest |d phi|, |d K| between full and truncated maps on the circle K (points whose regions agree)."""
     p = hovering.onset_parameters(StepSystem(V1=V1, V2=V2, qw1=QW1, qw2=QW2), H)
-    sec = Section(StepSystem(V1=V1, V2=V2, coupling=Bilinear(), eps=eps, qw1=QW1, qw2=QW2, geometry="step"), H)
+    sec = paper.section(eps)
     phi_s = np.linspace(-3.1, 3.1, 64)
     f = hovering.forcing_function(sec, phi_s)
     A = np.stack([np.sin((k + 1) * phi_s) for k in range(n_modes)], 1)

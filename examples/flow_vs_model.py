@@ -17,12 +17,12 @@ import time
 import numpy as np
 
 import hovering as hv
+from hovering import paper
 
 
 def system(eps: float) -> hv.StepSystem:
-    """The issue's oscillators-step system at coupling eps."""
-    return hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=eps,
-                         qw1=-1.0, qw2=-0.5, geometry="step")
+    """The issue's oscillators-step system at coupling eps (:func:`hovering.paper.system`)."""
+    return paper.system(eps)
 
 
 def compare(eps: float, samples: int, steps: int, rtol: float = 1e-10) -> dict:

@@ -21,13 +21,7 @@ import numpy as np
 
 import hovering
 from hovering import normal as fm
-
-V1, V2, H, QW1, QW2 = hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7), 1.0, -1.0, -0.5
-
-
-def section(eps):
-    return hovering.Section(hovering.StepSystem(V1=V1, V2=V2, coupling=hovering.Bilinear(), eps=eps, qw1=QW1, qw2=QW2,
-                                                geometry="step"), H)
+from hovering.paper import H, section
 
 
 def corner_fit(cc, p):

@@ -1,8 +1,11 @@
 """Shared set-up and helpers of the hovering test-suite.
 
 * Selects matplotlib's headless Agg backend before anything imports pyplot.
-* Puts this directory on ``sys.path`` so that the independent NumPy oracle imports as
-  ``numpy_reference`` and these helpers as ``conftest`` (``from conftest import ...``).
+* Puts this directory on ``sys.path`` so that every test folder imports the shared helpers as
+  ``from helpers import numpy_reference`` (``flow_reference``, ``pickle_helpers``) and these as
+  ``conftest`` (``from conftest import ...``). The test folders have no conftest.py of their own
+  and no ``__init__.py``: test file names are unique across the folders.
+* Fixtures of the paper's systems come from :mod:`hovering.paper` (never typed out again).
 
 The helpers never compute a map themselves: they pick test points away from the
 discontinuities (using the independent reference) and turn a reference orbit into a rigorous
@@ -26,17 +29,18 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import hovering  # noqa: E402
-import numpy_reference as ref  # noqa: E402
+from helpers import numpy_reference as ref  # noqa: E402
+from hovering import paper  # noqa: E402
 
-#: Figure parameters of the paper (fig:smalleps) without eps.
-PAPER = dict(Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
+#: Figure parameters of the paper (fig:smalleps) without eps: hovering.paper's, the one copy.
+PAPER = dict(paper.FIGURE)
 
 #: Parameter sets used throughout: the paper's figure for both signs of eps, the largest eps of
 #: fig:epsbig, and a case with tau1 < 0 and tau0 < 0 (J_R grows below the tangency circle).
 PARAM_SETS = {
-    "paper_eps+0.3": dict(eps=0.3, **PAPER),
-    "paper_eps-0.3": dict(eps=-0.3, **PAPER),
-    "paper_eps+0.92": dict(eps=0.92, **PAPER),
+    "paper_eps+0.3": dict(eps=paper.EPS_SMALL[0], **PAPER),
+    "paper_eps-0.3": dict(eps=paper.EPS_SMALL[1], **PAPER),
+    "paper_eps+0.92": dict(eps=paper.EPS_BIG, **PAPER),
     "tau1_negative": dict(eps=0.3, Omega0=1.3, theta_w=2.0, tau0=-0.7, tau1=-0.4, lam=0.7),
 }
 
@@ -162,6 +166,16 @@ class CtrlCOnceStarted:
 #: machine measures ~0.1-0.2 s; the bound only has to separate "promptly" from "at the end of a
 #: run of minutes", so it is generous.
 PROMPT = 10.0
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Every test that runs the C++ executable (it asks for ``sweep_exe``) is end-to-end: the
+    default run leaves it out (``-m "not slow and not e2e"`` in pyproject), so a plain
+    ``python -m pytest tests`` never builds hovering_sweep; CI and scripts/test.sh run it."""
+    for item in items:
+        if "sweep_exe" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.e2e)
 
 
 @pytest.fixture(scope="session")
