@@ -5,7 +5,7 @@ event-driven angle flow), wall and step geometries; and the linear flow V1 = Har
 V2 = Harmonic(1.3), bilinear eps = 0.1 (normal modes, stepped by the Tracer). Each method runs the
 same starts (precomputed points of Sigma_h, so only returns are timed) on one thread; the best of
 REPEATS runs is reported. "error" is the largest state difference to the exact stepper (whose own
-error is ~1e-15, tests/test_exact_flow.py). Not run in CI. Run: python benchmarks/bench_exact.py
+error is ~1e-15, tests/flow/test_exact_flow.py). Not run in CI. Run: python benchmarks/bench_exact.py
 """
 
 from __future__ import annotations

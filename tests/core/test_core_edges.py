@@ -48,7 +48,7 @@ def test_generic_action_of_tan_on_high_levels_with_steep_walls():
     # Against the closed form I = 2 h / (omega + sqrt(omega^2 + 2 alpha^2 h)) (8 eps). On a high
     # level p = sqrt(2 (h - V)) climbs to sqrt(2 h) within h / |V'| of a wall (1e-10 of the width at
     # h = 1.3e20 for Tan(2.6, 0.13)); one QAWS over the level returned 8.4e-9 off there, and 3.3e-11
-    # for the onset case of tests/test_onset_hard.py. Bound: the 1e-10 the onset error estimate takes
+    # for the onset case of tests/flow/test_onset_hard.py. Bound: the 1e-10 the onset error estimate takes
     # for a quadrature's action (measured worst 3.9e-11 over 40,000 random levels); the two named
     # cases now to 1e-12.
     for w, a, h in [(2.596276452619615, 0.12982146198486358, 1.2906874458886323e20),

@@ -37,6 +37,9 @@ import hovering as hv
 from helpers import flow_reference as ref
 from hovering import paper
 
+# Independent scipy solutions of the same flow (seconds each): slow; CI runs them, at the oldest dependencies too.
+pytestmark = pytest.mark.slow
+
 H = 1.0
 EPS_VALUES = (0.05, -0.1)
 N_RETURNS = 3

@@ -104,6 +104,7 @@ def rounding_scale(w1, a1, w2, a2, qw1, qw2, h):
     return float(EPS * (h + k1 * V1.V(qw1) + k2 * V2.V(qw2)))
 
 
+@pytest.mark.slow  # 80-digit mpmath quadratures (8 s): CI runs it, at the oldest dependencies too
 def test_reference_action_angle_variables_are_the_definitions():
     # The reference's closed-form T(h) and theta(q, h) against mpmath quadrature of
     # T = 2 int dq / sqrt(2 (h - V)) and eq:thw theta = omega int_q^qmax dq / sqrt(2 (h - V)),

@@ -43,6 +43,9 @@ from hovering._output import WriteError  # noqa: E402
 from hovering._provenance import provenance  # noqa: E402
 from hovering.parallel.checkpoint import Checkpoint  # noqa: E402
 
+# Processes killed mid-write, concurrent writers, a full tmpfs: end to end (CI and scripts/test.sh run them).
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[2]
 
 # A portrait that computes in well under a second (TITLE makes two runs' files differ).
@@ -181,11 +184,11 @@ def check_loads(d: Path):
     ("save-midwrite", "-", signal.SIGKILL),
     ("save-midwrite", "-", signal.SIGINT),
     # a whole scene run in the child, killed while it writes: end-to-end
-    pytest.param("scene", "r.npz", signal.SIGKILL, marks=pytest.mark.e2e),
-    pytest.param("scene", "r.json", signal.SIGKILL, marks=pytest.mark.e2e),
-    pytest.param("scene", "r.json", signal.SIGINT, marks=pytest.mark.e2e),
-    pytest.param("scene", "r.png", signal.SIGKILL, marks=pytest.mark.e2e),
-    pytest.param("scene", "r.png", signal.SIGINT, marks=pytest.mark.e2e),
+    pytest.param("scene", "r.npz", signal.SIGKILL),
+    pytest.param("scene", "r.json", signal.SIGKILL),
+    pytest.param("scene", "r.json", signal.SIGINT),
+    pytest.param("scene", "r.png", signal.SIGKILL),
+    pytest.param("scene", "r.png", signal.SIGINT),
 ])
 def test_a_write_interrupted_leaves_the_previous_file(tmp_path, action, block, sig):
     (tmp_path / "p.toml").write_text(PORTRAIT)
@@ -474,7 +477,6 @@ def dirs(tmp_path):
     return tmp_path
 
 
-@pytest.mark.e2e
 @pytest.mark.parametrize("output", ["ABS/elsewhere/x.png", "../elsewhere/x.png", "../elsewhere/new/x.png",
                                     "link/x.png"])
 def test_a_scene_cannot_write_outside_its_folder_and_the_working_directory(dirs, output, monkeypatch):
@@ -499,7 +501,6 @@ def test_a_scene_cannot_write_outside_its_folder_and_the_working_directory(dirs,
         pipeline.run_scene(spec)
 
 
-@pytest.mark.e2e
 @pytest.mark.parametrize("output,where", [("r.png", "work"), ("ABS/scenes/out/r.png", "scenes")])
 def test_a_scene_writes_under_the_working_directory_or_its_folder_and_names_every_file(dirs, output, where):
     scene = dirs / "scenes" / "p.toml"
@@ -514,7 +515,6 @@ def test_a_scene_writes_under_the_working_directory_or_its_folder_and_names_ever
     assert cli("scene", scene, cwd=dirs / "work").returncode == 0
 
 
-@pytest.mark.e2e
 @pytest.mark.parametrize("foreign", ["config.json", "config.png", "config.npz", "config.sweep.jsonl"])
 def test_a_scene_never_replaces_a_file_hovering_did_not_write(tmp_path, foreign):
     sweep = foreign.endswith(".jsonl")
@@ -535,7 +535,6 @@ def test_a_scene_never_replaces_a_file_hovering_did_not_write(tmp_path, foreign)
     assert cli("scene", "p.toml", "--quick", cwd=tmp_path).returncode == 0
 
 
-@pytest.mark.e2e
 def test_redraw_and_accuracy_refuse_foreign_files_too(tmp_path):
     (tmp_path / "p.toml").write_text(PORTRAIT)
     assert cli("scene", "p.toml", cwd=tmp_path).returncode == 0

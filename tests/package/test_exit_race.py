@@ -25,6 +25,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
+# Interpreters exiting during a long call, in subprocesses: end to end (the 200-run loops are also slow).
+pytestmark = pytest.mark.e2e
+
 SCENARIO = textwrap.dedent(
     """
     import sys, threading, time

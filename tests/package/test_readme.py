@@ -6,8 +6,12 @@ import pathlib
 import re
 
 import numpy as np
+import pytest
 
 import hovering
+
+# The README's code run as a user would: end to end.
+pytestmark = pytest.mark.e2e
 
 README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 

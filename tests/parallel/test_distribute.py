@@ -44,6 +44,7 @@ def test_process_pool_gives_the_single_process_answer(single, pieces):
     same(single, hovering_area(M, **KW, executor=Executor(workers=2, pieces=pieces)))
 
 
+@pytest.mark.e2e  # starts a Dask LocalCluster (seconds)
 def test_dask_local_cluster_and_an_existing_client_give_the_same_answer(single, cluster):
     same(single, hovering_area(M, **KW, executor=Executor(workers=2, dask=True, pieces=5)))
     same(single, hovering_area(M, **KW, executor=Executor(client=cluster, pieces=4)))

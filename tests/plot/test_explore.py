@@ -23,6 +23,9 @@ from hovering import Region, Status
 from hovering.explore import COLORS, DEFAULT_N_STEPS, Explorer, default_K_range, main
 from hovering.plot.style import REGION_COLORS
 
+# The explorer driven as a user drives it (figure, clicks, keys, orbits computed): end to end.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(autouse=True)
 def _close_figures():

@@ -8,7 +8,7 @@ a ``distributed.Client``, a :class:`concurrent.futures.Executor` of the caller's
 here), or an :class:`Executor` for the rest (a Dask ``LocalCluster``, the number
 of pieces, a checkpoint file that keeps finished pieces).
 
-A *piece* is a picklable function call (maps, systems and results pickle: tests/test_pickle.py).
+A *piece* is a picklable function call (maps, systems and results pickle: tests/package/test_pickle.py).
 :func:`run_pieces` submits them all, yields each result as it arrives (so the caller checkpoints
 it at once) and cancels what is left on Ctrl-C. The pieces of one computation are cut so that
 their union is exactly the single-process computation: the answer does not depend on where, or in

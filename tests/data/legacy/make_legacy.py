@@ -1,5 +1,5 @@
 """Write the pickles and NPZ files of tests/data/legacy with the hovering of main at commit 22d49ca
-(before maps, systems and potentials had one record each): tests/test_legacy_files.py loads them
+(before maps, systems and potentials had one record each): tests/package/test_records.py loads them
 with today's package and checks that each object steps bit for bit as it did then (the expected
 images are stored beside them, computed by the old objects).
 
