@@ -25,9 +25,16 @@ KERNELS = ("simd", "scalar")
 N_REGIONS = 5  # BESIDE, ABOVE, UPPER, RIGHT, MULTI
 
 
-@pytest.fixture(scope="module")
-def m():
-    return make_map(PARAM_SETS["paper_eps+0.3"])
+@pytest.fixture(scope="module", params=["TruncatedMap", "TruncatedFamily"])
+def m(request):
+    """The paper's map at eps = 0.3, and the same map as a TruncatedFamily (tabulated arcs; its
+    band ends at the grid's floor K = -2)."""
+    tm = make_map(PARAM_SETS["paper_eps+0.3"])
+    if request.param == "TruncatedMap":
+        return tm
+    s = np.linspace(np.sqrt(2.0), 0.0, 60)  # uniform in sqrt(-K) below 0, as |J_1| is splined there
+    grid = np.concatenate([-(s[:-1] ** 2), [0.0], np.linspace(0.0, 1.5, 40)[1:]])
+    return hovering.TruncatedFamily.from_map(tm, grid)
 
 
 @pytest.fixture(scope="module")
