@@ -93,8 +93,10 @@ def test_every_k_thins_what_the_memory_check_counts(m):
     # 1e12 steps of one orbit: every state would need 16 TB and is refused before any work; every
     # 1e11-th state is 11 states, so that run starts (Ctrl-C, pressed once work is under way,
     # ends it: the partial result has the thinned shape).
-    with pytest.raises(ValueError, match=r"every 1\).* needs .* GiB, more than half"):
+    with pytest.raises(ValueError, match=r"for 1 orbits x 1000000000000 steps needs .* GiB, more than half"):
         m.iterate([0.1], [0.1], 10**12, record=("orbit",))
+    with pytest.raises(ValueError, match=r"for 1 orbits x 1000000000000 steps \(every 2\) needs .* GiB"):
+        m.iterate([0.1], [0.1], 10**12, record=("orbit",), every=2)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt) as info:
         m.iterate([0.1], [0.1], 10**12, record=("orbit",), every=10**11, progress=press)

@@ -411,7 +411,8 @@ class FlowMap(MapAnalyses):
         per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
         per_return = 8 * sum(key in record for key in ("times", "energy_error", "steps")) + ("regions" in record) + \
             64 * ("itinerary" in record)
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns (every {every})",
+        thinned = f" (every {every})" if every > 1 else ""
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns{thinned}",
                      8 * per_point * p.size * n_states + per_return * p.size * n_returns)
         dt, per_orbit = 0.0, 0
         if "trajectory" in record:

@@ -296,7 +296,8 @@ class _MapAPI(MapAnalyses):
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         p = np.asarray(wrap(p), dtype=float)  # the recorded orbit starts on [-pi, pi) like every later point
         n_states, n_returns = recorded_counts(n_steps, every)
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps (every {every})",
+        thinned = f" (every {every})" if every > 1 else ""
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps{thinned}",
                      16 * p.size * n_states * ("orbit" in record) + p.size * n_returns * ("regions" in record))
         with progress_bar(progress, p.size * n_steps, desc=f"{type(self).__name__}.iterate", unit="step") as bar:
             d = self._iterate(
