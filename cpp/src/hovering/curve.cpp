@@ -78,16 +78,15 @@ Curve::Curve(std::vector<double> K) : n_(std::int64_t(K.size())), samples_(std::
         c[2] = M[a] / 2.0;
         c[3] = (M[b] - M[a]) / 6.0;
         // Extremes of the cell polynomial: its ends and the zeros of its derivative b + 2 c s + 3 d s^2 in (0, 1).
+        // The roots in the cancellation-free form q / (3 d), b / q: (-c +- sq) / (3 d) loses every
+        // digit when d is rounding noise (a cell whose two ends have equal M), and put the
+        // maximum of such a cell anywhere; the SIMD kernel's stop test trusts these bounds.
         double cand[4] = {0.0, 1.0, -1.0, -1.0};
-        if (c[3] != 0.0) {
-            const double disc = c[2] * c[2] - 3.0 * c[1] * c[3];
-            if (disc >= 0) {
-                const double sq = std::sqrt(disc);
-                cand[2] = (-c[2] + sq) / (3.0 * c[3]);
-                cand[3] = (-c[2] - sq) / (3.0 * c[3]);
-            }
-        } else if (c[2] != 0.0) {
-            cand[2] = -c[1] / (2.0 * c[2]);
+        const double disc = c[2] * c[2] - 3.0 * c[1] * c[3];
+        if (disc >= 0) {
+            const double q = -(c[2] + std::copysign(std::sqrt(disc), c[2]));
+            if (c[3] != 0.0) cand[2] = q / (3.0 * c[3]);
+            if (q != 0.0) cand[3] = c[1] / q;
         }
         for (double s : cand) {
             if (!(s >= 0.0 && s <= 1.0)) continue;
