@@ -160,6 +160,29 @@ def test_stop_tests_the_curve_with_its_own_arithmetic(kernel):
 
 
 @pytest.mark.parametrize("kernel", KERNELS)
+@pytest.mark.parametrize("side", ["Below", "Above"])
+def test_stop_just_inside_the_extreme_of_a_curve(kernel, side):
+    # The SIMD kernel skips the spline for packets beyond the curve's range (its lower / upper
+    # bound); a state just inside the extreme must still stop. Curve [0.2, 0.35, 0.35] has its
+    # maximum 0.3875 at phi = 0, inside a cell whose end curvatures are equal (d = 0 up to
+    # rounding), where the bound was once computed as 0.38719 and the SIMD kernel never stopped
+    # these orbits. At eps = 0, K stays K0 and phi rotates, so each orbit eventually passes phi ~ 0.
+    m0 = make_map(dict(PARAM_SETS["paper_eps+0.3"], eps=0.0))
+    sign = 1.0 if side == "Below" else -1.0
+    c = Curve(sign * np.array([0.2, 0.35, 0.35]))
+    top = c(0.0)
+    assert top == pytest.approx(sign * 0.3875, abs=1e-15)
+    K0 = top - sign * np.geomspace(3e-4, 1e-6, 40)
+    phi0 = np.full(40, -3.0)
+    stop = Below(c) if side == "Below" else Above(c)
+    full = m0.iterate(phi0, K0, 20_000, record=("orbit",), kernel=kernel)
+    expected = first_in_set(stop, full)
+    assert np.all(expected > 0)  # every orbit gets there, none starts there
+    res = m0.iterate(phi0, K0, 20_000, record=(), kernel=kernel, stop=stop)
+    assert np.array_equal(res.stop_step, expected)
+
+
+@pytest.mark.parametrize("kernel", KERNELS)
 def test_stop_comes_before_an_exit_at_the_same_state(m, starts, kernel):
     # A state in the stop set ends the orbit before its return is looked at: with stop_on_exit
     # too, an orbit whose first state in the set is also its first outside exit_regions is STOPPED.
