@@ -411,6 +411,25 @@ def test_flow_results_do_not_depend_on_the_thread_count(fm, flow_run):
         assert np.array_equal(getattr(a, attr), getattr(b, attr), equal_nan=getattr(a, attr).dtype.kind == "f"), attr
 
 
+def test_flow_interrupt_keeps_the_transport_records(fm):
+    # Ctrl-C (once work has begun) keeps each orbit's extrema, residence and stop so far: redoing
+    # the most advanced orbit for its steps_done returns gives the same numbers, bit for bit.
+    rng = np.random.default_rng(5)
+    phi, K = rng.uniform(-np.pi, np.pi, 100), rng.uniform(-0.06, 0.05, 100)
+    press = CtrlCOnceStarted()
+    kw = dict(record=("extrema", "residence"), stop=Above(0.045))
+    with pytest.raises(KeyboardInterrupt) as info:
+        fm.iterate(phi, K, 100_000, n_threads=2, progress=press, **kw)
+    assert time.perf_counter() - press.fired_at < PROMPT
+    res = info.value.partial
+    assert np.any(res.status == Status.INTERRUPTED)
+    for i in [int(np.argmax(np.where(res.status == Status.INTERRUPTED, res.steps_done, -1))),
+              *np.flatnonzero(res.status == Status.STOPPED)[:2].tolist()]:
+        again = fm.iterate(phi[i: i + 1], K[i: i + 1], int(res.steps_done[i]), **kw)
+        assert again.K_min[0] == res.K_min[i] and again.K_max[0] == res.K_max[i]
+        assert np.array_equal(again.residence[0], res.residence[i]) and again.stop_step[0] == res.stop_step[i]
+
+
 # ------------------------------------------------------------------------------------------------
 # bad input: a ValueError naming it, before any work (10**15 steps would never finish)
 
