@@ -23,6 +23,7 @@ from __future__ import annotations
 from ._version import __version__
 from . import _core, analysis, flow, normal, truncated
 from ._enums import FlowStatus, Geometry, Region, region_mask, Status, wrap
+from .curve import Above, Below, Curve
 from .interface import ReturnMap
 from ._provenance import show_versions
 from ._serial import load, save
@@ -106,6 +107,9 @@ __all__ = [
     "FlowMap",
     "FlowSteps",
     "ReturnMap",
+    "Curve",
+    "Above",
+    "Below",
     "Region",
     "Status",
     "FlowStatus",

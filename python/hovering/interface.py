@@ -15,9 +15,11 @@ import numpy as np
 from ._checks import _short, check_memory, integer, is_choice, real_number
 from ._enums import Status, region_mask, status_code
 from ._serial import Saveable
+from .curve import StopCondition
 
-__all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "trajectory_arguments",
-           "trajectory_rows", "require_map", "MAX_TRAJECTORY_POINTS", "register", "hook"]
+__all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "transport_arguments",
+           "recorded_counts", "trajectory_arguments", "trajectory_rows", "require_map", "MAX_TRAJECTORY_POINTS",
+           "register", "hook"]
 
 #: Functions of the layers above the models that the models' convenience methods call
 #: (``m.hovering_area()``, ``FlowMap(accuracy=...)``): each higher module registers its own when
@@ -78,8 +80,10 @@ class ReturnMap(Protocol):
         """Region of the return from each point."""
 
     def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ..., exit_regions: Optional[Iterable] = None,
-                stop_on_exit: bool = False, n_threads: int = 0, progress=False):
-        """Many orbits at once -> IterateResult (progress: see hovering._progress)."""
+                stop_on_exit: bool = False, n_threads: int = 0, progress=False, every: int = 1,
+                stop: Optional[StopCondition] = None):
+        """Many orbits at once -> IterateResult (progress: see hovering._progress; every, stop: see
+        :meth:`hovering.TruncatedMap.iterate`)."""
 
     def with_eps(self, eps: float) -> "ReturnMap":
         """The same map at another eps (F_0 for the hovering set's definition)."""
@@ -147,26 +151,50 @@ class MapAnalyses:
 class IterateResult(Saveable):
     """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
 
+    Every per-state and per-return record keeps every ``every``-th entry (``iterate(...,
+    every=k)``): the states ``x_0, x_k, x_2k, ...`` (``n_steps // k + 1`` per orbit) and the returns
+    taken from them (``ceil(n_steps / k)`` per orbit); ``every=1`` keeps all.
+
     Attributes
     ----------
     phi, K : ndarray or None
-        Orbits, shape ``(n_orbits, n_steps + 1)``, when ``"orbit"`` was recorded; NaN after an
-        orbit stopped (see ``status`` and ``steps_done``).
+        Orbits, shape ``(n_orbits, n_steps // every + 1)`` (column j is the state ``x_{j every}``),
+        when ``"orbit"`` was recorded; NaN for the states an orbit did not reach (after it
+        stopped: see ``status`` and ``steps_done``).
     region : ndarray of int8 or None
         Region code (:class:`Region`) of the point each step was taken from, shape
-        ``(n_orbits, n_steps)``, when ``"regions"`` was recorded; ``Region.NONE`` after a stop.
+        ``(n_orbits, ceil(n_steps / every))`` (column j: the return from ``x_{j every}``), when
+        ``"regions"`` was recorded; ``Region.NONE`` (-1) for the returns not taken. With
+        ``stop_on_exit`` the return that leaves ``exit_regions`` is recorded (at ``exit_step``),
+        though the orbit does not take it: it stops at ``x_{exit_step}``.
     rotation : ndarray or None
         The paper's rotation number rho: the mean of omega_a over the steps taken (NaN for an
         orbit that took no step), when ``"rotation"`` was recorded.
     phi_final, K_final : ndarray
         Last state reached by each orbit.
     status : ndarray of int8
-        Per-orbit :class:`Status`.
+        Per-orbit :class:`Status` (``STOPPED``: it reached the set of ``stop``).
     steps_done : ndarray of int64
         Number of steps each orbit took.
     exit_step : ndarray of int64 or None
         First n at which the orbit point lay outside ``exit_regions`` (-1 if never), when
         ``exit_regions`` was given.
+    stop_step : ndarray of int64 or None
+        With ``stop``: the first n at which the state ``x_n`` lay in the stop set (-1 if never);
+        the start counts (0: it started there). The orbit stopped there (``STOPPED``,
+        ``steps_done == stop_step``, final state ``x_{stop_step}``, the first state in the set).
+    K_min, K_max : ndarray or None
+        Record ``"extrema"``: per orbit, the least and greatest K (I in the flow's section
+        coordinates) over the states ``x_0 .. x_{steps_done}``, start and final state included
+        (streamed: nothing per step is stored; ``every`` does not thin them).
+    residence : ndarray of int64 or None
+        Record ``"residence"``: per orbit, the number of returns taken from each region, shape
+        ``(n_orbits, 5)``, columns in :class:`Region` order (BESIDE, ABOVE, UPPER, RIGHT, MULTI;
+        MULTI only on the flow). It counts the returns ``region`` would record with ``every=1``:
+        ``steps_done`` of them, plus the exiting one with ``stop_on_exit``; a region has a
+        nonzero count exactly when ``visited`` has its bit.
+    every : int
+        The recording stride the result was made with.
     n_steps : int
         Steps requested per orbit.
     map : TruncatedMap, TruncatedFamily or FlowMap
@@ -176,12 +204,16 @@ class IterateResult(Saveable):
     z : ndarray or None
         Flow only, record ``"states"``: the points of Sigma_h, shape ``(n_orbits, n_steps + 1, 4)``.
     time, energy_error : ndarray or None
-        Flow only, records ``"times"``, ``"energy_error"``: per return, shape ``(n_orbits, n_steps)``
-        (``|H - h|`` of each image before it is put back on Sigma_h).
+        Flow only, records ``"times"``, ``"energy_error"``: per return, shape ``(n_orbits,
+        ceil(n_steps / every))`` (``|H - h|`` of each image before it is put back on Sigma_h); NaN
+        for the returns not taken.
     integrator_steps : ndarray of int64 or None
-        Flow only, record ``"steps"``: accepted integrator steps of each return.
+        Flow only, record ``"steps"``: accepted integrator steps of each return (-1 for the
+        returns not taken).
     itinerary : list of list of str or None
-        Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'.
+        Flow only, record ``"itinerary"``: each return's impacts ('R', '1', ...) or '0' / 'u'
+        ('' on the smooth flow, which has no walls); ``'-'`` for a return not taken (the orbit had
+        stopped; no return's itinerary is '-').
     visited : ndarray of int8 or None
         Record ``"visited"``: per orbit, bit r set when it took a step from a point of Region r
         (including the point where it left ``exit_regions``); e.g. a hovering orbit has the bits of
@@ -234,6 +266,11 @@ class IterateResult(Saveable):
     trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
     trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
     work: Optional[dict] = None
+    stop_step: Optional[np.ndarray] = None
+    K_min: Optional[np.ndarray] = None
+    K_max: Optional[np.ndarray] = None
+    residence: Optional[np.ndarray] = None
+    every: int = 1
 
     def trajectory_of(self, i: int) -> np.ndarray:
         """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
@@ -321,6 +358,49 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
     if stop_on_exit and mask == 0:
         raise ValueError("stop_on_exit needs exit_regions (the regions an orbit must stay in)")
     return record, n_steps, mask
+
+
+def transport_arguments(every, stop) -> tuple:
+    """Check the recording stride and the stop condition of an ``iterate`` call.
+
+    Parameters
+    ----------
+    every : int
+        Record every k-th state, k >= 1.
+    stop : Above, Below or None
+        The stop condition.
+
+    Returns
+    -------
+    (int, int, hovering._core.Curve or None)
+        The stride, the core's side code (0 none, 1 above, 2 below) and the compiled curve.
+
+    Raises
+    ------
+    ValueError
+        For a stride that is not an integer >= 1, or a ``stop`` that is not ``hovering.Above(...)``
+        or ``hovering.Below(...)`` (or None).
+    """
+    try:
+        if isinstance(every, (bool, np.bool_)):
+            raise TypeError
+        k = operator.index(every)
+    except TypeError:
+        raise ValueError(f"every must be an integer >= 1 (record every k-th state), got {_short(every)}") from None
+    if not 1 <= k <= 2**53:
+        raise ValueError(f"every must be an integer in [1, 2**53] (record every k-th state), got {k}")
+    if stop is None:
+        return k, 0, None
+    if not isinstance(stop, StopCondition) or type(stop) is StopCondition:
+        raise ValueError(f"stop must be hovering.Above(curve_or_K) or hovering.Below(curve_or_K) (or None), got "
+                         f"{_short(stop)}")
+    return k, stop._side, stop.curve._c
+
+
+def recorded_counts(n_steps: int, every: int) -> Tuple[int, int]:
+    """States and returns an orbit's records keep with stride ``every``: ``(n_steps // every + 1,
+    ceil(n_steps / every))`` (the core's recorded_states / recorded_returns)."""
+    return n_steps // every + 1, -(-n_steps // every)
 
 
 #: Default bound of the points a trajectory recording keeps in total (all orbits of one call):

@@ -31,6 +31,7 @@ void register_enums(py::module_& m) {
         .value("IMPACT_LIMIT", Status::ImpactLimit, "flow: more impacts in one return than max_impacts")
         .value("OFF_SECTION", Status::OffSection, "flow: the point is not on Sigma_h at this energy")
         .value("OUTSIDE_WELL", Status::OutsideWell, "flow: no accepted step keeps the state inside a bounded well")
+        .value("STOPPED", Status::Stopped, "the orbit reached the set of its stop condition (hovering.Above / Below)")
         .finalize();
     py::native_enum<FlowStatus>(m, "FlowStatus", "enum.IntEnum", "Outcome of one return of the flow.")
         .value("OK", FlowStatus::Ok, "returned to Sigma_h")

@@ -77,20 +77,26 @@ py::dict steps(const FlowMap& fm, const darray& x, const darray& y, bool inverse
 
 py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int64_t n_steps, const py::set& record,
                  unsigned exit_mask, bool stop_on_exit, int n_threads, double trajectory_dt,
-                 std::int64_t max_points_per_orbit, py::object progress) {
+                 std::int64_t max_points_per_orbit, py::object progress, std::int64_t every, int stop_side,
+                 py::object stop_curve) {
     same_size(x0, y0, "x0", "y0");
     if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
+    if (every < 1) throw py::value_error("every must be >= 1, got " + std::to_string(every));
     const py::ssize_t n = x0.size();
-    const py::ssize_t np = py::ssize_t(n_steps) + 1, ns = py::ssize_t(n_steps);
+    // Points and returns kept per orbit: every e-th (see FlowIterateOutput).
+    const py::ssize_t np = py::ssize_t(recorded_states(n_steps, every)), ns = py::ssize_t(recorded_returns(n_steps, every));
     auto has = [&](const char* k) { return record.contains(py::str(k)); };
     FlowIterateOptions opt;
     opt.n_steps = n_steps;
     opt.exit_mask = exit_mask;
     opt.stop_on_exit = stop_on_exit;
     opt.n_threads = n_threads;
+    opt.every = every;
+    opt.stop = stop_condition(stop_side, std::move(stop_curve));
     // Labels only where something reads them: otherwise no crossing of q1 = qw1 is tracked and no
     // itinerary built (the orbit is the same bit for bit).
-    opt.labels = exit_mask != 0 || has("regions") || has("visited") || has("itinerary") || has("rotation");
+    opt.labels = exit_mask != 0 || has("regions") || has("visited") || has("itinerary") || has("rotation") ||
+                 has("residence");
     if (has("trajectory") != (trajectory_dt > 0))
         throw py::value_error("record 'trajectory' and trajectory_dt > 0 go together");
     if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
@@ -163,6 +169,23 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
         out.visited = a.mutable_data();
         d["visited"] = a;
     }
+    if (has("extrema")) {
+        darray lo(n), hi(n);
+        out.y_min = lo.mutable_data();
+        out.y_max = hi.mutable_data();
+        d["y_min"] = lo;
+        d["y_max"] = hi;
+    }
+    if (has("residence")) {
+        py::array_t<std::int64_t> a({n, py::ssize_t(kRegionCount)});
+        out.residence = a.mutable_data();
+        d["residence"] = a;
+    }
+    if (opt.stop.active()) {
+        py::array_t<std::int64_t> a(n);
+        out.stop_step = a.mutable_data();
+        d["stop_step"] = a;
+    }
     hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
     out.trajectory = traj.output();
     FlowWork work;
@@ -173,7 +196,7 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
     const hovering_py::ProgressReport report{&returns_done, std::int64_t(n) * n_steps, std::move(progress)};
     if (report.active()) opt.progress = &returns_done;  // no counting at all otherwise
     const bool interrupted = hovering_py::run_watched([&] { fm.iterate(x0.data(), y0.data(), n, opt, out); }, cancel,
-                                                      n * ns >= 16, &report);
+                                                      n * n_steps >= 16, &report);
     d["work"] = hovering_py::work_dict(work);
     traj.put(d);
     if (has("itinerary")) {
@@ -270,7 +293,8 @@ void register_normal(py::module_& m) {
         .def("steps", &steps, py::arg("x"), py::arg("y"), py::arg("inverse"), py::arg("n_threads"))
         .def("iterate", &iterate, py::arg("x0"), py::arg("y0"), py::arg("n_steps"), py::arg("record"),
              py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
-             py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none())
+             py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(), py::arg("every") = 1,
+             py::arg("stop_side") = 0, py::arg("stop_curve") = py::none())
         .def("to_section",
              [](const FlowMap& fm, const darray& x, const darray& y) {
                  same_size(x, y, "x", "y");

@@ -46,13 +46,17 @@ template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
                  bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
                  bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp, bool record_visited,
-                 py::object progress) {
+                 py::object progress, std::int64_t every, int stop_side, py::object stop_curve, bool record_extrema,
+                 bool record_residence) {
     if (phi0.ndim() != 1 || K0.ndim() != 1)
         throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
     if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
+    if (every < 1) throw py::value_error("every must be >= 1, got " + std::to_string(every));
     IterateOptions opt;
     opt.n_steps = n_steps;
+    opt.every = every;
+    opt.stop = stop_condition(stop_side, std::move(stop_curve));
     opt.exit_mask = exit_mask;
     opt.stop_on_exit = stop_on_exit;
     opt.n_threads = n_threads;
@@ -82,15 +86,17 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
     res["K_final"] = K_f;
     res["status"] = status;
     res["steps_done"] = steps;
+    const py::ssize_t n_states = py::ssize_t(recorded_states(n_steps, every)),
+                      n_returns = py::ssize_t(recorded_returns(n_steps, every));
     if (record_orbit) {
-        darray op({n, py::ssize_t(n_steps + 1)}), ok({n, py::ssize_t(n_steps + 1)});
+        darray op({n, n_states}), ok({n, n_states});
         out.orbit_phi = op.mutable_data();
         out.orbit_K = ok.mutable_data();
         res["phi"] = op;
         res["K"] = ok;
     }
     if (record_regions) {
-        py::array_t<std::int8_t> reg({n, py::ssize_t(n_steps)});
+        py::array_t<std::int8_t> reg({n, n_returns});
         out.regions = reg.mutable_data();
         res["region"] = reg;
     }
@@ -108,6 +114,23 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
         py::array_t<std::int8_t> vis(n);
         out.visited = vis.mutable_data();
         res["visited"] = vis;
+    }
+    if (record_extrema) {
+        darray lo(n), hi(n);
+        out.K_min = lo.mutable_data();
+        out.K_max = hi.mutable_data();
+        res["K_min"] = lo;
+        res["K_max"] = hi;
+    }
+    if (record_residence) {
+        py::array_t<std::int64_t> r({n, py::ssize_t(kRegionCount)});
+        out.residence = r.mutable_data();
+        res["residence"] = r;
+    }
+    if (opt.stop.active()) {
+        py::array_t<std::int64_t> st(n);
+        out.stop_step = st.mutable_data();
+        res["stop_step"] = st;
     }
 
     std::atomic<bool> cancel{false};
@@ -173,7 +196,9 @@ void bind_common(Cls& cls) {
         .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
              py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
              py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"),
-             py::arg("record_visited") = false, py::arg("progress") = py::none())
+             py::arg("record_visited") = false, py::arg("progress") = py::none(), py::arg("every") = 1,
+             py::arg("stop_side") = 0, py::arg("stop_curve") = py::none(), py::arg("record_extrema") = false,
+             py::arg("record_residence") = false)
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def("valid_band",
              [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },

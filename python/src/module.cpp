@@ -8,6 +8,7 @@ PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";
     hovering_py::register_gil_gate();  // before anything can take the GIL from another thread
     register_enums(m);
+    register_curve(m);
     auto truncated = m.def_submodule("truncated", "The truncated near-tangency family F_{eps1,eps2}.");
     register_truncated(truncated);
     auto flow = m.def_submodule("flow", "Potentials, the oscillators-step system, Sigma_h and the return map.");

@@ -53,6 +53,16 @@ using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 /// Register Region, Status, FlowStatus, Geometry and Kernel (enum.IntEnum classes).
 void register_enums(py::module_& m);
 
+/// Register the closed curve K(phi) (hovering._core.Curve).
+void register_curve(py::module_& m);
+
+namespace hovering {
+struct StopCondition;
+}
+/// The stop condition of an iteration from the Python layer's side code (0 none, 1 above, 2
+/// below) and its core Curve (None without one).
+hovering::StopCondition stop_condition(int side, py::object curve);
+
 /// Register the truncated-map classes (TruncatedMap, TruncatedFamily).
 void register_truncated(py::module_& m);
 

@@ -339,8 +339,10 @@ def test_exit_step_and_stop_on_exit(any_map, rng, kernel, allowed_names, allowed
         k = expected[i]
         assert np.array_equal(st.phi[i, : k + 1], res.phi[i, : k + 1])
         assert np.all(np.isnan(st.phi[i, k + 1:]))
-        assert np.array_equal(st.region[i, :k], res.region[i, :k])
-        assert np.all(st.region[i, k:] == Region.NONE)  # no step is taken from the exit point
+        # the exiting return is recorded (its region, outside the set), though not taken; after it, padding
+        assert np.array_equal(st.region[i, : k + 1], res.region[i, : k + 1])
+        assert int(st.region[i, k]) not in allowed
+        assert np.all(st.region[i, k + 1:] == Region.NONE)
         if k > 0:  # mean omega over the k steps taken (1e-12: k <= 60 terms summed in another order)
             assert st.rotation[i] == pytest.approx(m.rotation(res.phi[i, :k], res.K[i, :k]).mean(), abs=1e-12)
         else:
@@ -367,7 +369,7 @@ BAD_ITERATE = [
     (dict(n_steps=2.5), r"n_steps must be an integer >= 0, got 2\.5"),
     (dict(n_steps="3"), r"n_steps must be an integer >= 0"),
     (dict(n_steps=None), r"n_steps must be an integer >= 0"),
-    (dict(record=("orbit", "foo")), r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited'\]"),
+    (dict(record=("orbit", "foo")), r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited', 'extrema', 'residence'\]"),
     (dict(record="orbits"), r"record: unknown key\(s\) \['orbits'\]; allowed"),
     (dict(exit_regions=["X"]), r"unknown region 'X'; allowed: BESIDE \('0u'\), ABOVE \('0'\), UPPER \('1'\), RIGHT \('R'\), MULTI \('m'\)"),
     (dict(exit_regions=[9]), r"unknown region 9; allowed"),

@@ -32,7 +32,13 @@ enum class Status : std::int8_t {
     ImpactLimit = 8,   ///< flow: more impacts in one return than allowed (chattering)
     OffSection = 9,    ///< flow: the point is not on Sigma_h at this energy
     OutsideWell = 10,  ///< flow: no accepted step keeps the state inside a bounded well (e.g. Tan)
+    Stopped = 11,      ///< the orbit reached the set of the stop condition (above / below a curve)
 };
+
+/// States recorded per orbit with every = e: x_0, x_e, ..., x_{e floor(n_steps / e)}.
+inline std::int64_t recorded_states(std::int64_t n_steps, std::int64_t every) { return n_steps / every + 1; }
+/// Returns recorded per orbit with every = e: those from the recorded states x_n with n < n_steps.
+inline std::int64_t recorded_returns(std::int64_t n_steps, std::int64_t every) { return (n_steps + every - 1) / every; }
 
 /// Which implementation of one map step a batch iteration uses.
 enum class Kernel : std::int8_t {

@@ -3,6 +3,7 @@
 import enum
 
 import numpy as np
+import numpy.typing as npt
 
 from . import analysis as analysis
 from . import flow as flow
@@ -11,6 +12,20 @@ from . import truncated as truncated
 
 def build_info() -> list[tuple[str, str | int]]: ...
 def wrap(x: np.ndarray | float) -> np.ndarray | float: ...
+
+class Curve:
+    def __init__(self, K: npt.NDArray[np.float64]) -> None: ...
+    def evaluate(self, phi: npt.NDArray[np.float64]) -> np.ndarray: ...
+    @property
+    def samples(self) -> np.ndarray: ...
+    @property
+    def cells(self) -> np.ndarray: ...
+    @property
+    def lower(self) -> float: ...
+    @property
+    def upper(self) -> float: ...
+    @property
+    def max_samples(self) -> int: ...
 
 class Region(enum.IntEnum):
     NONE = -1
@@ -37,6 +52,7 @@ class Status(enum.IntEnum):
     IMPACT_LIMIT = 8
     OFF_SECTION = 9
     OUTSIDE_WELL = 10
+    STOPPED = 11
 
 class FlowStatus(enum.IntEnum):
     OK = 0

@@ -28,6 +28,11 @@ class _MapCore:
         sin_ulp: float,
         record_visited: bool = ...,
         progress: Optional[Callable[[int, int], object]] = ...,
+        every: int = ...,
+        stop_side: int = ...,
+        stop_curve: Optional[object] = ...,
+        record_extrema: bool = ...,
+        record_residence: bool = ...,
     ) -> dict[str, object]: ...
 
 class TruncatedMap(_MapCore):

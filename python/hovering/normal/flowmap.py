@@ -17,7 +17,7 @@ import numpy as np
 from .. import _core
 from .._checks import check_memory, flag, forcing_array, integer, is_choice, MAX_MODES, point_pair
 from .._enums import Region, wrap
-from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, trajectory_arguments
+from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, recorded_counts, trajectory_arguments, transport_arguments
 from .._progress import check_progress, progress_bar
 from ..interface import IterateResult, MapAnalyses, hook
 from .._pickle import reduce_record
@@ -32,7 +32,7 @@ __all__ = ["FlowMap", "FlowSteps", "FLOW_RECORD_KEYS"]
 
 #: What :meth:`FlowMap.iterate` can record (nothing else is computed or stored).
 FLOW_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "section", "states", "times", "energy_error", "steps",
-                    "itinerary", "trajectory")
+                    "itinerary", "trajectory", "extrema", "residence")
 
 
 @dataclass(frozen=True)
@@ -334,7 +334,7 @@ class FlowMap(MapAnalyses):
     def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ("orbit", "regions", "rotation"),
                 exit_regions: Optional[Iterable] = None, stop_on_exit: bool = False, n_threads: int = 0,
                 trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
-                progress=False) -> IterateResult:
+                progress=False, every: int = 1, stop=None) -> IterateResult:
         """Iterate many orbits in C++ (the core's thread pool, GIL released, no Python between returns).
 
         Parameters
@@ -351,14 +351,19 @@ class FlowMap(MapAnalyses):
             (theta, I), ``"states"`` (points of Sigma_h),
             ``"times"``, ``"energy_error"``, ``"steps"`` (integrator steps), ``"itinerary"``,
             ``"trajectory"`` (the flow between the returns, sampled every ``trajectory_dt``: see
-            :class:`IterateResult`). Returns are labelled (crossings of q1 = qw1 tracked,
-            itineraries built) only when ``"regions"``, ``"visited"``, ``"itinerary"``,
-            ``"rotation"`` or ``exit_regions`` need it; the orbit is the same either way.
+            :class:`IterateResult`), ``"extrema"`` (per orbit the least and greatest K reached:
+            ``K_min``, ``K_max``), ``"residence"`` (per orbit the returns from each region).
+            Returns are labelled (crossings of q1 = qw1 tracked, itineraries built) only when
+            ``"regions"``, ``"visited"``, ``"itinerary"``, ``"rotation"``, ``"residence"`` or
+            ``exit_regions`` need it; the orbit is the same either way.
         exit_regions : iterable of Region or str, optional
             Regions to watch (e.g. ``{"0u", "0"}``): ``exit_step`` is the first return from a point
             outside them.
         stop_on_exit : bool, optional
-            Stop an orbit (status EXITED) when it first leaves ``exit_regions``.
+            Stop an orbit (status EXITED) when it first leaves ``exit_regions``: at the point
+            ``x_{exit_step}``. The return that leaves (already computed) is recorded in every
+            per-return record (region, itinerary, time, ...) and in ``residence``, but not taken:
+            the orbit's last point is ``x_{exit_step}``.
         n_threads : int, optional
             Worker threads (0 = all cores; 1 when a potential is defined in Python).
         trajectory_dt : float, optional
@@ -376,6 +381,15 @@ class FlowMap(MapAnalyses):
             ``True``: a tqdm bar on stderr (unit: return, total ``n_orbits * n_steps``; an orbit
             that stops early counts its remaining returns). A callable ``progress(done, total)``
             is called every ~0.1 s and at the end. ``False`` (default): none.
+        every : int, optional
+            Record every k-th point (default 1): per-point records hold ``x_0, x_k, x_2k, ...``
+            (``n_steps // k + 1`` columns), per-return records the returns from them
+            (``ceil(n_steps / k)`` columns); the trajectory is not thinned.
+        stop : hovering.Above or hovering.Below, optional
+            Stop each orbit at the first point ``x_n`` (the start included) in the set
+            (``K >= curve(phi)``, resp. ``<=``, in this map's coordinates: (phi, K), or (theta, I)
+            with ``coordinates="section"``): status ``STOPPED``, ``stop_step = n`` (-1 if never),
+            final point ``x_n``. A start with no point of Sigma_h is ``OFF_SECTION`` instead.
 
         Returns
         -------
@@ -395,16 +409,18 @@ class FlowMap(MapAnalyses):
             On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
         """
         record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
+        every, stop_side, stop_curve = transport_arguments(every, stop)
         progress = check_progress(progress)
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         # The recorded orbit starts on [-pi, pi) like every later point.
         p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
-        n_points = p.size * (n_steps + 1)
+        n_states, n_returns = recorded_counts(n_steps, every)
         per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
         per_return = 8 * sum(key in record for key in ("times", "energy_error", "steps")) + ("regions" in record) + \
             64 * ("itinerary" in record)
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns",
-                     8 * per_point * n_points + per_return * p.size * n_steps)
+        thinned = f" (every {every})" if every > 1 else ""
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns{thinned}",
+                     8 * per_point * p.size * n_states + per_return * p.size * n_returns)
         dt, per_orbit = 0.0, 0
         if "trajectory" in record:
             if trajectory_dt is None:
@@ -417,7 +433,7 @@ class FlowMap(MapAnalyses):
         threads = _threads(n_threads, self.sys.python_defined)
         with progress_bar(progress, p.size * n_steps, desc="FlowMap.iterate", unit="return") as bar:
             d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit), threads, dt, per_orbit,
-                                   bar.part(0) or None)
+                                   bar.part(0) or None, every, stop_side, stop_curve)
         res = IterateResult(phi=d.get("x"), K=d.get("y"), region=d.get("region"), rotation=d.get("rotation"),
                             phi_final=d["x_final"], K_final=d["y_final"], status=d["status"], steps_done=d["steps_done"],
                             exit_step=d.get("exit_step"), n_steps=n_steps, map=self, theta=d.get("theta"), I=d.get("I"),
@@ -425,7 +441,9 @@ class FlowMap(MapAnalyses):
                             integrator_steps=d.get("integrator_steps"), itinerary=d.get("itinerary"),
                             visited=d.get("visited"), trajectory=d.get("trajectory"),
                             trajectory_index=d.get("trajectory_index"), trajectory_kind=d.get("trajectory_kind"),
-                            trajectory_truncated=d.get("trajectory_truncated"), work=d["work"])
+                            trajectory_truncated=d.get("trajectory_truncated"), work=d["work"],
+                            stop_step=d.get("stop_step"), K_min=d.get("y_min"), K_max=d.get("y_max"),
+                            residence=d.get("residence"), every=every)
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
             exc.partial = res

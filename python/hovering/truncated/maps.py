@@ -16,7 +16,7 @@ import numpy as np
 from .. import _core
 from .._checks import (check_memory, forcing_array, is_choice, point_pair, real_array, real_number, require_angles, require_finite, thread_count)
 from .._enums import Region, wrap
-from ..interface import iterate_arguments
+from ..interface import iterate_arguments, recorded_counts, transport_arguments
 from .._progress import check_progress, progress_bar
 from .._pickle import reduce_record
 from ..interface import IterateResult, MapAnalyses
@@ -24,7 +24,7 @@ from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 
-_RECORD_KEYS = ("orbit", "regions", "rotation", "visited")
+_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "extrema", "residence")
 
 
 
@@ -209,6 +209,8 @@ class _MapAPI(MapAnalyses):
         kernel: str = "simd",
         sin_ulp: float = 1.0,
         progress=False,
+        every: int = 1,
+        stop=None,
     ) -> IterateResult:
         """Iterate many orbits at once in C++ (multi-threaded, GIL released).
 
@@ -220,14 +222,19 @@ class _MapAPI(MapAnalyses):
         n_steps : int
             Steps per orbit (>= 0).
         record : sequence of str, optional
-            What to keep besides the final state and status: any of ``"orbit"`` (full orbits),
+            What to keep besides the final state and status: any of ``"orbit"`` (the states),
             ``"regions"`` (itinerary), ``"rotation"`` (rho = mean omega_a), ``"visited"`` (the set
-            of regions each orbit went through, one byte per orbit). Nothing else is stored.
+            of regions each orbit went through, one byte per orbit), ``"extrema"`` (per orbit the
+            least and greatest K reached, ``K_min``, ``K_max``), ``"residence"`` (per orbit the
+            returns taken from each region, ``residence``). Nothing else is stored; the last
+            three stream (a few numbers per orbit, whatever ``n_steps``).
         exit_regions : iterable of Region or str, optional
             A set of regions (e.g. ``{"0u", "0"}``, the no-impact set) to watch: ``exit_step`` is
             the first n at which an orbit point lies outside it.
         stop_on_exit : bool, optional
-            Stop an orbit (status ``EXITED``) when it first leaves ``exit_regions``.
+            Stop an orbit (status ``EXITED``) when it first leaves ``exit_regions``: at the point
+            ``x_{exit_step}``, whose return (the one that leaves the set) is recorded in
+            ``region`` and ``residence`` but not taken.
         n_threads : int, optional
             Worker threads; 0 uses every core.
         kernel : {"simd", "scalar"}, optional
@@ -242,6 +249,19 @@ class _MapAPI(MapAnalyses):
             that stops early counts its remaining steps). A callable ``progress(done, total)`` is
             called every ~0.1 s and at the end. ``False`` (default): none, at no cost. See
             :mod:`hovering._progress`.
+        every : int, optional
+            Record every k-th state (default 1: all): ``phi``, ``K`` hold ``x_0, x_k, x_2k, ...``
+            (``n_steps // k + 1`` columns) and ``region`` the returns from them (``ceil(n_steps /
+            k)`` columns). The orbit is the same; only what is stored is thinned (the memory check
+            before the run counts what is kept).
+        stop : hovering.Above or hovering.Below, optional
+            Stop each orbit the first time a state ``x_n`` lies in the set (``K >= curve(phi)``,
+            resp. ``<=``, the curve a :class:`hovering.Curve` or a number): status ``STOPPED``,
+            ``stop_step = n`` (-1 if never), final state ``x_n``. The start counts (``stop_step =
+            0``). A state is tested as soon as it is reached, so a stop at n comes before an exit
+            at the same n (an orbit takes no return from ``x_{stop_step}``); an image outside the
+            band is ``ESCAPED``, never ``STOPPED``. Both kernels test it with the curve's own
+            arithmetic (:meth:`hovering.Curve.__call__`), bit for bit.
 
         Returns
         -------
@@ -251,7 +271,7 @@ class _MapAPI(MapAnalyses):
         ------
         ValueError
             For non-finite initial points, a negative ``n_steps``, an unknown ``record`` key,
-            region or kernel.
+            region or kernel, an ``every`` below 1, or a ``stop`` that is not Above / Below.
         KeyboardInterrupt
             On Ctrl-C during a long run; its ``partial`` attribute holds the IterateResult with
             every orbit's state at the interruption (status ``INTERRUPTED``).
@@ -266,6 +286,7 @@ class _MapAPI(MapAnalyses):
         K differs only through the sin implementation (SLEEF vs libm, ~1 ulp).
         """
         record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
+        every, stop_side, stop_curve = transport_arguments(every, stop)
         progress = check_progress(progress)
         if not is_choice(kernel, ("simd", "scalar")):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
@@ -274,9 +295,10 @@ class _MapAPI(MapAnalyses):
         n_threads = thread_count(n_threads)
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         p = np.asarray(wrap(p), dtype=float)  # the recorded orbit starts on [-pi, pi) like every later point
-        n_points = p.size * (n_steps + 1)
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps",
-                     16 * n_points * ("orbit" in record) + p.size * n_steps * ("regions" in record))
+        n_states, n_returns = recorded_counts(n_steps, every)
+        thinned = f" (every {every})" if every > 1 else ""
+        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps{thinned}",
+                     16 * p.size * n_states * ("orbit" in record) + p.size * n_returns * ("regions" in record))
         with progress_bar(progress, p.size * n_steps, desc=f"{type(self).__name__}.iterate", unit="step") as bar:
             d = self._iterate(
                 np.ascontiguousarray(p.ravel()),
@@ -292,6 +314,11 @@ class _MapAPI(MapAnalyses):
                 float(sin_ulp),
                 "visited" in record,
                 bar.part(0) or None,
+                every,
+                stop_side,
+                stop_curve,
+                "extrema" in record,
+                "residence" in record,
             )
         res = IterateResult(
             phi=d.get("phi"),
@@ -306,6 +333,11 @@ class _MapAPI(MapAnalyses):
             n_steps=n_steps,
             map=self,
             visited=d.get("visited"),
+            stop_step=d.get("stop_step"),
+            K_min=d.get("K_min"),
+            K_max=d.get("K_max"),
+            residence=d.get("residence"),
+            every=every,
         )
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "hovering/curve.hpp"
 #include "hovering/flow/return_map.hpp"
 #include "hovering/normal/tangential_curve.hpp"
 #include "hovering/truncated/arcs.hpp"
@@ -28,6 +29,9 @@ struct FlowIterateOptions {
     std::int64_t n_steps = 0;         ///< returns per orbit (>= 0)
     unsigned exit_mask = 0;           ///< bit r: Region r is in the watched set; 0 disables the watch
     bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
+    /// Stop an orbit (Status::Stopped) at the first point x_n (x_0 included) in the set, in map coordinates.
+    StopCondition stop;
+    std::int64_t every = 1;           ///< record every k-th point (and the return from it), k >= 1
     int n_threads = 0;                ///< worker threads; 0 = all hardware threads
     const std::atomic<bool>* cancel = nullptr;  ///< polled between and inside returns
     /// Label returns (itinerary, region; needs the crossings of q1 = qw1 tracked). false: no
@@ -39,9 +43,15 @@ struct FlowIterateOptions {
     std::atomic<std::int64_t>* progress = nullptr;
 };
 
-/// Where a flow-map iteration writes; a null pointer means "not recorded". Per-point arrays are
-/// (n_orbits, n_steps + 1) (states: 4 per point), per-return arrays (n_orbits, n_steps); entries
-/// after an orbit stopped are NaN (Region::None, 0 steps, "" itinerary).
+/// Marks the itinerary of a return an orbit did not take (it had stopped); no return's own
+/// itinerary is "-" (impacts 'R', '1', ..., or '0' / 'u', or '' for the smooth flow).
+inline constexpr const char* kNoItinerary = "-";
+
+/// Where a flow-map iteration writes; a null pointer means "not recorded". With e = every,
+/// per-point arrays hold the points x_0, x_e, x_2e, ...: (n_orbits, n_steps / e + 1) (states: 4
+/// per point), per-return arrays the returns from them: (n_orbits, ceil(n_steps / e)). Entries an
+/// orbit did not reach are NaN (Region::None, -1 integrator steps, kNoItinerary). With stop_on_exit
+/// the return that leaves the watched set is recorded (region, itinerary, time, ...), not taken.
 struct FlowIterateOutput {
     double* x_final = nullptr;        ///< (n) last point reached: phi or theta
     double* y_final = nullptr;        ///< (n) K or I
@@ -60,6 +70,10 @@ struct FlowIterateOutput {
     std::int64_t* steps_done = nullptr;  ///< (n) returns taken
     std::int64_t* exit_step = nullptr;   ///< (n) first return outside the watched set, else -1
     std::int8_t* visited = nullptr;      ///< (n) bit r: a return of Region r was taken (as IterateOutput)
+    double* y_min = nullptr;             ///< (n) min of y (K or I) over the points x_0 .. x_steps_done
+    double* y_max = nullptr;             ///< (n) max of y over the same points
+    std::int64_t* residence = nullptr;   ///< (n, kRegionCount) returns per region (as IterateOutput)
+    std::int64_t* stop_step = nullptr;   ///< (n) first n with x_n in the stop set, else -1
     FlowWork* work = nullptr;            ///< the iteration's work counters (summed over workers)
     /// Dense output of each orbit across its returns (the clock runs on from return to return;
     /// each return's point is the image before the next start is put back on Sigma_h).

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "hovering/curve.hpp"
 #include "hovering/truncated/arcs.hpp"
 #include "hovering/truncated/forcing.hpp"
 #include "hovering/types.hpp"
@@ -22,13 +23,17 @@ namespace hovering {
 
 /// Where a batch iteration writes; a null pointer means "not recorded".
 ///
-/// Orbit arrays are row-major (n_orbits, n_steps + 1), regions (n_orbits, n_steps).
+/// Arrays are row-major. With e = IterateOptions::every, the orbit arrays hold the states
+/// x_0, x_e, x_2e, ... (n_orbits, n_steps / e + 1) and the regions the returns taken from them,
+/// (n_orbits, ceil(n_steps / e)); entries an orbit did not reach are NaN (Region::None).
 struct IterateOutput {
     double* phi_final = nullptr;       ///< (n_orbits,) last state reached
     double* K_final = nullptr;         ///< (n_orbits,)
-    double* orbit_phi = nullptr;       ///< (n_orbits, n_steps+1), NaN after the orbit stopped
-    double* orbit_K = nullptr;         ///< (n_orbits, n_steps+1), NaN after the orbit stopped
-    std::int8_t* regions = nullptr;    ///< (n_orbits, n_steps), Region::None after the orbit stopped
+    double* orbit_phi = nullptr;       ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
+    double* orbit_K = nullptr;         ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
+    /// (n_orbits, ceil(n_steps/every)), Region::None after the orbit stopped; with stop_on_exit the
+    /// return that leaves the watched set is recorded (its region), though not taken.
+    std::int8_t* regions = nullptr;
     double* rotation = nullptr;        ///< (n_orbits,) mean of omega_a over the steps taken (NaN if none)
     std::int8_t* status = nullptr;     ///< (n_orbits,) Status, always written when non-null
     std::int64_t* steps_done = nullptr;  ///< (n_orbits,) steps actually taken
@@ -36,6 +41,12 @@ struct IterateOutput {
     /// (n_orbits,) bit r set: the orbit reached a point of Region r (the points steps were taken
     /// from, and the one where it left the watched set)
     std::int8_t* visited = nullptr;
+    double* K_min = nullptr;             ///< (n_orbits,) min of K over the states x_0 .. x_steps_done
+    double* K_max = nullptr;             ///< (n_orbits,) max of K over the same states
+    /// (n_orbits, kRegionCount) returns per region code 0..4 (those taken, and with stop_on_exit
+    /// the one that leaves the watched set: the returns whose region `visited` sets)
+    std::int64_t* residence = nullptr;
+    std::int64_t* stop_step = nullptr;   ///< (n_orbits,) first n with x_n in the stop set, else -1
 };
 
 /// What a batch iteration does besides stepping.
@@ -44,6 +55,10 @@ struct IterateOptions {
     /// Bit r set: Region r is in the watched set (for exit_step / stop_on_exit); 0 disables the watch.
     unsigned exit_mask = 0;
     bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
+    /// Stop an orbit (Status::Stopped) at the first state x_n (x_0 included) in the set; a state
+    /// outside the band is Escaped instead.
+    StopCondition stop;
+    std::int64_t every = 1;           ///< record every k-th state (and the return from it), k >= 1
     int n_threads = 0;                ///< worker threads; 0 = all hardware threads
     Kernel kernel = Kernel::Simd;     ///< which step implementation to use
     /// SIMD kernel only: SLEEF's 3.5-ulp sin instead of the 1-ulp one (about 20% faster per step).

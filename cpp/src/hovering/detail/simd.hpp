@@ -4,6 +4,8 @@
 
 #include <sleef.h>
 
+#include <cstdint>
+
 #include <Eigen/Core>
 
 #if defined(__AVX2__) || defined(__SSE2__)
@@ -47,5 +49,25 @@ inline Packet psqrt_rn(const Packet& x) {
 #endif
 }
 
+// The four coefficients base[4 i + k], k = 0..3, of the cells i given as a packet of exact integers
+// in [0, 2^29) (a Curve has at most 2^24 cells): one gather per coefficient where the instruction
+// set has one (AVX2, AVX-512), lane by lane otherwise. Loads only: the values are the table's bits.
+inline void pgather_cells(const double* base, const Packet& cell, Packet c[4]) {
+#if defined(EIGEN_VECTORIZE_AVX512)
+    const __m256i i4 = _mm256_slli_epi32(_mm512_cvtpd_epi32(cell), 2);
+    for (int k = 0; k < 4; ++k) c[k] = _mm512_i32gather_pd(i4, base + k, 8);
+#elif defined(EIGEN_VECTORIZE_AVX) && defined(__AVX2__)
+    const __m128i i4 = _mm_slli_epi32(_mm256_cvtpd_epi32(cell), 2);
+    for (int k = 0; k < 4; ++k) c[k] = _mm256_i32gather_pd(base + k, i4, 8);
+#else
+    alignas(64) double f[kW], v[4][kW];
+    ei::pstore(f, cell);
+    for (int w = 0; w < kW; ++w) {
+        const double* cw = base + 4 * static_cast<std::int64_t>(f[w]);
+        for (int k = 0; k < 4; ++k) v[k][w] = cw[k];
+    }
+    for (int k = 0; k < 4; ++k) c[k] = ei::pload<Packet>(v[k]);
+#endif
+}
 
 }  // namespace hovering::detail

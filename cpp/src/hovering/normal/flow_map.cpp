@@ -142,20 +142,25 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
     if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
             std::to_string(opt.n_threads));
-    if (!opt.labels && (out.regions || out.visited || out.itinerary || out.rotation || opt.exit_mask))
-        bad("labels = false, but regions, visited, itinerary, rotation or an exit_mask need the returns labelled");
+    if (opt.every < 1) bad("every must be >= 1 (record every k-th point), got " + std::to_string(opt.every));
+    opt.stop.validate();
+    if (!opt.labels && (out.regions || out.visited || out.itinerary || out.rotation || out.residence || opt.exit_mask))
+        bad("labels = false, but regions, visited, itinerary, rotation, residence or an exit_mask need the returns "
+            "labelled");
     out.trajectory.validate();
     for (std::int64_t i = 0; i < n; ++i) {
         detail::require_angle(x0[i], "x0[" + std::to_string(i) + "]");
         detail::require_finite(y0[i], "y0[" + std::to_string(i) + "]");
     }
     if (n == 0) return;
-    const std::int64_t ns = opt.n_steps;
+    const std::int64_t ns = opt.n_steps, every = opt.every;
     const TrajectoryOutput& traj = out.trajectory;
-    const std::int64_t np = ns + 1;  // points per orbit
+    const std::int64_t np = recorded_states(ns, every), nr = recorded_returns(ns, every);  // per orbit
+    const StopCondition& stop = opt.stop;
 
+    // Point x_k of orbit i (k a multiple of every).
     auto record_point = [&](std::int64_t i, std::int64_t k, double x, double y, const std::array<double, 4>* z) {
-        const std::int64_t at = i * np + k;
+        const std::int64_t at = i * np + k / every;
         if (out.orbit_x) out.orbit_x[at] = x;
         if (out.orbit_y) out.orbit_y[at] = y;
         if (out.orbit_theta || out.orbit_I) {
@@ -170,15 +175,30 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             for (int c = 0; c < 4; ++c) out.states[4 * at + c] = zz[std::size_t(c)];
         }
     };
-    // An orbit's outputs once it stops, and the NaN / None tails of its recorded arrays.
-    auto finish = [&](std::int64_t i, double x, double y, double rot, std::int64_t steps, Status st, int visited) {
+    // The return from x_k of orbit i (k a multiple of every).
+    auto record_return = [&](std::int64_t i, std::int64_t k, const FlowStep& st) {
+        const std::int64_t at = i * nr + k / every;
+        if (out.regions) out.regions[at] = static_cast<std::int8_t>(st.region);
+        if (out.times) out.times[at] = st.ret.time;
+        if (out.energy_error) out.energy_error[at] = st.ret.energy_error;
+        if (out.integrator_steps) out.integrator_steps[at] = st.ret.steps;
+        if (out.itinerary) out.itinerary[at] = st.ret.itinerary;
+    };
+    // An orbit's outputs once it stops, and the NaN / None tails of its recorded arrays. `returns`:
+    // the returns recorded or skipped so far (steps, and the exiting one with stop_on_exit).
+    auto finish = [&](std::int64_t i, double x, double y, double rot, std::int64_t steps, Status st, int visited,
+                      double y_lo, double y_hi, const std::int64_t* res, std::int64_t returns) {
         if (out.visited) out.visited[i] = static_cast<std::int8_t>(visited);
         if (out.x_final) out.x_final[i] = x;
         if (out.y_final) out.y_final[i] = y;
         if (out.rotation) out.rotation[i] = steps > 0 ? rot / double(steps) : kNaN;
         if (out.status) out.status[i] = static_cast<std::int8_t>(st);
         if (out.steps_done) out.steps_done[i] = steps;
-        for (std::int64_t k = steps + 1; k < np; ++k) {
+        if (out.stop_step && st == Status::Stopped) out.stop_step[i] = steps;
+        if (out.y_min) out.y_min[i] = y_lo;
+        if (out.y_max) out.y_max[i] = y_hi;
+        if (out.residence) std::copy(res, res + kRegionCount, out.residence + i * kRegionCount);
+        for (std::int64_t k = steps / every + 1; k < np; ++k) {
             const std::int64_t at = i * np + k;
             if (out.orbit_x) out.orbit_x[at] = kNaN;
             if (out.orbit_y) out.orbit_y[at] = kNaN;
@@ -187,13 +207,13 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             if (out.states)
                 for (int c = 0; c < 4; ++c) out.states[4 * at + c] = kNaN;
         }
-        for (std::int64_t k = steps; k < ns; ++k) {
-            const std::int64_t at = i * ns + k;
+        for (std::int64_t k = (returns + every - 1) / every; k < nr; ++k) {
+            const std::int64_t at = i * nr + k;
             if (out.regions) out.regions[at] = static_cast<std::int8_t>(Region::None);
             if (out.times) out.times[at] = kNaN;
             if (out.energy_error) out.energy_error[at] = kNaN;
-            if (out.integrator_steps) out.integrator_steps[at] = 0;
-            if (out.itinerary) out.itinerary[at].clear();
+            if (out.integrator_steps) out.integrator_steps[at] = -1;
+            if (out.itinerary) out.itinerary[at] = kNoItinerary;
         }
     };
     auto cancelled = [&] { return opt.cancel && opt.cancel->load(std::memory_order_relaxed); };
@@ -207,13 +227,15 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         detail::DenseRecorder rec;
         detail::ProgressShare progress(opt.progress, 1);
         for (std::int64_t i; cur.pop(i);) {
-            double x = x0[i], y = y0[i], rot = 0;
+            double x = x0[i], y = y0[i], rot = 0, y_lo = y0[i], y_hi = y0[i];
+            std::int64_t res[kRegionCount] = {};
             if (out.exit_step) out.exit_step[i] = -1;
+            if (out.stop_step) out.stop_step[i] = -1;
             if (traj.truncated) traj.truncated[i] = 0;
             std::array<double, 4> z{};
             if (!state(x, y, z)) {
                 record_point(i, 0, x, y, nullptr);
-                finish(i, x, y, 0.0, 0, Status::OffSection, 0);
+                finish(i, x, y, 0.0, 0, Status::OffSection, 0, y_lo, y_hi, res, 0);
                 progress.add(ns);
                 continue;
             }
@@ -223,10 +245,12 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             }
             record_point(i, 0, x, y, &z);
             Status status = Status::Ok;
-            std::int64_t k = 0;
+            std::int64_t k = 0, returns = 0;
             bool reported = false;
             int visited = 0;
-            for (; k < ns; ++k) {
+            // The start counts: an orbit that starts in the set stops there, having taken no return.
+            if (stop.active() && stop.reached(wrap(x), y)) status = Status::Stopped;
+            for (; k < ns && status == Status::Ok; ++k) {
                 if (cancelled()) {
                     status = Status::Interrupted;
                     break;
@@ -238,28 +262,30 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 }
                 rec.offset += st.ret.time;  // the orbit's clock runs on into the next return
                 const int r = int(st.region);
-                if (r >= 0) visited |= 1 << r;
+                if (r >= 0) {
+                    visited |= 1 << r;
+                    ++res[r];
+                }
+                returns = k + 1;
+                if (k % every == 0) record_return(i, k, st);
                 if (opt.exit_mask && !reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
                     if (out.exit_step) out.exit_step[i] = k;
                     reported = true;
-                    if (opt.stop_on_exit) {
+                    if (opt.stop_on_exit) {  // recorded above, not taken
                         status = Status::Exited;
                         break;
                     }
                 }
-                const std::int64_t at = i * ns + k;
-                if (out.regions) out.regions[at] = static_cast<std::int8_t>(st.region);
-                if (out.times) out.times[at] = st.ret.time;
-                if (out.energy_error) out.energy_error[at] = st.ret.energy_error;
-                if (out.integrator_steps) out.integrator_steps[at] = st.ret.steps;
-                if (out.itinerary) out.itinerary[at] = st.ret.itinerary;
                 if (out.rotation) rot += rotation_of(x, y, st.region, st.x);
                 x = st.x;
                 y = st.y;
-                record_point(i, k + 1, x, y, nullptr);
+                y_lo = std::min(y_lo, y);
+                y_hi = std::max(y_hi, y);
+                if ((k + 1) % every == 0) record_point(i, k + 1, x, y, nullptr);
                 progress.add(1);
+                if (stop.active() && stop.reached(x, y)) status = Status::Stopped;
             }
-            finish(i, x, y, rot, k, status, visited);
+            finish(i, x, y, rot, k, status, visited, y_lo, y_hi, res, returns);
             if (traj.truncated) traj.truncated[i] = rec.truncated ? 1 : 0;
             // The returns an orbit that stopped early will not take are accounted for (not when
             // cancelled: the count then shows how far the run got).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -72,32 +73,69 @@ inline Packet force_packet(const FourierForcing& f, const Packet& p) {
 
 // ------------------------------------------------------------------ batch iteration
 
+// What an orbit gathers besides its state, for the records that stream (nothing per step is stored).
+struct Tally {
+    double rot = 0.0;                   // sum of omega_a over the steps taken
+    int visited = 0;                    // bit r: a return from Region r was taken (or was the exiting one)
+    double K_min = kNaN, K_max = kNaN;  // over the states x_0 .. x_steps
+    // Returns counted for the residence: from J_1, from J_R, from any point with K < 0 (all three
+    // arcs), and in all (those taken, plus the exiting one with stop_on_exit); J_0 and J_0u follow.
+    double upper = 0, right = 0, below = 0;
+    std::int64_t counted = 0;
+};
+
 // Writes an orbit's outputs once it stops, and the NaN / None tail of its recorded arrays.
 struct Finisher {
     const IterateOptions& opt;
     const IterateOutput& out;
     detail::ProgressShare& progress;  // credits the steps an orbit that stops early will not take
+    std::int64_t every, n_states, n_returns;  // recorded per orbit: every e-th state and return
+    Finisher(const IterateOptions& o, const IterateOutput& w, detail::ProgressShare& p)
+        : opt(o), out(w), progress(p), every(o.every), n_states(recorded_states(o.n_steps, o.every)),
+          n_returns(recorded_returns(o.n_steps, o.every)) {}
     void start(std::int64_t i, double phi, double K) const {
-        if (out.orbit_phi) out.orbit_phi[i * (opt.n_steps + 1)] = phi;
-        if (out.orbit_K) out.orbit_K[i * (opt.n_steps + 1)] = K;
+        if (out.orbit_phi) out.orbit_phi[i * n_states] = phi;
+        if (out.orbit_K) out.orbit_K[i * n_states] = K;
         if (out.exit_step) out.exit_step[i] = -1;
+        if (out.stop_step) out.stop_step[i] = -1;
     }
-    void operator()(std::int64_t i, double phi, double K, double rotsum, std::int64_t steps,
-                    Status st, int visited = 0) const {
-        const std::int64_t ns = opt.n_steps;
-        if (out.visited) out.visited[i] = static_cast<std::int8_t>(visited);
+    // State x_n of orbit i (n a multiple of every).
+    void state(std::int64_t i, std::int64_t n, double phi, double K) const {
+        if (out.orbit_phi) out.orbit_phi[i * n_states + n / every] = phi;
+        if (out.orbit_K) out.orbit_K[i * n_states + n / every] = K;
+    }
+    // Region of the return from x_n of orbit i (n a multiple of every, n < n_steps).
+    void region(std::int64_t i, std::int64_t n, int r) const {
+        if (out.regions) out.regions[i * n_returns + n / every] = static_cast<std::int8_t>(r);
+    }
+    void operator()(std::int64_t i, double phi, double K, std::int64_t steps, Status st, const Tally& t) const {
+        if (out.visited) out.visited[i] = static_cast<std::int8_t>(t.visited);
         if (out.phi_final) out.phi_final[i] = phi;
         if (out.K_final) out.K_final[i] = K;
-        if (out.rotation) out.rotation[i] = steps > 0 ? rotsum / double(steps) : kNaN;
+        if (out.rotation) out.rotation[i] = steps > 0 ? t.rot / double(steps) : kNaN;
         if (out.status) out.status[i] = static_cast<std::int8_t>(st);
         if (out.steps_done) out.steps_done[i] = steps;
-        if (st != Status::Interrupted) progress.add(ns - steps);
-        if (out.orbit_phi)
-            std::fill(out.orbit_phi + i * (ns + 1) + steps + 1, out.orbit_phi + (i + 1) * (ns + 1), kNaN);
-        if (out.orbit_K)
-            std::fill(out.orbit_K + i * (ns + 1) + steps + 1, out.orbit_K + (i + 1) * (ns + 1), kNaN);
+        if (out.stop_step && st == Status::Stopped) out.stop_step[i] = steps;
+        if (out.K_min) out.K_min[i] = t.K_min;
+        if (out.K_max) out.K_max[i] = t.K_max;
+        if (out.residence) {
+            std::int64_t* r = out.residence + i * kRegionCount;
+            r[int(Region::Beside)] = t.counted - std::int64_t(t.below);
+            r[int(Region::Above)] = std::int64_t(t.below - t.upper - t.right);
+            r[int(Region::Upper)] = std::int64_t(t.upper);
+            r[int(Region::Right)] = std::int64_t(t.right);
+            r[int(Region::Multi)] = 0;
+        }
+        if (st != Status::Interrupted) progress.add(opt.n_steps - steps);
+        if (steps % every == 0) state(i, steps, phi, K);
+        const std::int64_t s_end = steps / every + 1;  // first state index not reached
+        if (out.orbit_phi) std::fill(out.orbit_phi + i * n_states + s_end, out.orbit_phi + (i + 1) * n_states, kNaN);
+        if (out.orbit_K) std::fill(out.orbit_K + i * n_states + s_end, out.orbit_K + (i + 1) * n_states, kNaN);
+        // Returns recorded: those from x_n, n < steps, and the exiting one (n = steps) if it was.
+        const std::int64_t exiting = st == Status::Exited ? 1 : 0;
+        const std::int64_t r_end = (steps + exiting + every - 1) / every;
         if (out.regions)
-            std::fill(out.regions + i * ns + steps, out.regions + (i + 1) * ns,
+            std::fill(out.regions + i * n_returns + r_end, out.regions + (i + 1) * n_returns,
                       static_cast<std::int8_t>(Region::None));
     }
 };
@@ -124,17 +162,28 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     // its lane, which is refilled from the source at once, so the vectors stay full even when
     // orbits stop at very different times (early exit). Per-lane bookkeeping happens on a rare
     // path that unpacks the packets into lane arrays and packs them back.
-    const Finisher finish{opt, out, progress};
-    const std::int64_t ns = opt.n_steps;
+    const Finisher finish(opt, out, progress);
+    const std::int64_t ns = opt.n_steps, every = opt.every;
     const double lo = m.band().lo, hi = m.band().hi;
     const bool watch = opt.exit_mask != 0;
     const bool need_reg = watch || out.regions || out.visited;  // region codes are only built when read
+    const bool extrema = out.K_min || out.K_max, residence = out.residence != nullptr;
+    const bool rec_states = out.orbit_phi || out.orbit_K, rec = rec_states || out.regions;
+    const StopCondition& stop = opt.stop;
+    const bool stopping = stop.active(), above = stop.side == StopSide::Above;
+    const Curve* curve = stopping ? stop.curve.get() : nullptr;
+    const bool flat = stopping && curve->is_constant();
     const Packet zero = ei::pset1<Packet>(0.0), one = ei::pset1<Packet>(1.0), two = ei::pset1<Packet>(2.0),
                  three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
                  twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
                  half = ei::pset1<Packet>(0.5), eps = ei::pset1<Packet>(m.eps()), plo = ei::pset1<Packet>(lo),
                  phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero),
                  margin = ei::pset1<Packet>(kNearArcEnd), pi_less_margin = ei::pset1<Packet>(kPi - kNearArcEnd);
+    // The stop curve: its scale and cell count, and the bound beyond which no state can be in the set.
+    const Packet cscale = ei::pset1<Packet>(stopping ? curve->scale() : 0.0),
+                 ncells = ei::pset1<Packet>(stopping ? double(curve->size()) : 0.0),
+                 cflat = ei::pset1<Packet>(stopping ? curve->samples()[0] : 0.0),
+                 cbound = ei::pset1<Packet>(!stopping ? 0.0 : above ? curve->lower() : curve->upper());
     // detail::wrap and detail::wrap_once on packets (same operations, same order).
     auto pwrap = [&](const Packet& x) {
         Packet y = ei::psub(x, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(x, pi), inv2pi))));
@@ -142,16 +191,33 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         return ei::pselect(ei::pcmp_lt(y, mpi), ei::padd(y, twopi), y);
     };
     auto wrap_once = [&](const Packet& u) { return ei::pselect(ei::pcmp_le(pi, u), ei::psub(u, twopi), u); };
+    // Curve::value on packets (same operations, same order).
+    auto curve_at = [&](const Packet& p) {
+        if (flat) return cflat;
+        const Packet t = ei::pmul(ei::padd(p, pi), cscale);
+        Packet f = ei::pfloor(t);
+        const Packet s = ei::psub(t, f);
+        f = ei::pselect(ei::pcmp_le(ncells, f), ei::psub(f, ncells), f);
+        Packet c[4];
+        detail::pgather_cells(curve->cells(), f, c);
+        return ei::padd(c[0], ei::pmul(s, ei::padd(c[1], ei::pmul(s, ei::padd(c[2], ei::pmul(s, c[3]))))));
+    };
+    auto in_set = [&](const Packet& p, const Packet& k) {
+        const Packet c = curve_at(p);
+        return above ? ei::pcmp_le(c, k) : ei::pcmp_le(k, c);
+    };
     Packet allow[4];
     for (int r = 0; r < 4; ++r) allow[r] = (opt.exit_mask >> r) & 1u ? all : zero;
 
     Packet phi[kP], K[kP], rot[kP], live[kP], fresh[kP], reg[kP], omega[kP];
+    Packet kmin[kP], kmax[kP], nup[kP], nright[kP], nbelow[kP], mup[kP], mright[kP], mbelow[kP];
     alignas(64) double lphi[kLanes], lK[kLanes], lrot[kLanes], llive[kLanes], lfresh[kLanes], lreg[kLanes];
+    alignas(64) double lkmin[kLanes], lkmax[kLanes], lup[kLanes], lright[kLanes], lbelow[kLanes];
     // Regions visited (record "visited" only): one all-ones mask per region code 0..3 and lane.
     Packet seen[4][kP];
     alignas(64) double lseen[4][kLanes];
     const Packet code[4] = {zero, one, two, three};
-    std::int64_t idx[kLanes], start[kLanes];
+    std::int64_t idx[kLanes], start[kLanes], due[kLanes];  // due: the next n whose state / return is recorded
     std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
 
     auto unpack = [&] {
@@ -163,6 +229,15 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             ei::pstore(lfresh + q * kW, fresh[q]);
             if (out.visited)
                 for (int r = 0; r < 4; ++r) ei::pstore(lseen[r] + q * kW, seen[r][q]);
+            if (extrema) {
+                ei::pstore(lkmin + q * kW, kmin[q]);
+                ei::pstore(lkmax + q * kW, kmax[q]);
+            }
+            if (residence) {
+                ei::pstore(lup + q * kW, nup[q]);
+                ei::pstore(lright + q * kW, nright[q]);
+                ei::pstore(lbelow + q * kW, nbelow[q]);
+            }
         }
     };
     auto pack = [&] {
@@ -174,46 +249,76 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             fresh[q] = ei::pload<Packet>(lfresh + q * kW);
             if (out.visited)
                 for (int r = 0; r < 4; ++r) seen[r][q] = ei::pload<Packet>(lseen[r] + q * kW);
+            if (extrema) {
+                kmin[q] = ei::pload<Packet>(lkmin + q * kW);
+                kmax[q] = ei::pload<Packet>(lkmax + q * kW);
+            }
+            if (residence) {
+                nup[q] = ei::pload<Packet>(lup + q * kW);
+                nright[q] = ei::pload<Packet>(lright + q * kW);
+                nbelow[q] = ei::pload<Packet>(lbelow + q * kW);
+            }
         }
     };
     const double on = [] { double x; const std::uint64_t b = ~std::uint64_t(0); std::memcpy(&x, &b, 8); return x; }();
     auto is_live = [&](int j) { return std::memcmp(&llive[j], &on, 8) == 0; };
-    auto visited = [&](int j) {
-        int v = 0;
+    // Lane j's tally from the lane arrays (after unpack()); `exiting`: the exiting return is counted.
+    auto tally = [&](int j, bool exiting = false) {
+        Tally t;
+        t.rot = lrot[j];
         if (out.visited)
-            for (int r = 0; r < 4; ++r) v |= std::memcmp(&lseen[r][j], &on, 8) == 0 ? 1 << r : 0;
-        return v;
+            for (int r = 0; r < 4; ++r) t.visited |= std::memcmp(&lseen[r][j], &on, 8) == 0 ? 1 << r : 0;
+        t.K_min = lkmin[j];
+        t.K_max = lkmax[j];
+        t.upper = lup[j];
+        t.right = lright[j];
+        t.below = lbelow[j];
+        t.counted = it - start[j] + (exiting ? 1 : 0);
+        return t;
     };
-    // Put the next orbit that starts inside the band into lane j (orbits starting outside finish
-    // at once); with no work left the lane computes a harmless point that is ignored everywhere.
+    auto clear = [&](int j) {
+        lrot[j] = 0.0;
+        for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
+        lup[j] = lright[j] = lbelow[j] = 0.0;
+    };
+    // Put the next orbit that starts inside the band and outside the stop set into lane j (the
+    // others finish at once); with no work left the lane computes a harmless point that is ignored.
     auto fill = [&](int j) {
         for (std::int64_t i; src.pop(i);) {
             const double w = detail::wrap(phi0[i]);  // the kernel compares angles in [-pi, pi)
             finish.start(i, w, K0[i]);
+            Tally t0;
+            t0.K_min = t0.K_max = K0[i];
             if (!(K0[i] > lo && K0[i] < hi)) {
-                finish(i, w, K0[i], 0.0, 0, Status::Escaped);
+                finish(i, w, K0[i], 0, Status::Escaped, t0);
+                continue;
+            }
+            if (stopping && stop.reached(w, K0[i])) {
+                finish(i, w, K0[i], 0, Status::Stopped, t0);
                 continue;
             }
             if (ns == 0) {
-                finish(i, w, K0[i], 0.0, 0, Status::Ok);
+                finish(i, w, K0[i], 0, Status::Ok, t0);
                 continue;
             }
             lphi[j] = w;
             lK[j] = K0[i];
-            lrot[j] = 0.0;
             llive[j] = on;
             lfresh[j] = on;  // not yet reported as leaving the watched regions
-            for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
+            lkmin[j] = lkmax[j] = K0[i];
+            clear(j);
             idx[j] = i;
             start[j] = it;
+            due[j] = 0;
             return true;
         }
         lphi[j] = 0.0;
         lK[j] = 0.0;
-        lrot[j] = 0.0;
         llive[j] = 0.0;
         lfresh[j] = 0.0;
-        for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
+        lkmin[j] = lkmax[j] = 0.0;
+        clear(j);
+        due[j] = 0;
         return false;
     };
     int nlive = 0;
@@ -225,18 +330,28 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             if (is_live(j)) c = std::min(c, ns - (it - start[j]));
         return c;
     };
-    std::int64_t countdown = next_completion();
+    // The first iteration at which some live lane records its state / return.
+    auto next_record = [&] {
+        std::int64_t r = std::numeric_limits<std::int64_t>::max();
+        if (rec)
+            for (int j = 0; j < kLanes; ++j)
+                if (is_live(j)) r = std::min(r, start[j] + due[j]);
+        return r;
+    };
+    std::int64_t countdown = next_completion(), record_at = next_record();
 
     while (nlive > 0) {
         if ((it & 63) == 0 && cancelled(opt)) {
             unpack();
             for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Interrupted, visited(j));
+                if (is_live(j)) finish(idx[j], lphi[j], lK[j], it - start[j], Status::Interrupted, tally(j));
             for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
                 const double w = detail::wrap(phi0[i]);
                 finish.start(i, w, K0[i]);
                 const bool inside = K0[i] > lo && K0[i] < hi;
-                finish(i, w, K0[i], 0.0, 0, inside ? Status::Interrupted : Status::Escaped);
+                Tally t0;
+                t0.K_min = t0.K_max = K0[i];
+                finish(i, w, K0[i], 0, inside ? Status::Interrupted : Status::Escaped, t0);
             }
             return;
         }
@@ -279,6 +394,11 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 const Packet rt = ei::pandnot(ei::pand(neg, inR), up);
                 omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
                 if (need_reg) reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
+                if (residence) {
+                    mup[q] = up;
+                    mright[q] = rt;
+                    mbelow[q] = neg;
+                }
             }
             return ei::predux_any(near);
         };
@@ -301,11 +421,18 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             bool refilled = false;
             for (int j = 0; j < kLanes; ++j) {
                 if (!is_live(j) || std::memcmp(&lfresh[j], &on, 8) != 0) continue;
-                if ((opt.exit_mask >> int(lreg[j])) & 1u) continue;
-                if (out.exit_step) out.exit_step[idx[j]] = it - start[j];
+                const int r = int(lreg[j]);
+                if ((opt.exit_mask >> r) & 1u) continue;
+                const std::int64_t n = it - start[j];
+                if (out.exit_step) out.exit_step[idx[j]] = n;
                 lfresh[j] = 0.0;
                 if (opt.stop_on_exit) {
-                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Exited, visited(j));
+                    // The exiting return is recorded (its region, its residence count), not taken.
+                    if (n % every == 0) finish.region(idx[j], n, r);
+                    lbelow[j] += r != int(Region::Beside);
+                    lup[j] += r == int(Region::Upper);
+                    lright[j] += r == int(Region::Right);
+                    finish(idx[j], lphi[j], lK[j], n, Status::Exited, tally(j, true));
                     nlive -= !fill(j);
                     refilled = true;
                 }
@@ -313,16 +440,28 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             pack();
             if (refilled) {  // refilled lanes need their own classification
                 countdown = next_completion();
+                record_at = next_record();
                 continue;
             }
         }
-        if (out.regions) {
-            for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
-            ei::pstore(llive, live[0]);  // lane liveness is only read here and on the rare path
-            for (int q = 1; q < kP; ++q) ei::pstore(llive + q * kW, live[q]);
-            for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) out.regions[idx[j] * ns + (it - start[j])] = static_cast<std::int8_t>(lreg[j]);
+        if (it == record_at) {  // some lane records its state x_n and the region of its return
+            unpack();
+            if (out.regions)  // reg is only built when something reads it
+                for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
+            for (int j = 0; j < kLanes; ++j) {
+                if (!is_live(j) || it - start[j] != due[j]) continue;
+                if (rec_states) finish.state(idx[j], due[j], lphi[j], lK[j]);
+                if (out.regions) finish.region(idx[j], due[j], int(lreg[j]));
+                due[j] += every;
+            }
+            record_at = next_record();
         }
+        if (residence)
+            for (int q = 0; q < kP; ++q) {
+                nup[q] = ei::padd(nup[q], ei::pand(mup[q], one));
+                nright[q] = ei::padd(nright[q], ei::pand(mright[q], one));
+                nbelow[q] = ei::padd(nbelow[q], ei::pand(mbelow[q], one));
+            }
         // Step: rotate, wrap to [-pi, pi), kick.
         Packet outside = zero;
         for (int q = 0; q < kP; ++q) {
@@ -332,33 +471,42 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             K[q] = ei::padd(K[q], ei::pmul(eps, force_packet<Fast>(m.forcing(), p)));
             const Packet inside = ei::pand(ei::pcmp_lt(plo, K[q]), ei::pcmp_lt(K[q], phi_));
             outside = ei::por(outside, ei::pandnot(live[q], inside));
+            if (extrema) {
+                kmin[q] = ei::pmin(kmin[q], K[q]);
+                kmax[q] = ei::pmax(kmax[q], K[q]);
+            }
+        }
+        // Stop condition: only packets with a lane beyond the curve's bound can hold a state in the
+        // set; which lanes are is decided on the rare path by Curve::value itself (the same bits).
+        Packet hit = zero;
+        if (stopping) {
+            Packet maybe = zero;
+            for (int q = 0; q < kP; ++q)
+                maybe = ei::por(maybe, ei::pand(live[q], above ? ei::pcmp_le(cbound, K[q]) : ei::pcmp_le(K[q], cbound)));
+            if (ei::predux_any(maybe))
+                for (int q = 0; q < kP; ++q) hit = ei::por(hit, ei::pand(live[q], in_set(phi[q], K[q])));
         }
         ++it;
         --countdown;
         progress.add(nlive);  // every live lane took one step
-        if (out.orbit_phi || out.orbit_K) {
+        if (countdown == 0 || ei::predux_any(outside) || ei::predux_any(hit)) {
             unpack();
             for (int j = 0; j < kLanes; ++j) {
                 if (!is_live(j)) continue;
-                const std::int64_t at = idx[j] * (ns + 1) + (it - start[j]);
-                if (out.orbit_phi) out.orbit_phi[at] = lphi[j];
-                if (out.orbit_K) out.orbit_K[at] = lK[j];
-            }
-        }
-        if (countdown == 0 || ei::predux_any(outside)) {
-            unpack();
-            for (int j = 0; j < kLanes; ++j) {
-                if (!is_live(j)) continue;
+                const std::int64_t n = it - start[j];
                 if (!(lK[j] > lo && lK[j] < hi))
-                    finish(idx[j], lphi[j], lK[j], lrot[j], it - start[j], Status::Escaped, visited(j));
-                else if (it - start[j] == ns)
-                    finish(idx[j], lphi[j], lK[j], lrot[j], ns, Status::Ok, visited(j));
+                    finish(idx[j], lphi[j], lK[j], n, Status::Escaped, tally(j));
+                else if (stopping && stop.reached(lphi[j], lK[j]))
+                    finish(idx[j], lphi[j], lK[j], n, Status::Stopped, tally(j));
+                else if (n == ns)
+                    finish(idx[j], lphi[j], lK[j], ns, Status::Ok, tally(j));
                 else
                     continue;
                 nlive -= !fill(j);
             }
             pack();
             countdown = next_completion();
+            record_at = next_record();
         }
     }
 }
@@ -366,20 +514,28 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
 template <class A, class F>
 void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
                 const IterateOptions& opt, const IterateOutput& out, detail::ProgressShare& progress) {
-    const Finisher finish{opt, out, progress};
-    const std::int64_t ns = opt.n_steps;
+    const Finisher finish(opt, out, progress);
+    const std::int64_t ns = opt.n_steps, every = opt.every;
+    const bool rec_states = out.orbit_phi || out.orbit_K;
+    const StopCondition& stop = opt.stop;
     for (std::int64_t i; src.pop(i);) {
-        double phi = detail::wrap(phi0[i]), K = K0[i], rot = 0.0;
-        int vis = 0;
+        double phi = detail::wrap(phi0[i]), K = K0[i];
+        Tally t;
+        t.K_min = t.K_max = K;
         finish.start(i, phi, K);
         bool reported = false;
         std::int64_t n = 0;
         Status st = Status::Ok;
         if (!(K > m.band().lo && K < m.band().hi)) {
-            finish(i, phi, K, 0.0, 0, Status::Escaped);
+            finish(i, phi, K, 0, Status::Escaped, t);
+            continue;
+        }
+        if (stop.active() && stop.reached(phi, K)) {
+            finish(i, phi, K, 0, Status::Stopped, t);
             continue;
         }
         std::int64_t counted = 0;  // steps of this orbit handed to progress so far
+        std::int64_t phase = 0;    // n mod every
         for (; n < ns; ++n) {
             if ((n & 63) == 0) {
                 progress.add(n - counted);  // every 64 steps, off the per-step path
@@ -390,8 +546,19 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
                 }
             }
             const Classified c = classify(phi, K, m.arcs().at(K));
-            vis |= 1 << int(c.region);
-            if (opt.exit_mask && !reported && !((opt.exit_mask >> int(c.region)) & 1u)) {
+            const int r = int(c.region);
+            t.visited |= 1 << r;
+            // The return from x_n is counted (residence) and recorded (regions) also when it is
+            // the exiting one, which stop_on_exit then does not take.
+            t.upper += r == int(Region::Upper);
+            t.right += r == int(Region::Right);
+            t.below += r != int(Region::Beside);
+            ++t.counted;
+            if (phase == 0) {
+                if (rec_states) finish.state(i, n, phi, K);
+                finish.region(i, n, r);
+            }
+            if (opt.exit_mask && !reported && !((opt.exit_mask >> r) & 1u)) {
                 if (out.exit_step) out.exit_step[i] = n;
                 reported = true;
                 if (opt.stop_on_exit) {
@@ -399,20 +566,25 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
                     break;
                 }
             }
-            if (out.regions) out.regions[i * ns + n] = static_cast<std::int8_t>(c.region);
-            rot += c.omega;
+            t.rot += c.omega;
             phi = detail::rotate(phi, c.omega);
             K += m.eps() * m.forcing().at(phi);
-            if (out.orbit_phi) out.orbit_phi[i * (ns + 1) + n + 1] = phi;
-            if (out.orbit_K) out.orbit_K[i * (ns + 1) + n + 1] = K;
+            t.K_min = std::min(t.K_min, K);
+            t.K_max = std::max(t.K_max, K);
+            if (++phase == every) phase = 0;
             if (!(K > m.band().lo && K < m.band().hi)) {
                 st = Status::Escaped;
                 ++n;
                 break;
             }
+            if (stop.active() && stop.reached(phi, K)) {
+                st = Status::Stopped;
+                ++n;
+                break;
+            }
         }
         progress.add(n - counted);
-        finish(i, phi, K, rot, n, st, vis);
+        finish(i, phi, K, n, st, t);
     }
 }
 
@@ -441,6 +613,8 @@ void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n
     if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
             std::to_string(opt.n_threads));
+    if (opt.every < 1) bad("every must be >= 1 (record every k-th state), got " + std::to_string(opt.every));
+    opt.stop.validate();
     for (std::int64_t i = 0; i < n; ++i) {
         detail::require_angle(phi0[i], "phi0[" + std::to_string(i) + "]");
         detail::require_finite(K0[i], "K0[" + std::to_string(i) + "]");
