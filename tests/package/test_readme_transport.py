@@ -9,7 +9,7 @@ import numpy as np
 
 import hovering
 
-README = pathlib.Path(__file__).resolve().parents[1] / "README.md"
+README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 
 
 def test_transport_section_runs_and_agrees_with_its_comments():
