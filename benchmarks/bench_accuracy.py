@@ -81,12 +81,16 @@ def main():
         for row in wp.table:
             ea = row.get("error_after", {})
             if returns[-1] in ea and ea[1] > 0:
-                print(f"  {row['method']} {row['tolerance']:.0e}: error({returns[-1]}) / error(1) = "
-                      f"{ea[returns[-1]] / ea[1]:.3g}  (m^2 = {returns[-1] ** 2:.0e})")
+                print(
+                    f"  {row['method']} {row['tolerance']:.0e}: error({returns[-1]}) / error(1) = "
+                    f"{ea[returns[-1]] / ea[1]:.3g}  (m^2 = {returns[-1] ** 2:.0e})"
+                )
         if exact_available(sec):
             te, tr, d = exact_speed(sec)
-            print(f"  exact: {1e6 * te:.2f} us per return; rk8pd at rtol 1e-13: {1e6 * tr:.2f} us; "
-                  f"ratio {tr / te:.0f}x; max distance {d:.2g}")
+            print(
+                f"  exact: {1e6 * te:.2f} us per return; rk8pd at rtol 1e-13: {1e6 * tr:.2f} us; "
+                f"ratio {tr / te:.0f}x; max distance {d:.2g}"
+            )
         savefig(wp.plot(), DOCS / f"accuracy_{geometry}_eps{eps:g}.png", dpi=90)
     m = paper.truncated_map(0.05)
     wp = hovering.work_precision(m, quick=args.quick)

@@ -35,9 +35,11 @@ def timed(sys, z, opts):
 
 
 def main():
-    cases = [("eps=0 wall", case(paper.V2, 0.0, "wall")),
-             ("eps=0 step", case(paper.V2, 0.0, "step")),
-             ("linear eps=0.1 step", case(hovering.Harmonic(1.3), 0.1, "step"))]
+    cases = [
+        ("eps=0 wall", case(paper.V2, 0.0, "wall")),
+        ("eps=0 step", case(paper.V2, 0.0, "step")),
+        ("linear eps=0.1 step", case(hovering.Harmonic(1.3), 0.1, "step")),
+    ]
     rng = np.random.default_rng(0)
     print(f"{'system':22s} {'method':16s} {'us/return':>10s} {'ratio':>7s} {'error':>9s} {'steps':>7s}")
     for name, sys in cases:
@@ -49,8 +51,10 @@ def main():
             t, d = timed(sys, z, flow_options(stepper="rk8pd", rtol=rtol, atol=rtol))
             both = (d["status"] == 0) & (ref["status"] == 0)
             err = np.max(np.abs(d["z"][both] - ref["z"][both]))
-            print(f"{name:22s} {'rk8pd ' + format(rtol, 'g'):16s} {t:10.3f} {t / t_exact:7.1f} {err:9.1e} "
-                  f"{np.mean(d['steps']):7.1f}")
+            print(
+                f"{name:22s} {'rk8pd ' + format(rtol, 'g'):16s} {t:10.3f} {t / t_exact:7.1f} {err:9.1e} "
+                f"{np.mean(d['steps']):7.1f}"
+            )
 
 
 if __name__ == "__main__":

@@ -43,21 +43,27 @@ def rhs(t, z):
 def scipy_return(z0, rtol):
     """Return map with solve_ivp: wall event (terminal: reflect, restart), q1's minimum (arms the
     section) and the section event (p1 from + to -), all filtered to times after the restart."""
+
     def wall(t, z):
         return z[0] - QW1
+
     wall.terminal, wall.direction = True, -1
 
     def section(t, z):
         return z[1]
+
     section.direction = -1
 
     def q1_min(t, z):
         return z[1]
+
     q1_min.direction = 1
 
     z, t, impacts, armed = np.array(z0, float), 0.0, 0, False
     while impacts < 10:
-        sol = solve_ivp(rhs, (t, t + 20), z, method="DOP853", rtol=rtol, atol=rtol * 1e-2, events=[wall, section, q1_min])
+        sol = solve_ivp(
+            rhs, (t, t + 20), z, method="DOP853", rtol=rtol, atol=rtol * 1e-2, events=[wall, section, q1_min]
+        )
         evs = [(te, k, ye) for k in range(3) for te, ye in zip(sol.t_events[k], sol.y_events[k]) if te > t + 1e-9]
         for te, k, ye in sorted(evs, key=lambda e: e[0]):
             if k == 2:
@@ -81,9 +87,11 @@ def heyoka_integrator(rtol):
     q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
     w2, a2 = V2.omega, V2.alpha
     sys = [(q1, p1), (p1, -q1), (q2, p2), (p2, -(w2**2 / a2) * hy.tan(a2 * q2) / hy.cos(a2 * q2) ** 2)]
-    ev = [hy.t_event(q1 - QW1, direction=hy.event_direction.negative),
-          hy.t_event(p1, direction=hy.event_direction.negative),
-          hy.t_event(p1, direction=hy.event_direction.positive)]
+    ev = [
+        hy.t_event(q1 - QW1, direction=hy.event_direction.negative),
+        hy.t_event(p1, direction=hy.event_direction.negative),
+        hy.t_event(p1, direction=hy.event_direction.positive),
+    ]
     return hy.taylor_adaptive(sys, [1.0, 0.0, 0.0, 0.1], t_events=ev, tol=rtol)
 
 
@@ -161,8 +169,11 @@ def main():
     print(f"{'method':26s} {'tol':>8s} {'max angle error':>16s} {'us/return':>10s}")
     # Half decades from 1e-5 to 1e-14, refined around each target accuracy (where each method's
     # tolerance-to-error ratio decides which setting is the cheapest that reaches it).
-    grid = sorted({10.0 ** (-k / 2) for k in range(10, 29)}
-                  | {t * c for t in (1e-6, 1e-9, 1e-12) for c in (5.0, 3.0, 2.0, 1.5, 0.7, 0.5)}, reverse=True)
+    grid = sorted(
+        {10.0 ** (-k / 2) for k in range(10, 29)}
+        | {t * c for t in (1e-6, 1e-9, 1e-12) for c in (5.0, 3.0, 2.0, 1.5, 0.7, 0.5)},
+        reverse=True,
+    )
 
     def convert(states):
         """Section coordinates of returned states (untimed: ours returns them already)."""
@@ -179,6 +190,7 @@ def main():
             if tol not in hk:
                 hk[tol] = heyoka_integrator(tol)  # JIT compilation, once per tolerance
             return convert([heyoka_return(hk[tol], z)[0] for z in z0])
+
         methods["heyoka.py Taylor"] = run_heyoka
     except ImportError:
         print("heyoka.py not installed: skipped (pip install heyoka)")
@@ -186,18 +198,32 @@ def main():
     if hk:
         ta = hk[min(hk, key=lambda t: abs(np.log10(t) + 12))]
         t_call, _ = timed(lambda: [ta.propagate_until(ta.time + 1e-12) for _ in range(1000)], 3)
-        print(f"(heyoka.py's Python-side cost, kept in its times: {1e3 * t_call:.1f} us per propagate_until call, "
-              "3 calls per return)")
-    curves.update(work_precision({"scipy DOP853": lambda tol: convert([scipy_return(z, tol)[0] for z in z0])},
-                                 [10.0 ** -k for k in range(6, 14)], th, I, 1))
+        print(
+            f"(heyoka.py's Python-side cost, kept in its times: {1e3 * t_call:.1f} us per propagate_until call, "
+            "3 calls per return)"
+        )
+    curves.update(
+        work_precision(
+            {"scipy DOP853": lambda tol: convert([scipy_return(z, tol)[0] for z in z0])},
+            [10.0**-k for k in range(6, 14)],
+            th,
+            I,
+            1,
+        )
+    )
     print("\nAt matched achieved accuracy (each method's fastest setting whose max error is within the target):")
     print(f"{'target':>8s} " + " ".join(f"{m:>24s}" for m in curves) + "   ratios (other / ours)")
     for target in (1e-6, 1e-9, 1e-12):
         best = {m: cheapest(rows, target) for m, rows in curves.items()}
-        cells = " ".join(f"{'-':>24s}" if b is None else f"{1e6 * b[2]:8.1f} us (tol {b[0]:.0e})" for b in best.values())
+        cells = " ".join(
+            f"{'-':>24s}" if b is None else f"{1e6 * b[2]:8.1f} us (tol {b[0]:.0e})" for b in best.values()
+        )
         ours = best["hovering rk8pd"]
-        ratios = ", ".join(f"{m.split()[0]} {b[2] / ours[2]:.2f}x" for m, b in best.items()
-                           if b is not None and ours is not None and m != "hovering rk8pd")
+        ratios = ", ".join(
+            f"{m.split()[0]} {b[2] / ours[2]:.2f}x"
+            for m, b in best.items()
+            if b is not None and ours is not None and m != "hovering rk8pd"
+        )
         print(f"{target:8.0e} {cells}   {ratios}")
 
     # Near-grazing impacts: every one of these orbits dips below the wall by `dip` and must reflect

@@ -44,10 +44,19 @@ def heyoka_loop(theta, I, n_returns, tol):
 
     q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
     w2, a2 = 1.4, 0.7
-    sys = [(q1, p1), (p1, -q1 - EPS * q2), (q2, p2), (p2, -(w2**2 / a2) * hy.tan(a2 * q2) / hy.cos(a2 * q2) ** 2 - EPS * q1)]
+    sys = [
+        (q1, p1),
+        (p1, -q1 - EPS * q2),
+        (q2, p2),
+        (p2, -(w2**2 / a2) * hy.tan(a2 * q2) / hy.cos(a2 * q2) ** 2 - EPS * q1),
+    ]
     neg, pos = hy.event_direction.negative, hy.event_direction.positive
-    ev = [hy.t_event(q1 - QW1, direction=neg), hy.t_event(q2 - QW2, direction=neg), hy.t_event(p1, direction=neg),
-          hy.t_event(p1, direction=pos)]
+    ev = [
+        hy.t_event(q1 - QW1, direction=neg),
+        hy.t_event(q2 - QW2, direction=neg),
+        hy.t_event(p1, direction=neg),
+        hy.t_event(p1, direction=pos),
+    ]
     ta = hy.taylor_adaptive(sys, [1.0, 0.0, 0.0, 0.1], t_events=ev, tol=tol)
     z0 = hv.Section(SYS, H).point(theta, I)
     out = np.empty((len(theta), 4))
@@ -92,7 +101,9 @@ def main(argv=None) -> None:
         for thr in (1, 2):
             t, _ = best(lambda: f.iterate(phi0, K0, ns, record=(), n_threads=thr))
             rows[(atol, thr)] = n * ns / t
-            print(f"  atol {atol:g}, {thr} thread(s): {n * ns / t:9.0f} returns/s  ({t / (n * ns) * 1e6:.2f} us per return)")
+            print(
+                f"  atol {atol:g}, {thr} thread(s): {n * ns / t:9.0f} returns/s  ({t / (n * ns) * 1e6:.2f} us per return)"
+            )
     ref = rows[(1e-10, 1)]
     print(f"  thread scaling: {rows[(1e-10, 2)] / ref:.2f}x on 2 threads")
 
@@ -119,10 +130,14 @@ def main(argv=None) -> None:
     t_loop, _ = best(one_at_a_time, 1)
     t_batch, _ = best(python_loop, 1)
     r_loop, r_batch = m1 * n1 / t_loop, m1 * n1 / t_batch
-    print(f"Python loop over Section.return_map, one orbit per call: {r_loop:9.0f} returns/s -> FlowMap 1 thread "
-          f"{ref / r_loop:.1f}x, 2 threads {rows[(1e-10, 2)] / r_loop:.1f}x")
-    print(f"Python loop over returns, all {m1} orbits per call (1 thread): {r_batch:9.0f} returns/s -> FlowMap 1 thread "
-          f"{ref / r_batch:.1f}x")
+    print(
+        f"Python loop over Section.return_map, one orbit per call: {r_loop:9.0f} returns/s -> FlowMap 1 thread "
+        f"{ref / r_loop:.1f}x, 2 threads {rows[(1e-10, 2)] / r_loop:.1f}x"
+    )
+    print(
+        f"Python loop over returns, all {m1} orbits per call (1 thread): {r_batch:9.0f} returns/s -> FlowMap 1 thread "
+        f"{ref / r_batch:.1f}x"
+    )
 
     try:
         import heyoka  # noqa: F401
@@ -141,18 +156,24 @@ def main(argv=None) -> None:
             c1 = sec.coordinates(one)
             err1 = max(np.abs(hv.wrap(c1[:, 0] - tight.phi_final)).max(), np.abs(c1[:, 1] - tight.K_final).max())
             dev = max(np.abs(hv.wrap(c[:, 0] - ours.phi_final)).max(), np.abs(c[:, 1] - ours.K_final).max())
-            print(f"heyoka.py tol {tol:g}: {m1 * n1 / t_hy:9.0f} returns/s -> FlowMap 1 thread {ref * t_hy / (m1 * n1):.2f}x, "
-                  f"2 threads {rows[(1e-10, 2)] * t_hy / (m1 * n1):.2f}x; one-return error vs rtol 1e-14 {err1:.1e}; "
-                  f"after {n1} returns |ours - heyoka| = {dev:.1e}")
+            print(
+                f"heyoka.py tol {tol:g}: {m1 * n1 / t_hy:9.0f} returns/s -> FlowMap 1 thread {ref * t_hy / (m1 * n1):.2f}x, "
+                f"2 threads {rows[(1e-10, 2)] * t_hy / (m1 * n1):.2f}x; one-return error vs rtol 1e-14 {err1:.1e}; "
+                f"after {n1} returns |ours - heyoka| = {dev:.1e}"
+            )
         one_ours = hv.FlowMap(SYS, h=H, rtol=1e-10, coordinates="section").iterate(th, I, 1, record=())
-        err_ours = max(np.abs(hv.wrap(one_ours.phi_final - tight.phi_final)).max(), np.abs(one_ours.K_final - tight.K_final).max())
+        err_ours = max(
+            np.abs(hv.wrap(one_ours.phi_final - tight.phi_final)).max(), np.abs(one_ours.K_final - tight.K_final).max()
+        )
         print(f"  (ours at rtol = atol = 1e-10: one-return error vs rtol 1e-14 {err_ours:.1e})")
 
     samples, steps = (500, 500) if args.quick else (2000, 2000)
     t0 = time.perf_counter()
     area = fm.hovering_area(n_steps=steps, samples=samples)
-    print(f"hovering_area of the flow, {samples} points x {steps} returns (2 threads): {time.perf_counter() - t0:.1f} s "
-          f"(|HOV| = {area.area:.4f} +- {area.error:.4f}, theory {area.theory:.4f})")
+    print(
+        f"hovering_area of the flow, {samples} points x {steps} returns (2 threads): {time.perf_counter() - t0:.1f} s "
+        f"(|HOV| = {area.area:.4f} +- {area.error:.4f}, theory {area.theory:.4f})"
+    )
 
 
 if __name__ == "__main__":

@@ -83,10 +83,14 @@ def main(argv=None):
     mismatch = int(np.count_nonzero(alive_np != (r.status[:n_np] == Status.OK)))
 
     steps_taken = int(r.steps_done.sum())
-    print(f"hovering-set measurement, eps = {args.eps}, {hv.n_samples} points x {args.steps} iterates "
-          f"(F_eps; hovering_area also runs the F_0 check)")
-    print(f"  |HOV| = {hv.area:.4f} +- {hv.error:.4f} (theory eq:hovsetsize {hv.theory:.4f}); "
-          f"{steps_taken:.3e} steps taken with early exit of {hv.n_samples * args.steps:.3e} requested")
+    print(
+        f"hovering-set measurement, eps = {args.eps}, {hv.n_samples} points x {args.steps} iterates "
+        f"(F_eps; hovering_area also runs the F_0 check)"
+    )
+    print(
+        f"  |HOV| = {hv.area:.4f} +- {hv.error:.4f} (theory eq:hovsetsize {hv.theory:.4f}); "
+        f"{steps_taken:.3e} steps taken with early exit of {hv.n_samples * args.steps:.3e} requested"
+    )
     print(f"{'method':52s} {'time [s]':>9s} {'vs NumPy':>9s}")
     rows = [
         ("NumPy, early exit by compression (scaled from subsample)", t_np),
@@ -96,7 +100,9 @@ def main(argv=None):
     ]
     for name, t in rows:
         print(f"{name:52s} {t:9.2f} {t_np / t:8.1f}x")
-    print(f"early exit saves {t_full / t_exit:.1f}x; NumPy/C++ verdict mismatches on the subsample: {mismatch} of {n_np}")
+    print(
+        f"early exit saves {t_full / t_exit:.1f}x; NumPy/C++ verdict mismatches on the subsample: {mismatch} of {n_np}"
+    )
 
 
 if __name__ == "__main__":

@@ -66,17 +66,22 @@ def truncated(n_orbits: int, n_steps: int, repeat: int) -> None:
     ext = m.iterate(phi0, K0, n_steps, record=("extrema",), n_threads=1)
     K_top = float(np.max(ext.K_max)) + 0.1
     overlap = np.mean(ext.K_max >= ceiling.K.min())
-    print(f"\nTruncatedMap eps = 0.3: {n_orbits} orbits x {n_steps} steps, 1 thread, best of {repeat}; "
-          f"{overlap:.0%} of the orbits reach above the curve's minimum")
+    print(
+        f"\nTruncatedMap eps = 0.3: {n_orbits} orbits x {n_steps} steps, 1 thread, best of {repeat}; "
+        f"{overlap:.0%} of the orbits reach above the curve's minimum"
+    )
     for kernel in ("simd", "scalar"):
         confs = configurations(ceiling, K_top)
         for name, kw in confs:  # every configuration takes every step
             res = m.iterate(phi0, K0, n_steps, n_threads=1, kernel=kernel, **kw)
             assert res.count(hovering.Status.OK) == n_orbits, (name, np.unique(res.status, return_counts=True))
-        times = best_times([lambda kw=kw: m.iterate(phi0, K0, n_steps, n_threads=1, kernel=kernel, **kw)
-                            for _, kw in confs], repeat)
-        print(f"  {kernel:6s}  record=() {times[0] * 1e9 / (n_orbits * n_steps):.2f} ns/step;  " +
-              "  ".join(f"{name} {t / times[0]:.2f}" for (name, _), t in zip(confs[1:], times[1:])))
+        times = best_times(
+            [lambda kw=kw: m.iterate(phi0, K0, n_steps, n_threads=1, kernel=kernel, **kw) for _, kw in confs], repeat
+        )
+        print(
+            f"  {kernel:6s}  record=() {times[0] * 1e9 / (n_orbits * n_steps):.2f} ns/step;  "
+            + "  ".join(f"{name} {t / times[0]:.2f}" for (name, _), t in zip(confs[1:], times[1:]))
+        )
 
 
 def flow(n_orbits: int, n_steps: int, repeat: int) -> None:
@@ -92,8 +97,10 @@ def flow(n_orbits: int, n_steps: int, repeat: int) -> None:
     print(f"\nFlowMap (paper system, eps = 0.05): {phi0.size} orbits x {n_steps} returns, 1 thread, best of {repeat}")
     confs = configurations(ceiling, K_top)
     times = best_times([lambda kw=kw: fm.iterate(phi0, K0, n_steps, n_threads=1, **kw) for _, kw in confs], repeat)
-    print(f"  flow    record=() {times[0] * 1e6 / (phi0.size * n_steps):.1f} us/return;  " +
-          "  ".join(f"{name} {t / times[0]:.2f}" for (name, _), t in zip(confs[1:], times[1:])))
+    print(
+        f"  flow    record=() {times[0] * 1e6 / (phi0.size * n_steps):.1f} us/return;  "
+        + "  ".join(f"{name} {t / times[0]:.2f}" for (name, _), t in zip(confs[1:], times[1:]))
+    )
 
 
 def main() -> None:

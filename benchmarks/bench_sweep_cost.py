@@ -71,16 +71,19 @@ def main():
             plan = Path(d) / "p.toml"
             plan.write_text(plan_text(sc, points=points))
             t0 = time.perf_counter()
-            subprocess.run([args.exe, "--plan", str(plan), "--out", str(Path(d) / "c.jsonl")], check=True,
-                           capture_output=True)
+            subprocess.run(
+                [args.exe, "--plan", str(plan), "--out", str(Path(d) / "c.jsonl")], check=True, capture_output=True
+            )
             print(f"hovering_sweep on the same {len(points)} points: {time.perf_counter() - t0:.2f} s")
     per_eps = total / len(points)
     curve = 40 * per_eps
     print(f"\nmean per eps at 1e4 samples x 1e4 returns: {per_eps:,.0f} s on this machine ({cores} cores)")
     print(f"40 eps: {curve / 3600:.1f} h on this machine = {curve * cores / 3600:.0f} core-hours")
     for w in (1, 2, 8, 32):
-        print(f"  on {w:>2} machines of {cores} cores, ideal division (pieces per eps on a Dask scheduler): "
-              f"{curve / w / 3600:6.2f} h")
+        print(
+            f"  on {w:>2} machines of {cores} cores, ideal division (pieces per eps on a Dask scheduler): "
+            f"{curve / w / 3600:6.2f} h"
+        )
 
 
 if __name__ == "__main__":

@@ -34,8 +34,10 @@ def timed(fn):
 def main():
     tm = paper.truncated_map(0.3)
     fm = paper.flow_map(-0.1)
-    cases = [("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, samples=200_000), 16, "step"),
-             ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, samples=1600), 8, "return")]
+    cases = [
+        ("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, samples=200_000), 16, "step"),
+        ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, samples=1600), 8, "return"),
+    ]
     with executor(workers=2) as ex:  # what a pool's start costs (spawn + import hovering), for reference
         t_pool, _ = timed(lambda: list(run_pieces(ex, _noop, [(0,), (1,)])))
     print(f"process pool start (2 workers, first tasks): {t_pool:.2f} s, included in the pool times below")
@@ -59,8 +61,10 @@ def main():
             start = time.perf_counter() - ts
             t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, executor=Executor(client=client, pieces=pieces)))
             assert r.area == ref.area
-            print(f"Dask LocalCluster, {w} worker(s): {t:8.2f} s  speed-up vs pool 1 worker {base / t:.2f}x "
-                  f"(cluster start {start:.1f} s, not included)")
+            print(
+                f"Dask LocalCluster, {w} worker(s): {t:8.2f} s  speed-up vs pool 1 worker {base / t:.2f}x "
+                f"(cluster start {start:.1f} s, not included)"
+            )
             client.close()
             cluster.close()
     cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0")

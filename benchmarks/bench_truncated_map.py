@@ -153,9 +153,11 @@ def main(argv=None):
     a2, b2 = numpy_iterate_plain(phi0, K0, 1, p)
     assert np.max(np.abs(hovering.wrap(a2 - c1))) < 1e-12 and np.max(np.abs(b2 - d1)) < 1e-12
 
-    print(f"truncated map F_eps, {args.orbits} orbits x {args.steps} steps = {work:.2e} orbit-steps, "
-          f"best of {args.repeat}; SIMD width: {hovering.simd_width()} doubles "
-          f"({ {8: 'AVX-512', 4: 'AVX2', 2: 'SSE2'}.get(hovering.simd_width(), 'scalar') })")
+    print(
+        f"truncated map F_eps, {args.orbits} orbits x {args.steps} steps = {work:.2e} orbit-steps, "
+        f"best of {args.repeat}; SIMD width: {hovering.simd_width()} doubles "
+        f"({ {8: 'AVX-512', 4: 'AVX2', 2: 'SSE2'}.get(hovering.simd_width(), 'scalar') })"
+    )
     print(f"{'method':46s} {'orbit-steps/s':>14s} {'ns/step':>8s} {'vs NumPy':>9s} {'vs NumPy':>9s} {'vs scalar':>10s}")
     print(f"{'':46s} {'':>14s} {'':>8s} {'in-place':>9s} {'plain':>9s} {'C++ 1T':>10s}")
     for name, t in rows:

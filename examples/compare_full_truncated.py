@@ -19,7 +19,12 @@ import hovering
 from hovering import StepSystem, TruncatedFamily, TruncatedMap, paper
 from hovering.paper import QW1, QW2, V1, V2, H
 
-CODE = {"1": int(hovering.Region.UPPER), "R": int(hovering.Region.RIGHT), "0": int(hovering.Region.ABOVE), "u": int(hovering.Region.BESIDE)}
+CODE = {
+    "1": int(hovering.Region.UPPER),
+    "R": int(hovering.Region.RIGHT),
+    "0": int(hovering.Region.ABOVE),
+    "u": int(hovering.Region.BESIDE),
+}
 
 
 def compare(eps, K, n_phi=24, n_modes=6):
@@ -31,7 +36,7 @@ def compare(eps, K, n_phi=24, n_modes=6):
     A = np.stack([np.sin((k + 1) * phi_s) for k in range(n_modes)], 1)
     b = np.linalg.lstsq(A, f, rcond=None)[0]
     m = TruncatedMap(eps=eps, Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
-    grid = np.concatenate([-np.linspace(0.3, 0.0, 31) ** 2 * 10 / 9, np.linspace(0.01, 0.3, 10)])
+    grid = np.concatenate([-(np.linspace(0.3, 0.0, 31) ** 2) * 10 / 9, np.linspace(0.01, 0.3, 10)])
     fam = TruncatedFamily.from_map(m, grid, forcing=tuple(b))
     ph = np.linspace(-3.0, 3.0, n_phi)
     th, I = hovering.from_normal(sec, ph, np.full_like(ph, K))
@@ -40,17 +45,26 @@ def compare(eps, K, n_phi=24, n_modes=6):
     pt, Kt = fam.step(ph, np.full_like(ph, K))
     reg = fam.region(ph, np.full_like(ph, K))
     same = np.array([CODE.get(s, -2) == r for s, r in zip(out.itinerary, reg)]) & (out.status == 0)
-    return dict(same=int(same.sum()), n=n_phi, dphi=float(np.abs(hovering.wrap(pb - pt))[same].max()),
-                dK=float(np.abs(Kb - Kt)[same].max()), b=b)
+    return dict(
+        same=int(same.sum()),
+        n=n_phi,
+        dphi=float(np.abs(hovering.wrap(pb - pt))[same].max()),
+        dK=float(np.abs(Kb - Kt)[same].max()),
+        b=b,
+    )
 
 
 def main():
-    print(f"{'eps':>6s} {'K':>6s} {'regions agree':>14s} {'max|dphi|':>10s} {'max|dK|':>10s} {'dK/(eps|K|)':>12s} {'b1':>7s} {'b2':>7s}")
+    print(
+        f"{'eps':>6s} {'K':>6s} {'regions agree':>14s} {'max|dphi|':>10s} {'max|dK|':>10s} {'dK/(eps|K|)':>12s} {'b1':>7s} {'b2':>7s}"
+    )
     for eps in (0.005, 0.01, 0.02):
         for K in (-0.03, -0.01, 0.01, 0.03):
             r = compare(eps, K)
-            print(f"{eps:6.3f} {K:+6.2f} {r['same']:>8d}/{r['n']:<5d} {r['dphi']:10.2e} {r['dK']:10.2e} "
-                  f"{r['dK'] / (eps * abs(K)):12.2f} {r['b'][0]:7.3f} {r['b'][1]:7.4f}")
+            print(
+                f"{eps:6.3f} {K:+6.2f} {r['same']:>8d}/{r['n']:<5d} {r['dphi']:10.2e} {r['dK']:10.2e} "
+                f"{r['dK'] / (eps * abs(K)):12.2f} {r['b'][0]:7.3f} {r['b'][1]:7.4f}"
+            )
 
 
 if __name__ == "__main__":

@@ -34,11 +34,22 @@ def compare(eps: float, samples: int, steps: int, rtol: float = 1e-10) -> dict:
     t_flow = time.perf_counter() - t
     model = tm.hovering_area(n_steps=steps, samples=samples, K_low=flow.box[2], keep_points=True)
     th = fm.theory()
-    return dict(eps=eps, flow=flow.area, flow_err=flow.error, model=model.area, model_err=model.error, theory=th.area,
-                flow_both=flow.area_both_sides, model_both=model.area_both_sides,
-                agree_both=float(np.mean(flow.both_sides == model.both_sides)),
-                agree=float(np.mean(flow.hovering == model.hovering)), K_low=flow.box[2], b1=th.forcing[0],
-                seconds=t_flow, unresolved=flow.unresolved)
+    return dict(
+        eps=eps,
+        flow=flow.area,
+        flow_err=flow.error,
+        model=model.area,
+        model_err=model.error,
+        theory=th.area,
+        flow_both=flow.area_both_sides,
+        model_both=model.area_both_sides,
+        agree_both=float(np.mean(flow.both_sides == model.both_sides)),
+        agree=float(np.mean(flow.hovering == model.hovering)),
+        K_low=flow.box[2],
+        b1=th.forcing[0],
+        seconds=t_flow,
+        unresolved=flow.unresolved,
+    )
 
 
 def main(argv=None) -> None:
@@ -50,13 +61,17 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     print("|HOV| as defined (never impacts under eps, impacts under eps = 0), and [its part whose orbits visit both")
     print("J_0 and J_0u: the paper's hovering orbits]; verdicts: the same points classified by flow and model.")
-    print(f"{'eps':>6} {'flow |HOV|':>16} {'[both sides]':>12} {'model |HOV|':>16} {'[both sides]':>12} "
-          f"{'eq:hovsetsize':>13} {'agree':>6} {'[both]':>6} {'K_low':>7} {'b1':>6} {'flow s':>6}")
+    print(
+        f"{'eps':>6} {'flow |HOV|':>16} {'[both sides]':>12} {'model |HOV|':>16} {'[both sides]':>12} "
+        f"{'eq:hovsetsize':>13} {'agree':>6} {'[both]':>6} {'K_low':>7} {'b1':>6} {'flow s':>6}"
+    )
     for eps in (float(x) for x in args.eps.split(",")):
         r = compare(eps, args.samples, args.steps)
-        print(f"{r['eps']:6.2f} {r['flow']:8.4f} +- {r['flow_err']:.4f} {r['flow_both']:12.4f} {r['model']:8.4f} +- "
-              f"{r['model_err']:.4f} {r['model_both']:12.4f} {r['theory']:13.4f} {100 * r['agree']:5.1f}% "
-              f"{100 * r['agree_both']:5.1f}% {r['K_low']:7.4f} {r['b1']:6.3f} {r['seconds']:6.1f}")
+        print(
+            f"{r['eps']:6.2f} {r['flow']:8.4f} +- {r['flow_err']:.4f} {r['flow_both']:12.4f} {r['model']:8.4f} +- "
+            f"{r['model_err']:.4f} {r['model_both']:12.4f} {r['theory']:13.4f} {100 * r['agree']:5.1f}% "
+            f"{100 * r['agree_both']:5.1f}% {r['K_low']:7.4f} {r['b1']:6.3f} {r['seconds']:6.1f}"
+        )
 
 
 if __name__ == "__main__":

@@ -122,15 +122,36 @@ def draw(package: Path, out: Path, title: str) -> None:
             (x0, y0), (x1, y1) = pos[m], pos[d]
             loop = m in looped and d in looped and fl[m] == fl[d]
             n_back += loop
-            ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18),
-                        arrowprops=dict(arrowstyle="-|>", lw=1.2 if loop else 0.5, color="#c44e52" if loop else "0.7",
-                                        alpha=0.9 if loop else 0.5, shrinkA=0, shrinkB=0,
-                                        connectionstyle="arc3,rad=0.25" if loop else "arc3"))
+            ax.annotate(
+                "",
+                xy=(x1, y1 + 0.18),
+                xytext=(x0, y0 - 0.18),
+                arrowprops=dict(
+                    arrowstyle="-|>",
+                    lw=1.2 if loop else 0.5,
+                    color="#c44e52" if loop else "0.7",
+                    alpha=0.9 if loop else 0.5,
+                    shrinkA=0,
+                    shrinkB=0,
+                    connectionstyle="arc3,rad=0.25" if loop else "arc3",
+                ),
+            )
     for m, (x, y) in pos.items():
         short = m.removeprefix(package.name + ".")
-        ax.text(x, y, f"{short}\n{lines[m]}", ha="center", va="center", fontsize=6.5,
-                bbox=dict(boxstyle="round,pad=0.25", fc="#f4c7c3" if m in looped else "#dce6f2",
-                          ec="#c44e52" if m in looped else "#4c72b0", lw=0.8))
+        ax.text(
+            x,
+            y,
+            f"{short}\n{lines[m]}",
+            ha="center",
+            va="center",
+            fontsize=6.5,
+            bbox=dict(
+                boxstyle="round,pad=0.25",
+                fc="#f4c7c3" if m in looped else "#dce6f2",
+                ec="#c44e52" if m in looped else "#4c72b0",
+                lw=0.8,
+            ),
+        )
     ax.set_xlim(-0.3, width + 0.3)
     ax.set_ylim(-0.7, n_floors - 0.3)
     ax.set_yticks(range(n_floors), [f"floor {f + 1}" for f in range(n_floors)], fontsize=7)
@@ -138,8 +159,11 @@ def draw(package: Path, out: Path, title: str) -> None:
     for s in ("top", "right", "bottom"):
         ax.spines[s].set_visible(False)
     n_loops = sum(1 for c in components(graph) if len(c) > 1)
-    ax.set_title(f"{title}: {len(graph)} modules, {sum(lines.values())} lines, {n_floors} floors, "
-                 f"{n_loops} import cycle(s) (red), arrows = imports (inside functions too)", fontsize=9)
+    ax.set_title(
+        f"{title}: {len(graph)} modules, {sum(lines.values())} lines, {n_floors} floors, "
+        f"{n_loops} import cycle(s) (red), arrows = imports (inside functions too)",
+        fontsize=9,
+    )
     fig.tight_layout()
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)

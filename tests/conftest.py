@@ -74,12 +74,7 @@ def safe_mask(m, phi, K, margin):
     lo, hi = m.valid_band()
     phi = np.asarray(phi, dtype=float)
     K = np.asarray(K, dtype=float)
-    return (
-        (ref.boundary_distance(phi, K, p) > margin)
-        & (np.abs(K) > margin)
-        & (K > lo + margin)
-        & (K < hi - margin)
-    )
+    return (ref.boundary_distance(phi, K, p) > margin) & (np.abs(K) > margin) & (K > lo + margin) & (K < hi - margin)
 
 
 def omega_prime(phi, K, p, regions=None):
@@ -120,8 +115,12 @@ def error_bound(phis, Ks, p, local=LOCAL_ROUNDOFF):
         m11, m12, m21, m22 = np.ones(n_orb), np.zeros(n_orb), np.zeros(n_orb), np.ones(n_orb)
         acc[:, k + 1] += 1.0
         for j in range(k + 1, n):
-            m11, m12, m21, m22 = (a11[:, j] * m11 + a12[:, j] * m21, a11[:, j] * m12 + a12[:, j] * m22,
-                                  a21[:, j] * m11 + a22[:, j] * m21, a21[:, j] * m12 + a22[:, j] * m22)
+            m11, m12, m21, m22 = (
+                a11[:, j] * m11 + a12[:, j] * m21,
+                a11[:, j] * m12 + a12[:, j] * m22,
+                a21[:, j] * m11 + a22[:, j] * m21,
+                a21[:, j] * m12 + a22[:, j] * m22,
+            )
             acc[:, j + 1] += np.maximum(np.abs(m11) + np.abs(m12), np.abs(m21) + np.abs(m22))
     return local * acc
 
@@ -194,9 +193,14 @@ def sweep_exe():
     build = root / "build" / "ctest"
     if not (build / "CMakeCache.txt").exists():
         gen = ["-G", "Ninja"] if shutil.which("ninja") else []
-        subprocess.run([cmake, "-S", str(root), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release",
-                        "-DHOVERING_BUILD_TESTS=ON"], check=True, capture_output=True, timeout=600)
-    r = subprocess.run([cmake, "--build", str(build), "--target", "hovering_sweep"], capture_output=True, text=True,
-                       timeout=3600)
+        subprocess.run(
+            [cmake, "-S", str(root), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release", "-DHOVERING_BUILD_TESTS=ON"],
+            check=True,
+            capture_output=True,
+            timeout=600,
+        )
+    r = subprocess.run(
+        [cmake, "--build", str(build), "--target", "hovering_sweep"], capture_output=True, text=True, timeout=3600
+    )
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     return str(build / "hovering_sweep")

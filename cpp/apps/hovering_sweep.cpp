@@ -47,7 +47,9 @@ namespace {
 
 std::atomic<bool> g_cancel{false};
 
-extern "C" void on_signal(int) { g_cancel.store(true); }
+extern "C" void on_signal(int) {
+    g_cancel.store(true);
+}
 
 std::string num(double x) {
     char buf[64];
@@ -98,8 +100,7 @@ private:
 /// The checkpoint path of a run: --out, or the plan's own, relative to the plan's folder.
 std::string output_path(const Plan& plan, const std::string& out) {
     if (!out.empty()) return out;
-    if (plan.checkpoint.empty())
-        throw std::invalid_argument(plan.path + " names no checkpoint: give --out FILE");
+    if (plan.checkpoint.empty()) throw std::invalid_argument(plan.path + " names no checkpoint: give --out FILE");
     const fs::path c(plan.checkpoint);
     return c.is_absolute() ? c.string() : (fs::path(plan.path).parent_path() / c).string();
 }
@@ -122,14 +123,16 @@ std::string provenance(int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"Run a resolved sweep plan of hovering (written by python -m hovering plan SCENE.toml) without "
-                 "Python: each point measured and appended to a resumable checkpoint.",
-                 "hovering_sweep"};
+    CLI::App app{
+        "Run a resolved sweep plan of hovering (written by python -m hovering plan SCENE.toml) without "
+        "Python: each point measured and appended to a resumable checkpoint.",
+        "hovering_sweep"};
     std::string plan_path, out, scene;
     bool quick = false;
     int threads = 0;
-    app.add_option("--plan", plan_path, "Plan file (TOML) from python -m hovering plan, or written by hand "
-                                        "(docs/sweep-plan.md)");
+    app.add_option("--plan", plan_path,
+                   "Plan file (TOML) from python -m hovering plan, or written by hand "
+                   "(docs/sweep-plan.md)");
     app.add_option("--out", out,
                    "Checkpoint file (JSON lines) to append the points to (default: the plan's checkpoint, relative to "
                    "the plan's folder); points already in it are skipped, and python -m hovering scene reads it");
@@ -149,7 +152,8 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (plan_path.empty()) {
-        std::cerr << "hovering_sweep: --plan PLAN.toml is required (write one with python -m hovering plan SCENE.toml)\n";
+        std::cerr
+            << "hovering_sweep: --plan PLAN.toml is required (write one with python -m hovering plan SCENE.toml)\n";
         return 2;
     }
 
@@ -160,7 +164,8 @@ int main(int argc, char** argv) {
         {
             std::error_code ec;
             const fs::path p(path);
-            if (fs::is_directory(p, ec)) throw std::invalid_argument("--out must name a file, got the directory '" + path + "'");
+            if (fs::is_directory(p, ec))
+                throw std::invalid_argument("--out must name a file, got the directory '" + path + "'");
             const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
             if (!fs::is_directory(dir, ec))
                 throw std::invalid_argument("'" + path + "': the directory '" + dir.string() +
@@ -204,8 +209,8 @@ int main(int argc, char** argv) {
             }
             const bool mine = ckpt.append(p.key, row.row, prov);  // on disk (fsync) before the next point starts
             written += mine;
-            std::fprintf(stderr, "%s: |HOV| = %.6g +- %.2g (theory %.6g), %.1f s%s\n", what.c_str(), row.area, row.error,
-                         row.theory, row.seconds, mine ? "" : " (another run wrote it first: kept theirs)");
+            std::fprintf(stderr, "%s: |HOV| = %.6g +- %.2g (theory %.6g), %.1f s%s\n", what.c_str(), row.area,
+                         row.error, row.theory, row.seconds, mine ? "" : " (another run wrote it first: kept theirs)");
         }
         return 0;
     } catch (const std::bad_alloc&) {

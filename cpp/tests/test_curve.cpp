@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/curve.hpp"
 #include "hovering/detail/common.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 using hovering_test::MessageContains;
@@ -19,8 +19,12 @@ std::vector<double> sampled(int n, double (*f)(double)) {
     for (int j = 0; j < n; ++j) K[std::size_t(j)] = f(-kPi + 2 * kPi * j / n);
     return K;
 }
-double smooth(double phi) { return 0.3 + 0.1 * std::cos(phi) + 0.05 * std::sin(3 * phi); }
-double kinked(double phi) { return std::fabs(phi - 0.3) < kPi ? std::fabs(phi - 0.3) : 2 * kPi - std::fabs(phi - 0.3); }
+double smooth(double phi) {
+    return 0.3 + 0.1 * std::cos(phi) + 0.05 * std::sin(3 * phi);
+}
+double kinked(double phi) {
+    return std::fabs(phi - 0.3) < kPi ? std::fabs(phi - 0.3) : 2 * kPi - std::fabs(phi - 0.3);
+}
 }  // namespace
 
 TEST_CASE("curve: exact at the samples, spline accuracy, periodicity", "[curve]") {
@@ -38,7 +42,7 @@ TEST_CASE("curve: exact at the samples, spline accuracy, periodicity", "[curve]"
         worst = std::max(worst, std::fabs(c(phi) - smooth(phi)));
     }
     CHECKF(worst <= bound, "error %g > bound %g", worst, bound);
-    CHECK(c(kPi) == c(-kPi));              // pi wraps to -pi
+    CHECK(c(kPi) == c(-kPi));  // pi wraps to -pi
     CHECK(c(0.4 + 2 * kPi) == c(detail::wrap(0.4 + 2 * kPi)));
     CHECK(std::isnan(c(std::nan(""))));
     const Curve k(std::vector<double>{0.7});
@@ -61,7 +65,8 @@ TEST_CASE("curve: lower() and upper() bound every value, tightly", "[curve]") {
             }
             // bounds hold; and they are the spline's extremes (the dense grid finds them to
             // ~(2 pi / 2e5)^2 |K''| / 8 < 1e-6) plus a margin of 1e-12 of the coefficients
-            CHECKF(c.lower() <= lo && hi <= c.upper(), "n = %d: [%g, %g] vs values [%g, %g]", n, c.lower(), c.upper(), lo, hi);
+            CHECKF(c.lower() <= lo && hi <= c.upper(), "n = %d: [%g, %g] vs values [%g, %g]", n, c.lower(), c.upper(),
+                   lo, hi);
             CHECKF(lo - c.lower() < 1e-6 && c.upper() - hi < 1e-6, "n = %d: loose bounds", n);
         }
     }

@@ -32,7 +32,9 @@ FlowOptions tight() {
     return o;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 TangentialCurve rebuilt(const TangentialCurve& c) {
     const auto [et, eI] = c.interpolation_error();
@@ -71,8 +73,9 @@ TEST_CASE("tangential curve from its samples is the measured curve bit for bit",
 
 TEST_CASE("tangential curve from bad samples is refused with the reason", "[normal]") {
     const std::vector<double> th(16, 0.5), I(16, 0.3);
-    CHECK_INVALID(TangentialCurve::from_samples(1.0, 0.0, 0.3, std::vector<double>(7, 0.0), std::vector<double>(7, 0.3), 0, 0),
-                  "even number in [8, 4096] of samples, got 7");
+    CHECK_INVALID(
+        TangentialCurve::from_samples(1.0, 0.0, 0.3, std::vector<double>(7, 0.0), std::vector<double>(7, 0.3), 0, 0),
+        "even number in [8, 4096] of samples, got 7");
     CHECK_INVALID(TangentialCurve::from_samples(1.0, 0.0, 0.3, th, std::vector<double>(14, 0.3), 0, 0), "same length");
     std::vector<double> bad = I;
     bad[3] = std::nan("");

@@ -5,10 +5,10 @@
 #include <memory>
 #include <random>
 
-#include "testing.hpp"
 #include "hovering/flow/exact.hpp"
 #include "hovering/flow/return_map.hpp"
 #include "hovering/flow/tracer.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 
@@ -58,7 +58,8 @@ TEST_CASE("exact: event-driven angle flow = step loop on the closed form; first 
         double adv = th + s.V2->frequency(e2) * 3.14159265358979323846;
         adv = std::atan2(std::sin(adv), std::cos(adv));
         const auto [q2e, p2e] = s.V2->point_at(adv, e2);
-        CHECKF(r.status == FlowStatus::Ok && std::fabs(r.time - 3.14159265358979323846) < 1e-14, "first crossing time %.17g", r.time);
+        CHECKF(r.status == FlowStatus::Ok && std::fabs(r.time - 3.14159265358979323846) < 1e-14,
+               "first crossing time %.17g", r.time);
         CHECKF(std::fabs(r.z[0] + s.qw1) < 1e-14 && std::fabs(r.z[2] - q2e) < 1e-13 && std::fabs(r.z[3] - p2e) < 1e-13,
                "first crossing state (%.17g, %.17g, %.17g)", r.z[0], r.z[2], r.z[3]);
     }
@@ -66,7 +67,8 @@ TEST_CASE("exact: event-driven angle flow = step loop on the closed form; first 
 
 TEST_CASE("exact: linear flow against a Taylor series of exp(A t), eigenvalues > 0, = 0, < 0", "[exact]") {
     for (double eps : {0.1, -0.4, 1.3, 1.6}) {  // K = [[1, eps], [eps, 1.69]]: det > 0, > 0, = 0, < 0
-        const FlowSystem s = make(std::make_shared<Harmonic>(1.0), std::make_shared<Harmonic>(1.3), Geometry::Wall, eps);
+        const FlowSystem s =
+            make(std::make_shared<Harmonic>(1.0), std::make_shared<Harmonic>(1.3), Geometry::Wall, eps);
         FlowOptions o;
         o.stepper = "exact";
         CHECK(detail::exact_kind(s, o) == detail::ExactKind::Linear);
@@ -88,7 +90,8 @@ TEST_CASE("exact: linear flow against a Taylor series of exp(A t), eigenvalues >
             double y1[4];
             L.propagate(y0, t, y1);
             for (int i = 0; i < 4; ++i)
-                CHECKF(std::fabs(y1[i] - sum[i]) < 1e-15, "eps %g t %g: y[%d] = %.17g vs %.17g", eps, t, i, y1[i], sum[i]);
+                CHECKF(std::fabs(y1[i] - sum[i]) < 1e-15, "eps %g t %g: y[%d] = %.17g vs %.17g", eps, t, i, y1[i],
+                       sum[i]);
         }
         if (eps == 1.3) CHECK(std::fabs(L.eigenvalues()[0]) < 1e-15);
         if (eps == 1.6) CHECK(L.eigenvalues()[0] < 0);

@@ -2,14 +2,16 @@
 #include <cmath>
 #include <memory>
 
-#include "testing.hpp"
 #include "hovering/flow/return_map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 
 namespace {
 const double kPi = 3.14159265358979323846;
-double wrap(double x) { return x - 2 * kPi * std::floor((x + kPi) / (2 * kPi)); }
+double wrap(double x) {
+    return x - 2 * kPi * std::floor((x + kPi) / (2 * kPi));
+}
 }  // namespace
 
 TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, msadams", "[flow]") {
@@ -37,7 +39,8 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
             const auto c = section_coordinates(s, r.z.data());
             CHECKF(r.status == FlowStatus::Ok, "status");
             CHECKF(std::fabs(c[1] - I) < 1e-10, "I=%g th=%g: action %.15g changed", I, th, c[1]);
-            CHECKF(std::fabs(wrap(c[0] - th - Om)) < 1e-9, "I=%g th=%g: angle %.15g vs %.15g", I, th, c[0], wrap(th + Om));
+            CHECKF(std::fabs(wrap(c[0] - th - Om)) < 1e-9, "I=%g th=%g: angle %.15g vs %.15g", I, th, c[0],
+                   wrap(th + Om));
             CHECKF(std::fabs(r.time - T1) < 1e-9, "return time %.15g vs T1 %.15g", r.time, T1);
             CHECKF(r.energy_error < 1e-10, "energy error %.3g", r.energy_error);
             CHECKF(std::fabs(r.z[1]) < 1e-12 && r.z[0] > 0, "returned onto Sigma_h");
@@ -53,7 +56,7 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
         y[3] = -y[3];
         const auto back = return_map(s, y, o).z;
         CHECKF(std::fabs(back[2] - x[2]) < 1e-8 && std::fabs(back[3] + x[3]) < 1e-8 && std::fabs(back[0] - x[0]) < 1e-8,
-              "time reversal at th=%g: (%.12g, %.12g) vs (%.12g, %.12g)", th, back[2], back[3], x[2], -x[3]);
+               "time reversal at th=%g: (%.12g, %.12g) vs (%.12g, %.12g)", th, back[2], back[3], x[2], -x[3]);
     }
 
     // Bad input.
@@ -87,10 +90,11 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
             const bool hits = I < I_tan;
             const double T = hits ? oracle_wall_time(I) : s.V1->period(h - e2);
             // The infinite wall: an orbit that reaches q1 = qw1 reflects ('R'); the others never cross it ('u').
-            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "wall I=%g: itinerary '%s'", I, r.itinerary.c_str());
+            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "wall I=%g: itinerary '%s'", I,
+                   r.itinerary.c_str());
             CHECKF(std::fabs(r.time - T) < 1e-9, "wall I=%g th=%g: time %.15g vs %.15g", I, th, r.time, T);
             CHECKF(std::fabs(c[1] - I) < 1e-10 && std::fabs(wrap(c[0] - th - s.V2->frequency(e2) * T)) < 1e-9,
-                  "wall I=%g th=%g: (theta, I) off", I, th);
+                   "wall I=%g th=%g: (theta, I) off", I, th);
             CHECKF(r.energy_error < 1e-10, "wall energy error %.3g", r.energy_error);
         }
     }
@@ -121,7 +125,8 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
             ++seen_0;
         }
         CHECKF(std::fabs(r.time - T) < 1e-9 && std::fabs(wrap(c[0] - th - dth)) < 1e-9,
-              "step th=%g '%s': time %.12g vs %.12g, dtheta %.12g vs %.12g", th, r.itinerary.c_str(), r.time, T, wrap(c[0] - th), wrap(dth));
+               "step th=%g '%s': time %.12g vs %.12g, dtheta %.12g vs %.12g", th, r.itinerary.c_str(), r.time, T,
+               wrap(c[0] - th), wrap(dth));
     }
     CHECKF(seen_R > 5 && seen_1 > 1 && seen_0 > 5, "regions seen: R %d, 1 %d, 0 %d", seen_R, seen_1, seen_0);
 
@@ -135,7 +140,8 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
         below += return_map(wl, section_point(wl, h, th, I_tan - 1e-9), o).itinerary == "R";
         above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), o).itinerary == "u";
     }
-    CHECKF(graze == 100 && below == 100 && above == 100, "grazing %d, 1e-9 below reflected %d, above free %d (of 100)", graze, below, above);
+    CHECKF(graze == 100 && below == 100 && above == 100, "grazing %d, 1e-9 below reflected %d, above free %d (of 100)",
+           graze, below, above);
 
     // msadams (GSL's variable-order Adams): the same exact wall answers and near-grazing dips, its
     // events located on an rk8pd extension of each step. Adams' global error runs ~400x its local
@@ -152,13 +158,16 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
             const double dth = s.V2->frequency(e2) * (hits ? 2 * std::acos(wl.qw1 / A1) : s.V1->period(h - e2));
             const ReturnResult r = return_map(wl, section_point(wl, h, th, I), ms);
             const auto c = section_coordinates(wl, r.z.data());
-            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "msadams th=%g I=%g: '%s'", th, I, r.itinerary.c_str());
-            CHECKF(std::fabs(wrap(c[0] - th - dth)) < 5e-9, "msadams th=%g I=%g: dtheta error %.3g", th, I, wrap(c[0] - th - dth));
+            CHECKF(r.status == FlowStatus::Ok && r.itinerary == (hits ? "R" : "u"), "msadams th=%g I=%g: '%s'", th, I,
+                   r.itinerary.c_str());
+            CHECKF(std::fabs(wrap(c[0] - th - dth)) < 5e-9, "msadams th=%g I=%g: dtheta error %.3g", th, I,
+                   wrap(c[0] - th - dth));
         }
         ms_below += return_map(wl, section_point(wl, h, th, I_tan - 1e-9), ms).itinerary == "R";
         ms_above += return_map(wl, section_point(wl, h, th, I_tan + 1e-9), ms).itinerary == "u";
     }
-    CHECKF(ms_below == 40 && ms_above == 40, "msadams: 1e-9 below reflected %d, above free %d (of 40)", ms_below, ms_above);
+    CHECKF(ms_below == 40 && ms_above == 40, "msadams: 1e-9 below reflected %d, above free %d (of 40)", ms_below,
+           ms_above);
 }
 
 TEST_CASE("section coordinates at the bottom of well 2; section points next to the turning points", "[flow]") {
@@ -172,7 +181,8 @@ TEST_CASE("section coordinates at the bottom of well 2; section points next to t
     // by convention, for closed-form and quadrature V2 alike (it was "Tan.action: energy must be
     // finite and > 0, got 0").
     const std::array<double, 4> rest{1.2, 0.0, 0.0, 0.0};
-    for (auto V2 : {std::shared_ptr<const Potential>(std::make_shared<Tan>(1.4, 0.7)), std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
+    for (auto V2 : {std::shared_ptr<const Potential>(std::make_shared<Tan>(1.4, 0.7)),
+                    std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.3)),
                     std::shared_ptr<const Potential>(std::make_shared<Numerical>(std::make_shared<Tan>(1.4, 0.7)))}) {
         s.V2 = V2;
         const auto c = section_coordinates(s, rest.data());
@@ -192,7 +202,8 @@ TEST_CASE("section coordinates at the bottom of well 2; section points next to t
     };
     s.V2 = std::make_shared<Negative>();
     const std::array<double, 4> z{1.2, 0.0, 0.5, 0.0};
-    CHECK_INVALID(section_coordinates(s, z.data()), "H2 = p2^2/2 + V2(q2) = -0.125 at (q2, p2) = (0.5, 0) must be >= 0");
+    CHECK_INVALID(section_coordinates(s, z.data()),
+                  "H2 = p2^2/2 + V2(q2) = -0.125 at (q2, p2) = (0.5, 0) must be >= 0");
 
     // Points of Sigma_h with a quadrature V2 next to its turning points (theta = pi - 2e-6 raised
     // "quadrature ... did not converge" in point_at): the same point as the closed form's to the
@@ -203,6 +214,7 @@ TEST_CASE("section coordinates at the bottom of well 2; section points next to t
     for (double th : {kPi - 2e-6, kPi - 1e-6, -kPi + 3e-7, 2e-6, -1e-6, 1e-12}) {
         const auto zc = section_point(c, 1.0, th, 0.3), zn = section_point(n, 1.0, th, 0.3);
         CHECKF(std::fabs(zc[0] - zn[0]) < 1e-11 && std::fabs(zc[2] - zn[2]) < 1e-11 && std::fabs(zc[3] - zn[3]) < 1e-11,
-               "theta = %.17g: (%.17g, %.17g, %.17g) vs (%.17g, %.17g, %.17g)", th, zn[0], zn[2], zn[3], zc[0], zc[2], zc[3]);
+               "theta = %.17g: (%.17g, %.17g, %.17g) vs (%.17g, %.17g, %.17g)", th, zn[0], zn[2], zn[3], zc[0], zc[2],
+               zc[3]);
     }
 }

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/analysis/hovering_area.hpp"
 #include "hovering/detail/numpy_random.hpp"
 #include "hovering/truncated/map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 using hovering::detail::NumpyRandom;
@@ -34,7 +34,8 @@ TEST_CASE("NumpyRandom is numpy.random.default_rng(seed) to the bit") {
         {0, {0xa30febcfd9c2825fULL, 0x4510bdf882d9d721ULL, 0x0a7d3da94ecde8b8ULL}, 0.6369616873214543},
         {7, {0xa00641a9f1e54a8bULL, 0xe5afcdbcaf266a95ULL, 0xc693565f940af962ULL}, 0.625095466604667},
         {1099511627779ULL, {0xc60e533fbbb0872cULL, 0xfef0825f71d66341ULL, 0x792240db6171ac88ULL}, 0.7736560850714245},
-        {9223372036854775807ULL, {0x2ceb59116fb27514ULL, 0x784d3e7d390dc57cULL, 0xd335a7689ce43488ULL},
+        {9223372036854775807ULL,
+         {0x2ceb59116fb27514ULL, 0x784d3e7d390dc57cULL, 0xd335a7689ce43488ULL},
          0.1754661243027813},
     };
     for (const auto& r : refs) {
@@ -58,7 +59,8 @@ TEST_CASE("stratified_samples of a piece are the whole's samples of its range") 
     stratified_samples(5000, -0.4, 9, phi, K);
     const std::int64_t n = std::int64_t(phi.size());
     REQUIRE(n == sample_grid(5000, -0.4).size());
-    for (auto [lo, hi] : {std::pair<std::int64_t, std::int64_t>{0, 1}, {1, 2}, {0, n}, {37, 1234}, {n - 1, n}, {n, n}}) {
+    for (auto [lo, hi] :
+         {std::pair<std::int64_t, std::int64_t>{0, 1}, {1, 2}, {0, n}, {37, 1234}, {n - 1, n}, {n, n}}) {
         std::vector<double> p(std::size_t(hi - lo)), k(std::size_t(hi - lo));
         stratified_samples(5000, -0.4, 9, lo, hi, p.data(), k.data());
         for (std::int64_t i = lo; i < hi; ++i) {
@@ -196,7 +198,7 @@ TEST_CASE("default_depth: twice the deepest first-order curve through L1") {
     CHECK(std::isinf(default_depth(0.1, 0.0, {1.0, 0.5})));
     // G itself: b_1 (1 - cos psi) / (2 sin(Omega0 / 2)) + b_2 (1 - cos 2 psi) / (2 sin Omega0).
     const double psi = 0.7, O = 2.3;
-    CHECK(first_order_shape({0.5, -0.25}, O, psi) ==
-          Approx(0.5 * (1 - std::cos(psi)) / (2 * std::sin(0.5 * O)) - 0.25 * (1 - std::cos(2 * psi)) / (2 * std::sin(O)))
-              .epsilon(1e-15));
+    CHECK(first_order_shape({0.5, -0.25}, O, psi) == Approx(0.5 * (1 - std::cos(psi)) / (2 * std::sin(0.5 * O)) -
+                                                            0.25 * (1 - std::cos(2 * psi)) / (2 * std::sin(O)))
+                                                         .epsilon(1e-15));
 }

@@ -5,8 +5,8 @@
 #include <random>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/truncated/map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 namespace {
@@ -22,13 +22,31 @@ Run run(const TruncatedMap& m, const std::vector<double>& p0, const std::vector<
         Kernel kern, int threads, unsigned mask = 0, bool stop = false, const std::atomic<bool>* cancel = nullptr) {
     const std::size_t n = p0.size();
     Run r;
-    r.pf.resize(n); r.kf.resize(n); r.rot.resize(n); r.st.resize(n); r.done.resize(n); r.ex.resize(n);
-    r.op.resize(n * (ns + 1)); r.ok.resize(n * (ns + 1)); r.reg.resize(n * ns);
+    r.pf.resize(n);
+    r.kf.resize(n);
+    r.rot.resize(n);
+    r.st.resize(n);
+    r.done.resize(n);
+    r.ex.resize(n);
+    r.op.resize(n * (ns + 1));
+    r.ok.resize(n * (ns + 1));
+    r.reg.resize(n * ns);
     IterateOptions o;
-    o.n_steps = ns; o.kernel = kern; o.n_threads = threads; o.exit_mask = mask; o.stop_on_exit = stop; o.cancel = cancel;
+    o.n_steps = ns;
+    o.kernel = kern;
+    o.n_threads = threads;
+    o.exit_mask = mask;
+    o.stop_on_exit = stop;
+    o.cancel = cancel;
     IterateOutput out;
-    out.phi_final = r.pf.data(); out.K_final = r.kf.data(); out.orbit_phi = r.op.data(); out.orbit_K = r.ok.data();
-    out.regions = r.reg.data(); out.rotation = r.rot.data(); out.status = r.st.data(); out.steps_done = r.done.data();
+    out.phi_final = r.pf.data();
+    out.K_final = r.kf.data();
+    out.orbit_phi = r.op.data();
+    out.orbit_K = r.ok.data();
+    out.regions = r.reg.data();
+    out.rotation = r.rot.data();
+    out.status = r.st.data();
+    out.steps_done = r.done.data();
     out.exit_step = r.ex.data();
     m.iterate(p0.data(), k0.data(), std::int64_t(n), o, out);
     return r;
@@ -42,7 +60,10 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
     std::uniform_real_distribution<double> uphi(-kPi, kPi), uK(-0.3, 0.3);
     const std::size_t n = 1003;  // not a multiple of the chunk or lane width on purpose
     std::vector<double> p0(n), k0(n);
-    for (std::size_t i = 0; i < n; ++i) { p0[i] = uphi(rng); k0[i] = uK(rng); }
+    for (std::size_t i = 0; i < n; ++i) {
+        p0[i] = uphi(rng);
+        k0[i] = uK(rng);
+    }
 
     // Same kernel, 1 vs 2 threads: bit-identical (orbits are independent).
     Run a = run(m, p0, k0, 200, Kernel::Simd, 1), b = run(m, p0, k0, 200, Kernel::Simd, 2);
@@ -70,8 +91,10 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
             sum += m.rotation(p, k);
             CHECKF(r.reg[i * 50 + j] == static_cast<std::int8_t>(m.region(p, k)), "recorded region");
             auto nx = m.step(p, k);
-            p = nx.first; k = nx.second;
-            worst_orbit = std::max(worst_orbit, std::fabs(r.op[i * 51 + j + 1] - p) + std::fabs(r.ok[i * 51 + j + 1] - k));
+            p = nx.first;
+            k = nx.second;
+            worst_orbit =
+                std::max(worst_orbit, std::fabs(r.op[i * 51 + j + 1] - p) + std::fabs(r.ok[i * 51 + j + 1] - k));
         }
         if (nd > 0) worst_rot = std::max(worst_rot, std::fabs(r.rot[i] - sum / double(nd)));
     }
@@ -82,8 +105,12 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
     // it stops with Escaped, keeps the escaped image, and the tail of its orbit is NaN.
     const double lo = m.band().lo;
     std::vector<double> pe, ke;
-    for (int i = 0; i < 64; ++i) { pe.push_back(-kPi + i * 0.098); ke.push_back(lo + 1e-3); }
-    pe.push_back(0.0); ke.push_back(lo - 1.0);  // starts outside: Escaped with 0 steps
+    for (int i = 0; i < 64; ++i) {
+        pe.push_back(-kPi + i * 0.098);
+        ke.push_back(lo + 1e-3);
+    }
+    pe.push_back(0.0);
+    ke.push_back(lo - 1.0);  // starts outside: Escaped with 0 steps
     for (Kernel kern : {Kernel::Simd, Kernel::Scalar}) {
         Run e = run(m, pe, ke, 1000, kern, 2);
         int esc = 0;
@@ -109,7 +136,10 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
         for (std::size_t i = 0; i < 200; ++i) {
             std::int64_t first = -1;
             for (std::int64_t j = 0; j < w.done[i]; ++j)
-                if (w.reg[i * 300 + j] >= 2) { first = j; break; }
+                if (w.reg[i * 300 + j] >= 2) {
+                    first = j;
+                    break;
+                }
             CHECKF(w.ex[i] == first, "orbit %zu: exit_step %lld vs scan %lld", i, (long long)w.ex[i], (long long)first);
             if (first >= 0) {
                 ++checked;
@@ -123,14 +153,17 @@ TEST_CASE("batch iteration: kernels, threads, statuses, recording, exit watch, c
     std::atomic<bool> cancel{true};
     Run c = run(m, p0, k0, 100, Kernel::Simd, 2, 0, false, &cancel);
     bool all_int = true;
-    for (std::size_t i = 0; i < n; ++i) all_int &= c.st[i] == static_cast<std::int8_t>(Status::Interrupted) && c.done[i] == 0 && c.pf[i] == p0[i];
+    for (std::size_t i = 0; i < n; ++i)
+        all_int &= c.st[i] == static_cast<std::int8_t>(Status::Interrupted) && c.done[i] == 0 && c.pf[i] == p0[i];
     CHECKF(all_int, "cancelled run must report Interrupted with the initial state");
 
     // Bad options.
-    IterateOptions o; o.n_steps = -1;
+    IterateOptions o;
+    o.n_steps = -1;
     IterateOutput out;
     CHECK_INVALID(m.iterate(p0.data(), k0.data(), 1, o, out), "n_steps must be >= 0");
-    o.n_steps = 1; o.exit_mask = 1u << kRegionCount;  // region codes are 0 .. kRegionCount - 1
+    o.n_steps = 1;
+    o.exit_mask = 1u << kRegionCount;  // region codes are 0 .. kRegionCount - 1
     CHECK_INVALID(m.iterate(p0.data(), k0.data(), 1, o, out), "exit_mask");
     std::vector<double> pn = {0.0, NAN};
     o.exit_mask = 0;

@@ -96,14 +96,29 @@ TEST_CASE("flow map iteration: reproducible, statuses per orbit, early exit, vis
             std::vector<std::int8_t> st, reg, vis;
             std::vector<std::int64_t> done, ex;
         } r;
-        r.xf.resize(x.size()); r.yf.resize(x.size()); r.st.resize(x.size()); r.done.resize(x.size());
-        r.ex.resize(x.size()); r.vis.resize(x.size());
-        r.ox.resize(x.size() * (ns + 1)); r.oy.resize(x.size() * (ns + 1)); r.reg.resize(x.size() * ns);
+        r.xf.resize(x.size());
+        r.yf.resize(x.size());
+        r.st.resize(x.size());
+        r.done.resize(x.size());
+        r.ex.resize(x.size());
+        r.vis.resize(x.size());
+        r.ox.resize(x.size() * (ns + 1));
+        r.oy.resize(x.size() * (ns + 1));
+        r.reg.resize(x.size() * ns);
         FlowIterateOptions o;
-        o.n_steps = ns; o.n_threads = threads; o.exit_mask = mask; o.stop_on_exit = stop;
+        o.n_steps = ns;
+        o.n_threads = threads;
+        o.exit_mask = mask;
+        o.stop_on_exit = stop;
         FlowIterateOutput out;
-        out.x_final = r.xf.data(); out.y_final = r.yf.data(); out.status = r.st.data(); out.steps_done = r.done.data();
-        out.orbit_x = r.ox.data(); out.orbit_y = r.oy.data(); out.regions = r.reg.data(); out.exit_step = r.ex.data();
+        out.x_final = r.xf.data();
+        out.y_final = r.yf.data();
+        out.status = r.st.data();
+        out.steps_done = r.done.data();
+        out.orbit_x = r.ox.data();
+        out.orbit_y = r.oy.data();
+        out.regions = r.reg.data();
+        out.exit_step = r.ex.data();
         out.visited = r.vis.data();
         fm.iterate(x.data(), y.data(), n, o, out);
         return r;
@@ -121,7 +136,8 @@ TEST_CASE("flow map iteration: reproducible, statuses per orbit, early exit, vis
         const FlowStep st = fm.step(px, py);
         px = st.x;
         py = st.y;
-        CHECKF(px == a.ox[std::size_t(2 * (ns + 1) + k + 1)] && py == a.oy[std::size_t(2 * (ns + 1) + k + 1)], "step %d", k);
+        CHECKF(px == a.ox[std::size_t(2 * (ns + 1) + k + 1)] && py == a.oy[std::size_t(2 * (ns + 1) + k + 1)],
+               "step %d", k);
         CHECKF(st.region == Region(a.reg[std::size_t(2 * ns + k)]), "region of step %d", k);
     }
     // Early exit: watch {Beside, Above}; the first return outside it ends the orbit, Exited.
@@ -192,13 +208,22 @@ TEST_CASE("flow map iteration: labels only when read, dense output, work counter
     };
     auto run = [&](bool labels, double dt, std::int64_t max_points = 1000000) {
         R r;
-        r.xf.resize(x.size()); r.yf.resize(x.size()); r.reg.resize(x.size() * ns); r.trunc.resize(x.size());
-        r.pts.resize(x.size()); r.kinds.resize(x.size());
+        r.xf.resize(x.size());
+        r.yf.resize(x.size());
+        r.reg.resize(x.size() * ns);
+        r.trunc.resize(x.size());
+        r.pts.resize(x.size());
+        r.kinds.resize(x.size());
         std::atomic<std::int64_t> progress{0};
         FlowIterateOptions opt;
-        opt.n_steps = ns; opt.labels = labels; opt.progress = &progress; opt.n_threads = 2;
+        opt.n_steps = ns;
+        opt.labels = labels;
+        opt.progress = &progress;
+        opt.n_threads = 2;
         FlowIterateOutput out;
-        out.x_final = r.xf.data(); out.y_final = r.yf.data(); out.work = &r.work;
+        out.x_final = r.xf.data();
+        out.y_final = r.yf.data();
+        out.work = &r.work;
         if (labels) out.regions = r.reg.data();
         if (dt > 0) {
             out.trajectory.dt = dt;
@@ -263,7 +288,8 @@ TEST_CASE("flow map iteration: labels only when read, dense output, work counter
     bad_dt.trajectory.points = pts.data();
     bad_dt.trajectory.kinds = kinds.data();
     bad_dt.trajectory.max_points_per_orbit = 10;
-    CHECK_INVALID(fm.iterate(x.data(), y.data(), n, FlowIterateOptions{}, bad_dt), "trajectory dt must be finite and > 0");
+    CHECK_INVALID(fm.iterate(x.data(), y.data(), n, FlowIterateOptions{}, bad_dt),
+                  "trajectory dt must be finite and > 0");
     // No walls: no wall search at all.
     const FlowMap smooth(issue_system(-0.05, Geometry::None), 1.0, o, nullptr);
     FlowWork w;

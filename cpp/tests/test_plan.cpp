@@ -12,9 +12,9 @@
 #include <sstream>
 #include <string>
 
-#include "testing.hpp"
 #include "hovering/sweep/plan.hpp"
 #include "hovering/sweep/run.hpp"
+#include "testing.hpp"
 
 using namespace hovering::sweep;
 namespace fs = std::filesystem;
@@ -89,12 +89,14 @@ TEST_CASE("a hand-written plan is read with its numbers exact and its key canoni
     // Sorted keys, shortest round-trip numbers, the kind; label and theory are not parameters.
     CHECK(q.key ==
           "{\"K_low\":-0.2145848093800635,\"kind\":\"hovering_area\",\"map\":{\"Omega0\":3.883222077450933,\"eps\":0.1,"
-          "\"lam\":0.5,\"tau0\":1.0,\"tau1\":0.5,\"theta_w\":2.356194490192345},\"n_steps\":400,\"samples\":2000,\"seed\":0}");
+          "\"lam\":0.5,\"tau0\":1.0,\"tau1\":0.5,\"theta_w\":2.356194490192345},\"n_steps\":400,\"samples\":2000,"
+          "\"seed\":0}");
     const Plan labelled = parse_plan(kHead + point_with("theory", "theory = 0.7\nlabel = \"x\""), "p.toml");
     CHECK(labelled.points[0].key == q.key);
     // An integer where a number is asked is that number (a person may write tau0 = 1).
-    CHECK(parse_plan(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.883222077450933, theta_w = "
-                                               "2.356194490192345, tau0 = 1, tau1 = 0.5, lam = 0.5 }"),
+    CHECK(parse_plan(kHead + point_with("map",
+                                        "map = { eps = 0.1, Omega0 = 3.883222077450933, theta_w = "
+                                        "2.356194490192345, tau0 = 1, tau1 = 0.5, lam = 0.5 }"),
                      "p.toml")
               .points[0]
               .key == q.key);
@@ -137,11 +139,13 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     bad(kHead + point_with("n_steps", "n_steps = 2"),
         "p.toml: points[0].n_steps = 2: allowed: an integer in [4, 9007199254740992]");
     bad(kHead + point_with("samples", "samples = \"many\""), "points[0].samples = 'many': allowed: an integer");
-    bad(kHead + point_with("seed", "seed = -1"), "points[0].seed = -1: allowed: an integer in [0, 9223372036854775807]");
+    bad(kHead + point_with("seed", "seed = -1"),
+        "points[0].seed = -1: allowed: an integer in [0, 9223372036854775807]");
     bad(kHead + point_with("K_low", "K_low = 0.5"), "points[0].K_low = 0.5: allowed: a finite number < 0");
     bad(kHead + point_with("K_low", "K_low = nan"), "points[0].K_low = nan");
     bad(kHead + point_with("K_low", ""), "points[0].K_low is missing (a finite number < 0)");
-    bad(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.9, theta_w = 4.0, tau0 = 1.0, tau1 = 0.5, lam = 0.5 }"),
+    bad(kHead +
+            point_with("map", "map = { eps = 0.1, Omega0 = 3.9, theta_w = 4.0, tau0 = 1.0, tau1 = 0.5, lam = 0.5 }"),
         "points[0].map.theta_w = 4: allowed: a finite number in (0, 3.141592653589793)");
     bad(kHead + point_with("map", "map = { eps = 0.1, Omega0 = 3.9, theta_w = 2.0, tau0 = 1.0, tau1 = 0.5 }"),
         "points[0].map.lam is missing");
@@ -166,7 +170,8 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
         bad(t.replace(at, from.size(), to), needle);
     };
     CHECK(parse_plan(kFlow, "f.toml").points[0].system.coupling.size() == 1);
-    flow("stepper = \"rk8pd\"", "stepper = \"euler\"", "points[0].integrator.stepper = 'euler': allowed: one of 'rk8pd'");
+    flow("stepper = \"rk8pd\"", "stepper = \"euler\"",
+         "points[0].integrator.stepper = 'euler': allowed: one of 'rk8pd'");
     flow("rtol = 1e-10", "rtol = 2.0", "points[0].integrator.rtol = 2: allowed: a finite number in (0, 1)");
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 21]]", "points[0].system.coupling[0] = an array of 3");
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 1], [2.0, 1, 1]]", "each (i, j) once");
@@ -175,7 +180,8 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     flow("qw2 = -0.5", "qw2 = 0.5", "points[0].system.qw2 = 0.5: allowed: a finite number < 0");
     flow("geometry = \"step\"", "geometry = \"box\"", "geometry = 'box': allowed: one of 'none' 'wall' 'step'");
     flow("integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n",
-         "integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n[[points.models]]\nname = \"m\"\nK_low = -0.1\n"
+         "integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n[[points.models]]\nname = \"m\"\nK_low = "
+         "-0.1\n"
          "eps = 0.1\nK = [-1.0, -0.5, 0.0, 0.5]\nOmega = [1.0, 1.0, 1.0]\nJR = [1.0, 1.0, 1.0, 0.0]\n"
          "J1 = [1.0, 0.5, 0.0, 0.0]\nforcing = [1.0]\nK_max = inf\n",
          "points[0].models[0].Omega = an array of 3: allowed: an array of 4 to 4 entries");
@@ -213,9 +219,9 @@ TEST_CASE("checkpoint: header, points by key, torn and damaged lines", "[checkpo
     }
     CHECK(slurp(path) == good);
     // A damaged line with lines after it, or any complete line that is not a record: refused, untouched.
-    for (const std::string& broken : {std::string("{\"key\":{\"x\":0.2},\"ro\n"), std::string("[1, 2]\n"),
-                                      std::string("{\"key\":{\"x\":NaN},\"row\":{}}\n"),
-                                      std::string("{\"key\":{},\"row\":{},\"extra\":1}\n")}) {
+    for (const std::string& broken :
+         {std::string("{\"key\":{\"x\":0.2},\"ro\n"), std::string("[1, 2]\n"),
+          std::string("{\"key\":{\"x\":NaN},\"row\":{}}\n"), std::string("{\"key\":{},\"row\":{},\"extra\":1}\n")}) {
         const std::string text = good + broken + "{\"key\":{\"x\":0.3},\"row\":{}}\n";
         spit(path, text);
         CHECK_INVALID(Checkpoint{path}, "line 5: ");

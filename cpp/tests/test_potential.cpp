@@ -4,15 +4,17 @@
 #include <memory>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/flow/system.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 
 namespace {
 const double kPi = 3.14159265358979323846;
 using hovering_test::msg;
-double rel(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
+double rel(double a, double b) {
+    return std::fabs(a - b) / std::max(1.0, std::fabs(b));
+}
 }  // namespace
 
 TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways", "[flow][potential]") {
@@ -27,21 +29,24 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
             auto [na, nb] = num.turning_points(h);
             CHECKF(rel(a, na) < 1e-12 && rel(b, nb) < 1e-12, "%s turning points at h=%g", base->name().c_str(), h);
             CHECKF(rel(base->period(h), num.period(h)) < 1e-10, "%s period at h=%g: %.15g vs %.15g",
-                  base->name().c_str(), h, base->period(h), num.period(h));
+                   base->name().c_str(), h, base->period(h), num.period(h));
             CHECKF(rel(base->action(h), num.action(h)) < 1e-10, "%s action at h=%g: %.15g vs %.15g",
-                  base->name().c_str(), h, base->action(h), num.action(h));
+                   base->name().c_str(), h, base->action(h), num.action(h));
             CHECKF(rel(num.energy(num.action(h)), h) < 1e-10, "%s energy(action(h))", base->name().c_str());
             for (double f : {-0.9, -0.3, 0.0, 0.5}) {
                 const double q = f * b;
-                CHECKF(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10, "%s angle_of(%g, %g): %.15g vs %.15g",
-                      base->name().c_str(), q, h, base->angle_of(q, h), num.angle_of(q, h));
+                CHECKF(std::fabs(base->angle_of(q, h) - num.angle_of(q, h)) < 1e-10,
+                       "%s angle_of(%g, %g): %.15g vs %.15g", base->name().c_str(), q, h, base->angle_of(q, h),
+                       num.angle_of(q, h));
             }
             // angle_of_point inverts point_at to rounding, including at the turning points.
             for (double th : {-3.0, -1.0, 0.0, 1e-9, 2.0, 3.14}) {
                 const auto [q, p] = base->point_at(th, h);
-                CHECKF(std::fabs(base->angle_of_point(q, p, h) - th) < 1e-12, "%s angle_of_point(point_at(%g))", base->name().c_str(), th);
+                CHECKF(std::fabs(base->angle_of_point(q, p, h) - th) < 1e-12, "%s angle_of_point(point_at(%g))",
+                       base->name().c_str(), th);
                 const auto [nq, np] = num.point_at(th, h);
-                CHECKF(std::fabs(nq - q) < 1e-9 && std::fabs(np - p) < 1e-9, "%s generic point_at(%g)", base->name().c_str(), th);
+                CHECKF(std::fabs(nq - q) < 1e-9 && std::fabs(np - p) < 1e-9, "%s generic point_at(%g)",
+                       base->name().c_str(), th);
             }
             // dH/dI = omega(h): the frequency is the derivative of the energy in the action.
             const double I = base->action(h), dI = 1e-4 * I;
@@ -53,7 +58,9 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
     // Onset parameters: (1) definitions with closed-form potentials, (2) definitions with pure
     // quadrature, (3) the appendix closed forms (corrected). Derivatives by Richardson central
     // differences carry ~1e-9 error, so 1e-7 relative.
-    struct Case { double w1, a1, w2, a2, qw1, qw2, h; };
+    struct Case {
+        double w1, a1, w2, a2, qw1, qw2, h;
+    };
     for (Case c : {Case{1.0, 0.0, 1.4, 0.7, -1.0, -0.5, 1.0}, Case{1.0, 0.6, 1.4, 0.7, -0.8, -0.4, 1.2},
                    Case{1.2, 0.9, 1.0, 0.0, -0.7, -0.6, 1.5}, Case{1.0, 0.0, 1.0, 0.0, -1.0, -0.5, 1.0}}) {
         auto mk = [](double w, double a) -> std::shared_ptr<const Potential> {
@@ -69,8 +76,10 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
         const double fv[] = {f.Omega0, f.tau0, f.tau1, f.lam, f.theta_w, f.I_tan};
         const char* names[] = {"Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan"};
         for (int k = 0; k < 6; ++k) {
-            CHECKF(rel(dv[k], qv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs quadrature %.12g", c.a1, c.a2, names[k], dv[k], qv[k]);
-            CHECKF(rel(dv[k], fv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs closed form %.12g", c.a1, c.a2, names[k], dv[k], fv[k]);
+            CHECKF(rel(dv[k], qv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs quadrature %.12g", c.a1, c.a2,
+                   names[k], dv[k], qv[k]);
+            CHECKF(rel(dv[k], fv[k]) < 1e-7, "case a1=%g a2=%g: %s definitions %.12g vs closed form %.12g", c.a1, c.a2,
+                   names[k], dv[k], fv[k]);
         }
         // Harmonic-harmonic: no twist (tau0 = 0), Omega0 = 2 pi omega2 / omega1 (appendix limits).
         if (c.a1 == 0 && c.a2 == 0) {
@@ -81,11 +90,13 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
         if (c.a1 > 0) {
             const double h1w = V1->V(c.qw1), W1 = std::sqrt(c.w1 * c.w1 + 2 * c.a1 * c.a1 * h1w);
             const double W2 = std::sqrt(c.w2 * c.w2 + 2 * c.a2 * c.a2 * (c.h - h1w));
-            const double tau0_printed = (2 * kPi * c.a2 * c.a2 * std::pow(W1, 3) + 2 * kPi * c.a1 * c.a1 * W2 * W2) / std::pow(W1, 4);
+            const double tau0_printed =
+                (2 * kPi * c.a2 * c.a2 * std::pow(W1, 3) + 2 * kPi * c.a1 * c.a1 * W2 * W2) / std::pow(W1, 4);
             CHECKF(rel(tau0_printed, d.tau0) > 1e-3, "printed tau0 unexpectedly matches");
         }
         CHECKF(std::fabs((kPi - d.theta_w) - d.theta_w) > 1e-3, "printed theta_w (= pi - theta_w) distinguishable");
-        CHECKF(d.theta_w > kPi / 2 && d.tau1 > 0, "qw2 < 0: theta_w in (pi/2, pi) and tau1 > 0 (sign tau1 = -sign qw2)");
+        CHECKF(d.theta_w > kPi / 2 && d.tau1 > 0,
+               "qw2 < 0: theta_w in (pi/2, pi) and tau1 > 0 (sign tau1 = -sign qw2)");
     }
 
     // Bad input.
@@ -111,7 +122,8 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
     CHECKF(std::fabs(H.angle_of_point(1.0, -1e-12, 0.5) - 1e-12) < 1e-15, "level check tolerates a 1e-12 drift");
 
     // Tan beyond its wall is outside the well, not a periodic copy of it.
-    CHECKF(std::isinf(T.V(3.0)) && T.V(3.0) > 0 && std::isinf(T.V(-3.0)), "Tan.V = +inf beyond q_limit = %g", T.q_limit());
+    CHECKF(std::isinf(T.V(3.0)) && T.V(3.0) > 0 && std::isinf(T.V(-3.0)), "Tan.V = +inf beyond q_limit = %g",
+           T.q_limit());
     CHECKF(T.dV(3.0) == INFINITY && T.dV(-3.0) == -INFINITY, "Tan.dV = sign(q) inf beyond q_limit");
     CHECKF(std::isnan(T.V(NAN)), "Tan.V(nan) is nan");
 
@@ -149,11 +161,12 @@ TEST_CASE("generic turning points at every level", "[flow][potential]") {
     for (double h : {1e-300, 1e-10, 1.0, 1e10, 1e33, 1e100, 1e300}) {
         const auto [a, b] = num.turning_points(h);
         const double B = tan->turning_points(h).second;
-        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "h = %g: [%.17g, %.17g] vs +-%.17g", h, a, b, B);
+        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "h = %g: [%.17g, %.17g] vs +-%.17g",
+               h, a, b, B);
         CHECKF(num.V(b) <= h && num.V(-b) <= h, "h = %g: V(q_max) = %g <= h", h, num.V(b));
         if (h >= 1e33) {
-            CHECKF(b == std::nextafter(tan->q_limit(), 0.0) && a == -b, "h = %g: q_max %.17g is the last double before q_limit %.17g", h, b,
-                   tan->q_limit());
+            CHECKF(b == std::nextafter(tan->q_limit(), 0.0) && a == -b,
+                   "h = %g: q_max %.17g is the last double before q_limit %.17g", h, b, tan->q_limit());
         }
     }
     // Unbounded wells: the bracket doubles up to the largest double (it stopped at 2^200 ~ 1.6e60).
@@ -161,11 +174,13 @@ TEST_CASE("generic turning points at every level", "[flow][potential]") {
     for (double h : {1e-300, 1e-10, 1.0, 1e100, 1e300}) {
         const double B = std::sqrt(2 * h);
         const auto [a, b] = nh.turning_points(h);
-        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "Harmonic h = %g: %.17g vs %.17g", h, b, B);
+        CHECKF(std::fabs(b - B) <= 8 * eps * B && std::fabs(a + B) <= 8 * eps * B, "Harmonic h = %g: %.17g vs %.17g", h,
+               b, B);
     }
     // Above that value the level has hard walls (h - V ~ h at the turning points), which the
     // quadratures cannot resolve: a named error, not garbage.
-    CHECK_INVALID(num.period(1e100), "the level h = 1e+100 lies above the largest value V reaches inside the wall q_limit");
+    CHECK_INVALID(num.period(1e100),
+                  "the level h = 1e+100 lies above the largest value V reaches inside the wall q_limit");
     CHECK_INVALID(num.point_at(1.0, 1e100), "point_at: the level h = 1e+100 lies above");
     // ... and a bounded well that never reaches h before its wall is not a single well.
     struct Shallow final : Potential {
@@ -174,7 +189,8 @@ TEST_CASE("generic turning points at every level", "[flow][potential]") {
         std::string name() const override { return "Shallow"; }
         double q_limit() const override { return 1.0; }
     } shallow;
-    CHECK_INVALID(shallow.turning_points(2.0), "Shallow: V never reaches the energy 2 (V(-1) = 0.5 at the wall q_limit");
+    CHECK_INVALID(shallow.turning_points(2.0),
+                  "Shallow: V never reaches the energy 2 (V(-1) = 0.5 at the wall q_limit");
 }
 
 TEST_CASE("generic angles next to the turning points", "[flow][potential]") {
@@ -196,7 +212,8 @@ TEST_CASE("generic angles next to the turning points", "[flow][potential]") {
             thetas.push_back(-t);
         }
     for (int i = 0; i <= 200; ++i) thetas.push_back(-kPi + 2 * kPi * i / 200);
-    for (auto base : {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.0)), std::shared_ptr<const Potential>(tan)}) {
+    for (auto base :
+         {std::shared_ptr<const Potential>(std::make_shared<Harmonic>(1.0)), std::shared_ptr<const Potential>(tan)}) {
         Numerical n(base);
         for (double h : {1e-6, 1.0, 100.0}) {
             const double w = base->frequency(h), qm = base->turning_points(h).second;
@@ -207,18 +224,22 @@ TEST_CASE("generic angles next to the turning points", "[flow][potential]") {
                 worst_qp = std::max({worst_qp, std::fabs(q - Q), std::fabs(p - P)});
                 const double err = std::fabs(n.angle_of(Q, h) - std::fabs(th));
                 worst_angle = std::max(worst_angle, err / (1e-11 + 8 * eps * qm * w / std::fabs(P)));
-                CHECKF(std::fabs(q - Q) <= 1e-11 * std::max(1.0, qm) && std::fabs(p - P) <= 1e-11 * std::max(1.0, qm * w),
-                       "%s h = %g theta = %.17g: point_at (%.17g, %.17g) vs (%.17g, %.17g)", base->name().c_str(), h, th, q, p, Q, P);
-                CHECKF(err <= 1e-11 + 8 * eps * qm * w / std::fabs(P), "%s h = %g theta = %.17g: angle_of %.17g", base->name().c_str(), h,
-                       th, n.angle_of(Q, h));
+                CHECKF(
+                    std::fabs(q - Q) <= 1e-11 * std::max(1.0, qm) && std::fabs(p - P) <= 1e-11 * std::max(1.0, qm * w),
+                    "%s h = %g theta = %.17g: point_at (%.17g, %.17g) vs (%.17g, %.17g)", base->name().c_str(), h, th,
+                    q, p, Q, P);
+                CHECKF(err <= 1e-11 + 8 * eps * qm * w / std::fabs(P), "%s h = %g theta = %.17g: angle_of %.17g",
+                       base->name().c_str(), h, th, n.angle_of(Q, h));
             }
-            INFO(msg("%s h = %g: worst |dq|, |dp| %.3g, worst angle error / tolerance %.3g", base->name().c_str(), h, worst_qp, worst_angle));
+            INFO(msg("%s h = %g: worst |dq|, |dp| %.3g, worst angle error / tolerance %.3g", base->name().c_str(), h,
+                     worst_qp, worst_angle));
             CHECK(worst_qp < 1e-11);
         }
     }
 }
 
-TEST_CASE("onset: energy slopes and error estimates, near the step energy and far above it", "[flow][potential][onset]") {
+TEST_CASE("onset: energy slopes and error estimates, near the step energy and far above it",
+          "[flow][potential][onset]") {
     // Closed-form slopes (Tan, Harmonic) against the generic path (Ridders differences of the
     // quadratures) on the same V: the two share nothing but V, so their difference must lie within
     // the sum of the two error estimates, and that sum must be small (the estimates are useful).
@@ -228,16 +249,19 @@ TEST_CASE("onset: energy slopes and error estimates, near the step energy and fa
         for (double h : {1e-3, 0.7, 50.0}) {
             const Estimate a = base->period_slope(h), b = num.period_slope(h);
             CHECKF(std::fabs(a.value - b.value) <= a.error + b.error && a.error + b.error < 1e-8 * base->period(h) / h,
-                   "%s period_slope(%g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), h, a.value, a.error, b.value, b.error);
+                   "%s period_slope(%g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), h, a.value, a.error,
+                   b.value, b.error);
             const double qmax = base->turning_points(h).second;
             for (double f : {-0.999, -0.5, 0.3}) {
                 const Estimate c = base->angle_slope(f * qmax, h), d = num.angle_slope(f * qmax, h);
-                CHECKF(std::fabs(c.value - d.value) <= c.error + d.error && c.error + d.error < 1e-6 * std::fabs(c.value),
-                       "%s angle_slope(%g, %g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), f * qmax, h, c.value, c.error,
-                       d.value, d.error);
+                CHECKF(
+                    std::fabs(c.value - d.value) <= c.error + d.error && c.error + d.error < 1e-6 * std::fabs(c.value),
+                    "%s angle_slope(%g, %g): %.15g +- %.3g vs %.15g +- %.3g", base->name().c_str(), f * qmax, h,
+                    c.value, c.error, d.value, d.error);
             }
         }
-        CHECK_INVALID(base->angle_slope(2 * base->turning_points(1.0).second, 1.0), "must lie strictly inside the level");
+        CHECK_INVALID(base->angle_slope(2 * base->turning_points(1.0).second, 1.0),
+                      "must lie strictly inside the level");
     }
 
     // The system of the README: the old single Richardson step gave tau0 = 5.736 (closed form
@@ -246,27 +270,31 @@ TEST_CASE("onset: energy slopes and error estimates, near the step energy and fa
     Tan T(1.4, 0.7);
     const double hw = H.V(-1.0) + T.V(-0.5);
     CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, hw + 1e-12), "below the resolution of the step energy");
-    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, std::nextafter(hw, 1.0)), "below the resolution of the step energy");
+    CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, std::nextafter(hw, 1.0)),
+                  "below the resolution of the step energy");
     CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, hw, 1e-6), "h must exceed the step energy");
     CHECK_INVALID(onset_parameters(H, T, -1.0, -0.5, 1.0, 0.0), "rtol must lie in [1e-15, 1]");
     for (double h : {hw + 1e-6, 1.0, 1e8, 1e100}) {
-        const OnsetEstimate d = onset_estimate(H, T, -1.0, -0.5, h), c = onset_estimate_closed_form(1.0, 0.0, 1.4, 0.7, -1.0, -0.5, h);
+        const OnsetEstimate d = onset_estimate(H, T, -1.0, -0.5, h),
+                            c = onset_estimate_closed_form(1.0, 0.0, 1.4, 0.7, -1.0, -0.5, h);
         const double dv[] = {d.value.Omega0, d.value.tau0, d.value.tau1, d.value.lam, d.value.theta_w, d.value.I_tan};
         const double de[] = {d.error.Omega0, d.error.tau0, d.error.tau1, d.error.lam, d.error.theta_w, d.error.I_tan};
         const double cv[] = {c.value.Omega0, c.value.tau0, c.value.tau1, c.value.lam, c.value.theta_w, c.value.I_tan};
         const double ce[] = {c.error.Omega0, c.error.tau0, c.error.tau1, c.error.lam, c.error.theta_w, c.error.I_tan};
         for (int k = 0; k < 6; ++k)
             CHECKF(std::fabs(dv[k] - cv[k]) <= de[k] + ce[k] && de[k] <= 1e-6 * std::fabs(dv[k]),
-                   "h = %.17g field %d: definitions %.17g +- %.3g vs closed form %.17g +- %.3g", h, k, dv[k], de[k], cv[k], ce[k]);
+                   "h = %.17g field %d: definitions %.17g +- %.3g vs closed form %.17g +- %.3g", h, k, dv[k], de[k],
+                   cv[k], ce[k]);
         // Appendix: tau0 = 2 pi alpha2^2 / W1 with a harmonic V1, for every h; sign tau1 = -sign qw2.
-        CHECKF(std::fabs(d.value.tau0 - 2 * kPi * 0.49) <= 1e-13 * 2 * kPi * 0.49, "tau0 at h = %g: %.17g", h, d.value.tau0);
+        CHECKF(std::fabs(d.value.tau0 - 2 * kPi * 0.49) <= 1e-13 * 2 * kPi * 0.49, "tau0 at h = %g: %.17g", h,
+               d.value.tau0);
         CHECKF(d.value.tau1 > 0, "tau1 at h = %g: %.17g", h, d.value.tau1);
     }
     // The wall 1e-8 of q_limit from the Tan singularity: finite, or an error; never NaN.
     const double qw2 = -(1 - 1e-8) * T.q_limit();
     const OnsetEstimate w = onset_estimate(H, T, -1.0, qw2, 1.5 * (0.5 + T.V(qw2)));
-    CHECKF(std::isfinite(w.value.tau0) && std::isfinite(w.value.tau1) && w.value.tau1 > 0, "wall: tau0 %g tau1 %g", w.value.tau0,
-           w.value.tau1);
-    CHECKF(w.error.theta_w <= 1e-6 * w.value.theta_w && w.value.theta_w < kPi, "wall: theta_w %.17g +- %g", w.value.theta_w,
-           w.error.theta_w);
+    CHECKF(std::isfinite(w.value.tau0) && std::isfinite(w.value.tau1) && w.value.tau1 > 0, "wall: tau0 %g tau1 %g",
+           w.value.tau0, w.value.tau1);
+    CHECKF(w.error.theta_w <= 1e-6 * w.value.theta_w && w.value.theta_w < kPi, "wall: theta_w %.17g +- %g",
+           w.value.theta_w, w.error.theta_w);
 }

@@ -4,8 +4,8 @@
 #include <random>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/truncated/map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 namespace {
@@ -34,7 +34,10 @@ TEST_CASE("tabulated family equals F_eps on linear tables; any table + odd forci
     int disagree = 0;
     for (int i = 0; i < 20000; ++i) {
         double phi = uphi(rng), k = uK(rng);
-        if (fam.region(phi, k) != ref.region(phi, k)) { ++disagree; continue; }
+        if (fam.region(phi, k) != ref.region(phi, k)) {
+            ++disagree;
+            continue;
+        }
         auto [a, b] = fam.step(phi, k);
         auto [c, d] = ref.step(phi, k);
         worst = std::max({worst, std::fabs(wrap_angle(a - c)), std::fabs(b - d)});
@@ -60,7 +63,8 @@ TEST_CASE("tabulated family equals F_eps on linear tables; any table + odd forci
         worst_inv = std::max({worst_inv, std::fabs(wrap_angle(p0 - phi)), std::fabs(k0 - k)});
         double f1 = g.forcing().at(p1);
         auto [rp, rk] = g.step(-p1, k1 - 0.4 * f1);
-        worst_rev = std::max({worst_rev, std::fabs(wrap_angle(-rp - phi)), std::fabs(rk - 0.4 * g.forcing().at(rp) - k)});
+        worst_rev =
+            std::max({worst_rev, std::fabs(wrap_angle(-rp - phi)), std::fabs(rk - 0.4 * g.forcing().at(rp) - k)});
     }
     CHECKF(worst_inv < 1e-12, "nonlinear family: F^-1 F error %.3g", worst_inv);
     CHECKF(worst_rev < 1e-12, "nonlinear family: R F R error %.3g", worst_rev);
@@ -79,8 +83,10 @@ TEST_CASE("tabulated family equals F_eps on linear tables; any table + odd forci
     CHECK_INVALID(TabulatedArcs(K, Omnan, JR, J1), "Omega[5] must be finite");
     std::vector<double> JRneg = JR;
     for (auto& v : JRneg) v = -1.0;
-    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY), "no valid band");
-    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JR, J1), FourierForcing{{}}, INFINITY), "at least one sine coefficient");
+    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JRneg, J1), FourierForcing{{1.0}}, INFINITY),
+                  "no valid band");
+    CHECK_INVALID(TruncatedFamily(0.1, TabulatedArcs(K, Om, JR, J1), FourierForcing{{}}, INFINITY),
+                  "at least one sine coefficient");
 }
 
 TEST_CASE("tabulated arcs: nearly coincident circles are rejected, close but resolved ones kept", "[truncated]") {
@@ -99,7 +105,8 @@ TEST_CASE("tabulated arcs: nearly coincident circles are rejected, close but res
     // rounding of Omega times 1e14 (measured 3.1086 for these linear tables; -8e11 for measured
     // ones). Now refused, naming both circles and the rule.
     CHECK_INVALID(table({-1.0, -0.5, -0.2, -0.04, 0.0, 1e-14, 0.05, 0.5, 1.0}),
-                  "the K grid's points must be at least 1e-9 of its range (2) apart, but K[4] = 0 and K[5] = 1e-14 are 1e-14 apart");
+                  "the K grid's points must be at least 1e-9 of its range (2) apart, but K[4] = 0 and K[5] = 1e-14 are "
+                  "1e-14 apart");
     CHECK_INVALID(table({-1.0, -0.5, -0.5 + 1e-12, 0.0, 0.5, 1.0}), "K[1] = -0.5 and K[2] = -0.499999999999");
     // Just above the rule (spacing 2e-9 of the range) the grid is kept, and its slope at 0 is
     // still good to rounding x range / spacing = 1e-16 x 5e8 ~ 1e-7.

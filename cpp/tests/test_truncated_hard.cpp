@@ -4,8 +4,8 @@
 #include <random>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/truncated/map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 namespace {
@@ -85,7 +85,10 @@ TEST_CASE("the SIMD kernel computes phi and regions as step() does, bit for bit"
     IterateOptions o;
     o.n_steps = 1;
     IterateOutput out;
-    out.phi_final = pf.data(); out.K_final = kf.data(); out.regions = reg.data(); out.status = st.data();
+    out.phi_final = pf.data();
+    out.K_final = kf.data();
+    out.regions = reg.data();
+    out.status = st.data();
     m.iterate(phi.data(), K.data(), std::int64_t(n), o, out);
     int differ = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -106,7 +109,9 @@ TEST_CASE("one rotation bound, |Omega| <= 1e6, for parameters and points", "[tru
     IterateOptions o;
     o.n_steps = 10;
     IterateOutput out;
-    out.phi_final = pf; out.K_final = kf; out.status = st;
+    out.phi_final = pf;
+    out.K_final = kf;
+    out.status = st;
     m.iterate(phi0, K0, 2, o, out);
     CHECKF(st[0] == static_cast<std::int8_t>(Status::Escaped) && st[1] == static_cast<std::int8_t>(Status::Ok),
            "statuses %d %d", st[0], st[1]);

@@ -3,8 +3,8 @@
 #include <random>
 #include <vector>
 
-#include "testing.hpp"
 #include "hovering/truncated/map.hpp"
+#include "testing.hpp"
 
 using namespace hovering;
 namespace {
@@ -38,11 +38,14 @@ double band_by_scan(double tw, double tau1, double lam) {
 
 TEST_CASE("F_eps: band, bad input, exact inverse, reversibility, eps = 0 interval exchange", "[truncated]") {
     // Band: closed form against a scan (step 1e-5 in K, so agreement to 1e-5 is all a scan can give).
-    struct P { double tw, tau1, lam; };
+    struct P {
+        double tw, tau1, lam;
+    };
     for (P p : {P{3 * kPi / 4, 0.5, 0.5}, P{0.1, 0.5, 0.5}, P{2.0, -0.8, 1.3}, P{1.0, 0.0, 0.7}, P{2.5, 3.0, 0.2}}) {
         TruncatedMap m = make_truncated_map(0.1, 1.0, p.tw, 1.0, p.tau1, p.lam);
         double scan = band_by_scan(p.tw, p.tau1, p.lam);
-        CHECKF(std::fabs(m.band().lo - scan) <= 1.01e-5, "tw=%g tau1=%g lam=%g: band lo %.12g vs scan %.12g", p.tw, p.tau1, p.lam, m.band().lo, scan);
+        CHECKF(std::fabs(m.band().lo - scan) <= 1.01e-5, "tw=%g tau1=%g lam=%g: band lo %.12g vs scan %.12g", p.tw,
+               p.tau1, p.lam, m.band().lo, scan);
         // The top is where the rotation Omega0 + tau0 K reaches 1e6 rad (wrapping stays accurate).
         CHECKF(m.band().hi == 1e6 - 1.0, "hi = (1e6 - Omega0) / tau0, got %.17g", m.band().hi);
     }
@@ -115,7 +118,8 @@ TEST_CASE("F_eps: band, bad input, exact inverse, reversibility, eps = 0 interva
             CHECKF(f0.region(mid, K) == want[r], "K=%g arc %d midpoint region", K, r);
             auto [pm, km] = f0.step(mid, K);
             CHECKF(km == K, "eps=0 must keep K exactly");
-            CHECKF(std::fabs(wrap_angle(pm + mid)) < 1e-12, "K=%g arc %d: image midpoint %.15g != -%.15g", K, r, pm, mid);
+            CHECKF(std::fabs(wrap_angle(pm + mid)) < 1e-12, "K=%g arc %d: image midpoint %.15g != -%.15g", K, r, pm,
+                   mid);
             // Endpoints (just inside) map to the reflected endpoints, in reversed order.
             auto [pl, kl] = f0.step(wrap_angle(st[r] + 1e-9), K);
             CHECKF(std::fabs(wrap_angle(pl + st[r] + len[r])) < 1e-8, "left end of arc %d maps to -right end", r);

@@ -6,8 +6,8 @@
 
 #include <cstdarg>
 #include <cstdio>
-#include <stdexcept>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "hovering/flow/system.hpp"
@@ -55,10 +55,10 @@ private:
 }  // namespace hovering_test
 
 /// CHECK(cond) with printf-style context printed when it fails.
-#define CHECKF(cond, ...)                              \
-    do {                                               \
-        INFO(hovering_test::msg(__VA_ARGS__));         \
-        CHECK((cond));                                 \
+#define CHECKF(cond, ...)                      \
+    do {                                       \
+        INFO(hovering_test::msg(__VA_ARGS__)); \
+        CHECK((cond));                         \
     } while (0)
 
 /// expr throws std::invalid_argument whose message contains needle (bad input names itself).

@@ -20,23 +20,28 @@ systems also save to NPZ without pickle (``result.save(path)``, :func:`save`, :f
 
 from __future__ import annotations
 
-from ._version import __version__
-from . import _core, analysis, flow, normal, truncated
-from ._enums import FlowStatus, Geometry, Region, region_mask, Status, wrap
-from .curve import Above, Below, Curve
-from .interface import ReturnMap
+from . import _core, analysis, flow, normal, paper, truncated
+from ._enums import FlowStatus, Geometry, Region, Status, region_mask, wrap
 from ._provenance import show_versions
 from ._serial import load, save
+from ._version import __version__
 from .analysis import (
+    ConeCrossing,
     CriticalCurve,
     HoveringArea,
+    OrbitClasses,
     birkhoff_average,
+    classify_orbits,
+    cone_crossing,
+    converse_kam,
     critical_curve,
     hovering_area,
     regularity,
     rotation_number,
 )
-from .analysis import ConeCrossing, OrbitClasses, classify_orbits, cone_crossing, converse_kam
+from .curve import Above, Below, Curve
+from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
+from .explore import explore
 from .flow import (
     Bilinear,
     CustomPotential,
@@ -53,6 +58,7 @@ from .flow import (
     check_potential,
     onset_parameters,
 )
+from .interface import ReturnMap
 from .normal import (
     CornerCurves,
     FlowMap,
@@ -69,11 +75,11 @@ from .normal import (
     truncated_from_flow,
 )
 from .truncated import (
-    OMEGA_G,
-    K_crit,
     L1,
     L2,
+    OMEGA_G,
     IterateResult,
+    K_crit,
     Theory,
     TruncatedFamily,
     TruncatedMap,
@@ -86,10 +92,6 @@ from .truncated import (
     rho_crit,
 )
 from .truncated.theory import theory
-from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
-from .explore import explore
-from . import paper
-
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
 simd_width = _core.truncated.simd_width
@@ -183,8 +185,19 @@ __all__ = [
 # the scene pipeline, the figures and the module that joins them; and the old module paths
 # (hovering.geometry, hovering.fullmap, ...), which warn on use (hovering._deprecated).
 _LAZY_MODULES = ("pipeline", "scenes", "plot")
-_OLD_MODULES = ("accuracy", "references", "fullmap", "geometry", "maps", "potentials", "system", "plotting", "figures",
-                "distribute", "sweeps")
+_OLD_MODULES = (
+    "accuracy",
+    "references",
+    "fullmap",
+    "geometry",
+    "maps",
+    "potentials",
+    "system",
+    "plotting",
+    "figures",
+    "distribute",
+    "sweeps",
+)
 
 
 def __getattr__(name: str):

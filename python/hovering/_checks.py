@@ -12,9 +12,23 @@ import os
 
 import numpy as np
 
-__all__ = ["MAX_ANGLE", "MAX_MODES", "real_number", "integer", "flag", "require_type", "is_choice",
-           "thread_count", "forcing_array", "point_pair", "real_array", "require_finite", "require_angles",
-           "physical_memory", "check_memory"]
+__all__ = [
+    "MAX_ANGLE",
+    "MAX_MODES",
+    "real_number",
+    "integer",
+    "flag",
+    "require_type",
+    "is_choice",
+    "thread_count",
+    "forcing_array",
+    "point_pair",
+    "real_array",
+    "require_finite",
+    "require_angles",
+    "physical_memory",
+    "check_memory",
+]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
 #: beyond ~1e15; 1e6 keeps the wrapping error below 1e-9).
@@ -125,8 +139,10 @@ def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
     try:
         p, k = np.broadcast_arrays(p, k)
     except ValueError:
-        raise ValueError(f"{who + ': ' if who else ''}{names[0]} and {names[1]} must have broadcastable shapes, got "
-                         f"{np.shape(phi)} and {np.shape(K)}") from None
+        raise ValueError(
+            f"{who + ': ' if who else ''}{names[0]} and {names[1]} must have broadcastable shapes, got "
+            f"{np.shape(phi)} and {np.shape(K)}"
+        ) from None
     # np.ascontiguousarray would turn 0-d into 1-d; the bindings copy non-contiguous views themselves.
     return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
 
@@ -157,8 +173,10 @@ def require_angles(name: str, a) -> None:
     a = np.asarray(a)
     if a.size and np.max(np.abs(a)) > MAX_ANGLE:
         i = np.unravel_index(int(np.argmax(np.abs(a.ravel()) > MAX_ANGLE)), a.shape)
-        raise ValueError(f"{_entry(name, i)} must be an angle in [-1e6, 1e6] (larger ones cannot be wrapped to "
-                         f"[-pi, pi) accurately in double precision), got {a[i]}")
+        raise ValueError(
+            f"{_entry(name, i)} must be an angle in [-1e6, 1e6] (larger ones cannot be wrapped to "
+            f"[-pi, pi) accurately in double precision), got {a[i]}"
+        )
 
 
 def physical_memory() -> int:
@@ -173,8 +191,10 @@ def check_memory(what: str, nbytes: int) -> None:
     """Refuse, before any work, a result that would need more than half of this machine's memory."""
     total = physical_memory()
     if nbytes > total // 2:
-        raise ValueError(f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
-                         f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call")
+        raise ValueError(
+            f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
+            f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call"
+        )
 
 
 def _entry(name: str, index: tuple) -> str:

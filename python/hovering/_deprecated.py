@@ -14,8 +14,8 @@ import importlib
 import os
 import sys
 import warnings
+from collections.abc import Callable
 from types import FrameType
-from typing import Callable, Optional
 
 __all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
 
@@ -31,13 +31,13 @@ def _user_stacklevel() -> int:
     line (Python shows DeprecationWarnings of ``__main__`` by default), however many of our own
     frames lie between (``m.hovering_area`` -> hook -> ``hovering_area`` -> here)."""
     level = 1
-    f: Optional[FrameType] = sys._getframe(1)
+    f: FrameType | None = sys._getframe(1)
     while f is not None and os.path.abspath(f.f_code.co_filename).startswith(_PACKAGE):
         level, f = level + 1, f.f_back
     return level
 
 
-def warn(old: str, new: str, stacklevel: Optional[int] = None) -> None:
+def warn(old: str, new: str, stacklevel: int | None = None) -> None:
     """Warn that ``old`` is deprecated in favour of ``new``.
 
     Parameters
@@ -47,11 +47,14 @@ def warn(old: str, new: str, stacklevel: Optional[int] = None) -> None:
     stacklevel : int, optional
         Passed to :func:`warnings.warn`; default: the first frame outside the package (the user's line).
     """
-    warnings.warn(f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead",
-                  DeprecationWarning, stacklevel=stacklevel if stacklevel is not None else _user_stacklevel())
+    warnings.warn(
+        f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead",
+        DeprecationWarning,
+        stacklevel=stacklevel if stacklevel is not None else _user_stacklevel(),
+    )
 
 
-def moved_module(old: str, new: str, names: Optional[dict] = None) -> Callable[[str], object]:
+def moved_module(old: str, new: str, names: dict | None = None) -> Callable[[str], object]:
     """The module ``__getattr__`` of an old path: every name it is asked for comes from ``new``
     (or, for a name in ``names``, from the module path given there), with a warning.
 
@@ -82,7 +85,7 @@ def moved_module(old: str, new: str, names: Optional[dict] = None) -> Callable[[
     return __getattr__
 
 
-def renamed_argument(func: str, old: str, new: str, stacklevel: Optional[int] = None) -> None:
+def renamed_argument(func: str, old: str, new: str, stacklevel: int | None = None) -> None:
     """Warn that argument ``old`` of ``func`` is deprecated in favour of ``new``.
 
     Parameters

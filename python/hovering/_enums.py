@@ -8,12 +8,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import MAX_ANGLE, _short, real_array
 from . import _core
+from ._checks import MAX_ANGLE, _short, real_array
 from ._core import FlowStatus, Geometry, Kernel, Region, Status, TrajectoryPoint
 
-__all__ = ["Region", "Status", "FlowStatus", "Geometry", "Kernel", "TrajectoryPoint", "REGION_LABELS", "region_mask",
-           "status_code", "wrap"]
+__all__ = [
+    "Region",
+    "Status",
+    "FlowStatus",
+    "Geometry",
+    "Kernel",
+    "TrajectoryPoint",
+    "REGION_LABELS",
+    "region_mask",
+    "status_code",
+    "wrap",
+]
 
 #: The paper's label of each region code (``'m'``: more than one impact, the flow only).
 REGION_LABELS = {-1: "-", 0: "0u", 1: "0", 2: "1", 3: "R", 4: "m"}
@@ -24,7 +34,7 @@ def _label(self) -> str:
     return REGION_LABELS[int(self)]
 
 
-def _parse(cls, value) -> "Region":
+def _parse(cls, value) -> Region:
     """Convert a Region, its name (``'ABOVE'``), paper label (``'0'``) or code (1) to a Region.
 
     Parameters
@@ -85,8 +95,10 @@ def region_mask(regions) -> int:
     mask = 0
     for r in items:
         if isinstance(r, Region) and r is Region.NONE:
-            raise ValueError("Region.NONE (no return) is not a region an orbit can be in; allowed: "
-                             + ", ".join(f"{x.name} ('{REGION_LABELS[int(x)]}')" for x in Region if x is not Region.NONE))
+            raise ValueError(
+                "Region.NONE (no return) is not a region an orbit can be in; allowed: "
+                + ", ".join(f"{x.name} ('{REGION_LABELS[int(x)]}')" for x in Region if x is not Region.NONE)
+            )
         mask |= 1 << int(Region.parse(r))
     return mask
 
@@ -113,8 +125,10 @@ def wrap(x):
     with np.errstate(invalid="ignore"):
         if np.any(np.abs(x) > MAX_ANGLE):
             bad = x[np.abs(x) > MAX_ANGLE] if x.ndim else x
-            raise ValueError(f"angles to wrap must satisfy |x| <= 1e6 (beyond, 2 pi floor(x / 2 pi) loses accuracy), "
-                             f"got {np.ravel(bad)[0]}")
+            raise ValueError(
+                f"angles to wrap must satisfy |x| <= 1e6 (beyond, 2 pi floor(x / 2 pi) loses accuracy), "
+                f"got {np.ravel(bad)[0]}"
+            )
     y = _core.wrap(x)  # the core's one definition: every entry point wraps alike
     return y if np.ndim(y) else float(y)
 

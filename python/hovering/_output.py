@@ -36,11 +36,24 @@ from pathlib import Path
 
 from ._untrusted import is_result_file
 
-__all__ = ["output_path", "WriteError", "replacing", "write_bytes", "write_text", "savefig", "append_line", "locked",
-           "refuse_foreign", "is_ours"]
+__all__ = [
+    "output_path",
+    "WriteError",
+    "replacing",
+    "write_bytes",
+    "write_text",
+    "savefig",
+    "append_line",
+    "locked",
+    "refuse_foreign",
+    "is_ours",
+]
 
-_NO_SPACE = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "no space left (disk quota exceeded)",
-             errno.EFBIG: "no space left (the file would exceed the file system's or the process's file size limit)"}
+_NO_SPACE = {
+    errno.ENOSPC: "no space left on device",
+    errno.EDQUOT: "no space left (disk quota exceeded)",
+    errno.EFBIG: "no space left (the file would exceed the file system's or the process's file size limit)",
+}
 
 
 class WriteError(OSError, ValueError):
@@ -304,11 +317,13 @@ def refuse_foreign(paths, force: bool = False) -> None:
         return
     for p in paths:
         if os.path.lexists(p) and not is_ours(p):
-            raise ValueError(f"{os.fspath(p)} exists and was not written by hovering: refusing to replace it. Move or "
-                             "delete it, choose another output path, or pass --force (force=True) to replace it")
+            raise ValueError(
+                f"{os.fspath(p)} exists and was not written by hovering: refusing to replace it. Move or "
+                "delete it, choose another output path, or pass --force (force=True) to replace it"
+            )
 
 
-def output_path(where: str, path, within=None) -> "os.PathLike":
+def output_path(where: str, path, within=None) -> os.PathLike:
     """A figure path checked before any computation: its format is one matplotlib writes and its
     directory exists (or can be created) and is writable.
 
@@ -340,20 +355,26 @@ def output_path(where: str, path, within=None) -> "os.PathLike":
     p = Path(path)
     if p.suffix == "":
         if p.exists():  # "out" meaning out.png would silently write next to an existing out/ or /dev/null
-            raise ValueError(f"{where} = {str(path)!r} exists and is not a figure file; give a name with a suffix "
-                             f"(.png, .pdf, .svg, ...)")
+            raise ValueError(
+                f"{where} = {str(path)!r} exists and is not a figure file; give a name with a suffix "
+                f"(.png, .pdf, .svg, ...)"
+            )
         p = p.with_suffix(".png")
     if within is not None:
         real = p.resolve()
         bases = list(dict.fromkeys(Path(b).resolve() for b in within))
         if not any(real.is_relative_to(b) for b in bases):
-            raise ValueError(f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene "
-                             "writes only under its own folder or the working directory; give --out (out=) to write "
-                             "elsewhere")
+            raise ValueError(
+                f"{where} = {str(path)!r} is outside {' and '.join(str(b) for b in bases)}: a scene "
+                "writes only under its own folder or the working directory; give --out (out=) to write "
+                "elsewhere"
+            )
     formats = FigureCanvasBase.get_supported_filetypes()
     if p.suffix[1:].lower() not in formats:
-        raise ValueError(f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "
-                         f"allowed suffixes: {', '.join('.' + f for f in sorted(formats))}")
+        raise ValueError(
+            f"{where} = {str(path)!r}: matplotlib cannot write {p.suffix!r} files; "
+            f"allowed suffixes: {', '.join('.' + f for f in sorted(formats))}"
+        )
     if p.exists() and not p.is_file():
         raise ValueError(f"{where} = {str(path)!r} exists and is not a regular file")
     parent = p.parent if str(p.parent) else Path(".")

@@ -26,14 +26,14 @@ from __future__ import annotations
 
 import contextlib
 import sys
-from typing import Callable, Iterator, Optional, Union
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
 __all__ = ["Progress", "progress_bar", "check_progress", "ProgressArg"]
 
 #: What a ``progress`` argument may be.
-ProgressArg = Union[bool, Callable[[int, int], object]]
+ProgressArg = bool | Callable[[int, int], object]
 
 
 def check_progress(value, name: str = "progress"):
@@ -62,8 +62,9 @@ def check_progress(value, name: str = "progress"):
         return value
     r = repr(value)
     r = r if len(r) <= 60 else r[:57] + "..."
-    raise ValueError(f"{name} must be True (a tqdm bar on stderr), False (none) or a callable progress(done, total), "
-                     f"got {r}")
+    raise ValueError(
+        f"{name} must be True (a tqdm bar on stderr), False (none) or a callable progress(done, total), got {r}"
+    )
 
 
 class Progress:
@@ -78,7 +79,7 @@ class Progress:
         Units of work the call ends at.
     """
 
-    def __init__(self, sink: Optional[Callable[[int, int], object]], total: int):
+    def __init__(self, sink: Callable[[int, int], object] | None, total: int):
         self._sink = sink
         self.total = int(total)
         self.done = 0
@@ -153,7 +154,7 @@ class Progress:
 
 
 @contextlib.contextmanager
-def progress_bar(progress, total: int, desc: Optional[str] = None, unit: str = "step") -> Iterator[Progress]:
+def progress_bar(progress, total: int, desc: str | None = None, unit: str = "step") -> Iterator[Progress]:
     """A :class:`Progress` for one long call, from the call's ``progress`` argument.
 
     Parameters

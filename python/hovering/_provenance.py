@@ -20,7 +20,6 @@ import functools
 import importlib.metadata
 import platform
 import sys
-from typing import Optional
 
 import numpy as np
 
@@ -30,7 +29,7 @@ from ._version import __version__
 __all__ = ["provenance", "show_versions"]
 
 
-def _dist_version(name: str) -> Optional[str]:
+def _dist_version(name: str) -> str | None:
     # The installed distribution's metadata: no import (scipy costs ~0.3 s to import).
     try:
         return importlib.metadata.version(name)
@@ -38,7 +37,7 @@ def _dist_version(name: str) -> Optional[str]:
         return None
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _static() -> tuple:
     core = dict(_core.build_info())
     rec = {
@@ -59,7 +58,7 @@ def _static() -> tuple:
     return tuple(rec.items())
 
 
-def provenance(seed: Optional[int] = None, threads: Optional[int] = None) -> dict:
+def provenance(seed: int | None = None, threads: int | None = None) -> dict:
     """The provenance record of a result computed here and now.
 
     Parameters

@@ -33,15 +33,15 @@ import re
 import typing
 import zipfile
 from pathlib import Path, PurePath
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
 from . import _untrusted
 from ._output import replacing
 from ._provenance import provenance
-from ._version import __version__
 from ._untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
+from ._version import __version__
 
 __all__ = ["FORMAT", "Saveable", "from_tree", "load", "record_key", "save", "to_tree"]
 
@@ -75,8 +75,12 @@ def _resolve(name, kind: str = "any"):
     # hovering module imported from elsewhere).
     if not (isinstance(obj, type) and obj.__module__ == module and obj.__qualname__ == qual):
         raise ValueError(f"refusing to rebuild type {name!r}: it does not name a class defined in hovering")
-    ok = {"enum": lambda c: issubclass(c, enum.Enum), "dataclass": dataclasses.is_dataclass,
-          "record": lambda c: callable(getattr(c, "_from_record", None)), "any": lambda c: True}[kind]
+    ok = {
+        "enum": lambda c: issubclass(c, enum.Enum),
+        "dataclass": dataclasses.is_dataclass,
+        "record": lambda c: callable(getattr(c, "_from_record", None)),
+        "any": lambda c: True,
+    }[kind]
     if not ok(obj):
         raise ValueError(f"refusing to rebuild type {name!r} as a {kind}: it is not one")
     return obj
@@ -90,8 +94,10 @@ def _saveable_name(cls, kind: str, key: str) -> str:
     except ValueError:
         back = None
     if back is not cls:
-        raise TypeError(f"{key}: cannot save a {cls.__module__}.{cls.__qualname__} to NPZ: only hovering's own classes "
-                        "(importable by name) are written, so that reading a file never imports anything else")
+        raise TypeError(
+            f"{key}: cannot save a {cls.__module__}.{cls.__qualname__} to NPZ: only hovering's own classes "
+            "(importable by name) are written, so that reading a file never imports anything else"
+        )
     return name
 
 
@@ -105,8 +111,11 @@ def _put(arrays: dict, key: str, a: np.ndarray) -> str:
     """Store ``a`` under a member name made from ``key`` and return that name (unique: dict keys may
     contain the separators of another path). The tree records the name, so any name reads back; a
     path a zip member name cannot hold exactly (zip readers cut names at NUL) gets ``#n`` instead."""
-    if (_UNSAFE_NAME.search(key) or len(key.encode("utf-8", "surrogatepass")) > _MAX_NAME
-            or not _untrusted.safe_member_name(f"{key}.npy")):  # e.g. a dict key "a/../b": load refuses it
+    if (
+        _UNSAFE_NAME.search(key)
+        or len(key.encode("utf-8", "surrogatepass")) > _MAX_NAME
+        or not _untrusted.safe_member_name(f"{key}.npy")
+    ):  # e.g. a dict key "a/../b": load refuses it
         key = f"#{len(arrays)}"
     k, i = key, 1
     while k in arrays or k == _META_KEY:
@@ -149,8 +158,10 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
     if isinstance(obj, (int, np.integer)):
         v = int(obj)
         if v.bit_length() > _MAX_INT_BITS:  # beyond what str(int) and JSON read back (sys.get_int_max_str_digits)
-            raise ValueError(f"{key}: an integer of {v.bit_length()} bits cannot be saved (at most {_MAX_INT_BITS}); "
-                             "save it as a string")
+            raise ValueError(
+                f"{key}: an integer of {v.bit_length()} bits cannot be saved (at most {_MAX_INT_BITS}); "
+                "save it as a string"
+            )
         return v
     if isinstance(obj, (float, np.floating)):
         x = float(obj)
@@ -162,17 +173,22 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
             if all(isinstance(v, str) for v in a.flat):
                 # NumPy's fixed-width text drops trailing NULs: such a string would not read back.
                 if any(v.endswith("\0") for v in a.flat):
-                    raise ValueError(f"{key}: a string ending in NUL ('\\0') cannot be saved in an array of "
-                                     "strings (fixed-width text drops trailing NULs)")
+                    raise ValueError(
+                        f"{key}: a string ending in NUL ('\\0') cannot be saved in an array of "
+                        "strings (fixed-width text drops trailing NULs)"
+                    )
                 a = a.astype(str)
             else:
                 raise TypeError(f"{key}: arrays of Python objects cannot be saved without pickle")
         elif a.dtype.hasobject:  # a structured dtype with object fields: pickled, which load refuses
-            raise TypeError(f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without "
-                            "pickle")
+            raise TypeError(
+                f"{key}: arrays whose dtype holds Python objects ({a.dtype}) cannot be saved without pickle"
+            )
         elif not _untrusted.plain_dtype(a.dtype):  # load reads plain dtypes only
-            raise TypeError(f"{key}: arrays of dtype {a.dtype} cannot be saved; allowed: booleans, integers, floats, "
-                            "complex numbers and text")
+            raise TypeError(
+                f"{key}: arrays of dtype {a.dtype} cannot be saved; allowed: booleans, integers, floats, "
+                "complex numbers and text"
+            )
         return {"__array__": _put(arrays, key, a), "object": obj.dtype == object}
     if hasattr(obj, "_to_record"):
         try:  # first: it may refuse with a message of its own (Python code)
@@ -191,13 +207,17 @@ def to_tree(obj: Any, arrays: dict, key: str = "root"):
         if all(isinstance(k, str) for k in obj):
             return {"__dict__": {k: to_tree(v, arrays, f"{key}.{k}") for k, v in obj.items()}}
         items = list(obj.items())
-        return {"__items__": [[to_tree(k, arrays, f"{key}#k{i}"), to_tree(v, arrays, f"{key}#{i}")]
-                              for i, (k, v) in enumerate(items)]}
+        return {
+            "__items__": [
+                [to_tree(k, arrays, f"{key}#k{i}"), to_tree(v, arrays, f"{key}#{i}")] for i, (k, v) in enumerate(items)
+            ]
+        }
     if isinstance(obj, (list, tuple)):
         tag = "__tuple__" if isinstance(obj, tuple) else "__list__"
         return {tag: [to_tree(v, arrays, f"{key}[{i}]") for i, v in enumerate(obj)]}
-    raise TypeError(f"{key}: cannot save a {type(obj).__name__} to NPZ (not an array, number, string, "
-                    "dataclass or hovering object)")
+    raise TypeError(
+        f"{key}: cannot save a {type(obj).__name__} to NPZ (not an array, number, string, dataclass or hovering object)"
+    )
 
 
 def record_key(obj: Any) -> Any:
@@ -240,7 +260,7 @@ def record_key(obj: Any) -> Any:
     return inline(tree)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _field_types(cls) -> dict:
     try:
         return typing.get_type_hints(cls)
@@ -283,23 +303,28 @@ def _dataclass_from_fields(cls, fields: dict, key: str = "root"):
     known = {f.name: f for f in dataclasses.fields(cls)}
     unknown = sorted(set(fields) - set(known))
     if unknown:
-        raise ValueError(f"the file's {cls.__qualname__} has fields {unknown} this version does not know (written by "
-                         "another version of hovering?)")
+        raise ValueError(
+            f"the file's {cls.__qualname__} has fields {unknown} this version does not know (written by "
+            "another version of hovering?)"
+        )
     hints = _field_types(cls)
     obj = object.__new__(cls)
     for name, f in known.items():
         if name in fields:
             value = fields[name]
             if not (_conforms(value, hints.get(name)) or (value is None and f.default is None)):
-                raise ValueError(f"{key}.{name} must be of type {_type_name_of(hints[name])} (the type of "
-                                 f"{cls.__qualname__}.{name}), got {type(value).__name__}")
+                raise ValueError(
+                    f"{key}.{name} must be of type {_type_name_of(hints[name])} (the type of "
+                    f"{cls.__qualname__}.{name}), got {type(value).__name__}"
+                )
         elif f.default is not dataclasses.MISSING:
             value = f.default
         elif f.default_factory is not dataclasses.MISSING:
             value = f.default_factory()
         else:
-            raise ValueError(f"the file's {cls.__qualname__} lacks the field {name!r} (written by another version of "
-                             "hovering?)")
+            raise ValueError(
+                f"the file's {cls.__qualname__} lacks the field {name!r} (written by another version of hovering?)"
+            )
         object.__setattr__(obj, name, value)
     check = getattr(cls, "_validate_loaded", None)
     if check is not None:
@@ -380,8 +405,10 @@ def from_tree(tree, arrays, key: str = "root"):
         raise ValueError(f"malformed result file: a bare {type(tree).__name__} in the tree at {key}")
     if "__float__" in tree:
         if tree["__float__"] not in ("nan", "inf", "-inf"):  # finite numbers are written as numbers
-            raise ValueError(f"{key}: malformed result file: {{'__float__': {str(tree['__float__'])[:40]!r}}}; "
-                             "allowed: 'nan', 'inf', '-inf'")
+            raise ValueError(
+                f"{key}: malformed result file: {{'__float__': {str(tree['__float__'])[:40]!r}}}; "
+                "allowed: 'nan', 'inf', '-inf'"
+            )
         return float(tree["__float__"])
     if "__path__" in tree:
         if not isinstance(tree["__path__"], str):
@@ -392,8 +419,9 @@ def from_tree(tree, arrays, key: str = "root"):
         try:
             return cls(tree.get("value"))
         except (ValueError, TypeError):
-            raise ValueError(f"{key}: {repr(tree.get('value'))[:40]} is not a {cls.__qualname__}; allowed: "
-                             f"{[m.value for m in cls]}") from None
+            raise ValueError(
+                f"{key}: {repr(tree.get('value'))[:40]} is not a {cls.__qualname__}; allowed: {[m.value for m in cls]}"
+            ) from None
     if "__array__" in tree:
         k = tree["__array__"]
         if not isinstance(k, str) or k not in arrays:
@@ -407,16 +435,19 @@ def from_tree(tree, arrays, key: str = "root"):
         fields = tree.get("fields")
         if not isinstance(fields, dict):
             raise ValueError(f"malformed result file: the fields of {tree['__dataclass__']} are not a mapping")
-        return _dataclass_from_fields(cls, {name: from_tree(sub, arrays, f"{key}.{name}") for name, sub in fields.items()},
-                                      key)
+        return _dataclass_from_fields(
+            cls, {name: from_tree(sub, arrays, f"{key}.{name}") for name, sub in fields.items()}, key
+        )
     if "__record__" in tree:
         cls = _resolve(tree["__record__"], "record")
         return _from_record(cls, tree["__record__"], from_tree(tree.get("data"), arrays, f"{key}@"), key)
     if "__dict__" in tree:
         return {k: from_tree(v, arrays, f"{key}.{k}") for k, v in tree["__dict__"].items()}
     if "__items__" in tree:
-        return {from_tree(k, arrays, f"{key}#k{i}"): from_tree(v, arrays, f"{key}#{i}")
-                for i, (k, v) in enumerate(tree["__items__"])}
+        return {
+            from_tree(k, arrays, f"{key}#k{i}"): from_tree(v, arrays, f"{key}#{i}")
+            for i, (k, v) in enumerate(tree["__items__"])
+        }
     if "__tuple__" in tree:
         return tuple(from_tree(v, arrays, f"{key}[{i}]") for i, v in enumerate(tree["__tuple__"]))
     if "__list__" in tree:
@@ -440,15 +471,17 @@ def _check_meta(value, where: str = "meta") -> None:
     if isinstance(value, dict):
         for k, v in value.items():
             if not isinstance(k, str):
-                raise ValueError(f"{where}: key {k!r} is a {type(k).__name__}; metadata keys must be str (JSON would "
-                                 "read it back as a string)")
+                raise ValueError(
+                    f"{where}: key {k!r} is a {type(k).__name__}; metadata keys must be str (JSON would "
+                    "read it back as a string)"
+                )
             _check_meta(v, f"{where}[{k!r}]")
     elif isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
             _check_meta(v, f"{where}[{i}]")
 
 
-def _seed_of(obj) -> Optional[int]:
+def _seed_of(obj) -> int | None:
     """The random seed behind ``obj``: its own ``seed``, or its scene's (scene results)."""
     for o in (obj, getattr(obj, "scene", None)):
         seed = getattr(o, "seed", None)
@@ -505,8 +538,13 @@ def save(obj: Any, path: os.PathLike, meta: dict | None = None) -> str:
     _check_meta(meta or {})
     arrays: dict = {}
     tree = to_tree(obj, arrays)
-    doc = {"format": FORMAT, "version": __version__, "provenance": provenance(seed=_seed_of(obj)), "meta": meta or {},
-           "tree": tree}
+    doc = {
+        "format": FORMAT,
+        "version": __version__,
+        "provenance": provenance(seed=_seed_of(obj)),
+        "meta": meta or {},
+        "tree": tree,
+    }
     try:
         text = json.dumps(doc, allow_nan=False)
     except (TypeError, ValueError) as e:  # only the metadata can hold something else
@@ -528,9 +566,6 @@ def _write_npz(fh, members: dict) -> None:
         for name, a in members.items():
             with zf.open(f"{name}.npy", mode="w", force_zip64=True) as f:
                 np.lib.format.write_array(f, np.asanyarray(a), allow_pickle=False)
-
-
-
 
 
 def load(path: os.PathLike, meta: bool = False):
@@ -567,8 +602,10 @@ def load(path: os.PathLike, meta: bool = False):
         if dtype.kind != "U" or shape != ():
             raise ValueError(f"{not_ours}: its {_META_KEY} entry is not a string")
         if dtype.itemsize // 4 > _untrusted.MAX_TREE_CHARS:
-            raise ValueError(f"{not_ours}: its {_META_KEY} entry has {dtype.itemsize // 4} characters; allowed: at most "
-                             f"{_untrusted.MAX_TREE_CHARS}")
+            raise ValueError(
+                f"{not_ours}: its {_META_KEY} entry has {dtype.itemsize // 4} characters; allowed: at most "
+                f"{_untrusted.MAX_TREE_CHARS}"
+            )
         text = z.read(_META_KEY)
         try:
             text = str(text)
@@ -589,8 +626,10 @@ def load(path: os.PathLike, meta: bool = False):
             need += nbytes + (math.prod(shape) * _untrusted._OBJECT_BYTES_PER_ITEM if as_object else 0)
         budget = _untrusted.memory_budget()
         if need > budget:
-            raise ValueError(f"{path}: its arrays and tree need {need / 2**30:.3g} GiB (as its headers declare), more "
-                             f"than half of this machine's memory ({2 * budget / 2**30:.3g} GiB)")
+            raise ValueError(
+                f"{path}: its arrays and tree need {need / 2**30:.3g} GiB (as its headers declare), more "
+                f"than half of this machine's memory ({2 * budget / 2**30:.3g} GiB)"
+            )
         arrays = {k: z.read(k) for k in refs}  # the only members read: unnamed ones stay compressed, unread
     try:
         obj = from_tree(doc["tree"], arrays)

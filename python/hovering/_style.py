@@ -6,8 +6,18 @@ from __future__ import annotations
 
 from ._enums import Region
 
-__all__ = ["REGION_COLORS", "REGION_LABELS", "SPECIAL_COLORS", "SPECIAL_LABELS", "CORNER_STYLES", "GEOMETRY_COLOR",
-           "WALL_REGION_COLORS", "CORNER_COLORS", "orbit_color", "QUICK_MARK"]
+__all__ = [
+    "REGION_COLORS",
+    "REGION_LABELS",
+    "SPECIAL_COLORS",
+    "SPECIAL_LABELS",
+    "CORNER_STYLES",
+    "GEOMETRY_COLOR",
+    "WALL_REGION_COLORS",
+    "CORNER_COLORS",
+    "orbit_color",
+    "QUICK_MARK",
+]
 
 #: Colour of each region in region-coloured plots (J_0u, J_0, J_1, J_R, and two or more impacts).
 REGION_COLORS = {

@@ -25,9 +25,24 @@ import numpy as np
 
 from ._checks import physical_memory
 
-__all__ = ["MAX_TREE_CHARS", "MAX_TREE_DEPTH", "MAX_STRING_CHARS", "MAX_INT_BITS", "MAX_MEMBERS",
-           "MAX_DIRECTORY_BYTES", "MAX_NPY_HEADER", "TREE_BYTES_PER_CHAR", "memory_budget", "regular_file", "json_cost",
-           "json_nesting", "parse_json", "safe_member_name", "plain_dtype", "Archive"]
+__all__ = [
+    "MAX_TREE_CHARS",
+    "MAX_TREE_DEPTH",
+    "MAX_STRING_CHARS",
+    "MAX_INT_BITS",
+    "MAX_MEMBERS",
+    "MAX_DIRECTORY_BYTES",
+    "MAX_NPY_HEADER",
+    "TREE_BYTES_PER_CHAR",
+    "memory_budget",
+    "regular_file",
+    "json_cost",
+    "json_nesting",
+    "parse_json",
+    "safe_member_name",
+    "plain_dtype",
+    "Archive",
+]
 
 #: Longest JSON document read (characters). The largest tree hovering writes is a scene's: 36
 #: portrait panels of 10,000 orbits, each with its label, colour and kind (~32 characters), about
@@ -113,17 +128,21 @@ def _nesting(text: str) -> int:
     depth = top = 0
     chunk = 1 << 20
     for i in range(0, b.size, chunk):
-        c = b[i:i + chunk]
-        d = depth + np.cumsum((c == 91).view(np.int8) | (c == 123).view(np.int8), dtype=np.int64) \
+        c = b[i : i + chunk]
+        d = (
+            depth
+            + np.cumsum((c == 91).view(np.int8) | (c == 123).view(np.int8), dtype=np.int64)
             - np.cumsum((c == 93).view(np.int8) | (c == 125).view(np.int8), dtype=np.int64)
+        )
         if d.size:
             top, depth = max(top, int(d.max())), int(d[-1])
     return top
 
 
 def _refuse_constant(name: str):
-    raise ValueError(f"the JSON holds {name}, which hovering never writes (non-finite numbers are written "
-                     "as {'__float__': 'nan'})")
+    raise ValueError(
+        f"the JSON holds {name}, which hovering never writes (non-finite numbers are written as {{'__float__': 'nan'}})"
+    )
 
 
 def _finite_float(text: str) -> float:
@@ -136,8 +155,9 @@ def _finite_float(text: str) -> float:
 def _bounded_int(text: str) -> int:
     # More digits than any integer of MAX_INT_BITS bits has: refused before converting.
     if len(text.lstrip("-")) > math.ceil(MAX_INT_BITS * math.log10(2)):
-        raise ValueError(f"the JSON integer {text[:40]}... has {len(text)} digits; allowed: integers of at most "
-                         f"{MAX_INT_BITS} bits")
+        raise ValueError(
+            f"the JSON integer {text[:40]}... has {len(text)} digits; allowed: integers of at most {MAX_INT_BITS} bits"
+        )
     v = int(text)
     if v.bit_length() > MAX_INT_BITS:
         raise ValueError(f"the JSON integer {text[:40]}... has {v.bit_length()} bits; allowed: at most {MAX_INT_BITS}")
@@ -165,8 +185,12 @@ def json_cost(text: bytes) -> int:
     -------
     int
     """
-    return (96 * (text.count(b"[") + text.count(b"{")) + 32 * text.count(b'"')
-            + 40 * (text.count(b",") + text.count(b":") + text.count(b"\n") + 1) + 6 * len(text))
+    return (
+        96 * (text.count(b"[") + text.count(b"{"))
+        + 32 * text.count(b'"')
+        + 40 * (text.count(b",") + text.count(b":") + text.count(b"\n") + 1)
+        + 6 * len(text)
+    )
 
 
 def json_nesting(text: str) -> int:
@@ -247,7 +271,7 @@ def _directory(fh, size: int) -> tuple:
     tail = min(size, _EOCD.size + 0xFFFF)
     fh.seek(size - tail)
     data = fh.read(tail)
-    i = len(data) - _EOCD.size if data[-_EOCD.size:-_EOCD.size + 4] == b"PK\x05\x06" else data.rfind(b"PK\x05\x06")
+    i = len(data) - _EOCD.size if data[-_EOCD.size : -_EOCD.size + 4] == b"PK\x05\x06" else data.rfind(b"PK\x05\x06")
     if i < 0 or len(data) - i < _EOCD.size:
         raise zipfile.BadZipFile("no zip end record")
     _, _, _, _, members, cd_size, _, _ = _EOCD.unpack_from(data, i)
@@ -278,8 +302,13 @@ def safe_member_name(name: str) -> bool:
     bool
     """
     parts = name.split("/")
-    return (bool(name) and not name.startswith("/") and "\\" not in name and ".." not in parts
-            and not any(ord(c) < 32 for c in name))
+    return (
+        bool(name)
+        and not name.startswith("/")
+        and "\\" not in name
+        and ".." not in parts
+        and not any(ord(c) < 32 for c in name)
+    )
 
 
 def plain_dtype(dtype: np.dtype) -> bool:
@@ -322,8 +351,10 @@ class Archive:
             except (zipfile.BadZipFile, OSError) as e:
                 raise ValueError(f"{path} is not a hovering result file: {e}") from None
             if members > MAX_MEMBERS or cd_size > MAX_DIRECTORY_BYTES:
-                raise ValueError(f"{path}: an archive of {members} members and a directory of {cd_size} bytes; "
-                                 f"allowed: at most {MAX_MEMBERS} members and {MAX_DIRECTORY_BYTES} bytes")
+                raise ValueError(
+                    f"{path}: an archive of {members} members and a directory of {cd_size} bytes; "
+                    f"allowed: at most {MAX_MEMBERS} members and {MAX_DIRECTORY_BYTES} bytes"
+                )
             self._fh.seek(0)
             try:
                 self._zip = zipfile.ZipFile(self._fh)
@@ -332,8 +363,10 @@ class Archive:
             names = [i.filename for i in self._zip.infolist()]
             bad = next((n for n in names if not safe_member_name(n)), None)
             if bad is not None:
-                raise ValueError(f"{path}: the archive has a member named {bad[:80]!r}; a hovering result file's "
-                                 "members are relative names without '..' (nothing is ever extracted)")
+                raise ValueError(
+                    f"{path}: the archive has a member named {bad[:80]!r}; a hovering result file's "
+                    "members are relative names without '..' (nothing is ever extracted)"
+                )
             if len(set(names)) != len(names):
                 dup = next(n for n in names if names.count(n) > 1)
                 raise ValueError(f"{path}: the archive has two members named {dup[:80]!r}")
@@ -342,7 +375,7 @@ class Archive:
             self._fh.close()
             raise
 
-    def __enter__(self) -> "Archive":
+    def __enter__(self) -> Archive:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -391,12 +424,16 @@ class Archive:
         except (ValueError, EOFError, OSError, zipfile.BadZipFile, SyntaxError) as e:
             raise ValueError(f"{where}: {e}") from None
         if not plain_dtype(dtype):
-            raise ValueError(f"{where}: dtype {dtype.str!r} is refused; allowed: booleans, integers, floats, complex "
-                             "numbers and text (object arrays would need pickle)")
+            raise ValueError(
+                f"{where}: dtype {dtype.str!r} is refused; allowed: booleans, integers, floats, complex "
+                "numbers and text (object arrays would need pickle)"
+            )
         nbytes = math.prod(shape) * dtype.itemsize
         if info.file_size != len(head) + nbytes:
-            raise ValueError(f"{where}: the archive declares {info.file_size} bytes, its header "
-                             f"{len(head)} + {nbytes} (shape {shape}, dtype {dtype.str})")
+            raise ValueError(
+                f"{where}: the archive declares {info.file_size} bytes, its header "
+                f"{len(head)} + {nbytes} (shape {shape}, dtype {dtype.str})"
+            )
         return dtype, shape, nbytes
 
     def read(self, key: str) -> np.ndarray:

@@ -2,6 +2,12 @@
 
 from ._deprecated import moved_module
 
-__getattr__ = moved_module(__name__, "hovering.diagnostics", {"_reference_run": "hovering.diagnostics.work_precision",
-                                                              "_best_time": "hovering.diagnostics.work_precision",
-                                                              "_reverse": "hovering.diagnostics.work_precision"})
+__getattr__ = moved_module(
+    __name__,
+    "hovering.diagnostics",
+    {
+        "_reference_run": "hovering.diagnostics.work_precision",
+        "_best_time": "hovering.diagnostics.work_precision",
+        "_reverse": "hovering.diagnostics.work_precision",
+    },
+)

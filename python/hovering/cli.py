@@ -147,8 +147,10 @@ def _plan(args) -> int:
         path = write_plan(scene, out, quick=args.quick)
     except (OSError, ValueError) as e:
         return _error(e)
-    print(f"wrote {path} ({scene.kind}, {len(scene.eps) * len(getattr(scene, 'series', [None]))} points) in "
-          f"{time.perf_counter() - t0:.2f} s; run it with: hovering_sweep --plan {path}")
+    print(
+        f"wrote {path} ({scene.kind}, {len(scene.eps) * len(getattr(scene, 'series', [None]))} points) in "
+        f"{time.perf_counter() - t0:.2f} s; run it with: hovering_sweep --plan {path}"
+    )
     return 0
 
 
@@ -164,8 +166,10 @@ def _redraw(args) -> int:
         png, result, _ = redraw(args.path, out=out, force=args.force)
     except (OSError, ValueError) as e:
         return _error(e)
-    print(f"redrew {result.scene.kind} scene {result.scene.name!r} (computed by hovering "
-          f"{result.meta.get('version')}) without computing: wrote {png}")
+    print(
+        f"redrew {result.scene.kind} scene {result.scene.name!r} (computed by hovering "
+        f"{result.meta.get('version')}) without computing: wrote {png}"
+    )
     return 0
 
 
@@ -176,8 +180,7 @@ def _accuracy(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._output import output_path
-    from ._output import refuse_foreign, savefig, write_text
+    from ._output import output_path, refuse_foreign, savefig, write_text
     from ._provenance import provenance
     from .diagnostics import work_precision
     from .flow.section import Section
@@ -244,33 +247,59 @@ def main(argv=None) -> int:
 
     def progress_flags(sp):
         g = sp.add_mutually_exclusive_group()
-        g.add_argument("--progress", dest="progress", action="store_true", default=None,
-                       help="progress bars on stderr (default: when stderr is a terminal)")
+        g.add_argument(
+            "--progress",
+            dest="progress",
+            action="store_true",
+            default=None,
+            help="progress bars on stderr (default: when stderr is a terminal)",
+        )
         g.add_argument("--no-progress", dest="progress", action="store_false")
 
     def force_flag(sp):
-        sp.add_argument("--force", action="store_true",
-                        help="replace existing output files even if hovering did not write them (default: refuse)")
+        sp.add_argument(
+            "--force",
+            action="store_true",
+            help="replace existing output files even if hovering did not write them (default: refuse)",
+        )
 
     d = sub.add_parser("demo", help="the packaged demo scene: phase portraits of F_eps for +eps and -eps")
     d.add_argument("--out", default="hovering_demo.png", help="output PNG (default %(default)s)")
     d.add_argument("--eps", type=_checked(float, 0.0, 10.0), default=0.3, help="|eps| in [0, 10] (default %(default)s)")
-    d.add_argument("--orbits", type=_checked(int, 1, 10_000), default=30,
-                   help="initial conditions on L1, 1..10000 (default %(default)s)")
-    d.add_argument("--steps", type=_checked(int, 1, 10_000_000), default=20000,
-                   help="iterates per orbit, 1..1e7 (default %(default)s)")
-    d.add_argument("--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)")
+    d.add_argument(
+        "--orbits",
+        type=_checked(int, 1, 10_000),
+        default=30,
+        help="initial conditions on L1, 1..10000 (default %(default)s)",
+    )
+    d.add_argument(
+        "--steps",
+        type=_checked(int, 1, 10_000_000),
+        default=20000,
+        help="iterates per orbit, 1..1e7 (default %(default)s)",
+    )
+    d.add_argument(
+        "--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)"
+    )
     progress_flags(d)
     force_flag(d)
     sc = sub.add_parser("scene", help="make one figure from a scene file (examples/scenes/*.toml)")
     sc.add_argument("path", help="scene file (TOML)")
-    sc.add_argument("--out", default=None,
-                    help="output PNG (default: the scene's 'output', which must lie under the scene's folder or the "
-                         "working directory); the result NPZ + JSON are written next to it")
-    sc.add_argument("--quick", action="store_true",
-                    help="divide the iterate counts by 50 (a fast check, not the paper's figure)")
-    sc.add_argument("--workers", type=_checked(int, 1, 4096), default=None,
-                    help="sweep scenes: run the points on N local worker processes (1..4096)")
+    sc.add_argument(
+        "--out",
+        default=None,
+        help="output PNG (default: the scene's 'output', which must lie under the scene's folder or the "
+        "working directory); the result NPZ + JSON are written next to it",
+    )
+    sc.add_argument(
+        "--quick", action="store_true", help="divide the iterate counts by 50 (a fast check, not the paper's figure)"
+    )
+    sc.add_argument(
+        "--workers",
+        type=_checked(int, 1, 4096),
+        default=None,
+        help="sweep scenes: run the points on N local worker processes (1..4096)",
+    )
     sc.add_argument("--dask", action="store_true", help="with --workers: a Dask LocalCluster instead of a process pool")
     sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
@@ -287,11 +316,19 @@ def main(argv=None) -> int:
     ac = sub.add_parser("accuracy", help="work-precision diagram of a scene's system (error vs time per setting)")
     ac.add_argument("path", help="scene file (TOML)")
     ac.add_argument("--quick", action="store_true", help="fewer settings, points and returns (seconds, not minutes)")
-    ac.add_argument("--out", default=None, help="output PNG (default accuracy_<scene>.png); the table goes next to it as JSON")
+    ac.add_argument(
+        "--out", default=None, help="output PNG (default accuracy_<scene>.png); the table goes next to it as JSON"
+    )
     force_flag(ac)
     ex = sub.add_parser("explore", help="click to launch orbits on a scene's map (interactive backend)")
     ex.add_argument("path", help="scene file (TOML)")
     ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")
     args = p.parse_args(argv)
-    return {"demo": _demo, "scene": _scene, "plan": _plan, "redraw": _redraw, "accuracy": _accuracy,
-            "explore": _explore}[args.cmd](args)
+    return {
+        "demo": _demo,
+        "scene": _scene,
+        "plan": _plan,
+        "redraw": _redraw,
+        "accuracy": _accuracy,
+        "explore": _explore,
+    }[args.cmd](args)

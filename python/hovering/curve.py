@@ -21,7 +21,7 @@ import dataclasses
 import math
 import numbers
 import operator
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
@@ -42,10 +42,14 @@ def _sample_count(name: str, n) -> int:
             raise TypeError
         v = operator.index(n)
     except TypeError:
-        raise ValueError(f"{name} must be an integer, 1 (a constant) or in [3, {MAX_SAMPLES}], got {_short(n)}") from None
+        raise ValueError(
+            f"{name} must be an integer, 1 (a constant) or in [3, {MAX_SAMPLES}], got {_short(n)}"
+        ) from None
     if not (v == 1 or 3 <= v <= MAX_SAMPLES):
-        raise ValueError(f"{name} must be 1 (a constant) or in [3, {MAX_SAMPLES}] (a periodic cubic spline needs "
-                         f"three samples), got {v}")
+        raise ValueError(
+            f"{name} must be 1 (a constant) or in [3, {MAX_SAMPLES}] (a periodic cubic spline needs "
+            f"three samples), got {v}"
+        )
     return v
 
 
@@ -110,7 +114,7 @@ class Curve:
     # ------------------------------------------------------------------ construction
 
     @classmethod
-    def constant(cls, K) -> "Curve":
+    def constant(cls, K) -> Curve:
         """The constant curve ``K(phi) = K``.
 
         Parameters
@@ -127,7 +131,7 @@ class Curve:
         return cls([float(K)])
 
     @classmethod
-    def from_function(cls, f: Callable, n: int = 256) -> "Curve":
+    def from_function(cls, f: Callable, n: int = 256) -> Curve:
         """The curve through ``f`` at ``n`` uniform samples, with its interpolation error measured.
 
         Parameters
@@ -161,7 +165,7 @@ class Curve:
         return cls(K, error=np.maximum(dev, np.roll(dev, 1)))
 
     @classmethod
-    def from_orbit(cls, phi, K, n: Optional[int] = None) -> "Curve":
+    def from_orbit(cls, phi, K, n: int | None = None) -> Curve:
         """The curve through the points of a circle-filling orbit, with the scatter about it as error.
 
         The points are sorted by phi (wrapped to ``[-pi, pi)``); the sample at each grid angle
@@ -215,9 +219,11 @@ class Curve:
         counts = np.bincount(bins, minlength=n)
         if np.any(counts == 0):
             gaps = np.diff(np.concatenate([p, [p[0] + 2 * math.pi]]))
-            raise ValueError(f"the orbit leaves {int(np.count_nonzero(counts == 0))} of the n = {n} bins empty (its "
-                             f"widest gap in phi is {float(np.max(gaps)):.3g} rad, a bin is {h:.3g}): it does not fill "
-                             "the circle at this resolution; use a smaller n or a longer orbit")
+            raise ValueError(
+                f"the orbit leaves {int(np.count_nonzero(counts == 0))} of the n = {n} bins empty (its "
+                f"widest gap in phi is {float(np.max(gaps)):.3g} rad, a bin is {h:.3g}): it does not fill "
+                "the circle at this resolution; use a smaller n or a longer orbit"
+            )
         # The neighbours of each grid angle: the last point below it and the first at or above it.
         right = np.searchsorted(p, grid, side="left")
         left = right - 1
@@ -249,7 +255,7 @@ class Curve:
         return np.array(self._c.samples)
 
     @property
-    def error(self) -> Optional[np.ndarray]:
+    def error(self) -> np.ndarray | None:
         """Error estimate per sample (see :meth:`from_function`, :meth:`from_orbit`), or None."""
         return self._error
 
@@ -292,8 +298,10 @@ class Curve:
         if not isinstance(other, Curve):
             return NotImplemented
         e1, e2 = self._error, other._error
-        return bool(np.array_equal(self._c.samples, other._c.samples)
-                    and ((e1 is None and e2 is None) or (e1 is not None and e2 is not None and np.array_equal(e1, e2))))
+        return bool(
+            np.array_equal(self._c.samples, other._c.samples)
+            and ((e1 is None and e2 is None) or (e1 is not None and e2 is not None and np.array_equal(e1, e2)))
+        )
 
     def __hash__(self) -> int:
         return hash(self._c.samples.tobytes())
@@ -309,7 +317,7 @@ class Curve:
         return {"K": np.array(self._c.samples), "error": None if self._error is None else np.array(self._error)}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "Curve":
+    def _from_record(cls, record: dict) -> Curve:
         """Inverse of :meth:`_to_record` (validated again by the constructor)."""
         unknown = sorted(set(record) - {"K", "error"})
         if unknown:

@@ -32,18 +32,26 @@ import math
 import os
 import sys
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 
 from ._checks import integer, real_number, require_angles, require_type
 from ._enums import Region, Status, wrap
+from ._style import REGION_COLORS
 from .interface import require_map
 from .normal.flowmap import FlowMap
-from ._style import REGION_COLORS
 
-__all__ = ["explore", "Explorer", "Orbit", "default_K_range", "default_n_steps", "main", "COLORS", "DEFAULT_N_STEPS",
-           "MAX_N_STEPS"]
+__all__ = [
+    "explore",
+    "Explorer",
+    "Orbit",
+    "default_K_range",
+    "default_n_steps",
+    "main",
+    "COLORS",
+    "DEFAULT_N_STEPS",
+    "MAX_N_STEPS",
+]
 
 #: Default steps per orbit: a truncated-map step costs ~10 ns, a return of the flow ~10 us, so
 #: these keep a click's answer well under a tenth of a second for either.
@@ -193,8 +201,10 @@ class Orbit:
     artists: list = field(default_factory=list, repr=False)
 
     def __repr__(self) -> str:
-        return (f"Orbit(#{self.number}, start=({self.phi0:.6g}, {self.K0:.6g}), steps_done={self.steps_done}, "
-                f"status={self.status.name})")
+        return (
+            f"Orbit(#{self.number}, start=({self.phi0:.6g}, {self.K0:.6g}), steps_done={self.steps_done}, "
+            f"status={self.status.name})"
+        )
 
     @property
     def stopped(self) -> bool:
@@ -247,8 +257,15 @@ class Explorer:
         Naming the argument and its allowed range, before anything is drawn.
     """
 
-    def __init__(self, m, n_steps: Optional[int] = None, K_range=None, ax=None, marker_size: float = 2.0,
-                 max_points: int = 1_000_000):
+    def __init__(
+        self,
+        m,
+        n_steps: int | None = None,
+        K_range=None,
+        ax=None,
+        marker_size: float = 2.0,
+        max_points: int = 1_000_000,
+    ):
         require_map("m", m)
         self.n_steps = default_n_steps(m) if n_steps is None else integer("n_steps", n_steps, 1, MAX_N_STEPS)
         self.K_range = default_K_range(m) if K_range is None else _K_range(K_range)
@@ -271,17 +288,21 @@ class Explorer:
         self._rgba = self._region_rgba()
         self._setup_axes()
         canvas = self.fig.canvas
-        self._cids = [canvas.mpl_connect("button_press_event", self._on_press),
-                      canvas.mpl_connect("key_press_event", self._on_key)]
+        self._cids = [
+            canvas.mpl_connect("button_press_event", self._on_press),
+            canvas.mpl_connect("key_press_event", self._on_key),
+        ]
         self._say(f"left click: launch an orbit ({self.n_steps} steps)")
 
     def __repr__(self) -> str:
-        return (f"Explorer({type(self.map).__name__}(eps={self.map.eps:g}), n_steps={self.n_steps}, "
-                f"K_range={self.K_range}, {len(self.orbits)} orbit(s))")
+        return (
+            f"Explorer({type(self.map).__name__}(eps={self.map.eps:g}), n_steps={self.n_steps}, "
+            f"K_range={self.K_range}, {len(self.orbits)} orbit(s))"
+        )
 
     # ------------------------------------------------------------------ actions
 
-    def launch(self, phi, K) -> Optional[Orbit]:
+    def launch(self, phi, K) -> Orbit | None:
         """Iterate an orbit from ``(phi, K)`` and draw it: what a left click does.
 
         Parameters
@@ -315,7 +336,7 @@ class Explorer:
             raise
         return self._add(phi, K, res)
 
-    def remove_last(self) -> Optional[Orbit]:
+    def remove_last(self) -> Orbit | None:
         """Remove the most recent orbit (what a right click does).
 
         Returns
@@ -376,7 +397,7 @@ class Explorer:
 
     # ------------------------------------------------------------------ drawing
 
-    def _add(self, phi0: float, K0: float, res) -> Optional[Orbit]:
+    def _add(self, phi0: float, K0: float, res) -> Orbit | None:
         n = int(res.steps_done[0])
         status = Status(int(res.status[0]))
         if n == 0:
@@ -384,18 +405,44 @@ class Explorer:
             self._say(f"no orbit from ({phi0:.6g}, {K0:.6g}): {status.name} ({why})")
             return None
         self._count += 1
-        o = Orbit(number=self._count, phi0=phi0, K0=K0, phi=res.phi[0, : n + 1].copy(), K=res.K[0, : n + 1].copy(),
-                  region=res.region[0, :n].copy(), status=status, steps_done=n, result=res)
+        o = Orbit(
+            number=self._count,
+            phi0=phi0,
+            K0=K0,
+            phi=res.phi[0, : n + 1].copy(),
+            K=res.K[0, : n + 1].copy(),
+            region=res.region[0, :n].copy(),
+            status=status,
+            steps_done=n,
+            result=res,
+        )
         stride = max(1, -(-n // self.max_points))
         ax = self.ax
         # Points 0..n-1 are those a step was taken from, so each has the region that step used.
-        o.artists.append(ax.scatter(o.phi[:n:stride], o.K[:n:stride], s=self.marker_size,
-                                    c=self._rgba[o.region[::stride].astype(int) + 1], lw=0, zorder=3,
-                                    rasterized=n > 20_000))
+        o.artists.append(
+            ax.scatter(
+                o.phi[:n:stride],
+                o.K[:n:stride],
+                s=self.marker_size,
+                c=self._rgba[o.region[::stride].astype(int) + 1],
+                lw=0,
+                zorder=3,
+                rasterized=n > 20_000,
+            )
+        )
         o.artists += ax.plot([o.phi[0]], [o.K[0]], ls="none", marker="+", ms=11, mew=1.6, color="k", zorder=5)
         if o.stopped:
-            o.artists += ax.plot([o.phi[n]], [o.K[n]], ls="none", marker="x", ms=8, mew=1.6, color="k", zorder=5,
-                                 label=f"#{o.number}: {status.name} after {n}")
+            o.artists += ax.plot(
+                [o.phi[n]],
+                [o.K[n]],
+                ls="none",
+                marker="x",
+                ms=8,
+                mew=1.6,
+                color="k",
+                zorder=5,
+                label=f"#{o.number}: {status.name} after {n}",
+            )
         self.orbits.append(o)
         self._update_legend()
         start = f"#{o.number} from ({phi0:.6g}, {K0:.6g})"
@@ -435,8 +482,11 @@ class Explorer:
         lo, hi = self.K_range
         section = _in_section_coordinates(m)
         band_lo, band_hi = (float(v) for v in m.valid_band())
-        outside = [ax.axhspan(a, b, color="0.9", zorder=0, lw=0, label="outside valid_band()")
-                   for a, b in ((lo, min(band_lo, hi)), (max(band_hi, lo), hi)) if a < b]
+        outside = [
+            ax.axhspan(a, b, color="0.9", zorder=0, lw=0, label="outside valid_band()")
+            for a, b in ((lo, min(band_lo, hi)), (max(band_hi, lo), hi))
+            if a < b
+        ]
         if not section:
             if lo < 0 < hi:
                 ax.axhline(0.0, color="0.45", lw=0.8, zorder=1)
@@ -449,14 +499,18 @@ class Explorer:
         ax.set_xlabel(r"$\theta$" if section else r"$\phi$")
         ax.set_ylabel(r"$I$" if section else r"$K$")
         proxy = dict(ls="none", marker="o", ms=5)
-        self._legend_base = [Line2D([], [], color=COLORS[r], label=f"from J_{r.label}", **proxy)
-                             for r in self._regions_shown()]
+        self._legend_base = [
+            Line2D([], [], color=COLORS[r], label=f"from J_{r.label}", **proxy) for r in self._regions_shown()
+        ]
         self._legend_base.append(Line2D([], [], ls="none", marker="+", ms=9, mew=1.6, color="k", label="start"))
         self._legend_base += outside[:1]
         self._update_legend()
         if self._own_figure:  # a figure the caller made keeps its own title
-            self.fig.suptitle(f"{type(m).__name__}, eps = {m.eps:g}: {self.n_steps} steps per orbit   |   left "
-                              f"click: launch   right click / u / delete: remove last   x: clear", fontsize=9)
+            self.fig.suptitle(
+                f"{type(m).__name__}, eps = {m.eps:g}: {self.n_steps} steps per orbit   |   left "
+                f"click: launch   right click / u / delete: remove last   x: clear",
+                fontsize=9,
+            )
 
     def _draw_lines(self, K: np.ndarray) -> None:
         """L1, L2 (grey) and, for truncated maps, the corner-singularity curves (dotted) over heights K."""
@@ -468,8 +522,15 @@ class Explorer:
             except (ValueError, AttributeError):  # no onset parameters: no lines
                 return
             self.ax.plot(_break(phi), K, color="0.6", lw=0.8, ls=ls, zorder=1)
-            self.ax.annotate(fn, (phi[-1], K[-1]), fontsize=7, color="0.45", xytext=(2, -8),
-                             textcoords="offset points", annotation_clip=True)
+            self.ax.annotate(
+                fn,
+                (phi[-1], K[-1]),
+                fontsize=7,
+                color="0.45",
+                xytext=(2, -8),
+                textcoords="offset points",
+                annotation_clip=True,
+            )
         Kn = K[K < 0]
         if hasattr(self.map, "corner_curves") and Kn.size:
             for phi in self.map.corner_curves(Kn).values():
@@ -530,8 +591,15 @@ def _map_from_scene(path):
     return scene_map(load_scene(path, check_output=False))
 
 
-def explore(map_or_scene, n_steps: Optional[int] = None, K_range=None, *, ax=None, marker_size: float = 2.0,
-            max_points: int = 1_000_000) -> Explorer:
+def explore(
+    map_or_scene,
+    n_steps: int | None = None,
+    K_range=None,
+    *,
+    ax=None,
+    marker_size: float = 2.0,
+    max_points: int = 1_000_000,
+) -> Explorer:
     """Open a phase portrait of a return map where a click launches an orbit from the clicked point.
 
     The orbit is ``map.iterate(phi, K, n_steps, record=("orbit", "regions"))`` from the clicked
@@ -624,13 +692,24 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(
         prog="python -m hovering explore",
         description="Phase portrait of a scene's map (its first panel's) where a left click launches an orbit. "
-                    "Right click, u or delete: remove the last orbit; x: remove all.")
+        "Right click, u or delete: remove the last orbit; x: remove all.",
+    )
     p.add_argument("scene", help="scene file (TOML), e.g. examples/scenes/fig_smalleps.toml")
-    p.add_argument("--n-steps", type=_n_steps_arg, default=None,
-                   help=f"steps per orbit, 1..{MAX_N_STEPS} (default {DEFAULT_N_STEPS['truncated']} for a truncated "
-                        f"map, {DEFAULT_N_STEPS['flow']} for the flow)")
-    p.add_argument("--K-range", nargs=2, type=float, metavar=("K_LO", "K_HI"), default=None,
-                   help="heights shown (default: from 2 K_crit to the O(eps) scale, inside the band)")
+    p.add_argument(
+        "--n-steps",
+        type=_n_steps_arg,
+        default=None,
+        help=f"steps per orbit, 1..{MAX_N_STEPS} (default {DEFAULT_N_STEPS['truncated']} for a truncated "
+        f"map, {DEFAULT_N_STEPS['flow']} for the flow)",
+    )
+    p.add_argument(
+        "--K-range",
+        nargs=2,
+        type=float,
+        metavar=("K_LO", "K_HI"),
+        default=None,
+        help="heights shown (default: from 2 K_crit to the O(eps) scale, inside the band)",
+    )
     args = p.parse_args(argv)
     import matplotlib.pyplot as plt
 
@@ -643,12 +722,17 @@ def main(argv=None) -> int:
         import matplotlib
 
         ex.close()
-        print(f"{p.prog}: matplotlib's backend {matplotlib.get_backend()!r} cannot open a window (no display, or "
-              f"MPLBACKEND names a file backend); nothing shown, nothing written. Run it where a display is "
-              f"available (e.g. MPLBACKEND=TkAgg or QtAgg), or use hovering.explore(...) in Jupyter with "
-              f"'%matplotlib widget'.", file=sys.stderr)
+        print(
+            f"{p.prog}: matplotlib's backend {matplotlib.get_backend()!r} cannot open a window (no display, or "
+            f"MPLBACKEND names a file backend); nothing shown, nothing written. Run it where a display is "
+            f"available (e.g. MPLBACKEND=TkAgg or QtAgg), or use hovering.explore(...) in Jupyter with "
+            f"'%matplotlib widget'.",
+            file=sys.stderr,
+        )
         return 0
-    print(f"{ex.map!r}: {ex.n_steps} steps per orbit. Left click: launch; right click, u or delete: remove the "
-          f"last orbit; x: clear. Close the window to quit.")
+    print(
+        f"{ex.map!r}: {ex.n_steps} steps per orbit. Left click: launch; right click, u or delete: remove the "
+        f"last orbit; x: clear. Close the window to quit."
+    )
     plt.show()
     return 0

@@ -2,5 +2,6 @@
 
 from ._deprecated import moved_module
 
-__getattr__ = moved_module(__name__, "hovering.plot.figures", {"SPECIAL_COLORS": "hovering._style",
-                                                               "SPECIAL_LABELS": "hovering._style"})
+__getattr__ = moved_module(
+    __name__, "hovering.plot.figures", {"SPECIAL_COLORS": "hovering._style", "SPECIAL_LABELS": "hovering._style"}
+)

@@ -7,8 +7,9 @@ never each other.
 from __future__ import annotations
 
 import operator
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Optional, Protocol, Sequence, Tuple, Union, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -17,9 +18,20 @@ from ._enums import Status, region_mask, status_code
 from ._serial import Saveable
 from .curve import StopCondition
 
-__all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "transport_arguments",
-           "recorded_counts", "trajectory_arguments", "trajectory_rows", "require_map", "MAX_TRAJECTORY_POINTS",
-           "register", "hook"]
+__all__ = [
+    "ReturnMap",
+    "IterateResult",
+    "MapAnalyses",
+    "iterate_arguments",
+    "transport_arguments",
+    "recorded_counts",
+    "trajectory_arguments",
+    "trajectory_rows",
+    "require_map",
+    "MAX_TRAJECTORY_POINTS",
+    "register",
+    "hook",
+]
 
 #: Functions of the layers above the models that the models' convenience methods call
 #: (``m.hovering_area()``, ``FlowMap(accuracy=...)``): each higher module registers its own when
@@ -27,7 +39,7 @@ __all__ = ["ReturnMap", "IterateResult", "MapAnalyses", "iterate_arguments", "tr
 _HOOKS: dict = {}
 
 
-def register(name: str, fn: Optional[Callable] = None) -> Callable:
+def register(name: str, fn: Callable | None = None) -> Callable:
     """Make ``fn`` the implementation of the hook ``name`` (called by the module that owns it);
     without ``fn``, a decorator that does so.
 
@@ -61,7 +73,9 @@ def hook(name: str) -> Callable:
     try:
         return _HOOKS[name]
     except KeyError:
-        raise RuntimeError(f"{name} is provided by a part of hovering that is not loaded; import hovering first") from None
+        raise RuntimeError(
+            f"{name} is provided by a part of hovering that is not loaded; import hovering first"
+        ) from None
 
 
 @runtime_checkable
@@ -79,16 +93,26 @@ class ReturnMap(Protocol):
     def region(self, phi, K):
         """Region of the return from each point."""
 
-    def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ..., exit_regions: Optional[Iterable] = None,
-                stop_on_exit: bool = False, n_threads: int = 0, progress=False, every: int = 1,
-                stop: Optional[StopCondition] = None):
+    def iterate(
+        self,
+        phi0,
+        K0,
+        n_steps: int,
+        record: Sequence[str] = ...,
+        exit_regions: Iterable | None = None,
+        stop_on_exit: bool = False,
+        n_threads: int = 0,
+        progress=False,
+        every: int = 1,
+        stop: StopCondition | None = None,
+    ):
         """Many orbits at once -> IterateResult (progress: see hovering._progress; every, stop: see
         :meth:`hovering.TruncatedMap.iterate`)."""
 
-    def with_eps(self, eps: float) -> "ReturnMap":
+    def with_eps(self, eps: float) -> ReturnMap:
         """The same map at another eps (F_0 for the hovering set's definition)."""
 
-    def valid_band(self) -> Tuple[float, float]:
+    def valid_band(self) -> tuple[float, float]:
         """Open interval of K on which the map is defined."""
 
     def theory(self):
@@ -242,34 +266,34 @@ class IterateResult(Saveable):
         no dense sample.
     """
 
-    phi: Optional[np.ndarray]
-    K: Optional[np.ndarray]
-    region: Optional[np.ndarray]
-    rotation: Optional[np.ndarray]
+    phi: np.ndarray | None
+    K: np.ndarray | None
+    region: np.ndarray | None
+    rotation: np.ndarray | None
     phi_final: np.ndarray
     K_final: np.ndarray
     status: np.ndarray
     steps_done: np.ndarray
-    exit_step: Optional[np.ndarray]
+    exit_step: np.ndarray | None
     n_steps: int
     map: object = field(default=None, repr=False, compare=False)
-    theta: Optional[np.ndarray] = None
-    I: Optional[np.ndarray] = None
-    z: Optional[np.ndarray] = None
-    time: Optional[np.ndarray] = None
-    energy_error: Optional[np.ndarray] = None
-    integrator_steps: Optional[np.ndarray] = None
-    itinerary: Optional[list] = None
-    visited: Optional[np.ndarray] = None
-    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
-    work: Optional[dict] = None
-    stop_step: Optional[np.ndarray] = None
-    K_min: Optional[np.ndarray] = None
-    K_max: Optional[np.ndarray] = None
-    residence: Optional[np.ndarray] = None
+    theta: np.ndarray | None = None
+    I: np.ndarray | None = None
+    z: np.ndarray | None = None
+    time: np.ndarray | None = None
+    energy_error: np.ndarray | None = None
+    integrator_steps: np.ndarray | None = None
+    itinerary: list | None = None
+    visited: np.ndarray | None = None
+    trajectory: np.ndarray | None = field(default=None, repr=False)
+    trajectory_index: np.ndarray | None = field(default=None, repr=False)
+    trajectory_kind: np.ndarray | None = field(default=None, repr=False)
+    trajectory_truncated: np.ndarray | None = field(default=None, repr=False)
+    work: dict | None = None
+    stop_step: np.ndarray | None = None
+    K_min: np.ndarray | None = None
+    K_max: np.ndarray | None = None
+    residence: np.ndarray | None = None
     every: int = 1
 
     def trajectory_of(self, i: int) -> np.ndarray:
@@ -297,7 +321,7 @@ class IterateResult(Saveable):
         """Number of orbits."""
         return int(self.status.shape[0])
 
-    def count(self, status: Union[Status, int]) -> int:
+    def count(self, status: Status | int) -> int:
         """Number of orbits with the given status.
 
         Parameters
@@ -333,7 +357,9 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
     try:
         record = tuple(record)
     except TypeError:
-        raise ValueError(f"record must be a sequence of keys from {list(allowed)} (or () for none), got {record!r}") from None
+        raise ValueError(
+            f"record must be a sequence of keys from {list(allowed)} (or () for none), got {record!r}"
+        ) from None
     unknown = [r for r in record if not is_choice(r, allowed)]
     if unknown:
         raise ValueError(f"record: unknown key(s) {unknown}; allowed: {list(allowed)}")
@@ -392,12 +418,13 @@ def transport_arguments(every, stop) -> tuple:
     if stop is None:
         return k, 0, None
     if not isinstance(stop, StopCondition) or type(stop) is StopCondition:
-        raise ValueError(f"stop must be hovering.Above(curve_or_K) or hovering.Below(curve_or_K) (or None), got "
-                         f"{_short(stop)}")
+        raise ValueError(
+            f"stop must be hovering.Above(curve_or_K) or hovering.Below(curve_or_K) (or None), got {_short(stop)}"
+        )
     return k, stop._side, stop.curve._c
 
 
-def recorded_counts(n_steps: int, every: int) -> Tuple[int, int]:
+def recorded_counts(n_steps: int, every: int) -> tuple[int, int]:
     """States and returns an orbit's records keep with stride ``every``: ``(n_steps // every + 1,
     ceil(n_steps / every))`` (the core's recorded_states / recorded_returns)."""
     return n_steps // every + 1, -(-n_steps // every)
@@ -435,8 +462,9 @@ def trajectory_arguments(trajectory_dt, max_trajectory_points, n_orbits: int) ->
     """
     dt = real_number("trajectory_dt", trajectory_dt, 0.0)
     least = 2 * max(n_orbits, 1)
-    cap = integer(f"max_trajectory_points (at least 2 per orbit: {n_orbits} orbits)", max_trajectory_points, least,
-                  2**62)
+    cap = integer(
+        f"max_trajectory_points (at least 2 per orbit: {n_orbits} orbits)", max_trajectory_points, least, 2**62
+    )
     per_orbit = cap // max(n_orbits, 1)
     # Per-orbit vectors (growing by doubling) and the flat arrays they are copied into: ~3x the
     # 41 bytes of a point in the worst case.
@@ -465,8 +493,10 @@ def trajectory_rows(res, i) -> np.ndarray:
         If no trajectory was recorded or i is out of range.
     """
     if res.trajectory is None:
-        raise ValueError("no trajectory was recorded: pass record=('trajectory',) (FlowMap.iterate) or "
-                         "trajectory_dt (Section.return_map)")
+        raise ValueError(
+            "no trajectory was recorded: pass record=('trajectory',) (FlowMap.iterate) or "
+            "trajectory_dt (Section.return_map)"
+        )
     n = res.trajectory_index.size - 1
     i = integer("i (orbit index)", i, -n, n - 1) % n
     return res.trajectory[res.trajectory_index[i] : res.trajectory_index[i + 1]]

@@ -26,8 +26,21 @@ from .normal.flowmap import FlowMap
 from .truncated.maps import TruncatedMap
 from .truncated.theory import OMEGA_G
 
-__all__ = ["OMEGA_G", "FIGURE", "EPS_SMALL", "EPS_BIG", "truncated_map", "V1", "V2", "QW1", "QW2", "H", "system",
-           "section", "flow_map"]
+__all__ = [
+    "OMEGA_G",
+    "FIGURE",
+    "EPS_SMALL",
+    "EPS_BIG",
+    "truncated_map",
+    "V1",
+    "V2",
+    "QW1",
+    "QW2",
+    "H",
+    "system",
+    "section",
+    "flow_map",
+]
 
 #: The truncated map's parameters of fig:smalleps (and of every figure of sec:truncatedmapnum), eps aside.
 FIGURE = dict(Omega0=OMEGA_G, theta_w=3 * math.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)

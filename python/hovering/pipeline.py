@@ -9,7 +9,6 @@ import io
 import os
 import time
 from pathlib import Path
-from typing import Optional
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -27,8 +26,16 @@ from .scenes.spec import SceneSpec
 __all__ = ["run_scene", "redraw", "phase_portrait", "draw_geometry"]
 
 
-def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool = False, keep_figure: bool = False,
-              progress=False, force: bool = False, executor=None, **where) -> dict:
+def run_scene(
+    scene: SceneSpec,
+    out: os.PathLike | None = None,
+    quick: bool = False,
+    keep_figure: bool = False,
+    progress=False,
+    force: bool = False,
+    executor=None,
+    **where,
+) -> dict:
     """Compute a scene, save its result (NPZ + JSON), draw its figure and write the PNG.
 
     Where it writes: ``out`` if given, else the scene's ``output``, which must lie under the scene
@@ -71,8 +78,11 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
         write, or a failed write (:class:`hovering._output.WriteError`, e.g. ``no space left``).
     """
     t0 = time.perf_counter()
-    png = output_path("out", out) if out is not None else output_path("output", scene.output,
-                                                                         within=output_dirs(scene.path))
+    png = (
+        output_path("out", out)
+        if out is not None
+        else output_path("output", scene.output, within=output_dirs(scene.path))
+    )
     npz, side, ckpt = png.with_suffix(".npz"), png.with_suffix(".json"), png.with_suffix(".sweep.jsonl")
     sweep = scene.kind in SWEEP_KINDS
     refuse_foreign([png, npz, side] + ([ckpt] if sweep else []), force)
@@ -98,16 +108,19 @@ def run_scene(scene: SceneSpec, out: Optional[os.PathLike] = None, quick: bool =
             plt.close(fig)
     summary = result.summary()
     summary["runtime_s"] = time.perf_counter() - t0
-    summary.update(output=str(png), npz=npz_path, json=json_path,
-                   files=[npz_path, json_path, str(png)] + ([result.meta["checkpoint"]] if "checkpoint" in result.meta
-                                                             else []))
+    summary.update(
+        output=str(png),
+        npz=npz_path,
+        json=json_path,
+        files=[npz_path, json_path, str(png)] + ([result.meta["checkpoint"]] if "checkpoint" in result.meta else []),
+    )
     if keep_figure:
         summary["figure"] = fig
         summary["result"] = result
     return summary
 
 
-def redraw(path: os.PathLike, out: Optional[os.PathLike] = None, keep_figure: bool = False, force: bool = False):
+def redraw(path: os.PathLike, out: os.PathLike | None = None, keep_figure: bool = False, force: bool = False):
     """Redraw a saved scene result without computing anything.
 
     Parameters
@@ -216,8 +229,10 @@ def phase_portrait(m, n_orbits=30, n_steps=20_000, K_range=(-1.2, 0.6), ax=None,
     ax.set_xlabel(r"$\phi$")
     ax.set_ylabel(r"$K$")
     if title is None:
-        title = (rf"$\varepsilon={m.eps:g},\ \Omega_0={m.Omega0:.4f},\ \theta_w={m.theta_w:.4f},\ "
-                 rf"\tau_0={m.tau0:g},\ \tau_1={m.tau1:g},\ \lambda={m.lam:g}$")
+        title = (
+            rf"$\varepsilon={m.eps:g},\ \Omega_0={m.Omega0:.4f},\ \theta_w={m.theta_w:.4f},\ "
+            rf"\tau_0={m.tau0:g},\ \tau_1={m.tau1:g},\ \lambda={m.lam:g}$"
+        )
     ax.set_title(title, fontsize=9)
     if color_by == "region":
         ax.legend(loc="upper right", markerscale=40, fontsize=7, framealpha=0.8)

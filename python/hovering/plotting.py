@@ -3,5 +3,6 @@ removed in 0.4.0)."""
 
 from ._deprecated import moved_module
 
-__getattr__ = moved_module(__name__, "hovering.pipeline", {"plot_orbits": "hovering.plot.primitives",
-                                                           "REGION_COLORS": "hovering._style"})
+__getattr__ = moved_module(
+    __name__, "hovering.pipeline", {"plot_orbits": "hovering.plot.primitives", "REGION_COLORS": "hovering._style"}
+)

@@ -3,5 +3,8 @@
 
 from ._deprecated import moved_module
 
-__getattr__ = moved_module(__name__, "hovering.flow", {n: "hovering.normal.coordinates" for n in (
-    "forcing_function", "from_normal", "tangential_curve", "to_normal")})
+__getattr__ = moved_module(
+    __name__,
+    "hovering.flow",
+    {n: "hovering.normal.coordinates" for n in ("forcing_function", "from_normal", "tangential_curve", "to_normal")},
+)

@@ -61,7 +61,8 @@ template <class Map>
 void bind_outcomes(py::module_& m) {
     m.def(
         "hovering_outcomes",
-        [](const Map& map, const darray& phi, const darray& K, std::int64_t n_steps, int n_threads, py::object progress) {
+        [](const Map& map, const darray& phi, const darray& K, std::int64_t n_steps, int n_threads,
+           py::object progress) {
             return outcomes(phi, K, n_steps, n_threads, std::move(progress),
                             [&](const double* p, const double* k, std::int64_t n, const HoveringAreaOptions& o) {
                                 return hovering_outcomes(map, p, k, n, o);

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "hovering/flow/return_map.hpp"
 #include "flow_results.hpp"
+#include "hovering/flow/return_map.hpp"
 #include "pybind.hpp"
 #include "signals.hpp"
 
@@ -16,7 +16,8 @@ using namespace hovering;
 namespace {
 
 FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<const Potential> V2,
-                       std::vector<std::array<double, 3>> terms, double eps, double qw1, double qw2, Geometry geometry) {
+                       std::vector<std::array<double, 3>> terms, double eps, double qw1, double qw2,
+                       Geometry geometry) {
     FlowSystem s;
     s.V1 = std::move(V1);
     s.V2 = std::move(V2);
@@ -41,16 +42,18 @@ void register_flow(py::module_& m) {
         .def_readonly("qw1", &FlowSystem::qw1)
         .def_readonly("qw2", &FlowSystem::qw2)
         .def_readonly("geometry", &FlowSystem::geometry)
-        .def_property_readonly("terms", [](const FlowSystem& s) { return s.coupling.terms; },
-                               "Coupling terms (c, i, j): Vc = sum c q1^i q2^j.")
-        .def("energy",
-             [](const FlowSystem& s, const darray& z) {
-                 if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
-                 darray out(z.shape(0));
-                 for (py::ssize_t i = 0; i < z.shape(0); ++i) out.mutable_data()[i] = s.energy(z.data() + 4 * i);
-                 return out;
-             },
-             py::arg("z"), "H of states z (shape (n, 4)).");
+        .def_property_readonly(
+            "terms", [](const FlowSystem& s) { return s.coupling.terms; },
+            "Coupling terms (c, i, j): Vc = sum c q1^i q2^j.")
+        .def(
+            "energy",
+            [](const FlowSystem& s, const darray& z) {
+                if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
+                darray out(z.shape(0));
+                for (py::ssize_t i = 0; i < z.shape(0); ++i) out.mutable_data()[i] = s.energy(z.data() + 4 * i);
+                return out;
+            },
+            py::arg("z"), "H of states z (shape (n, 4)).");
 
     py::tuple steppers(kSteppers.size());
     for (std::size_t i = 0; i < kSteppers.size(); ++i) steppers[i] = kSteppers[i];
@@ -84,90 +87,95 @@ void register_flow(py::module_& m) {
         .def_readonly("max_impacts", &FlowOptions::max_impacts)
         .def_readonly("grazing_tol", &FlowOptions::grazing_tol)
         .def_readonly("corner_tol", &FlowOptions::corner_tol)
-        .def("validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
-             "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");
+        .def(
+            "validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
+            "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");
 
-    m.def("section_points",
-          [](const FlowSystem& s, double h, const darray& theta, const darray& I) {
-              if (theta.ndim() != 1 || I.ndim() != 1 || theta.size() != I.size())
-                  throw py::value_error("theta and I must be 1-D arrays of the same size");
-              const py::ssize_t n = theta.size();
-              darray z({n, py::ssize_t(4)});
-              py::array_t<bool> ok(n);
-              std::vector<std::string> why(static_cast<std::size_t>(n));
-              for (py::ssize_t i = 0; i < n; ++i) {
-                  std::array<double, 4> p{};
-                  const bool good = try_section_point(s, h, theta.data()[i], I.data()[i], p, &why[std::size_t(i)]);
-                  if (!good) p.fill(std::numeric_limits<double>::quiet_NaN());
-                  ok.mutable_data()[i] = good;
-                  for (int k = 0; k < 4; ++k) z.mutable_data()[4 * i + k] = p[std::size_t(k)];
-              }
-              return py::make_tuple(z, ok, why);
-          },
-          py::arg("system"), py::arg("h"), py::arg("theta"), py::arg("I"),
-          "Points of Sigma_h at (theta, I): (z (n, 4), ok, reasons); NaN rows where no point exists.");
-    m.def("section_coordinates",
-          [](const FlowSystem& s, const darray& z) {
-              if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
-              darray out({z.shape(0), py::ssize_t(2)});
-              for (py::ssize_t i = 0; i < z.shape(0); ++i) {
-                  const double* zi = z.data() + 4 * i;
-                  std::array<double, 2> c{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-                  if (std::isfinite(zi[0]) && std::isfinite(zi[1]) && std::isfinite(zi[2]) && std::isfinite(zi[3]))
-                      c = section_coordinates(s, zi);
-                  out.mutable_data()[2 * i] = c[0];
-                  out.mutable_data()[2 * i + 1] = c[1];
-              }
-              return out;
-          },
-          py::arg("system"), py::arg("z"), "Section coordinates (theta, I) of states z (NaN rows stay NaN).");
-    m.def("return_maps",
-          [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads, double trajectory_dt,
-             std::int64_t max_points_per_orbit, py::object progress) {
-              o.validate();
-              if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
-              if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
-                  throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
-                                        std::to_string(trajectory_dt));
-              const py::ssize_t n = z0.shape(0);
-              darray z({n, py::ssize_t(4)}), time(n), err(n);
-              py::array_t<std::int8_t> status(n), region(n);
-              py::array_t<std::int64_t> steps(n);
-              std::vector<std::string> itin{static_cast<std::size_t>(n)};
-              hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
-              FlowWork work;
-              ReturnMapsOutput out;
-              out.z = z.mutable_data();
-              out.time = time.mutable_data();
-              out.energy_error = err.mutable_data();
-              out.status = status.mutable_data();
-              out.region = region.mutable_data();
-              out.steps = steps.mutable_data();
-              out.itinerary = itin.data();
-              out.work = &work;
-              out.trajectory = traj.output();
-              std::atomic<bool> cancel{false};
-              std::atomic<std::int64_t> done{0};
-              const hovering_py::ProgressReport report{&done, std::int64_t(n), std::move(progress)};
-              // Orbits are independent and write disjoint slots of freshly allocated arrays.
-              const bool interrupted = hovering_py::run_watched(
-                  [&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out, report.active() ? &done : nullptr); },
-                  cancel, n >= 64, &report);
-              py::dict d;
-              d["z"] = z;
-              d["time"] = time;
-              d["energy_error"] = err;
-              d["status"] = status;
-              d["region"] = region;
-              d["steps"] = steps;
-              d["itinerary"] = itin;
-              d["work"] = hovering_py::work_dict(work);
-              traj.put(d);
-              d["interrupted"] = interrupted;
-              return d;
-          },
-          py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
-          py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(),
-          "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit; with trajectory_dt > 0 "
-          "each return's trajectory too; progress(done, total) is called every ~0.1 s and at the end.");
+    m.def(
+        "section_points",
+        [](const FlowSystem& s, double h, const darray& theta, const darray& I) {
+            if (theta.ndim() != 1 || I.ndim() != 1 || theta.size() != I.size())
+                throw py::value_error("theta and I must be 1-D arrays of the same size");
+            const py::ssize_t n = theta.size();
+            darray z({n, py::ssize_t(4)});
+            py::array_t<bool> ok(n);
+            std::vector<std::string> why(static_cast<std::size_t>(n));
+            for (py::ssize_t i = 0; i < n; ++i) {
+                std::array<double, 4> p{};
+                const bool good = try_section_point(s, h, theta.data()[i], I.data()[i], p, &why[std::size_t(i)]);
+                if (!good) p.fill(std::numeric_limits<double>::quiet_NaN());
+                ok.mutable_data()[i] = good;
+                for (int k = 0; k < 4; ++k) z.mutable_data()[4 * i + k] = p[std::size_t(k)];
+            }
+            return py::make_tuple(z, ok, why);
+        },
+        py::arg("system"), py::arg("h"), py::arg("theta"), py::arg("I"),
+        "Points of Sigma_h at (theta, I): (z (n, 4), ok, reasons); NaN rows where no point exists.");
+    m.def(
+        "section_coordinates",
+        [](const FlowSystem& s, const darray& z) {
+            if (z.ndim() != 2 || z.shape(1) != 4) throw py::value_error("z must have shape (n, 4)");
+            darray out({z.shape(0), py::ssize_t(2)});
+            for (py::ssize_t i = 0; i < z.shape(0); ++i) {
+                const double* zi = z.data() + 4 * i;
+                std::array<double, 2> c{std::numeric_limits<double>::quiet_NaN(),
+                                        std::numeric_limits<double>::quiet_NaN()};
+                if (std::isfinite(zi[0]) && std::isfinite(zi[1]) && std::isfinite(zi[2]) && std::isfinite(zi[3]))
+                    c = section_coordinates(s, zi);
+                out.mutable_data()[2 * i] = c[0];
+                out.mutable_data()[2 * i + 1] = c[1];
+            }
+            return out;
+        },
+        py::arg("system"), py::arg("z"), "Section coordinates (theta, I) of states z (NaN rows stay NaN).");
+    m.def(
+        "return_maps",
+        [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads, double trajectory_dt,
+           std::int64_t max_points_per_orbit, py::object progress) {
+            o.validate();
+            if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
+            if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
+                throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
+                                      std::to_string(trajectory_dt));
+            const py::ssize_t n = z0.shape(0);
+            darray z({n, py::ssize_t(4)}), time(n), err(n);
+            py::array_t<std::int8_t> status(n), region(n);
+            py::array_t<std::int64_t> steps(n);
+            std::vector<std::string> itin{static_cast<std::size_t>(n)};
+            hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
+            FlowWork work;
+            ReturnMapsOutput out;
+            out.z = z.mutable_data();
+            out.time = time.mutable_data();
+            out.energy_error = err.mutable_data();
+            out.status = status.mutable_data();
+            out.region = region.mutable_data();
+            out.steps = steps.mutable_data();
+            out.itinerary = itin.data();
+            out.work = &work;
+            out.trajectory = traj.output();
+            std::atomic<bool> cancel{false};
+            std::atomic<std::int64_t> done{0};
+            const hovering_py::ProgressReport report{&done, std::int64_t(n), std::move(progress)};
+            // Orbits are independent and write disjoint slots of freshly allocated arrays.
+            const bool interrupted = hovering_py::run_watched(
+                [&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out, report.active() ? &done : nullptr); },
+                cancel, n >= 64, &report);
+            py::dict d;
+            d["z"] = z;
+            d["time"] = time;
+            d["energy_error"] = err;
+            d["status"] = status;
+            d["region"] = region;
+            d["steps"] = steps;
+            d["itinerary"] = itin;
+            d["work"] = hovering_py::work_dict(work);
+            traj.put(d);
+            d["interrupted"] = interrupted;
+            return d;
+        },
+        py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
+        py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(),
+        "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit; with trajectory_dt > 0 "
+        "each return's trajectory too; progress(done, total) is called every ~0.1 s and at the end.");
 }

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "flow_results.hpp"
 #include "hovering/normal/flow_map.hpp"
 #include "hovering/normal/tangential_curve.hpp"
-#include "flow_results.hpp"
 #include "pybind.hpp"
 #include "signals.hpp"
 
@@ -84,7 +84,8 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
     if (every < 1) throw py::value_error("every must be >= 1, got " + std::to_string(every));
     const py::ssize_t n = x0.size();
     // Points and returns kept per orbit: every e-th (see FlowIterateOutput).
-    const py::ssize_t np = py::ssize_t(recorded_states(n_steps, every)), ns = py::ssize_t(recorded_returns(n_steps, every));
+    const py::ssize_t np = py::ssize_t(recorded_states(n_steps, every)),
+                      ns = py::ssize_t(recorded_returns(n_steps, every));
     auto has = [&](const char* k) { return record.contains(py::str(k)); };
     FlowIterateOptions opt;
     opt.n_steps = n_steps;
@@ -95,8 +96,8 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
     opt.stop = stop_condition(stop_side, std::move(stop_curve));
     // Labels only where something reads them: otherwise no crossing of q1 = qw1 is tracked and no
     // itinerary built (the orbit is the same bit for bit).
-    opt.labels = exit_mask != 0 || has("regions") || has("visited") || has("itinerary") || has("rotation") ||
-                 has("residence");
+    opt.labels =
+        exit_mask != 0 || has("regions") || has("visited") || has("itinerary") || has("rotation") || has("residence");
     if (has("trajectory") != (trajectory_dt > 0))
         throw py::value_error("record 'trajectory' and trajectory_dt > 0 go together");
     if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
@@ -222,17 +223,23 @@ void register_normal(py::module_& m) {
                  return std::make_shared<TangentialCurve>(TangentialCurve::measure(s, h, n, o, n_check));
              }),
              py::arg("system"), py::arg("h"), py::arg("n"), py::arg("options"), py::arg("n_check"))
-        .def("I_tan", [](const TangentialCurve& c, const darray& th) { return map1(th, [&](double t) { return c.I_tan(t); }); },
-             py::arg("theta"), "I_tan(theta) (the curve must be a graph).")
-        .def("parameter_of",
-             [](const TangentialCurve& c, const darray& th) { return map1(th, [&](double t) { return c.parameter_of(t); }); },
-             py::arg("theta"), "Wall angle s with theta(s) = theta.")
-        .def("at",
-             [](const TangentialCurve& c, const darray& s) {
-                 return py::make_tuple(map1(s, [&](double x) { return c.at(x).first; }),
-                                       map1(s, [&](double x) { return c.at(x).second; }));
-             },
-             py::arg("s"), "(theta(s), I(s)) at wall angles s.")
+        .def(
+            "I_tan",
+            [](const TangentialCurve& c, const darray& th) { return map1(th, [&](double t) { return c.I_tan(t); }); },
+            py::arg("theta"), "I_tan(theta) (the curve must be a graph).")
+        .def(
+            "parameter_of",
+            [](const TangentialCurve& c, const darray& th) {
+                return map1(th, [&](double t) { return c.parameter_of(t); });
+            },
+            py::arg("theta"), "Wall angle s with theta(s) = theta.")
+        .def(
+            "at",
+            [](const TangentialCurve& c, const darray& s) {
+                return py::make_tuple(map1(s, [&](double x) { return c.at(x).first; }),
+                                      map1(s, [&](double x) { return c.at(x).second; }));
+            },
+            py::arg("s"), "(theta(s), I(s)) at wall angles s.")
         .def_property_readonly("is_graph", &TangentialCurve::is_graph)
         .def_property_readonly("min_slope", &TangentialCurve::min_slope)
         .def_property_readonly("min_slope_at", &TangentialCurve::min_slope_at)
@@ -241,7 +248,8 @@ void register_normal(py::module_& m) {
         .def_property_readonly("I_tan0", &TangentialCurve::I_tan0)
         .def_property_readonly("h", &TangentialCurve::h)
         .def_property_readonly("s", [](const TangentialCurve& c) { return darray(c.s().size(), c.s().data()); })
-        .def_property_readonly("theta", [](const TangentialCurve& c) { return darray(c.theta().size(), c.theta().data()); })
+        .def_property_readonly("theta",
+                               [](const TangentialCurve& c) { return darray(c.theta().size(), c.theta().data()); })
         .def_property_readonly("I", [](const TangentialCurve& c) { return darray(c.I().size(), c.I().data()); })
         .def_static(
             "measure_refined",
@@ -250,7 +258,8 @@ void register_normal(py::module_& m) {
                 return std::make_shared<TangentialCurve>(TangentialCurve::measure_refined(s, h, o, n_check));
             },
             py::arg("system"), py::arg("h"), py::arg("options"), py::arg("n_check") = 4,
-            "The curve from 64 wall points, doubled (up to 1024) until its measured interpolation error is below 1e-12.")
+            "The curve from 64 wall points, doubled (up to 1024) until its measured interpolation error is below "
+            "1e-12.")
         .def(
             "forcing_coefficients",
             [](const TangentialCurve& c, int n_modes, int n_phi) {
@@ -258,7 +267,8 @@ void register_normal(py::module_& m) {
                 return darray(py::ssize_t(b.size()), b.data());
             },
             py::arg("n_modes") = TangentialCurve::kForcingModes, py::arg("n_phi") = TangentialCurve::kForcingSamples,
-            "Sine coefficients b_1..b_n_modes of the measured forcing f (eq:defoff), f sampled at forcing_angles(n_phi).");
+            "Sine coefficients b_1..b_n_modes of the measured forcing f (eq:defoff), f sampled at "
+            "forcing_angles(n_phi).");
     m.attr("FORCING_MODES") = TangentialCurve::kForcingModes;
     m.attr("FORCING_SAMPLES") = TangentialCurve::kForcingSamples;
     m.def(

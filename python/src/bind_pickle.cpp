@@ -22,21 +22,24 @@ namespace {
 /// The tuple a __setstate__ received, checked to have n entries.
 py::tuple state_of(const py::handle& state, std::size_t n, const char* cls, const char* fields) {
     if (!py::isinstance<py::tuple>(state) || py::len(state) != n)
-        throw py::value_error(std::string(cls) + ".__setstate__: expected the tuple " + fields + ", got " + short_repr(state));
+        throw py::value_error(std::string(cls) + ".__setstate__: expected the tuple " + fields + ", got " +
+                              short_repr(state));
     return py::reinterpret_borrow<py::tuple>(state);
 }
 
 /// A list of real numbers from a state entry (a ValueError naming the entry otherwise).
 std::vector<double> reals(const py::handle& v, const char* cls, const char* name) {
     if (!py::isinstance<py::sequence>(v) || py::isinstance<py::str>(v))
-        throw py::value_error(std::string(cls) + ".__setstate__: " + name + " must be a sequence of real numbers, got " +
-                              short_repr(v));
+        throw py::value_error(std::string(cls) + ".__setstate__: " + name +
+                              " must be a sequence of real numbers, got " + short_repr(v));
     std::vector<double> out;
     for (const auto& x : py::reinterpret_borrow<py::sequence>(v)) out.push_back(real_arg(x, cls, name));
     return out;
 }
 
-py::array_t<double> as_array(const std::vector<double>& v) { return py::array_t<double>(py::ssize_t(v.size()), v.data()); }
+py::array_t<double> as_array(const std::vector<double>& v) {
+    return py::array_t<double>(py::ssize_t(v.size()), v.data());
+}
 
 /// The K grid and tables a TruncatedFamily was built from, read back from its splines: Omega on the
 /// whole grid, |J_R| and |J_1| on its K <= 0 part (|J_1| splined in sqrt(-K), in reverse order);
@@ -52,8 +55,8 @@ py::tuple family_state(const TruncatedFamily& m) {
         JR[i] = jr[i];
         J1[i] = j1[n_neg - 1 - i];
     }
-    return py::make_tuple(m.eps(), as_array(K), as_array(a.Omega.y()), as_array(JR), as_array(J1), as_array(m.forcing().b),
-                          m.band().hi);
+    return py::make_tuple(m.eps(), as_array(K), as_array(a.Omega.y()), as_array(JR), as_array(J1),
+                          as_array(m.forcing().b), m.band().hi);
 }
 
 }  // namespace
@@ -106,8 +109,9 @@ void register_pickles(py::module_& core) {
                                   o.corner_tol);
         },
         [](const py::object& state) {
-            const py::tuple t = state_of(state, 8, "FlowOptions",
-                                         "(stepper, rtol, atol, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)");
+            const py::tuple t =
+                state_of(state, 8, "FlowOptions",
+                         "(stepper, rtol, atol, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)");
             FlowOptions o;
             try {
                 o.stepper = t[0].cast<std::string>();
@@ -138,7 +142,8 @@ void register_pickles(py::module_& core) {
             const char* who = "TangentialCurve";
             const py::tuple t = state_of(state, 7, who, "(h, eps, I_tan0, theta, I, err_theta, err_I)");
             return std::make_shared<TangentialCurve>(TangentialCurve::from_samples(
-                real_arg(t[0], who, "h"), real_arg(t[1], who, "eps"), real_arg(t[2], who, "I_tan0"), reals(t[3], who, "theta"),
-                reals(t[4], who, "I"), real_arg(t[5], who, "err_theta"), real_arg(t[6], who, "err_I")));
+                real_arg(t[0], who, "h"), real_arg(t[1], who, "eps"), real_arg(t[2], who, "I_tan0"),
+                reals(t[3], who, "theta"), reals(t[4], who, "I"), real_arg(t[5], who, "err_theta"),
+                real_arg(t[6], who, "err_I")));
         }));
 }

@@ -14,9 +14,9 @@
 #include <memory>
 #include <string>
 
+#include "gil.hpp"
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/system.hpp"
-#include "gil.hpp"
 #include "pybind.hpp"
 
 using namespace hovering;
@@ -151,8 +151,8 @@ private:
         }
         if (!v) return fallback;
         if (!PyUnicode_Check(v.ptr()))
-            wrong_return(fallback + ": name" + (called ? "() must return" : " must be") + " a str, got " + short_repr(v) +
-                         " of type " + std::string(Py_TYPE(v.ptr())->tp_name));
+            wrong_return(fallback + ": name" + (called ? "() must return" : " must be") + " a str, got " +
+                         short_repr(v) + " of type " + std::string(Py_TYPE(v.ptr())->tp_name));
         return v.cast<std::string>();
     }
 
@@ -191,7 +191,8 @@ public:
     /// Stores the callables; q_limit > 0 (inf for an unbounded well).
     CallablePotential(py::object V, py::object dV, double q_limit, std::string name)
         : V_(std::move(V)), dV_(std::move(dV)), q_limit_(q_limit), name_(std::move(name)) {
-        if (!PyCallable_Check(V_.ptr()) || !PyCallable_Check(dV_.ptr())) throw py::value_error("V and dV must be callable");
+        if (!PyCallable_Check(V_.ptr()) || !PyCallable_Check(dV_.ptr()))
+            throw py::value_error("V and dV must be callable");
         if (!(q_limit_ > 0)) throw py::value_error("q_limit must be > 0 (or inf), got " + fmt(q_limit_));
     }
     /// The last reference may go from a thread without the GIL (a core object holding the
@@ -231,8 +232,9 @@ private:
 /// feature of pybind11 >= 3 only).
 std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
     if (!py::isinstance<Potential>(obj))
-        throw py::type_error("expected a hovering potential (Harmonic, Tan, CustomPotential, a Potential subclass), got " +
-                             py::repr(obj).cast<std::string>());
+        throw py::type_error(
+            "expected a hovering potential (Harmonic, Tan, CustomPotential, a Potential subclass), got " +
+            py::repr(obj).cast<std::string>());
     const Potential* cpp = obj.cast<const Potential*>();
     std::shared_ptr<py::object> owner(new py::object(obj), [](py::object* o) {
         const hovering_py::Gil gil;
@@ -246,7 +248,8 @@ std::shared_ptr<const Potential> keep_python_alive(const py::object& obj) {
 /// otherwise: a corrupted or foreign pickle, not a crash).
 py::tuple state_tuple(const py::handle& state, std::size_t n, const char* cls, const char* fields) {
     if (!py::isinstance<py::tuple>(state) || py::len(state) != n)
-        throw py::value_error(std::string(cls) + ".__setstate__: expected the tuple " + fields + ", got " + short_repr(state));
+        throw py::value_error(std::string(cls) + ".__setstate__: expected the tuple " + fields + ", got " +
+                              short_repr(state));
     return py::reinterpret_borrow<py::tuple>(state);
 }
 
@@ -299,7 +302,9 @@ void register_potential_pickles(py::module_& m) {
         }));
     py::class_<OnsetParameters> onset(m.attr("OnsetParameters"));
     onset.def(py::pickle(
-        [](const OnsetParameters& p) { return py::object(py::make_tuple(p.Omega0, p.tau0, p.tau1, p.lam, p.theta_w, p.I_tan)); },
+        [](const OnsetParameters& p) {
+            return py::object(py::make_tuple(p.Omega0, p.tau0, p.tau1, p.lam, p.theta_w, p.I_tan));
+        },
         [](const py::object& state) {
             const py::tuple t = state_tuple(state, 6, "OnsetParameters", "(Omega0, tau0, tau1, lam, theta_w, I_tan)");
             const char* names[6] = {"Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan"};
@@ -312,7 +317,6 @@ void register_potential_pickles(py::module_& m) {
 }  // namespace
 
 void register_potential(py::module_& m) {
-
     py::class_<Potential, PyPotential, std::shared_ptr<Potential>> pot(
         m, "Potential",
         "A single-well potential V(q), V(0) = 0, q V'(q) > 0. Subclass it in Python by defining V(self, q) and "
@@ -340,14 +344,15 @@ void register_potential(py::module_& m) {
              "Angle of (q, p < 0) on the level h: omega(h) x time from q to q_max (paper's convention).")
         .def("point_at", two(&Potential::point_at, "point_at", "theta", "h"), py::arg("theta"), py::arg("h"),
              "(q, p) at angle theta in [-pi, pi] on the level h (sign(p) = -sign(theta)).")
-        .def("angle_of_point",
-             [](const Potential& self, py::handle q, py::handle p, py::handle h) {
-                 return self.angle_of_point(real_arg(q, "angle_of_point", "q"), real_arg(p, "angle_of_point", "p"),
-                                            real_arg(h, "angle_of_point", "h"));
-             },
-             py::arg("q"), py::arg("p"), py::arg("h"),
-             "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q) (ValueError if "
-             "p^2/2 + V(q) differs from h by more than 1e-8 h).")
+        .def(
+            "angle_of_point",
+            [](const Potential& self, py::handle q, py::handle p, py::handle h) {
+                return self.angle_of_point(real_arg(q, "angle_of_point", "q"), real_arg(p, "angle_of_point", "p"),
+                                           real_arg(h, "angle_of_point", "h"));
+            },
+            py::arg("q"), py::arg("p"), py::arg("h"),
+            "Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q) (ValueError if "
+            "p^2/2 + V(q) differs from h by more than 1e-8 h).")
         .def_property_readonly("name", &Potential::name)
         .def_property_readonly("q_limit", &Potential::q_limit, "Largest |q| inside the well (inf if unbounded).")
         .def("__repr__", &Potential::name);
@@ -357,16 +362,19 @@ void register_potential(py::module_& m) {
     py::object err = py::reinterpret_borrow<py::object>(reinterpret_cast<PyObject*>(&PyType_Type))(
         "ReturnError", py::make_tuple(py::handle(PyExc_ValueError), py::handle(PyExc_TypeError)),
         py::dict(py::arg("__module__") = m.attr("__name__"), py::arg("__qualname__") = "Potential.ReturnError",
-                 py::arg("__doc__") = "A method of a potential defined in Python (V, dV, q_limit, name) returned a value "
-                                      "of the wrong kind: a ValueError, and the TypeError V and V' raised for it before."));
+                 py::arg("__doc__") =
+                     "A method of a potential defined in Python (V, dV, q_limit, name) returned a value "
+                     "of the wrong kind: a ValueError, and the TypeError V and V' raised for it before."));
     pot.attr("ReturnError") = err;
     potential_return_error = err.release().ptr();
-    py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>>(m, "Harmonic", "V = omega^2 q^2 / 2 (closed-form action-angle).")
-        .def(py::init([](py::handle omega) { return std::make_shared<Harmonic>(real_arg(omega, "Harmonic", "omega")); }),
-             py::arg("omega"))
+    py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>>(m, "Harmonic",
+                                                               "V = omega^2 q^2 / 2 (closed-form action-angle).")
+        .def(
+            py::init([](py::handle omega) { return std::make_shared<Harmonic>(real_arg(omega, "Harmonic", "omega")); }),
+            py::arg("omega"))
         .def_property_readonly("omega", &Harmonic::omega);
-    py::class_<Tan, Potential, std::shared_ptr<Tan>>(m, "Tan",
-                                                    "V = omega^2 / (2 alpha^2) tan^2(alpha q) (closed-form action-angle).")
+    py::class_<Tan, Potential, std::shared_ptr<Tan>>(
+        m, "Tan", "V = omega^2 / (2 alpha^2) tan^2(alpha q) (closed-form action-angle).")
         .def(py::init([](py::handle omega, py::handle alpha) {
                  return std::make_shared<Tan>(real_arg(omega, "Tan", "omega"), real_arg(alpha, "Tan", "alpha"));
              }),
@@ -410,19 +418,24 @@ void register_potential(py::module_& m) {
             e.restore();
         }
     });
-    m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"),
-          py::arg("rtol") = 1e-6);
+    m.def("_onset_parameters", &onset_parameters, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"),
+          py::arg("h"), py::arg("rtol") = 1e-6);
     m.def("_onset_parameters_closed_form", &onset_parameters_closed_form, py::arg("omega1"), py::arg("alpha1"),
           py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"), py::arg("rtol") = 1e-6);
     // (values, errors) as two OnsetParameters.
-    m.def("_onset_estimate", [](const Potential& V1, const Potential& V2, double qw1, double qw2, double h, double rtol) {
-        const OnsetEstimate e = onset_estimate(V1, V2, qw1, qw2, h, rtol);
-        return std::make_pair(e.value, e.error);
-    }, py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"), py::arg("rtol") = 1e-6);
-    m.def("_onset_estimate_closed_form", [](double w1, double a1, double w2, double a2, double qw1, double qw2, double h,
-                                            double rtol) {
-        const OnsetEstimate e = onset_estimate_closed_form(w1, a1, w2, a2, qw1, qw2, h, rtol);
-        return std::make_pair(e.value, e.error);
-    }, py::arg("omega1"), py::arg("alpha1"), py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"),
-          py::arg("h"), py::arg("rtol") = 1e-6);
+    m.def(
+        "_onset_estimate",
+        [](const Potential& V1, const Potential& V2, double qw1, double qw2, double h, double rtol) {
+            const OnsetEstimate e = onset_estimate(V1, V2, qw1, qw2, h, rtol);
+            return std::make_pair(e.value, e.error);
+        },
+        py::arg("V1"), py::arg("V2"), py::arg("qw1"), py::arg("qw2"), py::arg("h"), py::arg("rtol") = 1e-6);
+    m.def(
+        "_onset_estimate_closed_form",
+        [](double w1, double a1, double w2, double a2, double qw1, double qw2, double h, double rtol) {
+            const OnsetEstimate e = onset_estimate_closed_form(w1, a1, w2, a2, qw1, qw2, h, rtol);
+            return std::make_pair(e.value, e.error);
+        },
+        py::arg("omega1"), py::arg("alpha1"), py::arg("omega2"), py::arg("alpha2"), py::arg("qw1"), py::arg("qw2"),
+        py::arg("h"), py::arg("rtol") = 1e-6);
 }

@@ -14,11 +14,12 @@ using namespace hovering;
 
 namespace {
 
-std::vector<py::ssize_t> shape_of(const darray& a) { return {a.shape(), a.shape() + a.ndim()}; }
+std::vector<py::ssize_t> shape_of(const darray& a) {
+    return {a.shape(), a.shape() + a.ndim()};
+}
 
 void same_shape(const darray& a, const darray& b, const char* an, const char* bn) {
-    if (shape_of(a) != shape_of(b))
-        throw py::value_error(std::string(an) + " and " + bn + " must have the same shape");
+    if (shape_of(a) != shape_of(b)) throw py::value_error(std::string(an) + " and " + bn + " must have the same shape");
 }
 
 // Apply a scalar (phi, K) -> (x, y) member elementwise.
@@ -43,13 +44,11 @@ py::tuple map2(const Map& m, const darray& phi, const darray& K, Fn fn) {
 // Runs the batch iteration with Ctrl-C watched (signals.hpp), so a long run can be interrupted and
 // still hand back everything computed so far.
 template <class Map>
-py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps,
-                 bool record_orbit, bool record_regions, bool record_rotation, unsigned exit_mask,
-                 bool stop_on_exit, int n_threads, const std::string& kernel, double sin_ulp, bool record_visited,
-                 py::object progress, std::int64_t every, int stop_side, py::object stop_curve, bool record_extrema,
-                 bool record_residence) {
-    if (phi0.ndim() != 1 || K0.ndim() != 1)
-        throw py::value_error("phi0 and K0 must be 1-D arrays");
+py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps, bool record_orbit,
+                 bool record_regions, bool record_rotation, unsigned exit_mask, bool stop_on_exit, int n_threads,
+                 const std::string& kernel, double sin_ulp, bool record_visited, py::object progress,
+                 std::int64_t every, int stop_side, py::object stop_curve, bool record_extrema, bool record_residence) {
+    if (phi0.ndim() != 1 || K0.ndim() != 1) throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
     if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
     if (every < 1) throw py::value_error("every must be >= 1, got " + std::to_string(every));
@@ -148,9 +147,10 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
 
 template <class Map, class Cls>
 void bind_common(Cls& cls) {
-    cls.def("_step", [](const Map& m, const darray& phi, const darray& K) {
-           return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step(p, k); });
-       })
+    cls.def("_step",
+            [](const Map& m, const darray& phi, const darray& K) {
+                return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step(p, k); });
+            })
         .def("_step_inverse",
              [](const Map& m, const darray& phi, const darray& K) {
                  return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step_inverse(p, k); });
@@ -193,27 +193,27 @@ void bind_common(Cls& cls) {
                  }
                  return out;
              })
-        .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"),
-             py::arg("record_orbit"), py::arg("record_regions"), py::arg("record_rotation"),
-             py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"),
-             py::arg("record_visited") = false, py::arg("progress") = py::none(), py::arg("every") = 1,
-             py::arg("stop_side") = 0, py::arg("stop_curve") = py::none(), py::arg("record_extrema") = false,
-             py::arg("record_residence") = false)
+        .def("_iterate", &iterate<Map>, py::arg("phi0"), py::arg("K0"), py::arg("n_steps"), py::arg("record_orbit"),
+             py::arg("record_regions"), py::arg("record_rotation"), py::arg("exit_mask"), py::arg("stop_on_exit"),
+             py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"), py::arg("record_visited") = false,
+             py::arg("progress") = py::none(), py::arg("every") = 1, py::arg("stop_side") = 0,
+             py::arg("stop_curve") = py::none(), py::arg("record_extrema") = false, py::arg("record_residence") = false)
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
-        .def("valid_band",
-             [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },
-             "Open interval (lo, hi) of K on which the map is defined: all three arcs in (0, 2 pi) and the\n"
-             "rotation |Omega(K)| <= 1e6 (beyond, one step keeps less than ~2e-10 rad of phi).");
+        .def(
+            "valid_band", [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },
+            "Open interval (lo, hi) of K on which the map is defined: all three arcs in (0, 2 pi) and the\n"
+            "rotation |Omega(K)| <= 1e6 (beyond, one step keeps less than ~2e-10 rad of phi).");
 }
 
 }  // namespace
 
 void register_truncated(py::module_& mod) {
     py::class_<TruncatedMap> tm(mod, "TruncatedMap", "Compiled F_eps (eq:truncatedmap); use hovering.TruncatedMap.");
-    tm.def(py::init([](double eps, double Omega0, double theta_w, double tau0, double tau1, double lam,
-                       double K_max) { return make_truncated_map(eps, Omega0, theta_w, tau0, tau1, lam, K_max); }),
-           py::arg("eps"), py::arg("Omega0"), py::arg("theta_w"), py::arg("tau0"), py::arg("tau1"),
-           py::arg("lam"), py::arg("K_max"))
+    tm.def(py::init([](double eps, double Omega0, double theta_w, double tau0, double tau1, double lam, double K_max) {
+               return make_truncated_map(eps, Omega0, theta_w, tau0, tau1, lam, K_max);
+           }),
+           py::arg("eps"), py::arg("Omega0"), py::arg("theta_w"), py::arg("tau0"), py::arg("tau1"), py::arg("lam"),
+           py::arg("K_max"))
         .def_property_readonly("Omega0", [](const TruncatedMap& m) { return m.arcs().Omega0; })
         .def_property_readonly("theta_w", [](const TruncatedMap& m) { return m.arcs().theta_w; })
         .def_property_readonly("tau0", [](const TruncatedMap& m) { return m.arcs().tau0; })
@@ -232,5 +232,6 @@ void register_truncated(py::module_& mod) {
     bind_common<TruncatedFamily>(tf);
 
     mod.def("simd_is_avx2", &simd_is_avx2, "Whether this build has AVX2 (its SIMD kernel uses AVX2 or wider vectors).");
-    mod.def("simd_width", &simd_width, "Doubles per SIMD packet of the kernel in this build (8 AVX-512, 4 AVX2, 2 SSE2).");
+    mod.def("simd_width", &simd_width,
+            "Doubles per SIMD packet of the kernel in this build (8 AVX-512, 4 AVX2, 2 SSE2).");
 }

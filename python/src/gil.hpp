@@ -87,8 +87,7 @@ public:
         finaliser() = true;
         word().fetch_or(kClosed);
         if (inside() == 0) return;
-        Py_BEGIN_ALLOW_THREADS
-        wait_until_empty();
+        Py_BEGIN_ALLOW_THREADS wait_until_empty();
         Py_END_ALLOW_THREADS
     }
 

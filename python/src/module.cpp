@@ -1,8 +1,8 @@
 // Entry point of hovering._core: a thin module with one submodule per topic of the core
 // (truncated, flow, normal, analysis), each registering itself; the shared enums live at the top.
+#include "gil.hpp"
 #include "hovering/build_info.hpp"
 #include "pybind.hpp"
-#include "gil.hpp"
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "Compiled core of hovering: the truncated map, the impact flow, and the flow as a map on (phi, K).";

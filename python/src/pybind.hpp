@@ -43,8 +43,8 @@ inline std::string short_repr(py::handle o, std::size_t width = 60) {
 inline double real_arg(py::handle o, const char* who, const char* name) {
     double v;
     if (as_real(o, &v)) return v;
-    throw py::value_error(std::string(who) + ": " + name + " must be a real number (within the range of a double), got " +
-                          short_repr(o));
+    throw py::value_error(std::string(who) + ": " + name +
+                          " must be a real number (within the range of a double), got " + short_repr(o));
 }
 
 /// Input arrays: C-contiguous doubles, converted (copied) only when the caller's array is not.

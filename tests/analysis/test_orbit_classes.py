@@ -207,8 +207,9 @@ def test_brute_force_box_counting_agrees():
     res = m.iterate(m.L1(K0), K0, n, record=("orbit",))
     c = hovering.classify_orbits(res)
     for i, k in enumerate(K0):
-        ratio = (covered_fraction(res.phi[i], res.K[i], k - 0.1, k + 0.1, 64)
-                 / covered_fraction(res.phi[i], res.K[i], k - 0.1, k + 0.1, 32))
+        ratio = covered_fraction(res.phi[i], res.K[i], k - 0.1, k + 0.1, 64) / covered_fraction(
+            res.phi[i], res.K[i], k - 0.1, k + 0.1, 32
+        )
         assert c.kind[i] == "circle" and ratio < 0.7, (k, c.kind[i], ratio)
 
 
@@ -273,8 +274,13 @@ def test_converse_kam_truncated_map():
     r = hovering.converse_kam(m, m.L2(K_isl[isl]), K_isl[isl], 2000)
     assert np.all(r.crossed)
     Kg = np.linspace(-0.5, 0.5, 11)
-    family = hovering.TruncatedFamily(0.3, Kg, m.Omega0 + m.tau0 * Kg, 2 * (math.pi - m.theta_w) + m.tau1 * Kg,
-                                      2 * m.lam * np.sqrt(np.maximum(-Kg, 0.0)))
+    family = hovering.TruncatedFamily(
+        0.3,
+        Kg,
+        m.Omega0 + m.tau0 * Kg,
+        2 * (math.pi - m.theta_w) + m.tau1 * Kg,
+        2 * m.lam * np.sqrt(np.maximum(-Kg, 0.0)),
+    )
     r = hovering.converse_kam(m, m.L1(-0.35), -0.35, 2000)
     assert r.status[0] == "left_domain"
     res = m.iterate(m.L1(-0.35), -0.35, r.step[0], record=("orbit", "regions"))
@@ -307,8 +313,15 @@ def test_flow_map_agrees_with_its_model():
     """README system at eps = -0.05 (hovers; its critical curve lies near K = -0.025): starts on L1
     well above it are circles for the flow and for its truncated model alike, and the start at
     K = -0.05 is in the period-2 island chain for both."""
-    sys_ = hovering.StepSystem(V1=hovering.Harmonic(omega=1.0), V2=hovering.Tan(omega=1.4, alpha=0.7),
-                               coupling=hovering.Bilinear(), eps=-0.05, qw1=-1.0, qw2=-0.5, geometry="step")
+    sys_ = hovering.StepSystem(
+        V1=hovering.Harmonic(omega=1.0),
+        V2=hovering.Tan(omega=1.4, alpha=0.7),
+        coupling=hovering.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
     fm = hovering.FlowMap(sys_, h=1.0, rtol=1e-10)
     tm = fm.truncated()
     K0 = np.array([0.01, 0.03, 0.06, -0.05])

@@ -51,8 +51,10 @@ def test_generic_action_of_tan_on_high_levels_with_steep_walls():
     # for the onset case of tests/flow/test_onset_hard.py. Bound: the 1e-10 the onset error estimate takes
     # for a quadrature's action (measured worst 3.9e-11 over 40,000 random levels); the two named
     # cases now to 1e-12.
-    for w, a, h in [(2.596276452619615, 0.12982146198486358, 1.2906874458886323e20),
-                    (8.058421877614817, 1.0, 1.3508147725979195e24)]:
+    for w, a, h in [
+        (2.596276452619615, 0.12982146198486358, 1.2906874458886323e20),
+        (8.058421877614817, 1.0, 1.3508147725979195e24),
+    ]:
         T = Tan(w, a)
         assert abs(Numerical(T).action(h) / T.action(h) - 1) <= 1e-12, (w, a, h)
     rng = np.random.default_rng(5)
@@ -111,8 +113,9 @@ def test_return_map_batch_with_a_quadrature_V2_near_the_turning_points():
     I = np.full(th.size, 0.3)
 
     def sec(V2):
-        return Section(StepSystem(V1=Harmonic(1.0), V2=V2, coupling=Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5,
-                                  geometry="step"), 1.0)
+        return Section(
+            StepSystem(V1=Harmonic(1.0), V2=V2, coupling=Bilinear(), eps=0.05, qw1=-1.0, qw2=-0.5, geometry="step"), 1.0
+        )
 
     ref = sec(Tan(1.4, 0.7)).return_map(th, I, rtol=1e-12, n_threads=1)
     out = sec(Numerical(Tan(1.4, 0.7))).return_map(th, I, rtol=1e-12, n_threads=1)
@@ -166,9 +169,11 @@ def test_wrong_name_and_V_are_named_value_errors():
     with pytest.raises(ValueError, match=r"Sub\(\): name\(\) must return a str, got None"):
         _sub(name=lambda self: None).period(-1.0)
     assert repr(_sub(name=lambda self: "mine")) == "mine"
+
     # A name that raises does not replace the core's message: the class name stands in.
     def boom(self):
         raise RuntimeError("no name")
+
     assert repr(_sub(name=property(boom))) == "Sub()"
     # V and V' returning a non-number: a ValueError, and still the TypeError it was before.
     bad_V = _sub(V=lambda self, q: "x")
@@ -191,8 +196,18 @@ def test_zero_dimensional_arrays_are_real_arguments():
     assert Tan(np.array(1.4, dtype=np.float32), np.array(0.7)).alpha == 0.7
     assert Harmonic(1.0).period(np.array(0.5)) == 2 * np.pi
     assert Harmonic(np.uint8(3)).omega == 3.0
-    for bad in (np.array([2.0]), np.array([[2.0]]), np.array(True), np.array(1 + 2j), np.array("2"),
-                np.array(2.0, dtype=object), True, 1 + 2j, "2", None):
+    for bad in (
+        np.array([2.0]),
+        np.array([[2.0]]),
+        np.array(True),
+        np.array(1 + 2j),
+        np.array("2"),
+        np.array(2.0, dtype=object),
+        True,
+        1 + 2j,
+        "2",
+        None,
+    ):
         with pytest.raises(ValueError, match="Harmonic: omega must be a real number"):
             Harmonic(bad)
 
@@ -200,7 +215,9 @@ def test_zero_dimensional_arrays_are_real_arguments():
 # ------------------------------------------------------------------ section coordinates, H2 = 0
 
 
-@pytest.mark.parametrize("V2", [Tan(1.4, 0.7), Harmonic(1.3), Numerical(Tan(1.4, 0.7))], ids=["tan", "harmonic", "numerical"])
+@pytest.mark.parametrize(
+    "V2", [Tan(1.4, 0.7), Harmonic(1.3), Numerical(Tan(1.4, 0.7))], ids=["tan", "harmonic", "numerical"]
+)
 def test_coordinates_at_the_bottom_of_well_2(V2):
     # H2 = 0 is the centre of the polar-like (theta, I): I = 0 exactly, theta = 0 by convention
     # (it raised "Tan.action: energy must be finite and > 0, got 0"). Non-finite rows stay NaN.
@@ -224,11 +241,15 @@ def test_nearly_coincident_circles_are_rejected():
     # tables, to -8e11 on measured ones).
     def fam(K):
         K = np.asarray(K)
-        return hv.TruncatedFamily(0.3, K, 2.0 + 3.1 * K, np.where(K <= 0, 1.5 + 0.5 * K, 0.0),
-                                  np.sqrt(np.maximum(-K, 0.0)))
+        return hv.TruncatedFamily(
+            0.3, K, 2.0 + 3.1 * K, np.where(K <= 0, 1.5 + 0.5 * K, 0.0), np.sqrt(np.maximum(-K, 0.0))
+        )
 
-    with pytest.raises(ValueError, match=r"the K grid's points must be at least 1e-9 of its range \(2\) apart, but "
-                                         r"K\[4\] = 0 and K\[5\] = 1e-14 are 1e-14 apart"):
+    with pytest.raises(
+        ValueError,
+        match=r"the K grid's points must be at least 1e-9 of its range \(2\) apart, but "
+        r"K\[4\] = 0 and K\[5\] = 1e-14 are 1e-14 apart",
+    ):
         fam([-1.0, -0.5, -0.2, -0.04, 0.0, 1e-14, 0.05, 0.5, 1.0])
     f = fam([-1.0, -0.5, -0.2, -0.04, 0.0, 4e-9, 0.05, 0.5, 1.0])  # 2e-9 of the range: kept
     assert f.onset()[2] == pytest.approx(3.1, abs=1e-6)

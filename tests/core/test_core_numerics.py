@@ -29,8 +29,9 @@ def numpy_samples(samples, K_low, seed):
     return phi, np.minimum(K, -1e-300)
 
 
-@pytest.mark.parametrize("samples, K_low, seed", [(1, -0.1, 0), (1500, -0.37, 3), (20_000, -3.0, 2**40 + 1),
-                                                   (777, -1e-3, 2**63 - 1)])
+@pytest.mark.parametrize(
+    "samples, K_low, seed", [(1, -0.1, 0), (1500, -0.37, 3), (20_000, -3.0, 2**40 + 1), (777, -1e-3, 2**63 - 1)]
+)
 def test_samples_are_numpys_stream_and_pieces_are_slices(samples, K_low, seed):
     phi, K = _stratified(samples, K_low, seed)
     rphi, rK = numpy_samples(samples, K_low, seed)
@@ -45,8 +46,9 @@ def test_samples_are_numpys_stream_and_pieces_are_slices(samples, K_low, seed):
 
 def maps():
     m = hv.TruncatedMap(eps=0.15, **PAPER)
-    fam = hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1, 0, 30) ** 2, [0.5, 1.0]]),
-                                      forcing=(1.0, 0.3, -0.1))
+    fam = hv.TruncatedFamily.from_map(
+        m, np.concatenate([-(np.linspace(1, 0, 30) ** 2), [0.5, 1.0]]), forcing=(1.0, 0.3, -0.1)
+    )
     return {"truncated": (m, 400), "family": (fam, 400), "flow": (paper.flow_map(-0.1), 60)}
 
 
@@ -66,8 +68,10 @@ def test_outcomes_and_estimate_are_the_definitions(name):
     impacts0 = np.isin(s0, [int(hv.Status.EXITED), int(hv.Status.CORNER), int(hv.Status.GRAZING)])
     stayed = s1 == hv.Status.OK
     box = 2 * math.pi * -K_low
-    areas = [box * np.count_nonzero(impacts0 & (stayed | (steps >= N))) / K.size
-             for N in (n_steps // 4, n_steps // 2, n_steps)]
+    areas = [
+        box * np.count_nonzero(impacts0 & (stayed | (steps >= N))) / K.size
+        for N in (n_steps // 4, n_steps // 2, n_steps)
+    ]
     hov = impacts0 & stayed
     p = np.count_nonzero(hov) / K.size
     sampling = box * math.sqrt(max(p * (1 - p), 1.0 / K.size) / K.size)
@@ -76,8 +80,9 @@ def test_outcomes_and_estimate_are_the_definitions(name):
     both = (1 << int(hv.Region.BESIDE)) | (1 << int(hv.Region.ABOVE))
     assert np.array_equal(e["hovering"], hov) and np.array_equal(e["both_sides"], hov & ((visited & both) == both))
     assert e["floor_touched"] == bool(np.any(hov & (K < 0.9 * K_low)))
-    assert e["unresolved"] == np.count_nonzero(~np.isin(s1, [int(hv.Status.OK), int(hv.Status.EXITED),
-                                                             int(hv.Status.ESCAPED)]))
+    assert e["unresolved"] == np.count_nonzero(
+        ~np.isin(s1, [int(hv.Status.OK), int(hv.Status.EXITED), int(hv.Status.ESCAPED)])
+    )
     if name != "flow":
         assert 0 < e["area"] < box  # something hovers, something does not: the counts are tested
 
@@ -91,7 +96,9 @@ def test_default_box_is_twice_the_deepest_first_order_curve():
         # NumPy's cos may differ from the C library's by an ulp on some machines: 2 ulps of slack.
         assert default_depth(m) == pytest.approx(ref, rel=4.5e-16, abs=0)
         assert default_depth(m) == pytest.approx(2 * abs(eps) / abs(math.sin(0.5 * Om)), rel=1e-12)
-        assert hv.hovering_area(m, n_steps=4, samples=1).box[2] == max(-default_depth(m), m.valid_band()[0] * (1 - 1e-9))
+        assert hv.hovering_area(m, n_steps=4, samples=1).box[2] == max(
+            -default_depth(m), m.valid_band()[0] * (1 - 1e-9)
+        )
     th = hv.theory(0.1, 2.0, 2.0, forcing=(1.0, 0.4, -0.2))
     psi = np.linspace(-3, 3, 7)
     G = sum(b * (1 - np.cos((k + 1) * psi)) / (2 * math.sin(0.5 * (k + 1) * 2.0)) for k, b in enumerate(th.forcing))

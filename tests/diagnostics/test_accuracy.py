@@ -28,8 +28,14 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def wp_step():
-    return hovering.work_precision(Section(system(0.05), 1.0), tolerances=(1e-6, 1e-9, 1e-12),
-                                   steppers=("rk8pd", "rkck"), n_points=16, returns=(1, 100), repeat=1)
+    return hovering.work_precision(
+        Section(system(0.05), 1.0),
+        tolerances=(1e-6, 1e-9, 1e-12),
+        steppers=("rk8pd", "rkck"),
+        n_points=16,
+        returns=(1, 100),
+        repeat=1,
+    )
 
 
 def test_reference_of_the_wall_system_matches_the_closed_form():
@@ -168,15 +174,29 @@ def test_bad_arguments_are_named():
     with pytest.raises(ValueError, match="target"):
         hovering.work_precision(object())
     with pytest.raises(ValueError, match="sin_ulp"):
-        hovering.work_precision(hovering.TruncatedMap(eps=0.1, Omega0=2.0, theta_w=2.0, tau0=1.0, tau1=0.5, lam=0.5),
-                                steppers=(2.0,))
+        hovering.work_precision(
+            hovering.TruncatedMap(eps=0.1, Omega0=2.0, theta_w=2.0, tau0=1.0, tau1=0.5, lam=0.5), steppers=(2.0,)
+        )
 
 
 @pytest.mark.e2e
 def test_cli_accuracy_writes_the_diagram_and_table(tmp_path):
     out = tmp_path / "acc.png"
-    p = subprocess.run([sys.executable, "-m", "hovering", "accuracy", str(ROOT / "examples/scenes/flow_portrait.toml"),
-                        "--quick", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "hovering",
+            "accuracy",
+            str(ROOT / "examples/scenes/flow_portrait.toml"),
+            "--quick",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert p.returncode == 0, p.stderr
     assert out.stat().st_size > 10_000
     table = json.loads(out.with_suffix(".json").read_text())
@@ -184,8 +204,12 @@ def test_cli_accuracy_writes_the_diagram_and_table(tmp_path):
     assert len([r for r in table["rows"] if r["method"] in ("rk8pd", "rkck")]) == 6
     assert len([r for r in table["rows"] if r["method"] == "scipy DOP853"]) == 3  # scipy is in the test extras
     assert "| rk8pd |" in p.stdout
-    bad = subprocess.run([sys.executable, "-m", "hovering", "accuracy", str(tmp_path / "missing.toml")],
-                         capture_output=True, text=True, timeout=60)
+    bad = subprocess.run(
+        [sys.executable, "-m", "hovering", "accuracy", str(tmp_path / "missing.toml")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert bad.returncode == 2 and bad.stderr.startswith("error:")
 
 
@@ -216,8 +240,9 @@ def test_scipy_curve_is_an_independent_implementation_that_agrees():
         c = sec.coordinates(np.array([np.full(4, np.nan) if o is None else o for o in out]))
         assert np.max(np.abs(hovering.wrap(c[ok, 0] - ex.theta[ok]))) < 1e-7
         assert np.max(np.abs(c[ok, 1] - ex.I[ok])) < 1e-7
-    wp = hovering.work_precision(sec, tolerances=(1e-8,), steppers=("rk8pd",), n_points=8, returns=(1,),
-                                 external=("scipy",), repeat=1)
+    wp = hovering.work_precision(
+        sec, tolerances=(1e-8,), steppers=("rk8pd",), n_points=8, returns=(1,), external=("scipy",), repeat=1
+    )
     assert [r["method"] for r in wp.table] == ["rk8pd", "scipy DOP853"]
     with pytest.raises(ValueError, match="external"):
         hovering.work_precision(sec, external=("julia",))
@@ -228,8 +253,9 @@ def test_hovering_area_diagram_against_its_largest_setting():
     # must lie within 4x the two stated error bars combined (each bar is ~2 sigma of the
     # stratified sampling plus the iteration-count part: a 4x margin keeps this from flaking)
     m = paper.truncated_map(0.3)
-    wp = hovering.work_precision(m, quantity="hovering_area", tolerances=[(400, 250), (1600, 500), (6400, 1000)],
-                                 repeat=1)
+    wp = hovering.work_precision(
+        m, quantity="hovering_area", tolerances=[(400, 250), (1600, 500), (6400, 1000)], repeat=1
+    )
     assert wp.kind == "hovering_area" and [r["tolerance"] for r in wp.table] == ["400x250", "1600x500"]
     for r in wp.table:
         assert r["error"] <= 4 * (r["stated_error"] + wp.reference["error"]), r

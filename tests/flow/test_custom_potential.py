@@ -415,11 +415,18 @@ THREADED = textwrap.dedent(
 def test_threads_no_deadlock_and_errors_from_workers():
     import pathlib
 
-    r = subprocess.run([sys.executable, "-c", THREADED], capture_output=True, text=True, timeout=120,
-                       cwd=pathlib.Path(__file__).parent)
+    r = subprocess.run(
+        [sys.executable, "-c", THREADED], capture_output=True, text=True, timeout=120, cwd=pathlib.Path(__file__).parent
+    )
     assert r.returncode == 0, r.stderr
-    assert r.stdout.split("\n") == ["same callables", "same subclass", "Boom from a worker", "ValueError True",
-                                    "alive True", ""], r.stdout
+    assert r.stdout.split("\n") == [
+        "same callables",
+        "same subclass",
+        "Boom from a worker",
+        "ValueError True",
+        "alive True",
+        "",
+    ], r.stdout
 
 
 def test_default_threads_fall_back_to_one_for_python_potentials():

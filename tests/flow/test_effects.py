@@ -10,13 +10,27 @@ import pytest
 import hovering as hv
 from hovering import Region, Status
 
-KEYS = {"field_evaluations", "coupling_evaluations", "wall_searches", "section_searches", "label_operations",
-        "dense_samples", "steps"}
+KEYS = {
+    "field_evaluations",
+    "coupling_evaluations",
+    "wall_searches",
+    "section_searches",
+    "label_operations",
+    "dense_samples",
+    "steps",
+}
 
 
 def system(eps=-0.05, geometry="step"):
-    return hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=eps,
-                         qw1=-1.0, qw2=-0.5, geometry=geometry)
+    return hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=eps,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry=geometry,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -67,8 +81,10 @@ def test_eps0_evaluates_no_coupling(points):
     assert hv.Section(system(eps=0.05), 1.0).return_map(th, I).work["coupling_evaluations"] > 0
 
 
-@pytest.mark.parametrize("record, exit_regions", [(("regions",), None), (("visited",), None), (("itinerary",), None),
-                                                   (("rotation",), None), ((), ("0u", "0"))])
+@pytest.mark.parametrize(
+    "record, exit_regions",
+    [(("regions",), None), (("visited",), None), (("itinerary",), None), (("rotation",), None), ((), ("0u", "0"))],
+)
 def test_labels_only_when_something_reads_them(fm, points, record, exit_regions):
     # Nothing reads a label: no crossing of q1 = qw1 tracked, no itinerary built. Something does:
     # the bookkeeping runs, on orbits that cross q1 = qw1 above the step (region ABOVE) and on

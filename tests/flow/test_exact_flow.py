@@ -58,12 +58,14 @@ class MpOscillator:
             self.theta = mp.atan2(-p * self.a * mp.cos(self.a * q) / (self.omega * self.k), mp.sin(self.a * q) / self.k)
 
     def V(self, q):
-        return self.w**2 * q * q / 2 if self.kind == "harmonic" else self.w**2 / (2 * self.a**2) * mp.tan(self.a * q)**2
+        return (
+            self.w**2 * q * q / 2 if self.kind == "harmonic" else self.w**2 / (2 * self.a**2) * mp.tan(self.a * q) ** 2
+        )
 
     def dV(self, q):
         if self.kind == "harmonic":
             return self.w**2 * q
-        return self.w**2 / self.a * mp.tan(self.a * q) / mp.cos(self.a * q)**2
+        return self.w**2 / self.a * mp.tan(self.a * q) / mp.cos(self.a * q) ** 2
 
     def at(self, th):
         """(q, p) at angle th."""
@@ -136,8 +138,15 @@ def mp_return(spec1, spec2, geometry, z0, first=False):
 
 
 def system(spec1, spec2, geometry, eps=0.0, coupling=None):
-    return hovering.StepSystem(V1=potential(spec1), V2=potential(spec2), coupling=coupling or hovering.Bilinear(),
-                               eps=eps, qw1=QW1, qw2=QW2, geometry=geometry)
+    return hovering.StepSystem(
+        V1=potential(spec1),
+        V2=potential(spec2),
+        coupling=coupling or hovering.Bilinear(),
+        eps=eps,
+        qw1=QW1,
+        qw2=QW2,
+        geometry=geometry,
+    )
 
 
 def core_returns(sys, z, stepper="exact", rtol=1e-13):
@@ -153,8 +162,11 @@ def starts(sys, n, seed, h=H, I=(0.02, 0.6)):
     return z[status]
 
 
-PAIRS = [(("harmonic", 1.0), ("tan", 1.4, 0.7)), (("tan", 1.0, 0.5), ("harmonic", 1.1)),
-         (("harmonic", 1.0), ("harmonic", 1.3))]
+PAIRS = [
+    (("harmonic", 1.0), ("tan", 1.4, 0.7)),
+    (("tan", 1.0, 0.5), ("harmonic", 1.1)),
+    (("harmonic", 1.0), ("harmonic", 1.3)),
+]
 # A fast oscillator 2 at h = 5 (I in (0.625, 0.9): both wall lines reached): q2 bounces on the
 # upper wall several times while q1 stays beyond qw1, the multi-impact returns ('11', '111').
 FAST = (("harmonic", 1.0), ("harmonic", 5.0))
@@ -167,11 +179,13 @@ def test_reference_formulas_solve_hamiltons_equations(spec):
     # checked by mpmath's numerical derivative at 50 digits, independently of the core.
     o = MpOscillator(spec, 0.3, -0.9)
     for th0 in (-2.9, -0.4, 0.0, 1.3, 2.7):
+
         def q(t):
             return o.at(th0 + o.omega * t)[0]
 
         def p(t):
             return o.at(th0 + o.omega * t)[1]
+
         qq, pp = o.at(th0)
         assert abs(mp.diff(q, 0) - pp) < 1e-35
         assert abs(mp.diff(p, 0) + o.dV(qq)) < 1e-35
@@ -276,10 +290,10 @@ def test_exact_trajectory_samples_lie_on_the_reference_orbit():
 # ---------------------------------------------------------------------------- the linear flow
 
 
-def mp_linear_return(w1, w2, c, geometry, z0, dt=mp.mpf("0.02")):
+def mp_linear_return(w1, w2, c, geometry, z0, dt=mp.mpf("0.02")):  # noqa: B008 (an immutable number)
     """One return of q'' = -K q, K = [[w1^2, c], [c, w2^2]] with walls: expm on a fine grid, every
     sign change (and every minimum of a wall distance) between grid points refined by findroot."""
-    A = mp.matrix([[0, 1, 0, 0], [-w1**2, 0, -c, 0], [0, 0, 0, 1], [-c, 0, -w2**2, 0]])
+    A = mp.matrix([[0, 1, 0, 0], [-(w1**2), 0, -c, 0], [0, 0, 0, 1], [-c, 0, -(w2**2), 0]])
     P = mp.expm(A * dt)
     z = mp.matrix([mp.mpf(float(x)) for x in z0])
     t, armed, crossed, itinerary = mp.mpf(0), False, False, ""
@@ -382,20 +396,38 @@ def test_linear_exact_with_a_zero_or_negative_eigenvalue(eps):
 # ---------------------------------------------------------------------------- bad systems
 
 
-@pytest.mark.parametrize("make, text", [
-    (lambda: system(("tan", 1.4, 0.7), ("harmonic", 1.0), "step", eps=0.1), "V1 = Tan(omega=1.4, alpha=0.7)"),
-    (lambda: system(("harmonic", 1.0), ("harmonic", 1.3), "step", eps=0.1,
-                    coupling=hovering.Polynomial({(3, 0): 1.0})), "1 q1^3 q2^0"),
-    (lambda: hovering.StepSystem(V1=hovering.CustomPotential(lambda q: 0.5 * q * q, lambda q: q),
-                                 V2=hovering.Harmonic(1.0), coupling=hovering.Bilinear(), eps=0.0, qw1=QW1, qw2=QW2,
-                                 geometry="wall"), "V1 = "),
-])
+@pytest.mark.parametrize(
+    "make, text",
+    [
+        (lambda: system(("tan", 1.4, 0.7), ("harmonic", 1.0), "step", eps=0.1), "V1 = Tan(omega=1.4, alpha=0.7)"),
+        (
+            lambda: system(
+                ("harmonic", 1.0), ("harmonic", 1.3), "step", eps=0.1, coupling=hovering.Polynomial({(3, 0): 1.0})
+            ),
+            "1 q1^3 q2^0",
+        ),
+        (
+            lambda: hovering.StepSystem(
+                V1=hovering.CustomPotential(lambda q: 0.5 * q * q, lambda q: q),
+                V2=hovering.Harmonic(1.0),
+                coupling=hovering.Bilinear(),
+                eps=0.0,
+                qw1=QW1,
+                qw2=QW2,
+                geometry="wall",
+            ),
+            "V1 = ",
+        ),
+    ],
+)
 def test_exact_refuses_systems_without_a_closed_form(make, text):
     sys = make()
     sec = hovering.Section(sys, H)
-    for call in (lambda: sec.return_map([0.1], [0.3], stepper="exact"),
-                 lambda: hovering.FlowMap(sys, H, coordinates="normal", stepper="exact"),
-                 lambda: flow_options(stepper="exact").validate_for(sys.core)):
+    for call in (
+        lambda: sec.return_map([0.1], [0.3], stepper="exact"),
+        lambda: hovering.FlowMap(sys, H, coordinates="normal", stepper="exact"),
+        lambda: flow_options(stepper="exact").validate_for(sys.core),
+    ):
         with pytest.raises(ValueError, match="stepper 'exact' needs a flow in closed form") as e:
             call()
         assert text in str(e.value)

@@ -13,7 +13,9 @@ def section(eps=0.0, V1=None, V2=None, coupling=None, geometry="none", h=1.0):
     return paper.section(eps, geometry, h, V1=V1, V2=V2, coupling=coupling)
 
 
-@pytest.mark.parametrize("V1,V2", [(Harmonic(1.0), Tan(1.4, 0.7)), (Tan(1.2, 0.5), Harmonic(1.3)), (Tan(1.0, 0.6), Tan(1.4, 0.7))])
+@pytest.mark.parametrize(
+    "V1,V2", [(Harmonic(1.0), Tan(1.4, 0.7)), (Tan(1.2, 0.5), Harmonic(1.3)), (Tan(1.0, 0.6), Tan(1.4, 0.7))]
+)
 def test_uncoupled_return_is_the_exact_rotation(V1, V2):
     # eps = 0: I is conserved, the return time is T1(h - H2(I)) and theta advances by
     # Omega0(I) = omega2 T1 (eq:omega0ofI): exact closed-form oracles. rk8pd at rtol 1e-12: 1e-10.

@@ -206,8 +206,7 @@ def test_return_map_vs_reference(reference):
     assert KINDS <= {s for s in kept_its if len(s) == 1}, Counter(kept_its)
 
     assert np.all(np.asarray(out.status)[keep] == 0)
-    bad = [(k, ref_its[k], out.itinerary[k]) for k in np.flatnonzero(keep)
-           if out.itinerary[k] != ref_its[k]]
+    bad = [(k, ref_its[k], out.itinerary[k]) for k in np.flatnonzero(keep) if out.itinerary[k] != ref_its[k]]
     assert not bad, f"itineraries differ (index, reference, hovering): {bad}"
 
     tol = _tolerance(margin[keep])
@@ -233,8 +232,11 @@ def test_flowmap_iterate_vs_reference(reference):
     kept_its = [s for k in np.flatnonzero(keep) for s in reference["itinerary"][k]]
     assert KINDS <= set(kept_its), Counter(kept_its)
 
-    bad = [(k, reference["itinerary"][k], list(res.itinerary[k])) for k in np.flatnonzero(keep)
-           if list(res.itinerary[k]) != reference["itinerary"][k]]
+    bad = [
+        (k, reference["itinerary"][k], list(res.itinerary[k]))
+        for k in np.flatnonzero(keep)
+        if list(res.itinerary[k]) != reference["itinerary"][k]
+    ]
     assert not bad, f"itineraries differ (index, reference, hovering): {bad}"
 
     assert np.max(_angle_diff(phi[:, 0], theta)) < 1e-15 and np.max(np.abs(K[:, 0] - I)) < 1e-15

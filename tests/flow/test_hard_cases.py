@@ -88,8 +88,9 @@ def test_grazing_the_upper_wall_at_depth(sec, d):
 # the particle passes over the step and q2, still falling, meets the upper wall ('1').
 
 
-@pytest.mark.parametrize("delta", [0.0, 1e-15, -1e-15, 1e-13, -1e-13, 1e-11, -1e-11,
-                                   1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3])
+@pytest.mark.parametrize(
+    "delta", [0.0, 1e-15, -1e-15, 1e-13, -1e-13, 1e-11, -1e-11, 1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3]
+)
 def test_corner_hits_exactly_and_near(sec, delta):
     H2 = 0.35
     I, W = V2.action(H2), V2.frequency(H2)
@@ -151,8 +152,13 @@ def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
     I = np.array([V2.action(e) for e in np.linspace(0.01 * h, 0.999 * h, 40)])
     r = s.return_map(th, I, rtol=1e-2, atol=1e-2, stepper=stepper, max_steps=100_000)
     assert np.all(np.abs(r.z[:, 2]) < qlim) and np.all(np.isfinite(r.z))
-    assert set(np.unique(r.status)) <= {FlowStatus.OK, FlowStatus.OUTSIDE_WELL, FlowStatus.CORNER,
-                                        FlowStatus.GRAZING, FlowStatus.IMPACT_LIMIT}
+    assert set(np.unique(r.status)) <= {
+        FlowStatus.OK,
+        FlowStatus.OUTSIDE_WELL,
+        FlowStatus.CORNER,
+        FlowStatus.GRAZING,
+        FlowStatus.IMPACT_LIMIT,
+    }
     stopped = r.status != FlowStatus.OK
     assert np.all(r.time[stopped] > 0)  # where it stopped, in time
     if stepper == "rkf45":  # the loose tolerance does leave the well here (measured: 11-17 of 40)
@@ -187,8 +193,12 @@ def test_step_limit_reports_the_time_and_state_reached(sec, max_steps):
 def test_non_finite_reports_the_time_and_state_reached():
     # A runaway (an indefinite coupled potential): NON_FINITE once the state overflows, with the
     # last finite state (~1e307) and its time (~1040, not 0); its own coordinates are NaN.
-    s = Section(StepSystem(V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1,
-                           qw2=-2, geometry="wall"), 0.3)
+    s = Section(
+        StepSystem(
+            V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
+        ),
+        0.3,
+    )
     r = s.return_map([np.linspace(-np.pi, np.pi, 41)[12]], [0.5])
     assert r.status[0] == FlowStatus.NON_FINITE
     assert np.isfinite(r.z[0]).all() and np.max(np.abs(r.z[0])) > 1e300

@@ -20,8 +20,9 @@ from hovering import FlowStatus, Status
 
 #: An indefinite quadratic potential (eps = -0.5 > the oscillators' 0.04): orbits that do not
 #: reflect off the wall quickly run away (t ~ 1040, the state ~1e307, NON_FINITE).
-RUNAWAY = hv.StepSystem(V1=hv.Harmonic(0.2), V2=hv.Harmonic(0.2), coupling=hv.Bilinear(), eps=-0.5, qw1=-1, qw2=-2,
-                        geometry="wall")
+RUNAWAY = hv.StepSystem(
+    V1=hv.Harmonic(0.2), V2=hv.Harmonic(0.2), coupling=hv.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
+)
 H = 0.3
 THETA = np.linspace(-math.pi, math.pi, 41)[[0, 1, 2, 12, 33, 34]]
 I0 = np.full(6, 0.5)
@@ -82,8 +83,21 @@ def test_flow_map_keeps_the_good_orbits_beside_a_runaway():
         assert same(fm.returns(THETA[i : i + 1], I0[i : i + 1], inverse=True).phi[0], back.phi[i])
         alone = fm.iterate(THETA[i : i + 1], I0[i : i + 1], 3, record=record)
         assert alone.status[0] == it.status[i] and alone.steps_done[0] == it.steps_done[i]
-        for f in ("phi", "K", "region", "rotation", "theta", "I", "z", "time", "energy_error", "integrator_steps",
-                  "phi_final", "K_final", "visited"):
+        for f in (
+            "phi",
+            "K",
+            "region",
+            "rotation",
+            "theta",
+            "I",
+            "z",
+            "time",
+            "energy_error",
+            "integrator_steps",
+            "phi_final",
+            "K_final",
+            "visited",
+        ):
             assert same(getattr(alone, f)[0], getattr(it, f)[i]), (i, f)
         assert alone.itinerary[0] == it.itinerary[i]
         assert same(hv.rotation_number(alone)[0], rot[i])
@@ -104,8 +118,15 @@ def test_results_with_a_runaway_save_and_load(sec, tmp_path):
 
 def test_flow_analyses_keep_the_good_orbits_beside_a_stopped_one():
     # Normal coordinates (the rotation analyses need them): a start below the band is OFF_SECTION.
-    s = hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=-0.05,
-                      qw1=-1.0, qw2=-0.5, geometry="step")
+    s = hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
     fm = hv.FlowMap(s, 1.0)
     phi, K = np.array([0.5, 1.0, 1.5]), np.array([-0.1, fm.valid_band()[0] - 0.2, 0.1])
     res = fm.iterate(phi, K, 40, record=("orbit", "regions", "rotation"))
@@ -123,8 +144,9 @@ def test_flow_analyses_keep_the_good_orbits_beside_a_stopped_one():
 def test_truncated_analyses_keep_the_good_orbits_beside_an_escaped_one(which):
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
     if which == "family":
-        m = hv.TruncatedFamily.from_map(m, np.concatenate([np.linspace(-2.0, 0.0, 41), np.linspace(0.05, 1.0, 20)]),
-                                        forcing=(1.0, 0.2))
+        m = hv.TruncatedFamily.from_map(
+            m, np.concatenate([np.linspace(-2.0, 0.0, 41), np.linspace(0.05, 1.0, 20)]), forcing=(1.0, 0.2)
+        )
     lo = m.valid_band()[0]
     phi, K = np.array([0.5, 0.5, 1.5]), np.array([-0.1, lo + 1e-9, 0.3])  # the second leaves the band
     record = ("orbit", "regions", "rotation", "visited")

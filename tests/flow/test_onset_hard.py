@@ -33,6 +33,7 @@ RTOL = 1e-6
 
 # ---------------------------------------------------------------- the mpmath reference
 
+
 class _MP:
     """Harmonic (alpha = 0) or Tan potential in mpmath, from the exact double parameters."""
 
@@ -91,9 +92,17 @@ def reference(w1, a1, w2, a2, qw1, qw2, h, dps=80):
             return (f(It + s) - f(It - s)) / (2 * s)
 
         w2 = 2 * mp.pi / V2.T(hh - h1w)
-        return dict(Omega0=Omega0(It), tau0=d(Omega0, k * min(It - Ilo, Ihi - It, It)),
-                    tau1=-2 * d(theta_w, k * min(It - Ilo, It)), lam=mp.sqrt(2 * w2**3) / abs(V1.dV(qw1)),
-                    theta_w=theta_w(It), I_tan=It, h1w=h1w, h2w=V2.V(qw2), delta=hh - h1w - V2.V(qw2))
+        return dict(
+            Omega0=Omega0(It),
+            tau0=d(Omega0, k * min(It - Ilo, Ihi - It, It)),
+            tau1=-2 * d(theta_w, k * min(It - Ilo, It)),
+            lam=mp.sqrt(2 * w2**3) / abs(V1.dV(qw1)),
+            theta_w=theta_w(It),
+            I_tan=It,
+            h1w=h1w,
+            h2w=V2.V(qw2),
+            delta=hh - h1w - V2.V(qw2),
+        )
 
 
 def rounding_scale(w1, a1, w2, a2, qw1, qw2, h):
@@ -127,6 +136,7 @@ def test_reference_action_angle_variables_are_the_definitions():
 
 
 # ---------------------------------------------------------------- the contract
+
 
 def system(V1, V2, qw1, qw2):
     return StepSystem(V1=V1, V2=V2, coupling=Bilinear(), eps=0.0, qw1=qw1, qw2=qw2, geometry="step")
@@ -188,8 +198,9 @@ def cases(draw):
 # Found by a random run: a Tan wall 5e-12 from its singularity at h = 1.35e24, where one quadrature
 # over the level gave I_tan 3.3e-11 off with an error of 1e-11 claimed (now: 3e-15, each wall's layer
 # integrated on its own).
-@example((0.26416483203860924, 1.0, 8.058421877614817, 1.0, -1.5707960573345419, -1.5707806188316287,
-          1.3508147725979195e+24))
+@example(
+    (0.26416483203860924, 1.0, 8.058421877614817, 1.0, -1.5707960573345419, -1.5707806188316287, 1.3508147725979195e24)
+)
 def test_every_returned_parameter_is_within_its_error_of_the_definitions(args):
     w1, a1, w2, a2, qw1, qw2, h = args
     sys = system(pot(w1, a1), pot(w2, a2), qw1, qw2)

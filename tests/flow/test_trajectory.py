@@ -14,21 +14,30 @@ W1, W2 = 1.0, 1.4
 
 
 def harmonic(geometry="none"):
-    return hv.StepSystem(V1=hv.Harmonic(W1), V2=hv.Harmonic(W2), coupling=hv.Bilinear(), eps=0.0, qw1=-1.0, qw2=-0.5,
-                         geometry=geometry)
+    return hv.StepSystem(
+        V1=hv.Harmonic(W1), V2=hv.Harmonic(W2), coupling=hv.Bilinear(), eps=0.0, qw1=-1.0, qw2=-0.5, geometry=geometry
+    )
 
 
 def example():
-    return hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=-0.05,
-                         qw1=-1.0, qw2=-0.5, geometry="step")
+    return hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
 
 
 def closed_form(z, t):
     """The eps = 0 flow of two harmonic oscillators from z = (q1, p1, q2, p2) after times t."""
     q1, p1, q2, p2 = z
     c1, s1, c2, s2 = np.cos(W1 * t), np.sin(W1 * t), np.cos(W2 * t), np.sin(W2 * t)
-    return np.stack([q1 * c1 + p1 / W1 * s1, -q1 * W1 * s1 + p1 * c1, q2 * c2 + p2 / W2 * s2, -q2 * W2 * s2 + p2 * c2],
-                    axis=-1)
+    return np.stack(
+        [q1 * c1 + p1 / W1 * s1, -q1 * W1 * s1 + p1 * c1, q2 * c2 + p2 / W2 * s2, -q2 * W2 * s2 + p2 * c2], axis=-1
+    )
 
 
 def rows(res, i):
@@ -62,7 +71,9 @@ def test_smooth_harmonic_trajectory_is_the_closed_form(rtol):
         k_last = int(np.ceil(T[-1] / dt)) - 1
         assert np.array_equal(s, np.arange(k_last + 1) * dt)
         # No walls: only samples and the ns return points, at the return times.
-        assert np.array_equal(np.flatnonzero(kind != TrajectoryPoint.SAMPLE), np.flatnonzero(kind == TrajectoryPoint.RETURN))
+        assert np.array_equal(
+            np.flatnonzero(kind != TrajectoryPoint.SAMPLE), np.flatnonzero(kind == TrajectoryPoint.RETURN)
+        )
         assert np.allclose(t[kind == TrajectoryPoint.RETURN], T[1:], rtol=0, atol=1e-12)
         # Each return's samples are the closed-form flow from the point of Sigma_h it started from.
         for j in range(ns):
@@ -168,15 +179,21 @@ def test_max_trajectory_points_truncates_per_orbit_and_is_checked_first():
         fm.iterate(phi, K, 3, record=("trajectory",), trajectory_dt=0.01, max_trajectory_points=5)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(record=("trajectory",)), r"trajectory_dt \(the sample spacing\) must be a number in \(0, inf\) .*got None"),
-    (dict(record=("orbit",), trajectory_dt=0.1), "only used with record 'trajectory'"),
-    (dict(record=("trajectory",), trajectory_dt=0.0), r"trajectory_dt must lie in \(0.0, inf\), got 0.0"),
-    (dict(record=("trajectory",), trajectory_dt=float("nan")), "trajectory_dt must be finite"),
-    (dict(record=("trajectory",), trajectory_dt="0.1"), "trajectory_dt must be a real number"),
-    (dict(record=("trajectory",), trajectory_dt=0.1, max_trajectory_points=2.5), "max_trajectory_points"),
-    (dict(record=("trajectories",)), "unknown key"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (
+            dict(record=("trajectory",)),
+            r"trajectory_dt \(the sample spacing\) must be a number in \(0, inf\) .*got None",
+        ),
+        (dict(record=("orbit",), trajectory_dt=0.1), "only used with record 'trajectory'"),
+        (dict(record=("trajectory",), trajectory_dt=0.0), r"trajectory_dt must lie in \(0.0, inf\), got 0.0"),
+        (dict(record=("trajectory",), trajectory_dt=float("nan")), "trajectory_dt must be finite"),
+        (dict(record=("trajectory",), trajectory_dt="0.1"), "trajectory_dt must be a real number"),
+        (dict(record=("trajectory",), trajectory_dt=0.1, max_trajectory_points=2.5), "max_trajectory_points"),
+        (dict(record=("trajectories",)), "unknown key"),
+    ],
+)
 def test_bad_trajectory_arguments_are_named(kwargs, match):
     fm = hv.FlowMap(harmonic(), h=1.0, coordinates="section")
     with pytest.raises(ValueError, match=match):

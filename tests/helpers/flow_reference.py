@@ -139,10 +139,7 @@ def _rk4(y, tau, eps, tan=np.tan):
     k2 = _deriv(*[a + 0.5 * tau * k for a, k in zip(y, k1)], eps, tan)
     k3 = _deriv(*[a + 0.5 * tau * k for a, k in zip(y, k2)], eps, tan)
     k4 = _deriv(*[a + tau * k for a, k in zip(y, k3)], eps, tan)
-    return tuple(
-        a + (tau / 6.0) * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
-        for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4)
-    )
+    return tuple(a + (tau / 6.0) * (b1 + 2.0 * b2 + 2.0 * b3 + b4) for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4))
 
 
 def _substep(y0, tau, eps):
@@ -310,10 +307,7 @@ def return_map_details(theta, I, eps, h=H_LEVEL, dt=DT, max_impacts=100):
 
     out[:, ~ok] = np.nan
     theta1, I1 = coordinates(out[2], out[3])
-    itinerary = [
-        (imp if imp else ("0" if c else "u")) if good else "?"
-        for imp, c, good in zip(impacts, crossed, ok)
-    ]
+    itinerary = [(imp if imp else ("0" if c else "u")) if good else "?" for imp, c, good in zip(impacts, crossed, ok)]
     return {
         "theta": theta1,
         "I": I1,

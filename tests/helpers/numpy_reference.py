@@ -47,12 +47,30 @@ tau0, tau1, lam``.
 import numpy as np
 
 __all__ = [
-    "BESIDE", "ABOVE", "UPPER", "RIGHT", "INVALID", "TWO_PI",
-    "wrap", "forcing",
-    "arcs", "region", "rotation", "step", "step_inverse", "reversal",
-    "boundary_distance", "valid_band", "iterate",
-    "arcs_general", "region_general", "rotation_general", "step_general",
-    "step_inverse_general", "reversal_general", "boundary_distance_general",
+    "BESIDE",
+    "ABOVE",
+    "UPPER",
+    "RIGHT",
+    "INVALID",
+    "TWO_PI",
+    "wrap",
+    "forcing",
+    "arcs",
+    "region",
+    "rotation",
+    "step",
+    "step_inverse",
+    "reversal",
+    "boundary_distance",
+    "valid_band",
+    "iterate",
+    "arcs_general",
+    "region_general",
+    "rotation_general",
+    "step_general",
+    "step_inverse_general",
+    "reversal_general",
+    "boundary_distance_general",
     "valid_band_general",
 ]
 
@@ -68,6 +86,7 @@ TWO_PI = 2.0 * np.pi
 # ---------------------------------------------------------------------------
 # small helpers
 # ---------------------------------------------------------------------------
+
 
 def _cmod(x):
     """Reduce ``x`` modulo 2 pi into ``[0, 2 pi)`` (guarding the round-off case)."""
@@ -121,8 +140,7 @@ def forcing(phi, b=(1.0,)):
 
 
 def _bcast(phi, K):
-    phi, K = np.broadcast_arrays(np.asarray(phi, dtype=float),
-                                 np.asarray(K, dtype=float))
+    phi, K = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
     return phi.copy(), K.copy()
 
 
@@ -178,9 +196,7 @@ def _classify(phi, K, phi01, L1, LR, L0, closed_side):
         if closed_side == "left":
             rf = np.where(d < L1, UPPER, np.where(d < L1 + LR, RIGHT, ABOVE))
         else:
-            rf = np.where(d == 0.0, ABOVE,
-                          np.where(d <= L1, UPPER,
-                                   np.where(d <= L1 + LR, RIGHT, ABOVE)))
+            rf = np.where(d == 0.0, ABOVE, np.where(d <= L1, UPPER, np.where(d <= L1 + LR, RIGHT, ABOVE)))
         r = np.where(amb, rf, r)
     reg = np.where(neg, np.where(ok, r, INVALID), reg)
     reg = np.where(np.isfinite(K) & np.isfinite(phi), reg, INVALID)
@@ -209,6 +225,7 @@ def _boundary_distance(phi, K, phi01, L1, LR):
 # ---------------------------------------------------------------------------
 # truncated map F_eps
 # ---------------------------------------------------------------------------
+
 
 def arcs(K, p):
     """Arc data of the truncated map on the circle of height ``K``.
@@ -411,18 +428,18 @@ def boundary_distance(phi, K, p):
     return _boundary_distance(phi, K, phi01, L1, LR)
 
 
-def _band_lower_edge(lengths, k_start=1e-3, k_max=1e15, n_scan=1_000_001,
-                     tol=1e-13):
+def _band_lower_edge(lengths, k_start=1e-3, k_max=1e15, n_scan=1_000_001, tol=1e-13):
     """Numerical lower edge of the band where all arc lengths are in (0, 2 pi).
 
     ``lengths(K)`` returns ``(L1, LR, L0)`` for an array of ``K < 0``.
     """
+
     def ok(Kv):
         Kv = np.atleast_1d(np.asarray(Kv, dtype=float))
         L1, LR, L0 = lengths(Kv)
-        return _lengths_strict_ok(np.broadcast_to(L1, Kv.shape),
-                                  np.broadcast_to(LR, Kv.shape),
-                                  np.broadcast_to(L0, Kv.shape))
+        return _lengths_strict_ok(
+            np.broadcast_to(L1, Kv.shape), np.broadcast_to(LR, Kv.shape), np.broadcast_to(L0, Kv.shape)
+        )
 
     # 1) find some depth Kfar < 0 at which the condition fails
     depth = k_start
@@ -433,7 +450,7 @@ def _band_lower_edge(lengths, k_start=1e-3, k_max=1e15, n_scan=1_000_001,
     # 2) dense scan of [-depth, 0), uniform in s = sqrt(-K) (the lengths are
     #    smooth in s, not in K), to find the failure closest to K = 0
     u = np.linspace(1.0, 0.0, n_scan, endpoint=False)[::-1]  # increasing in (0,1]
-    Ks = -depth * u * u                                      # from ~0 down to -depth
+    Ks = -depth * u * u  # from ~0 down to -depth
     good = ok(Ks)
     first_bad = int(np.argmin(good))  # first False
     if good[first_bad]:
@@ -472,9 +489,11 @@ def valid_band(p):
         value is the last verified-good bisection point, within ``1e-13`` of
         the true edge, on its valid side).  ``hi = +inf``.
     """
+
     def lengths(Kv):
         _, L1, LR, L0 = arcs(Kv, p)
         return L1, LR, L0
+
     return _band_lower_edge(lengths), np.inf
 
 
@@ -530,13 +549,13 @@ def iterate(phi0, K0, n, p):
 # general symmetric family F_{eps1, eps2}
 # ---------------------------------------------------------------------------
 
+
 def _eval_on_negative(fn, K):
     """Evaluate a callable only where K < 0 (nan elsewhere)."""
     out = np.full(K.shape, np.nan)
     neg = K < 0.0
     if np.any(neg):
-        out[neg] = np.broadcast_to(np.asarray(fn(K[neg]), dtype=float),
-                                   K[neg].shape)
+        out[neg] = np.broadcast_to(np.asarray(fn(K[neg]), dtype=float), K[neg].shape)
     return out
 
 
@@ -734,7 +753,9 @@ def valid_band_general(Omega, JR, J1):
         identically empty arc (e.g. ``J1 = 0``) has ``lo`` within ``1e-13``
         of 0 here.
     """
+
     def lengths(Kv):
         _, L1, LR, L0, _ = arcs_general(Kv, Omega, JR, J1)
         return L1, LR, L0
+
     return _band_lower_edge(lengths), np.inf

@@ -87,7 +87,7 @@ def maps() -> dict:
     n = 300
     phi = rng.uniform(-np.pi, np.pi, n)
     m = hv.TruncatedMap(eps=0.3, **PAPER)
-    grid = np.concatenate([-np.linspace(1.0, 0.0, 40) ** 2, np.linspace(0.05, 1.0, 20)])
+    grid = np.concatenate([-(np.linspace(1.0, 0.0, 40) ** 2), np.linspace(0.05, 1.0, 20)])
     fam = hv.TruncatedFamily.from_map(m, grid, forcing=(1.0, 0.25, -0.1))
     capped = hv.TruncatedMap(eps=-0.2, Omega0=1.3, theta_w=2.0, tau0=-0.7, tau1=-0.4, lam=0.7, K_max=0.4)
     out = {
@@ -95,8 +95,11 @@ def maps() -> dict:
         "truncated_capped": (capped, phi, rng.uniform(-0.3, 0.15, n)),
         "family": (fam, phi, rng.uniform(-0.5, 0.5, n)),
         "flow_normal": (hv.FlowMap(issue_system(-0.05), h=1.0), phi, rng.uniform(-0.1, 0.05, n)),
-        "flow_section": (hv.FlowMap(issue_system(0.05), h=1.0, coordinates="section", stepper="rkck", max_impacts=50),
-                         phi, rng.uniform(0.25, 0.45, n)),
+        "flow_section": (
+            hv.FlowMap(issue_system(0.05), h=1.0, coordinates="section", stepper="rkck", max_impacts=50),
+            phi,
+            rng.uniform(0.25, 0.45, n),
+        ),
         # A potential defined in Python: one thread, ~13x slower per return, so fewer points.
         "flow_custom": (hv.FlowMap(issue_system(-0.05, V1=quartic()), h=1.0), phi[:40], rng.uniform(-0.05, 0.03, 40)),
     }
@@ -111,12 +114,28 @@ def results() -> dict:
     fm, fphi, fK = maps()["flow_normal"]
     sec = fm.section
     out = {
-        "iterate_truncated": m.iterate(phi[:50], K[:50], 200, record=("orbit", "regions", "rotation", "visited"),
-                                       exit_regions={"0u", "0"}),
+        "iterate_truncated": m.iterate(
+            phi[:50], K[:50], 200, record=("orbit", "regions", "rotation", "visited"), exit_regions={"0u", "0"}
+        ),
         "iterate_family": fam.iterate(phi[:30], K[:30], 100),
-        "iterate_flow": fm.iterate(fphi[:12], fK[:12], 6, record=("orbit", "regions", "rotation", "visited", "section",
-                                                                 "states", "times", "energy_error", "steps", "itinerary"),
-                                   exit_regions={"0u", "0"}),
+        "iterate_flow": fm.iterate(
+            fphi[:12],
+            fK[:12],
+            6,
+            record=(
+                "orbit",
+                "regions",
+                "rotation",
+                "visited",
+                "section",
+                "states",
+                "times",
+                "energy_error",
+                "steps",
+                "itinerary",
+            ),
+            exit_regions={"0u", "0"},
+        ),
         "iterate_custom": maps()["flow_custom"][0].iterate(fphi[:4], fK[:4], 3, record=("orbit", "itinerary")),
         "return_map": sec.return_map(fphi[:20], fm.curve.I_tan0 + fK[:20]),
         "flow_steps": fm.returns(fphi[:20], fK[:20]),
@@ -146,8 +165,11 @@ def same(a, b) -> bool:
         return a == b or (math.isnan(a) and math.isnan(b))
     if dataclasses.is_dataclass(a) and not isinstance(a, type):
         return type(a) is type(b) and all(
-            (type(getattr(a, f.name)) is type(getattr(b, f.name))) if f.name == "map"
-            else same(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a))
+            (type(getattr(a, f.name)) is type(getattr(b, f.name)))
+            if f.name == "map"
+            else same(getattr(a, f.name), getattr(b, f.name))
+            for f in dataclasses.fields(a)
+        )
     if isinstance(a, (list, tuple)):
         return type(a) is type(b) and len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
     if isinstance(a, dict):

@@ -132,7 +132,9 @@ def test_from_orbit_recovers_an_invariant_circle_to_its_bin_error(eps, K0):
     # itself: F(phi, c(phi)) lies on c to ~ the error times the map's stretch (measured <= 1.3).
     m = paper(eps)
     r = m.iterate([m.L1(K0)], [K0], 40_000, record=("orbit", "regions"))
-    assert r.status[0] == hovering.Status.OK and np.all(np.isin(r.region, [hovering.Region.BESIDE, hovering.Region.ABOVE]))
+    assert r.status[0] == hovering.Status.OK and np.all(
+        np.isin(r.region, [hovering.Region.BESIDE, hovering.Region.ABOVE])
+    )
     phi, K = r.phi[0], r.K[0]
     c = Curve.from_orbit(phi[:20_000], K[:20_000], n=256)
     assert c.n == 256 and c.error.shape == (256,)
@@ -191,14 +193,17 @@ def test_a_curve_record_is_validated_on_load():
 # bad input
 
 
-@pytest.mark.parametrize("K,match", [
-    ([1.0, 2.0], r"the number of samples must be 1 \(a constant\) or in \[3, 16777216\].*got 2"),
-    ([], r"the number of samples must be 1 \(a constant\) or in \[3, 16777216\]"),
-    (np.ones((3, 3)), r"K \(curve samples\) must be a 1-D array, got shape \(3, 3\)"),
-    ([0.1, np.nan, 0.2, 0.3], r"K \(curve samples\)"),
-    ([0.1, 0.2, np.inf], r"K \(curve samples\)"),
-    (["a", "b", "c"], r"K \(curve samples\)"),
-])
+@pytest.mark.parametrize(
+    "K,match",
+    [
+        ([1.0, 2.0], r"the number of samples must be 1 \(a constant\) or in \[3, 16777216\].*got 2"),
+        ([], r"the number of samples must be 1 \(a constant\) or in \[3, 16777216\]"),
+        (np.ones((3, 3)), r"K \(curve samples\) must be a 1-D array, got shape \(3, 3\)"),
+        ([0.1, np.nan, 0.2, 0.3], r"K \(curve samples\)"),
+        ([0.1, 0.2, np.inf], r"K \(curve samples\)"),
+        (["a", "b", "c"], r"K \(curve samples\)"),
+    ],
+)
 def test_bad_samples(K, match):
     with pytest.raises(ValueError, match=match):
         Curve(K)
@@ -230,7 +235,9 @@ def test_bad_orbits():
     with pytest.raises(ValueError, match=r"an orbit needs at least 3 points"):
         Curve.from_orbit([0.0, np.nan, 1.0], [0.1, 0.2, 0.3])
     # points in half of the circle only: empty bins, named with the widest gap
-    with pytest.raises(ValueError, match=r"the orbit leaves 16 of the n = 32 bins empty \(its widest gap in phi is 3\.2"):
+    with pytest.raises(
+        ValueError, match=r"the orbit leaves 16 of the n = 32 bins empty \(its widest gap in phi is 3\.2"
+    ):
         Curve.from_orbit(np.linspace(0.0, 3.0, 300), np.ones(300), n=32)
     with pytest.raises(ValueError, match=r"n must be in \[3, 2\*\*24\] for a curve from an orbit, got 1"):
         Curve.from_orbit(np.linspace(-3, 3, 30), np.ones(30), n=1)

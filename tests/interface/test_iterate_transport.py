@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import hovering
-from conftest import PROMPT, PARAM_SETS, CtrlCOnceStarted, band_sample, make_map
+from conftest import PARAM_SETS, PROMPT, CtrlCOnceStarted, band_sample, make_map
 from hovering import Above, Below, Curve, Region, Status
 
 KERNELS = ("simd", "scalar")
@@ -133,7 +133,7 @@ def test_stop_is_the_first_state_in_the_set(m, starts, kernel, which):
     for i in rows[:: max(1, rows.size // 200)]:
         s = expected[i]
         assert np.array_equal(res.phi[i, : s + 1], full.phi[i, : s + 1])
-        assert np.all(np.isnan(res.phi[i, s + 1:])) and np.all(np.isnan(res.K[i, s + 1:]))
+        assert np.all(np.isnan(res.phi[i, s + 1 :])) and np.all(np.isnan(res.K[i, s + 1 :]))
         assert np.array_equal(res.region[i, :s], full.region[i, :s])
         assert np.all(res.region[i, s:] == Region.NONE)  # no return is taken from x_{stop_step}
     # orbits that never reach the set are untouched
@@ -149,8 +149,15 @@ def test_stop_tests_the_curve_with_its_own_arithmetic(kernel):
     m = make_map(PARAM_SETS["paper_eps+0.3"])
     c = wavy()
     rng = np.random.default_rng(3)
-    phi0 = np.concatenate([rng.uniform(-np.pi, np.pi, 4000), c.phi, np.nextafter(c.phi, np.inf),
-                           np.nextafter(c.phi, -np.inf)[1:], [-np.pi, np.nextafter(np.pi, 0)]])
+    phi0 = np.concatenate(
+        [
+            rng.uniform(-np.pi, np.pi, 4000),
+            c.phi,
+            np.nextafter(c.phi, np.inf),
+            np.nextafter(c.phi, -np.inf)[1:],
+            [-np.pi, np.nextafter(np.pi, 0)],
+        ]
+    )
     on = c(phi0)
     for stop, off in ((Above(c), np.nextafter(on, -np.inf)), (Below(c), np.nextafter(on, np.inf))):
         a = m.iterate(phi0, on, 0, record=(), kernel=kernel, stop=stop)
@@ -189,11 +196,17 @@ def test_stop_comes_before_an_exit_at_the_same_state(m, starts, kernel):
     phi0, K0 = starts
     stop = Above(wavy())
     plain = m.iterate(phi0, K0, 100, record=("regions",), kernel=kernel, stop=stop)
-    both = m.iterate(phi0, K0, 100, record=("regions",), kernel=kernel, stop=stop,
-                     exit_regions={"0u", "0"}, stop_on_exit=True)
-    first_out = np.array([np.argmax(~np.isin(r, [Region.BESIDE, Region.ABOVE]) & (r != Region.NONE))
-                          if np.any(~np.isin(r, [Region.BESIDE, Region.ABOVE]) & (r != Region.NONE)) else -1
-                          for r in plain.region])
+    both = m.iterate(
+        phi0, K0, 100, record=("regions",), kernel=kernel, stop=stop, exit_regions={"0u", "0"}, stop_on_exit=True
+    )
+    first_out = np.array(
+        [
+            np.argmax(~np.isin(r, [Region.BESIDE, Region.ABOVE]) & (r != Region.NONE))
+            if np.any(~np.isin(r, [Region.BESIDE, Region.ABOVE]) & (r != Region.NONE))
+            else -1
+            for r in plain.region
+        ]
+    )
     stopped_first = (plain.stop_step >= 0) & ((first_out == -1) | (plain.stop_step <= first_out))
     exited_first = (first_out >= 0) & ((plain.stop_step == -1) | (first_out < plain.stop_step))
     assert np.any(stopped_first) and np.any(exited_first)
@@ -247,8 +260,22 @@ def test_residence_counts_the_recorded_returns(m, starts, kernel, exit_kw):
 
 
 ALL = dict(record=("orbit", "regions", "rotation", "visited", "extrema", "residence"), every=3)
-ATTRS = ("phi", "K", "region", "rotation", "visited", "phi_final", "K_final", "status", "steps_done", "exit_step",
-         "stop_step", "K_min", "K_max", "residence")
+ATTRS = (
+    "phi",
+    "K",
+    "region",
+    "rotation",
+    "visited",
+    "phi_final",
+    "K_final",
+    "status",
+    "steps_done",
+    "exit_step",
+    "stop_step",
+    "K_min",
+    "K_max",
+    "residence",
+)
 
 
 def _same(a, b):
@@ -290,8 +317,16 @@ def test_interrupt_keeps_the_transport_records(kernel):
     phi0, K0 = band_sample(m, n, np.random.default_rng(5), K_hi=0.8, margin=0.5)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt) as info:
-        m.iterate(phi0, K0, 100_000, record=("extrema", "residence"), n_threads=2, kernel=kernel,
-                  stop=Above(wavy()), progress=press)
+        m.iterate(
+            phi0,
+            K0,
+            100_000,
+            record=("extrema", "residence"),
+            n_threads=2,
+            kernel=kernel,
+            stop=Above(wavy()),
+            progress=press,
+        )
     assert time.perf_counter() - press.fired_at < PROMPT
     res = info.value.partial
     st = res.status
@@ -299,8 +334,14 @@ def test_interrupt_keeps_the_transport_records(kernel):
     # the partial records are those of the states reached: redo a few orbits to where they were
     idx = np.flatnonzero(st == Status.INTERRUPTED)[:5].tolist() + np.flatnonzero(st == Status.STOPPED)[:5].tolist()
     for i in idx:
-        again = m.iterate(phi0[i: i + 1], K0[i: i + 1], int(res.steps_done[i]), record=("extrema", "residence"),
-                          kernel=kernel, stop=Above(wavy()))
+        again = m.iterate(
+            phi0[i : i + 1],
+            K0[i : i + 1],
+            int(res.steps_done[i]),
+            record=("extrema", "residence"),
+            kernel=kernel,
+            stop=Above(wavy()),
+        )
         assert again.K_min[0] == res.K_min[i] and again.K_max[0] == res.K_max[i]
         assert np.array_equal(again.residence[0], res.residence[i])
         assert again.stop_step[0] == res.stop_step[i]
@@ -312,7 +353,9 @@ def test_interrupt_keeps_the_transport_records(kernel):
 
 def test_a_result_with_the_transport_records_saves_and_loads(m, starts, tmp_path):
     phi0, K0 = starts
-    res = m.iterate(phi0[:50], K0[:50], 30, stop=Below(wavy()), every=4, **{k: v for k, v in ALL.items() if k != "every"})
+    res = m.iterate(
+        phi0[:50], K0[:50], 30, stop=Below(wavy()), every=4, **{k: v for k, v in ALL.items() if k != "every"}
+    )
     path = hovering.save(res, tmp_path / "r.npz")
     back = hovering.load(path)
     assert back.every == 4
@@ -325,8 +368,15 @@ def test_a_result_with_the_transport_records_saves_and_loads(m, starts, tmp_path
 
 @pytest.fixture(scope="module")
 def fm():
-    sys = hovering.StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7), coupling=hovering.Bilinear(),
-                              eps=-0.05, qw1=-1.0, qw2=-0.5, geometry="step")
+    sys = hovering.StepSystem(
+        V1=hovering.Harmonic(1.0),
+        V2=hovering.Tan(1.4, 0.7),
+        coupling=hovering.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
     return hovering.FlowMap(sys, h=1.0, rtol=1e-10)
 
 
@@ -367,7 +417,7 @@ def test_flow_stop_extrema_and_residence_against_the_full_record(fm, flow_run, s
     assert np.array_equal(res.K_final[hit], full.K[rows, expected[hit]])
     for i in rows:
         s = expected[i]
-        assert np.array_equal(res.K[i, : s + 1], full.K[i, : s + 1]) and np.all(np.isnan(res.K[i, s + 1:]))
+        assert np.array_equal(res.K[i, : s + 1], full.K[i, : s + 1]) and np.all(np.isnan(res.K[i, s + 1 :]))
         assert res.itinerary[i][:s] == full.itinerary[i][:s] and res.itinerary[i][s:] == ["-"] * (24 - s)
         assert np.all(res.region[i, s:] == Region.NONE)
     # streamed records vs the states and returns recorded
@@ -385,19 +435,25 @@ def test_flow_stop_on_exit_records_the_exiting_return(fm, flow_run):
     allowed = {int(Region.BESIDE), int(Region.ABOVE)}
     first = np.array([next((j for j, r in enumerate(row) if int(r) not in allowed), -1) for row in full.region])
     assert np.any(first >= 0)
-    res = fm.iterate(phi0, K0, 24, record=("orbit", "regions", "itinerary", "times", "steps", "residence"),
-                     exit_regions={"0u", "0"}, stop_on_exit=True)
+    res = fm.iterate(
+        phi0,
+        K0,
+        24,
+        record=("orbit", "regions", "itinerary", "times", "steps", "residence"),
+        exit_regions={"0u", "0"},
+        stop_on_exit=True,
+    )
     for i in np.flatnonzero(first >= 0):
         k = first[i]
         assert res.status[i] == Status.EXITED and res.exit_step[i] == k and res.steps_done[i] == k
         assert res.itinerary[i][: k + 1] == full.itinerary[i][: k + 1]
         assert res.itinerary[i][k] not in ("", "-")
-        assert res.itinerary[i][k + 1:] == ["-"] * (24 - k - 1)
+        assert res.itinerary[i][k + 1 :] == ["-"] * (24 - k - 1)
         assert np.array_equal(res.region[i, : k + 1], full.region[i, : k + 1])
-        assert np.all(res.region[i, k + 1:] == Region.NONE)
-        assert np.array_equal(res.time[i, : k + 1], full.time[i, : k + 1]) and np.all(np.isnan(res.time[i, k + 1:]))
-        assert np.all(res.integrator_steps[i, k + 1:] == -1)
-        assert np.all(np.isnan(res.phi[i, k + 1:]))
+        assert np.all(res.region[i, k + 1 :] == Region.NONE)
+        assert np.array_equal(res.time[i, : k + 1], full.time[i, : k + 1]) and np.all(np.isnan(res.time[i, k + 1 :]))
+        assert np.all(res.integrator_steps[i, k + 1 :] == -1)
+        assert np.all(np.isnan(res.phi[i, k + 1 :]))
         assert res.residence[i].sum() == k + 1
 
 
@@ -406,8 +462,19 @@ def test_flow_results_do_not_depend_on_the_thread_count(fm, flow_run):
     kw = dict(record=("orbit", "regions", "extrema", "residence"), every=2, stop=Above(0.03))
     a = fm.iterate(phi0, K0, 12, n_threads=1, **kw)
     b = fm.iterate(phi0, K0, 12, n_threads=2, **kw)
-    for attr in ("phi", "K", "region", "phi_final", "K_final", "status", "steps_done", "stop_step", "K_min", "K_max",
-                 "residence"):
+    for attr in (
+        "phi",
+        "K",
+        "region",
+        "phi_final",
+        "K_final",
+        "status",
+        "steps_done",
+        "stop_step",
+        "K_min",
+        "K_max",
+        "residence",
+    ):
         assert np.array_equal(getattr(a, attr), getattr(b, attr), equal_nan=getattr(a, attr).dtype.kind == "f"), attr
 
 
@@ -423,9 +490,11 @@ def test_flow_interrupt_keeps_the_transport_records(fm):
     assert time.perf_counter() - press.fired_at < PROMPT
     res = info.value.partial
     assert np.any(res.status == Status.INTERRUPTED)
-    for i in [int(np.argmax(np.where(res.status == Status.INTERRUPTED, res.steps_done, -1))),
-              *np.flatnonzero(res.status == Status.STOPPED)[:2].tolist()]:
-        again = fm.iterate(phi[i: i + 1], K[i: i + 1], int(res.steps_done[i]), **kw)
+    for i in [
+        int(np.argmax(np.where(res.status == Status.INTERRUPTED, res.steps_done, -1))),
+        *np.flatnonzero(res.status == Status.STOPPED)[:2].tolist(),
+    ]:
+        again = fm.iterate(phi[i : i + 1], K[i : i + 1], int(res.steps_done[i]), **kw)
         assert again.K_min[0] == res.K_min[i] and again.K_max[0] == res.K_max[i]
         assert np.array_equal(again.residence[0], res.residence[i]) and again.stop_step[0] == res.stop_step[i]
 
@@ -440,7 +509,10 @@ BAD = [
     (dict(every=2.5), r"every must be an integer >= 1 \(record every k-th state\), got 2\.5"),
     (dict(every=True), r"every must be an integer >= 1"),
     (dict(every="2"), r"every must be an integer >= 1"),
-    (dict(stop=0.5), r"stop must be hovering\.Above\(curve_or_K\) or hovering\.Below\(curve_or_K\) \(or None\), got 0\.5"),
+    (
+        dict(stop=0.5),
+        r"stop must be hovering\.Above\(curve_or_K\) or hovering\.Below\(curve_or_K\) \(or None\), got 0\.5",
+    ),
     (dict(stop="above"), r"stop must be hovering\.Above"),
     (dict(stop=wavy), r"stop must be hovering\.Above"),
 ]
@@ -459,13 +531,16 @@ def test_bad_transport_arguments_flow(fm, kw, match):
         fm.iterate([0.1], [0.01], 10**15, record=(), **kw)
 
 
-@pytest.mark.parametrize("bad,match", [
-    (float("nan"), r"Above: K must be finite, got nan"),
-    (float("inf"), r"Above: K must be finite, got inf"),
-    ("0.3", r"Above takes a hovering\.Curve or a number K \(a constant curve\), got '0\.3'"),
-    (True, r"Above takes a hovering\.Curve or a number K"),
-    ([0.1, 0.2, 0.3], r"Above takes a hovering\.Curve or a number K"),
-])
+@pytest.mark.parametrize(
+    "bad,match",
+    [
+        (float("nan"), r"Above: K must be finite, got nan"),
+        (float("inf"), r"Above: K must be finite, got inf"),
+        ("0.3", r"Above takes a hovering\.Curve or a number K \(a constant curve\), got '0\.3'"),
+        (True, r"Above takes a hovering\.Curve or a number K"),
+        ([0.1, 0.2, 0.3], r"Above takes a hovering\.Curve or a number K"),
+    ],
+)
 def test_bad_stop_conditions(bad, match):
     with pytest.raises(ValueError, match=match):
         Above(bad)

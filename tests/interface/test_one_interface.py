@@ -15,7 +15,9 @@ from hovering import Region, Status, paper
 @pytest.fixture(scope="module")
 def maps():
     m = paper.truncated_map(0.1)
-    fam = hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1.0, 0.0, 81) ** 2, np.linspace(0.02, 1.0, 30)]))
+    fam = hv.TruncatedFamily.from_map(
+        m, np.concatenate([-(np.linspace(1.0, 0.0, 81) ** 2), np.linspace(0.02, 1.0, 30)])
+    )
     return {"TruncatedMap": m, "TruncatedFamily": fam, "FlowMap": paper.flow_map(-0.05)}
 
 
@@ -51,13 +53,17 @@ def test_enums_are_the_cores():
 
 
 OLD_PATHS = [  # (old module, name, the object it must still give)
-    ("maps", "TruncatedMap", lambda: hv.TruncatedMap), ("geometry", "K_crit", lambda: hv.K_crit),
-    ("fullmap", "TangentialCurve", lambda: hv.TangentialCurve), ("system", "Section", lambda: hv.Section),
-    ("system", "to_normal", lambda: hv.to_normal), ("potentials", "CustomPotential", lambda: hv.CustomPotential),
-    ("accuracy", "work_precision", lambda: hv.work_precision), ("references", "scipy_return_map",
-                                                                 lambda: hv.diagnostics.scipy_return_map),
+    ("maps", "TruncatedMap", lambda: hv.TruncatedMap),
+    ("geometry", "K_crit", lambda: hv.K_crit),
+    ("fullmap", "TangentialCurve", lambda: hv.TangentialCurve),
+    ("system", "Section", lambda: hv.Section),
+    ("system", "to_normal", lambda: hv.to_normal),
+    ("potentials", "CustomPotential", lambda: hv.CustomPotential),
+    ("accuracy", "work_precision", lambda: hv.work_precision),
+    ("references", "scipy_return_map", lambda: hv.diagnostics.scipy_return_map),
     ("plotting", "phase_portrait", lambda: hv.pipeline.phase_portrait),
-    ("figures", "render", lambda: hv.plot.figures.render), ("scenes", "run_scene", lambda: hv.pipeline.run_scene),
+    ("figures", "render", lambda: hv.plot.figures.render),
+    ("scenes", "run_scene", lambda: hv.pipeline.run_scene),
     ("scenes", "redraw", lambda: hv.pipeline.redraw),
 ]
 
@@ -71,12 +77,15 @@ def test_old_module_paths_still_work_and_warn(old, name, new):
     import hovering.plot.figures  # noqa: F401
 
     mod = importlib.import_module(f"hovering.{old}")
-    with pytest.warns(DeprecationWarning, match=rf"hovering\.{old}\.{name} is deprecated and will be removed in "
-                                                rf"hovering 0\.4\.0; use hovering\.[\w.]+\.{name} instead"):
+    with pytest.warns(
+        DeprecationWarning,
+        match=rf"hovering\.{old}\.{name} is deprecated and will be removed in "
+        rf"hovering 0\.4\.0; use hovering\.[\w.]+\.{name} instead",
+    ):
         value = getattr(mod, name)
     assert value is new()
     with pytest.raises(AttributeError):
-        getattr(mod, "no_such_name")
+        _ = mod.no_such_name
 
 
 def test_stubs_name_what_the_compiled_module_has():
@@ -86,12 +95,19 @@ def test_stubs_name_what_the_compiled_module_has():
     import pathlib
 
     stubs = pathlib.Path(hv.__file__).parent / "_core"
-    for name, mod in (("__init__", hv._core), ("truncated", hv._core.truncated), ("flow", hv._core.flow),
-                      ("normal", hv._core.normal)):
+    for name, mod in (
+        ("__init__", hv._core),
+        ("truncated", hv._core.truncated),
+        ("flow", hv._core.flow),
+        ("normal", hv._core.normal),
+    ):
         tree = ast.parse((stubs / f"{name}.pyi").read_text())
         declared = {n.name for n in tree.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
         declared.discard("_MapCore")  # the stubs' common base of the two map classes, not a runtime name
         assert declared <= set(dir(mod)), (name, declared - set(dir(mod)))
-        public = {k for k, v in vars(mod).items() if not k.startswith("__") and (callable(v) or isinstance(v, type))
-                  and not isinstance(v, type(hv._core))}
+        public = {
+            k
+            for k, v in vars(mod).items()
+            if not k.startswith("__") and (callable(v) or isinstance(v, type)) and not isinstance(v, type(hv._core))
+        }
         assert public <= declared, (name, public - declared)

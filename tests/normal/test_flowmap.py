@@ -175,8 +175,9 @@ def test_early_exit_and_exit_step(fm005):
 
 
 def test_records_are_only_what_is_asked(fm005):
-    res = fm005.iterate([0.1], [0.01], 4, record=("times", "energy_error", "steps", "itinerary", "section",
-                                                   "states", "visited"))
+    res = fm005.iterate(
+        [0.1], [0.01], 4, record=("times", "energy_error", "steps", "itinerary", "section", "states", "visited")
+    )
     assert res.phi is None and res.region is None and res.rotation is None
     assert res.time.shape == (1, 4) and np.all(res.time > 5) and np.all(res.energy_error < 1e-10)
     assert res.integrator_steps.shape == (1, 4) and np.all(res.integrator_steps > 10)

@@ -21,13 +21,12 @@ def compare(eps, K, n_phi=12, n_modes=6):
     p = hovering.onset_parameters(paper.system(0.0), paper.H)
     b = hovering.forcing_coefficients(sec, n_modes=n_modes, n_phi=64)
     m = hovering.TruncatedMap(eps=eps, Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
-    grid = np.concatenate([-np.linspace(0.3, 0.0, 31) ** 2 * 10 / 9, np.linspace(0.01, 0.3, 10)])
+    grid = np.concatenate([-(np.linspace(0.3, 0.0, 31) ** 2) * 10 / 9, np.linspace(0.01, 0.3, 10)])
     fam = hovering.TruncatedFamily.from_map(m, grid, forcing=tuple(b))
     phi = np.linspace(-3.0, 3.0, n_phi)
     c = hovering.compare_maps(sec, None, fam, phi, np.full_like(phi, K))
     same = c.agree & (c.region_full != "?")
-    return dict(same=int(same.sum()), dphi=float(np.abs(c.dphi[same]).max()), dK=float(np.abs(c.dK[same]).max()),
-                b=b)
+    return dict(same=int(same.sum()), dphi=float(np.abs(c.dphi[same]).max()), dK=float(np.abs(c.dK[same]).max()), b=b)
 
 
 def test_remainders_scale_as_thm_returnmap():

@@ -45,9 +45,11 @@ def test_corner_curves_follow_thm_cornersing_with_swapped_tau(sec0, curve0):
     cc = fm.corner_curves(sec0, K, curve0)
     assert np.all(cc.other == 0)
     t_R0_printed, t_01_printed = -(p.tau0 + p.tau1) / 2, (p.tau1 - p.tau0) / 2
-    cases = (("phi_R0", -p.theta_w - p.Omega0 / 2, 1, t_01_printed, t_R0_printed),
-             ("phi_01", p.theta_w - p.Omega0 / 2, -1, t_R0_printed, t_01_printed),
-             ("phi_1R", p.theta_w - p.Omega0 / 2, 1, t_R0_printed, t_01_printed))
+    cases = (
+        ("phi_R0", -p.theta_w - p.Omega0 / 2, 1, t_01_printed, t_R0_printed),
+        ("phi_01", p.theta_w - p.Omega0 / 2, -1, t_R0_printed, t_01_printed),
+        ("phi_1R", p.theta_w - p.Omega0 / 2, 1, t_R0_printed, t_01_printed),
+    )
     for name, phi0, A, tau_swapped, tau_printed in cases:
         y = getattr(cc, name)
         swapped = hovering.wrap(y - (phi0 + A * p.lam * s + tau_swapped * K))
@@ -100,7 +102,9 @@ def test_remainder_GK_scales_like_eps_K_in_J0():
         p = hovering.onset_parameters(sec.sys, 1.0)
         m = hovering.TruncatedFamily.from_map(
             hovering.TruncatedMap(eps=eps, Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam),
-            np.concatenate([-np.linspace(0.3, 0.0, 31) ** 2, np.linspace(0.01, 0.3, 10)]), forcing=tuple(b))
+            np.concatenate([-(np.linspace(0.3, 0.0, 31) ** 2), np.linspace(0.01, 0.3, 10)]),
+            forcing=tuple(b),
+        )
         for K in (-0.01, -0.005):
             c = fm.compare_maps(sec, curve, m, ph, np.full(ph.shape, K))
             sel = (c.region_full == "0") & np.isfinite(c.GK)

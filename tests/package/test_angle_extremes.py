@@ -52,11 +52,13 @@ def seam_gap(a, b) -> float:
 
 # ------------------------------------------------------------------ the truncated models
 
+
 @pytest.fixture(scope="module")
 def truncated_maps():
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
-    fam = hv.TruncatedFamily.from_map(m, np.concatenate([np.linspace(-1.5, 0.0, 31), np.linspace(0.05, 1.0, 20)]),
-                                      forcing=(1.0, 0.2))
+    fam = hv.TruncatedFamily.from_map(
+        m, np.concatenate([np.linspace(-1.5, 0.0, 31), np.linspace(0.05, 1.0, 20)]), forcing=(1.0, 0.2)
+    )
     return {"TruncatedMap": m, "TruncatedFamily": fam}
 
 
@@ -112,13 +114,25 @@ def test_critical_curve_on_a_vertical_line_at_the_seam(truncated_maps):
 
 # ------------------------------------------------------------------ the flow
 
+
 @pytest.fixture(scope="module")
 def flow():
-    s = hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=-0.05,
-                      qw1=-1.0, qw2=-0.5, geometry="step")
+    s = hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
     fm = hv.FlowMap(s, 1.0)
-    return {"sys": s, "sec": hv.Section(s, 1.0), "normal": fm,
-            "section": hv.FlowMap(s, 1.0, coordinates="section", curve=None)}
+    return {
+        "sys": s,
+        "sec": hv.Section(s, 1.0),
+        "normal": fm,
+        "section": hv.FlowMap(s, 1.0, coordinates="section", curve=None),
+    }
 
 
 #: (coordinates, heights): K in normal coordinates, I in section coordinates; orbits that return

@@ -17,7 +17,9 @@ import hovering
 
 API = json.loads((Path(__file__).parents[1] / "data" / "api-0.2.0.json").read_text())["public"]
 NAMES = [(mod, name) for mod, names in sorted(API.items()) for name in names]
-MESSAGE = re.compile(r"^(hovering[\w.]*) is deprecated and will be removed in hovering (\d+\.\d+\.\d+); use (.+) instead$")
+MESSAGE = re.compile(
+    r"^(hovering[\w.]*) is deprecated and will be removed in hovering (\d+\.\d+\.\d+); use (.+) instead$"
+)
 
 
 def test_the_snapshot_is_the_whole_public_api():

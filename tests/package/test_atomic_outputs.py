@@ -85,10 +85,12 @@ def sweep_scene(n_steps: int = 2000, eps=(0.2,)) -> str:
 
 def cli(*args, cwd, timeout=300, pre=None):
     """``python -m hovering ARGS`` in ``cwd``; ``pre``: Python run first in the child (a file-size limit)."""
-    code = (pre or "") + ("\nimport runpy, sys\nsys.argv[0] = 'hovering'\n"
-                          "runpy.run_module('hovering', run_name='__main__')")
-    return subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True, cwd=cwd,
-                          timeout=timeout)
+    code = (pre or "") + (
+        "\nimport runpy, sys\nsys.argv[0] = 'hovering'\nrunpy.run_module('hovering', run_name='__main__')"
+    )
+    return subprocess.run(
+        [sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=timeout
+    )
 
 
 def files(d: Path) -> dict:
@@ -102,8 +104,10 @@ def temporaries(d: Path) -> list:
 
 def fsize_limit(n: int) -> str:
     # SIGXFSZ ignored: a write past the limit fails with EFBIG instead of killing the process.
-    return (f"import resource, signal\nsignal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
-            f"resource.setrlimit(resource.RLIMIT_FSIZE, ({n}, {n}))\n")
+    return (
+        f"import resource, signal\nsignal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        f"resource.setrlimit(resource.RLIMIT_FSIZE, ({n}, {n}))\n"
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -161,8 +165,12 @@ print("done", flush=True)
 
 
 def writer(d: Path, action: str, variant: str, block: str = "-"):
-    return subprocess.Popen([sys.executable, "-c", WRITER, action, variant, block, str(d)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-c", WRITER, action, variant, block, str(d)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def check_loads(d: Path):
@@ -178,18 +186,21 @@ def check_loads(d: Path):
             assert p.read_bytes().endswith(b"IEND\xaeB`\x82"), p
 
 
-@pytest.mark.parametrize("action,block,sig", [
-    ("save", "r.npz", signal.SIGKILL),
-    ("save", "r.npz", signal.SIGINT),
-    ("save-midwrite", "-", signal.SIGKILL),
-    ("save-midwrite", "-", signal.SIGINT),
-    # a whole scene run in the child, killed while it writes: end-to-end
-    pytest.param("scene", "r.npz", signal.SIGKILL),
-    pytest.param("scene", "r.json", signal.SIGKILL),
-    pytest.param("scene", "r.json", signal.SIGINT),
-    pytest.param("scene", "r.png", signal.SIGKILL),
-    pytest.param("scene", "r.png", signal.SIGINT),
-])
+@pytest.mark.parametrize(
+    "action,block,sig",
+    [
+        ("save", "r.npz", signal.SIGKILL),
+        ("save", "r.npz", signal.SIGINT),
+        ("save-midwrite", "-", signal.SIGKILL),
+        ("save-midwrite", "-", signal.SIGINT),
+        # a whole scene run in the child, killed while it writes: end-to-end
+        pytest.param("scene", "r.npz", signal.SIGKILL),
+        pytest.param("scene", "r.json", signal.SIGKILL),
+        pytest.param("scene", "r.json", signal.SIGINT),
+        pytest.param("scene", "r.png", signal.SIGKILL),
+        pytest.param("scene", "r.png", signal.SIGINT),
+    ],
+)
 def test_a_write_interrupted_leaves_the_previous_file(tmp_path, action, block, sig):
     (tmp_path / "p.toml").write_text(PORTRAIT)
     first = writer(tmp_path, action.replace("-midwrite", ""), "old")
@@ -227,6 +238,7 @@ def test_a_write_interrupted_leaves_the_previous_file(tmp_path, action, block, s
 
 # ------------------------------------------------------------------------------------------------
 # A full disk
+
 
 @pytest.mark.parametrize("which", ["first file", "figure"])
 def test_full_disk_is_one_error_and_keeps_the_previous_outputs(tmp_path, which):
@@ -278,8 +290,12 @@ def test_full_disk_in_the_api_is_a_write_error_and_keeps_the_files(tmp_path):
     c.put({"eps": 0.1}, {"area": 0.5})
     before = files(tmp_path)
     limit = max(len(v) for v in before.values()) + 64
-    r = subprocess.run([sys.executable, "-c", fsize_limit(limit) + FULL_API, str(tmp_path)], capture_output=True,
-                       text=True, timeout=120)
+    r = subprocess.run(
+        [sys.executable, "-c", fsize_limit(limit) + FULL_API, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stderr
     save, put = r.stdout.strip().splitlines()
     # One error type, both an OSError and a ValueError, naming the file and the reason.
@@ -327,6 +343,7 @@ def test_full_tmpfs_keeps_the_previous_outputs(tmp_path):
 # ------------------------------------------------------------------------------------------------
 # hovering_sweep: runs sharing a checkpoint, provenance lines, a full disk
 
+
 def sweep_plan(tmp_path: Path, n_steps: int = 2000, eps=(0.2,)) -> Path:
     """The plan of the one-series sweep scene at ``eps``, written by python -m hovering plan."""
     (tmp_path / "s.toml").write_text(sweep_scene(n_steps=n_steps, eps=eps))
@@ -338,23 +355,34 @@ def sweep_plan(tmp_path: Path, n_steps: int = 2000, eps=(0.2,)) -> Path:
 def ckpt_parts(path: Path):
     """(provenance records, header lines, point lines) of a checkpoint."""
     recs = [json.loads(x) for x in path.read_text().splitlines()]
-    return ([r["provenance"] for r in recs if "provenance" in r], [r for r in recs if "format" in r],
-            [r for r in recs if "key" in r])
+    return (
+        [r["provenance"] for r in recs if "provenance" in r],
+        [r for r in recs if "format" in r],
+        [r for r in recs if "key" in r],
+    )
 
 
 def test_two_sweeps_started_together_never_write_a_point_twice(tmp_path, sweep_exe):
     plan = sweep_plan(tmp_path, n_steps=20_000)
     for trial in range(20):
         out = tmp_path / f"c{trial}.jsonl"
-        runs = [subprocess.Popen([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+        runs = [
+            subprocess.Popen(
+                [sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for _ in range(2)
+        ]
         results = [(p.wait(timeout=300), p.communicate()[1]) for p in runs]
         assert all(rc == 0 for rc, _ in results), (trial, results)
         prov, heads, points = ckpt_parts(out)
         # one header, one point; a provenance line per run that wrote a point (one here)
         assert len(heads) == 1 and len(points) == 1 and len(prov) == 1, (trial, out.read_text())
-        again = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True,
-                               timeout=300)
+        again = subprocess.run(
+            [sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True, timeout=300
+        )
         assert again.returncode == 0 and "1 already in" in again.stderr, (trial, again.stderr)
 
 
@@ -363,8 +391,12 @@ def test_a_sweep_waits_for_a_writer_holding_the_checkpoint(tmp_path, sweep_exe):
     out = tmp_path / "c.jsonl"
     with open(out, "a") as held:
         fcntl.flock(held.fileno(), fcntl.LOCK_EX)
-        p = subprocess.Popen([sweep_exe, "--plan", str(plan), "--out", str(out)], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
+        p = subprocess.Popen(
+            [sweep_exe, "--plan", str(plan), "--out", str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         time.sleep(0.5)
         assert p.poll() is None and out.read_bytes() == b""  # nothing read or written under another's lock
     _, err = p.communicate(timeout=300)
@@ -375,8 +407,10 @@ def test_a_sweep_waits_for_a_writer_holding_the_checkpoint(tmp_path, sweep_exe):
 def test_a_sweep_on_a_full_disk_keeps_its_points(tmp_path, sweep_exe):
     plan = sweep_plan(tmp_path)
     out = tmp_path / "c.jsonl"
-    assert subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], timeout=300,
-                          capture_output=True).returncode == 0
+    assert (
+        subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], timeout=300, capture_output=True).returncode
+        == 0
+    )
     before = out.read_bytes()
     plan = sweep_plan(tmp_path, eps=(0.2, 0.3))
     argv = [sweep_exe, "--plan", str(plan), "--out", str(out)]
@@ -385,16 +419,21 @@ def test_a_sweep_on_a_full_disk_keeps_its_points(tmp_path, sweep_exe):
     assert r.returncode == 2, r.stderr
     assert "writing a point to " in r.stderr and "failed: no space left" in r.stderr
     assert out.read_bytes() == before  # the half line was cut back off
-    ok = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True,
-                        timeout=300)
+    ok = subprocess.run(
+        [sweep_exe, "--plan", str(plan), "--out", str(out)], capture_output=True, text=True, timeout=300
+    )
     assert ok.returncode == 0 and "1 already in" in ok.stderr and len(ckpt_parts(out)[2]) == 2
 
 
 def test_sweep_checkpoint_records_the_cores_provenance(tmp_path, sweep_exe):
     plan = sweep_plan(tmp_path)
     out = tmp_path / "c.jsonl"
-    r = subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"], capture_output=True,
-                       text=True, timeout=300)
+    r = subprocess.run(
+        [sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "1"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     lines = out.read_text().splitlines()
     assert lines[0] == '{"format":"hovering-checkpoint","version":1}' and lines[1].startswith('{"provenance":')
@@ -408,12 +447,20 @@ def test_sweep_checkpoint_records_the_cores_provenance(tmp_path, sweep_exe):
     check_commit(prov["git"])
     assert prov["threads"] == 1
     # A later run writes its own line before its first point; a run that writes nothing writes none.
-    subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"], check=True,
-                   capture_output=True, timeout=300)
+    subprocess.run(
+        [sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     assert len(ckpt_parts(out)[0]) == 1
     plan = sweep_plan(tmp_path, eps=(0.2, 0.3))
-    subprocess.run([sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"], check=True,
-                   capture_output=True, timeout=300)
+    subprocess.run(
+        [sweep_exe, "--plan", str(plan), "--out", str(out), "--threads", "2"],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     prov, heads, points = ckpt_parts(out)
     assert [p["threads"] for p in prov] == [1, 2] and len(heads) == 1 and len(points) == 2
     assert out.read_text().splitlines()[-2].startswith('{"provenance":')
@@ -422,21 +469,33 @@ def test_sweep_checkpoint_records_the_cores_provenance(tmp_path, sweep_exe):
 # ------------------------------------------------------------------------------------------------
 # Keys and values that must read back
 
-@pytest.mark.parametrize("obj", [
-    {  # str keys: the array members are named after their paths
-        "a\0b": np.arange(3),            # zip member names stop at NUL
-        "\ud800": np.arange(2),           # not encodable as a zip member name
-        "k" * 70_000: np.arange(4),       # longer than a zip member name can be
-        "__meta__": np.arange(5),         # the archive's own member
-        "__array__": "a tag of the tree", "__dict__": {"__items__": 1},
-        "x.y": np.zeros(1), "x": {"y": np.ones(1)},  # two paths that spell the same
-        "nul\0value": "v\0",
-    },
-    {  # keys of other types
-        3: "int", 2.5: "float", (1, "t"): np.arange(2), None: "none", True: "bool", hovering.Status.CORNER: "enum",
-        Path("p"): "path", "a\0b": np.arange(3),
-    },
-])
+
+@pytest.mark.parametrize(
+    "obj",
+    [
+        {  # str keys: the array members are named after their paths
+            "a\0b": np.arange(3),  # zip member names stop at NUL
+            "\ud800": np.arange(2),  # not encodable as a zip member name
+            "k" * 70_000: np.arange(4),  # longer than a zip member name can be
+            "__meta__": np.arange(5),  # the archive's own member
+            "__array__": "a tag of the tree",
+            "__dict__": {"__items__": 1},
+            "x.y": np.zeros(1),
+            "x": {"y": np.ones(1)},  # two paths that spell the same
+            "nul\0value": "v\0",
+        },
+        {  # keys of other types
+            3: "int",
+            2.5: "float",
+            (1, "t"): np.arange(2),
+            None: "none",
+            True: "bool",
+            hovering.Status.CORNER: "enum",
+            Path("p"): "path",
+            "a\0b": np.arange(3),
+        },
+    ],
+)
 def test_any_saveable_key_reads_back(tmp_path, obj):
     hovering.save(obj, tmp_path / "k.npz")
     back = hovering.load(tmp_path / "k.npz")
@@ -450,13 +509,21 @@ def test_any_saveable_key_reads_back(tmp_path, obj):
         assert type(key) is type(k), repr(k)[:40]
 
 
-@pytest.mark.parametrize("obj,meta,error,match", [
-    ({"s": np.array(["ok", "ends in NUL\0"], dtype=object)}, None, ValueError, r"root\.s: a string ending in NUL"),
-    ({"rec": np.zeros(2, dtype=[("a", "f8"), ("o", "O")])}, None, TypeError, r"root\.rec: arrays whose dtype holds"),
-    ({"n": 1 << 20_000}, None, ValueError, r"root\.n: an integer of 20001 bits"),
-    ({"x": 1}, {1: "int key"}, ValueError, r"meta: key 1 is a int"),
-    ({"x": 1}, {"nested": [{(1, 2): "tuple key"}]}, ValueError, r"meta\['nested'\]\[0\]: key \(1, 2\)"),
-])
+@pytest.mark.parametrize(
+    "obj,meta,error,match",
+    [
+        ({"s": np.array(["ok", "ends in NUL\0"], dtype=object)}, None, ValueError, r"root\.s: a string ending in NUL"),
+        (
+            {"rec": np.zeros(2, dtype=[("a", "f8"), ("o", "O")])},
+            None,
+            TypeError,
+            r"root\.rec: arrays whose dtype holds",
+        ),
+        ({"n": 1 << 20_000}, None, ValueError, r"root\.n: an integer of 20001 bits"),
+        ({"x": 1}, {1: "int key"}, ValueError, r"meta: key 1 is a int"),
+        ({"x": 1}, {"nested": [{(1, 2): "tuple key"}]}, ValueError, r"meta\['nested'\]\[0\]: key \(1, 2\)"),
+    ],
+)
 def test_values_that_would_not_read_back_are_refused_at_save(tmp_path, obj, meta, error, match):
     target = tmp_path / "r.npz"
     hovering.save({"x": np.arange(3)}, target)
@@ -469,6 +536,7 @@ def test_values_that_would_not_read_back_are_refused_at_save(tmp_path, obj, meta
 # ------------------------------------------------------------------------------------------------
 # Where a scene writes
 
+
 @pytest.fixture
 def dirs(tmp_path):
     (tmp_path / "scenes").mkdir()
@@ -477,8 +545,9 @@ def dirs(tmp_path):
     return tmp_path
 
 
-@pytest.mark.parametrize("output", ["ABS/elsewhere/x.png", "../elsewhere/x.png", "../elsewhere/new/x.png",
-                                    "link/x.png"])
+@pytest.mark.parametrize(
+    "output", ["ABS/elsewhere/x.png", "../elsewhere/x.png", "../elsewhere/new/x.png", "link/x.png"]
+)
 def test_a_scene_cannot_write_outside_its_folder_and_the_working_directory(dirs, output, monkeypatch):
     (dirs / "work" / "link").symlink_to(dirs / "elsewhere")
     scene = dirs / "scenes" / "p.toml"
@@ -552,6 +621,7 @@ def test_redraw_and_accuracy_refuse_foreign_files_too(tmp_path):
 # ------------------------------------------------------------------------------------------------
 # Summaries with NaN
 
+
 def test_sweep_at_omega0_two_pi_prints_its_nan_theory(tmp_path):
     # eq:hovsetsize divides by sin(Omega0 / 2) = 0 at Omega0 = 2 pi: the theory is NaN.
     (tmp_path / "s.toml").write_text(sweep_scene().replace("Omega0 = 2.1", 'Omega0 = "2*pi"'))
@@ -576,18 +646,54 @@ def test_checkpoint_row_with_nan_area_prints_as_nan(tmp_path):
 
 def test_every_number_of_a_summary_may_be_missing():
     # A flow sweep's and a portrait's summary with every number None (a NaN): printed, never raised.
-    flow = dict(scene="f", kind="flow_hovering_area", title="t", quick=False, runtime_s=None, n_steps=10,
-                points=[dict(eps=None, flow=None, flow_error=None, flow_both_sides=None, theory=None, K_low=None,
-                             b1=None, seconds=None, unresolved=0,
-                             models={"onset": dict(area=None, error=None, agree=None, K_low=None)})],
-                output="f.png", npz="f.npz", json="f.json", files=["f.npz", "f.json", "f.png"])
+    flow = dict(
+        scene="f",
+        kind="flow_hovering_area",
+        title="t",
+        quick=False,
+        runtime_s=None,
+        n_steps=10,
+        points=[
+            dict(
+                eps=None,
+                flow=None,
+                flow_error=None,
+                flow_both_sides=None,
+                theory=None,
+                K_low=None,
+                b1=None,
+                seconds=None,
+                unresolved=0,
+                models={"onset": dict(area=None, error=None, agree=None, K_low=None)},
+            )
+        ],
+        output="f.png",
+        npz="f.npz",
+        json="f.json",
+        files=["f.npz", "f.json", "f.png"],
+    )
     text = scenes.format_summary(flow)
     assert "flow |HOV| = nan +- nan" in text and "(own box from K = nan" in text and "in nan s" in text
-    orbit = dict(scene="o", kind="portrait", title="t", quick=True, runtime_s=1.0, panels=[dict(
-        id="a", params=dict(eps=None, Omega0=None, theta_w=None), K_crit=None, rho_crit=None, n_escaped=0,
-        orbits=[dict(label="x", kind="blue", K0=None, K_min=None, rho=None, status="OK", impacts=0)],
-        critical=dict(found=True, K0=None, K_min=None, rotation_mean=None, rotation=None, K_pred=None,
-                      rotation_pred=None))])
+    orbit = dict(
+        scene="o",
+        kind="portrait",
+        title="t",
+        quick=True,
+        runtime_s=1.0,
+        panels=[
+            dict(
+                id="a",
+                params=dict(eps=None, Omega0=None, theta_w=None),
+                K_crit=None,
+                rho_crit=None,
+                n_escaped=0,
+                orbits=[dict(label="x", kind="blue", K0=None, K_min=None, rho=None, status="OK", impacts=0)],
+                critical=dict(
+                    found=True, K0=None, K_min=None, rotation_mean=None, rotation=None, K_pred=None, rotation_pred=None
+                ),
+            )
+        ],
+    )
     text = scenes.format_summary(orbit)
     assert "eps = nan, Omega0 = nan" in text and "K0 = nan, K_min = nan, rho = nan" in text
 
@@ -595,8 +701,23 @@ def test_every_number_of_a_summary_may_be_missing():
 # ------------------------------------------------------------------------------------------------
 # Provenance
 
-KEYS = ["hovering", "git", "python", "numpy", "scipy", "matplotlib", "compiler", "gsl", "eigen", "sleef", "simd_width",
-        "platform", "hardware_threads", "threads", "seed"]
+KEYS = [
+    "hovering",
+    "git",
+    "python",
+    "numpy",
+    "scipy",
+    "matplotlib",
+    "compiler",
+    "gsl",
+    "eigen",
+    "sleef",
+    "simd_width",
+    "platform",
+    "hardware_threads",
+    "threads",
+    "seed",
+]
 
 
 def git(*args):
@@ -667,8 +788,9 @@ def test_the_commit_is_taken_from_the_checkout_or_unknown(tmp_path):
     src = tmp_path / "repo" / "src"
     src.mkdir(parents=True)
     subprocess.run(["git", "init", "-q", str(tmp_path / "repo")], check=True)
-    subprocess.run([cmake, f"-DSOURCE_DIR={src}", f"-DOUTPUT={tmp_path / 'sdist.h'}", "-P", str(script)], check=True,
-                   timeout=60)
+    subprocess.run(
+        [cmake, f"-DSOURCE_DIR={src}", f"-DOUTPUT={tmp_path / 'sdist.h'}", "-P", str(script)], check=True, timeout=60
+    )
     assert '#define HOVERING_GIT_COMMIT "unknown"' in (tmp_path / "sdist.h").read_text()
 
 
@@ -679,7 +801,8 @@ def test_show_versions_prints_the_record(capsys):
     rec = provenance()
     del rec["seed"]
     assert {re.split(r"\s+:\s", x, maxsplit=1)[0].strip(): x.split(" : ", 1)[1] for x in out[2:]} == {
-        k: str(v) for k, v in rec.items()}
+        k: str(v) for k, v in rec.items()
+    }
     assert "show_versions" in hovering.__all__
 
 
@@ -737,8 +860,10 @@ def test_files_written_before_provenance_still_load(tmp_path):
 def test_concurrent_checkpoint_writers_never_mix_lines(tmp_path):
     # Four processes append 200 records each to one checkpoint, each record longer than a file
     # buffer (so an unlocked writer would issue several writes that interleave): every line is whole.
-    code = ("import sys\nfrom hovering.parallel.checkpoint import Checkpoint\nc = Checkpoint(sys.argv[1])\n"
-            "for i in range(200):\n    c.put({'w': int(sys.argv[2]), 'i': i}, {'pad': 'x' * 20_000})\n")
+    code = (
+        "import sys\nfrom hovering.parallel.checkpoint import Checkpoint\nc = Checkpoint(sys.argv[1])\n"
+        "for i in range(200):\n    c.put({'w': int(sys.argv[2]), 'i': i}, {'pad': 'x' * 20_000})\n"
+    )
     ck = tmp_path / "c.jsonl"
     procs = [subprocess.Popen([sys.executable, "-c", code, str(ck), str(w)]) for w in range(4)]
     assert all(p.wait(timeout=300) == 0 for p in procs)

@@ -96,8 +96,9 @@ SCENARIOS = {
 
 
 def _run(kind: str, delay: float, size: int):
-    r = subprocess.run([sys.executable, "-c", SCENARIO, kind, repr(delay), str(size)], capture_output=True,
-                       text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, "-c", SCENARIO, kind, repr(delay), str(size)], capture_output=True, text=True, timeout=300
+    )
     return kind, delay, r.returncode, r.stderr
 
 
@@ -110,8 +111,11 @@ def _loop(runs: int) -> None:
             jobs.append((kind, delays[i % len(delays)], n))
     with ThreadPoolExecutor(2) as pool:  # two processes at a time: a loaded 2-core machine
         results = list(pool.map(lambda j: _run(*j), jobs))
-    bad = [(kind, delay, rc, err[-300:]) for kind, delay, rc, err in results
-           if rc != 0 or any(word in err for word in ("terminate", "FATAL", "Traceback", "Segmentation"))]
+    bad = [
+        (kind, delay, rc, err[-300:])
+        for kind, delay, rc, err in results
+        if rc != 0 or any(word in err for word in ("terminate", "FATAL", "Traceback", "Segmentation"))
+    ]
     counts = {kind: sum(1 for b in bad if b[0] == kind) for kind in SCENARIOS}
     assert not bad, (counts, bad[:5])
 
@@ -217,7 +221,11 @@ FORK_CHILD = textwrap.dedent(
 def test_a_fork_child_exits_without_waiting_for_the_parents_threads():
     # A child made by os.fork has only the forking thread: the passes of the parent's threads
     # that were calling Python at the fork must not make the child's exit wait for them forever.
-    r = subprocess.run([sys.executable, "-W", "ignore::DeprecationWarning", "-c", FORK_CHILD], capture_output=True,
-                       text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, "-W", "ignore::DeprecationWarning", "-c", FORK_CHILD],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr[-500:]
     assert r.stdout.strip() == "True"

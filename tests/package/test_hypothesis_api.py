@@ -36,8 +36,13 @@ from hovering import paper
 # Derandomised by default so CI is reproducible; HOVERING_FUZZ=N runs N random examples per test
 # (a deeper local search: HOVERING_FUZZ=2000 python -m pytest tests/package/test_hypothesis_api.py).
 _DEEP = int(os.environ.get("HOVERING_FUZZ", "0"))
-SETTINGS = settings(max_examples=_DEEP or 60, deadline=None, derandomize=not _DEEP, database=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+SETTINGS = settings(
+    max_examples=_DEEP or 60,
+    deadline=None,
+    derandomize=not _DEEP,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
 
 M = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
 SYS = paper.system(0.05)
@@ -50,18 +55,21 @@ FM = hv.FlowMap(SYS, 1.0)
 SCALARS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.sampled_from([0.0, -0.0, 5e-324, 1e-300, 1e300, -1e300, math.pi, 2 * math.pi, 1e6 + 1]),
-    st.integers(min_value=-2**80, max_value=2**80),
+    st.integers(min_value=-(2**80), max_value=2**80),
     st.booleans(),
     st.none(),
     st.text(max_size=4),
     st.complex_numbers(max_magnitude=10.0),
     st.just(complex("nan+1j")),
     st.builds(np.float32, st.floats(width=32)),
-    st.builds(np.int64, st.integers(-2**63, 2**63 - 1)),
+    st.builds(np.int64, st.integers(-(2**63), 2**63 - 1)),
 )
 ARRAYS = st.one_of(
-    hnp.arrays(st.sampled_from([np.float64, np.float32]), hnp.array_shapes(min_dims=0, max_dims=2, max_side=3),
-               elements=st.floats(allow_nan=True, allow_infinity=True, width=32)),
+    hnp.arrays(
+        st.sampled_from([np.float64, np.float32]),
+        hnp.array_shapes(min_dims=0, max_dims=2, max_side=3),
+        elements=st.floats(allow_nan=True, allow_infinity=True, width=32),
+    ),
     hnp.arrays(np.int64, hnp.array_shapes(min_dims=0, max_dims=2, max_side=3)),
     hnp.arrays(np.bool_, hnp.array_shapes(min_dims=1, max_dims=1, max_side=3)),
     hnp.arrays(np.complex128, hnp.array_shapes(min_dims=1, max_dims=1, max_side=2)),
@@ -75,10 +83,12 @@ def counts(small_max: int):
     """Count-like values: anything, but valid integers only up to small_max (a valid huge count
     is a legitimately long computation); invalid huge ones stay in."""
     return st.one_of(
-        st.integers(min_value=-2**70, max_value=small_max),
+        st.integers(min_value=-(2**70), max_value=small_max),
         st.sampled_from([2**53 + 1, 2**63 - 1, 2**64, 2**70, math.nan, math.inf, -math.inf]),
         st.floats(max_value=float(small_max)),
-        st.booleans(), st.none(), st.text(max_size=3),
+        st.booleans(),
+        st.none(),
+        st.text(max_size=3),
         st.builds(np.int64, st.integers(-5, small_max)),
     )
 
@@ -103,8 +113,16 @@ def _alarm():
 
 
 RANGE_WORDS = re.compile(r"must|allowed|one of|expected|outside|needs|cannot|got", re.I)
-FOREIGN = ("incompatible function arguments", "arg0", "ufunc", "object of type", "has no attribute",
-           "unsupported operand", "division by zero", "Traceback")
+FOREIGN = (
+    "incompatible function arguments",
+    "arg0",
+    "ufunc",
+    "object of type",
+    "has no attribute",
+    "unsupported operand",
+    "division by zero",
+    "Traceback",
+)
 
 
 def outcome(call, *names):
@@ -169,8 +187,17 @@ def test_truncated_map_parameters(param, value):
         check_iterate(m.iterate([0.1, -2.0, 3.0], [-0.1, -0.3, 0.05], 20))
 
 
-ITERATE = dict(phi0=ANY, K0=ANY, n_steps=counts(50), record=ANY, exit_regions=ANY, stop_on_exit=ANY,
-               n_threads=counts(4), kernel=ANY, sin_ulp=ANY)
+ITERATE = dict(
+    phi0=ANY,
+    K0=ANY,
+    n_steps=counts(50),
+    record=ANY,
+    exit_regions=ANY,
+    stop_on_exit=ANY,
+    n_threads=counts(4),
+    kernel=ANY,
+    sin_ulp=ANY,
+)
 
 
 @pytest.mark.parametrize("param", list(ITERATE))
@@ -202,7 +229,7 @@ def test_truncated_pointwise(method, phi, K):
 def test_truncated_curves(method, K):
     r = outcome(lambda: getattr(M, method)(K), "K")
     if r is not None:
-        for x in (r.values() if isinstance(r, dict) else r if isinstance(r, tuple) else (r,)):
+        for x in r.values() if isinstance(r, dict) else r if isinstance(r, tuple) else (r,):
             assert not np.any(np.isinf(np.asarray(x, dtype=float)))
 
 
@@ -250,8 +277,11 @@ THEORY = {
 }
 
 
-@pytest.mark.parametrize("case", [(f, i) for f, (_, names, _) in THEORY.items() for i in range(len(names))],
-                         ids=lambda c: f"{c[0]}:{THEORY[c[0]][1][c[1]]}")
+@pytest.mark.parametrize(
+    "case",
+    [(f, i) for f, (_, names, _) in THEORY.items() for i in range(len(names))],
+    ids=lambda c: f"{c[0]}:{THEORY[c[0]][1][c[1]]}",
+)
 @SETTINGS
 @given(value=ANY)
 def test_theory_functions(case, value):
@@ -269,8 +299,11 @@ def test_theory_functions(case, value):
 # Potentials and the flow
 
 
-@pytest.mark.parametrize("make,param", [(lambda v: hv.Harmonic(v), "omega"), (lambda v: hv.Tan(v, 0.7), "omega"),
-                                        (lambda v: hv.Tan(1.4, v), "alpha")], ids=["Harmonic", "Tan-omega", "Tan-alpha"])
+@pytest.mark.parametrize(
+    "make,param",
+    [(lambda v: hv.Harmonic(v), "omega"), (lambda v: hv.Tan(v, 0.7), "omega"), (lambda v: hv.Tan(1.4, v), "alpha")],
+    ids=["Harmonic", "Tan-omega", "Tan-alpha"],
+)
 @SETTINGS
 @given(value=ANY)
 def test_potential_parameters(make, param, value):
@@ -291,8 +324,11 @@ def test_potential_energy_questions(pot, method, h):
 
 @pytest.mark.parametrize("pot", [hv.Harmonic(1.0), hv.Tan(1.4, 0.7), hv.Numerical(hv.Harmonic(1.0))], ids=repr)
 @SETTINGS
-@given(q=st.floats(allow_nan=True, allow_infinity=True), p=st.floats(allow_nan=True, allow_infinity=True),
-       h=st.one_of(st.floats(min_value=-1.0, max_value=10.0), st.just(math.nan)))
+@given(
+    q=st.floats(allow_nan=True, allow_infinity=True),
+    p=st.floats(allow_nan=True, allow_infinity=True),
+    h=st.one_of(st.floats(min_value=-1.0, max_value=10.0), st.just(math.nan)),
+)
 def test_angle_of_point(pot, q, p, h):
     th = outcome(lambda: pot.angle_of_point(q, p, h), "q and p", "energy", "level")
     if th is not None:
@@ -316,8 +352,19 @@ def test_step_system_parameters(param, data):
             finite_or_explained(r.theta, r.status, int(hv.FlowStatus.OK))
 
 
-RETURN_MAP = dict(theta=ANY, I=ANY, rtol=ANY, atol=ANY, stepper=ANY, event_tol=ANY, max_steps=counts(10**5),
-                  max_impacts=counts(100), grazing_tol=ANY, corner_tol=ANY, n_threads=counts(4))
+RETURN_MAP = dict(
+    theta=ANY,
+    I=ANY,
+    rtol=ANY,
+    atol=ANY,
+    stepper=ANY,
+    event_tol=ANY,
+    max_steps=counts(10**5),
+    max_impacts=counts(100),
+    grazing_tol=ANY,
+    corner_tol=ANY,
+    n_threads=counts(4),
+)
 
 
 @pytest.mark.parametrize("param", list(RETURN_MAP))
@@ -343,8 +390,9 @@ def test_section_energy(h):
         finite_or_explained(r.theta, r.status, int(hv.FlowStatus.OK))
 
 
-FLOW_ITERATE = dict(phi0=ANY, K0=ANY, n_steps=counts(3), record=ANY, exit_regions=ANY, stop_on_exit=ANY,
-                    n_threads=counts(2))
+FLOW_ITERATE = dict(
+    phi0=ANY, K0=ANY, n_steps=counts(3), record=ANY, exit_regions=ANY, stop_on_exit=ANY, n_threads=counts(2)
+)
 
 
 @pytest.mark.parametrize("param", list(FLOW_ITERATE))
@@ -358,8 +406,9 @@ def test_flowmap_iterate_parameters(param, data):
         check_iterate(res, ok=int(hv.Status.OK))
 
 
-@pytest.mark.parametrize("fn,names", [(hv.to_normal, ("theta", "I")), (hv.from_normal, ("phi", "K"))],
-                         ids=["to_normal", "from_normal"])
+@pytest.mark.parametrize(
+    "fn,names", [(hv.to_normal, ("theta", "I")), (hv.from_normal, ("phi", "K"))], ids=["to_normal", "from_normal"]
+)
 @SETTINGS
 @given(a=ANY, b=ANY)
 def test_normal_coordinates(fn, names, a, b):
@@ -381,8 +430,17 @@ OTHER = {
     "rotation_number": (hv.rotation_number, dict(res=_RES, method="mean")),
     "regularity": (hv.regularity, dict(res=_RES)),
     "theory": (hv.theory, dict(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0, tau0=1.0, forcing=(1.0, 0.2), n_grid=1001)),
-    "TruncatedFamily": (hv.TruncatedFamily, dict(eps=0.3, K=[-2.0, -1.0, -0.5, 0.0, 1.0], Omega=[3.9] * 5, JR=[1.6] * 5,
-                                                 J1=[1.0, 0.8, 0.5, 0.0, 0.0], forcing=(1.0,))),
+    "TruncatedFamily": (
+        hv.TruncatedFamily,
+        dict(
+            eps=0.3,
+            K=[-2.0, -1.0, -0.5, 0.0, 1.0],
+            Omega=[3.9] * 5,
+            JR=[1.6] * 5,
+            J1=[1.0, 0.8, 0.5, 0.0, 0.0],
+            forcing=(1.0,),
+        ),
+    ),
     "family.step": (_FAM.step, dict(phi=0.1, K=-0.1)),
     "forcing_at": (M.forcing_at, dict(phi=0.3)),
     "k_eps2": (M.k_eps2, dict(phi=[0.1, 0.2], K0=-0.1)),
@@ -400,7 +458,7 @@ def test_other_entry_points(case, value):
     fn, kw = OTHER[name]
     r = outcome(lambda: fn(**{**kw, param: value}), param, param.rstrip("0"), "status", "region")
     if r is not None and not isinstance(r, (hv.Theory, hv.TruncatedFamily)):
-        for x in (r if isinstance(r, tuple) else (r,)):
+        for x in r if isinstance(r, tuple) else (r,):
             if isinstance(x, (int, float, np.ndarray)):
                 a = np.asarray(x, dtype=float)
                 # NaN only where documented (an orbit that took no step / a stopped tail); never inf.

@@ -15,9 +15,18 @@ PACKAGE = ROOT / "python" / "hovering"
 
 
 def _lint_imports(cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-c", "import sys; from importlinter.cli import lint_imports_command; "
-                           "sys.exit(lint_imports_command())"], cwd=cwd, capture_output=True, text=True, timeout=300,
-                          env=env)
+    return subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())",
+        ],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
 
 
 def test_the_contracts_see_a_cycle_made_inside_a_function(tmp_path):
@@ -31,7 +40,8 @@ def test_the_contracts_see_a_cycle_made_inside_a_function(tmp_path):
     (pkg / "sub" / "b.py").write_text("from . import a\n")
     (tmp_path / "pyproject.toml").write_text(
         '[tool.importlinter]\nroot_packages = ["toy"]\n\n[[tool.importlinter.contracts]]\nname = "No cycles"\n'
-        'type = "acyclic_siblings"\nancestors = ["toy"]\n')
+        'type = "acyclic_siblings"\nancestors = ["toy"]\n'
+    )
     r = _lint_imports(tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
     assert r.returncode == 1 and "No cycles BROKEN" in r.stdout, r.stdout[-2000:] + r.stderr[-2000:]
     assert "toy.sub" in r.stdout  # the package whose children loop
@@ -46,9 +56,11 @@ def test_layers_and_no_cycles_contracts_are_kept():
 
 
 def test_import_hovering_is_light():
-    code = ("import sys, json, hovering; "
-            "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in "
-            "('hovering', 'matplotlib', 'dask', 'distributed', 'scipy', 'tqdm'))))")
+    code = (
+        "import sys, json, hovering; "
+        "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in "
+        "('hovering', 'matplotlib', 'dask', 'distributed', 'scipy', 'tqdm'))))"
+    )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
     loaded = set(json.loads(r.stdout))
     heavy = {m for m in loaded if m.split(".")[0] in ("matplotlib", "dask", "distributed", "scipy")}

@@ -62,8 +62,18 @@ def potential_answers(p) -> list:
     for h in (0.05, 0.7, 2.5):
         qmin, qmax = p.turning_points(h)
         q, pp = p.point_at(0.7, h)
-        out += [qmin, qmax, p.period(h), p.frequency(h), p.action(h), p.energy(p.action(h)), p.angle_of(0.3 * qmax, h),
-                q, pp, p.angle_of_point(q, pp, h)]
+        out += [
+            qmin,
+            qmax,
+            p.period(h),
+            p.frequency(h),
+            p.action(h),
+            p.energy(p.action(h)),
+            p.angle_of(0.3 * qmax, h),
+            q,
+            pp,
+            p.angle_of_point(q, pp, h),
+        ]
     return out
 
 
@@ -137,11 +147,17 @@ def test_compiled_states_are_checked():
         (_core.flow.Tan, (1.0,), r"Tan.__setstate__: expected the tuple \(omega, alpha\)"),
         (_core.flow.OnsetParameters, (1.0,) * 5, r"expected the tuple \(Omega0, tau0"),
         (_core.truncated.TruncatedMap, (0.3, 1.0, 4.0, 1.0, 0.5, 0.5, 1.0), r"theta_w"),
-        (_core.truncated.TruncatedFamily, (0.1, [0.0, 1.0], [1.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0], 1.0),
-         r"K grid needs at least 3 points|at least 3"),
+        (
+            _core.truncated.TruncatedFamily,
+            (0.1, [0.0, 1.0], [1.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0], 1.0),
+            r"K grid needs at least 3 points|at least 3",
+        ),
         (_core.flow.FlowOptions, ("rk8pd", 0.0, 1e-12, 1e-15, 100, 10, 1e-12, 1e-10), r"rtol"),
-        (_core.normal.TangentialCurve, (1.0, 0.0, 0.3, np.zeros(7), np.ones(7), 0.0, 0.0),
-         r"even number in \[8, 4096\] of samples, got 7"),
+        (
+            _core.normal.TangentialCurve,
+            (1.0, 0.0, 0.3, np.zeros(7), np.ones(7), 0.0, 0.0),
+            r"even number in \[8, 4096\] of samples, got 7",
+        ),
     ]
     for cls, state, msg in cases:
         obj = cls.__new__(cls)
@@ -150,6 +166,7 @@ def test_compiled_states_are_checked():
 
 
 # ------------------------------------------------------------------ couplings, systems, sections, curves
+
 
 def test_couplings_systems_and_sections_round_trip():
     poly = hv.Polynomial({(1, 1): 0.5, (2, 1): -0.25})
@@ -165,8 +182,9 @@ def test_couplings_systems_and_sections_round_trip():
         sec2 = f(sec)
         assert sec2 == sec and same(sec2.point([0.3], [0.4]), sec.point([0.3], [0.4]))
         o2 = f(onset)
-        assert o2 == onset and [getattr(o2, k) for k in ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")] == \
-            [getattr(onset, k) for k in ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")]
+        assert o2 == onset and [getattr(o2, k) for k in ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")] == [
+            getattr(onset, k) for k in ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
+        ]
         opts = hv.flow.flow_options(rtol=1e-9, stepper="rkck", max_impacts=7)
         o3 = f(opts)
         assert (o3.rtol, o3.stepper, o3.max_impacts, o3.max_steps) == (1e-9, "rkck", 7, opts.max_steps)
@@ -196,8 +214,11 @@ def test_tangential_curve_round_trips_without_tracing(monkeypatch):
 
 # ------------------------------------------------------------------ maps
 
+
 @pytest.mark.parametrize("how", ["pickle2", f"pickle{pickle.HIGHEST_PROTOCOL}", "copy", "deepcopy"])
-@pytest.mark.parametrize("name", ["truncated", "truncated_capped", "family", "flow_normal", "flow_section", "flow_custom"])
+@pytest.mark.parametrize(
+    "name", ["truncated", "truncated_capped", "family", "flow_normal", "flow_section", "flow_custom"]
+)
 def test_maps_step_bit_for_bit_after_a_round_trip(name, how):
     m, phi, K = maps()[name]
     m2 = COPIES[how](m)
@@ -241,6 +262,7 @@ class SubMap(hv.TruncatedMap):
 
 # ------------------------------------------------------------------ results
 
+
 @pytest.mark.parametrize("how", ["pickle2", f"pickle{pickle.HIGHEST_PROTOCOL}", "deepcopy"])
 @pytest.mark.parametrize("name", list(results()))
 def test_results_round_trip(name, how):
@@ -259,6 +281,7 @@ def test_results_round_trip(name, how):
 
 
 # ------------------------------------------------------------------ processes
+
 
 def test_spawned_pool_steps_like_the_direct_call():
     # Each task pickles the map (bound method m.step and its arguments) into a fresh interpreter.

@@ -34,8 +34,15 @@ class Recorder:
 
 
 def flow_system(eps=-0.05):
-    return hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=eps,
-                         qw1=-1.0, qw2=-0.5, geometry="step")
+    return hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=eps,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -53,8 +60,11 @@ def tm():
 def test_truncated_iterate_reports_every_step(tm, kind, kernel):
     # 4000 orbits x 5000 steps, half of them leaving J_0 u J_0u early (stop_on_exit): an orbit that
     # stops credits the steps it will not take, so done ends exactly at n * n_steps.
-    m = tm if kind == "map" else hv.TruncatedFamily.from_map(tm, np.concatenate([-np.linspace(1, 0, 41) ** 2,
-                                                                                   np.linspace(0.05, 1, 20)]))
+    m = (
+        tm
+        if kind == "map"
+        else hv.TruncatedFamily.from_map(tm, np.concatenate([-(np.linspace(1, 0, 41) ** 2), np.linspace(0.05, 1, 20)]))
+    )
     rng = np.random.default_rng(2)
     phi, K = rng.uniform(-np.pi, np.pi, 4000), rng.uniform(-0.3, 0.3, 4000)
     rec = Recorder()
@@ -63,7 +73,9 @@ def test_truncated_iterate_reports_every_step(tm, kind, kernel):
     rec.check(4000 * 5000)
     assert res.count(Status.EXITED) > 0 and res.count(Status.OK) > 0
     plain = m.iterate(phi, K, 5000, **kw)
-    assert np.array_equal(res.phi_final, plain.phi_final) and np.array_equal(res.rotation, plain.rotation, equal_nan=True)
+    assert np.array_equal(res.phi_final, plain.phi_final) and np.array_equal(
+        res.rotation, plain.rotation, equal_nan=True
+    )
     assert np.array_equal(res.steps_done, plain.steps_done)
 
 
@@ -131,11 +143,13 @@ def test_progress_runs_off_the_main_thread(tm):
 
 @pytest.mark.parametrize("bad", ["yes", 1, None, 0.5, [print]])
 def test_bad_progress_is_a_named_value_error(tm, fm, bad):
-    for call in (lambda: tm.iterate([0.0], [0.1], 10, progress=bad),
-                 lambda: fm.iterate([0.0], [0.01], 2, progress=bad),
-                 lambda: fm.section.return_map([0.0], [0.3], progress=bad),
-                 lambda: hv.hovering_area(tm, n_steps=8, samples=4, progress=bad),
-                 lambda: hv.critical_curve(tm, n_steps=16, progress=bad)):
+    for call in (
+        lambda: tm.iterate([0.0], [0.1], 10, progress=bad),
+        lambda: fm.iterate([0.0], [0.01], 2, progress=bad),
+        lambda: fm.section.return_map([0.0], [0.3], progress=bad),
+        lambda: hv.hovering_area(tm, n_steps=8, samples=4, progress=bad),
+        lambda: hv.critical_curve(tm, n_steps=16, progress=bad),
+    ):
         with pytest.raises(ValueError, match="progress must be True .* False .* or a callable progress"):
             call()
 

@@ -39,7 +39,9 @@ def test_readme_examples_run_and_agree_with_the_text():
     # which allows ~37 of 1e5 samples to flip on another SIMD width (AVX-512 rounds sin alike to
     # 1 ulp, not bit for bit) and is still far below the stated error 0.0066.
     hv, cc = ns["hv"], ns["cc"]
-    assert abs(hv.theory - 0.5093) < 1e-4 and abs(cc.K_pred - (-0.2747)) < 1e-4 and abs(cc.rotation_pred - 3.7694) < 1e-4
+    assert (
+        abs(hv.theory - 0.5093) < 1e-4 and abs(cc.K_pred - (-0.2747)) < 1e-4 and abs(cc.rotation_pred - 3.7694) < 1e-4
+    )
     assert abs(hv.area - 0.4985) < 1e-3 and abs(hv.error - 0.0066) < 1e-3
     assert abs(cc.K_min - (-0.2764)) < 1e-3 and abs(cc.rotation - 3.7719) < 1e-3
     assert hovering.regularity(ns["orbit"])[0] > 12

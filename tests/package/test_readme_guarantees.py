@@ -73,8 +73,9 @@ def test_angle_of_point_refuses_a_point_off_its_level_by_more_than_1e8(V):
 def test_flow_records_are_nan_after_a_stop_and_nowhere_else():
     # "A stopped orbit keeps its last state; its later records are NaN, and NaN appears nowhere
     # else": the runaway system of test_one_bad_orbit, iterated with every per-return record.
-    sys_ = hv.StepSystem(V1=hv.Harmonic(0.2), V2=hv.Harmonic(0.2), coupling=hv.Bilinear(), eps=-0.5, qw1=-1, qw2=-2,
-                         geometry="wall")
+    sys_ = hv.StepSystem(
+        V1=hv.Harmonic(0.2), V2=hv.Harmonic(0.2), coupling=hv.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
+    )
     fm = hv.FlowMap(sys_, 0.3, coordinates="section")
     theta = np.linspace(-math.pi, math.pi, 41)[[0, 1, 12, 33]]
     res = fm.iterate(theta, np.full(4, 0.5), 4, record=("orbit", "section", "states", "times", "energy_error"))
@@ -116,8 +117,15 @@ def test_ctrl_c_stops_hovering_area():
 
 def test_ctrl_c_stops_critical_curve():
     # On the flow (~10 us per return): 64 x 5e4 returns for the grid alone, with 55 MB of orbits.
-    s = hv.StepSystem(V1=hv.Harmonic(omega=1.0), V2=hv.Tan(omega=1.4, alpha=0.7), coupling=hv.Bilinear(), eps=-0.05,
-                      qw1=-1.0, qw2=-0.5, geometry="step")
+    s = hv.StepSystem(
+        V1=hv.Harmonic(omega=1.0),
+        V2=hv.Tan(omega=1.4, alpha=0.7),
+        coupling=hv.Bilinear(),
+        eps=-0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
     fm = hv.FlowMap(s, 1.0)
     assert _interrupted(lambda: fm.critical_curve(n_steps=50_000, grid=64, n_threads=2)) < 30
 

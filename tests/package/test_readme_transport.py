@@ -14,7 +14,7 @@ README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 
 def test_transport_section_runs_and_agrees_with_its_comments():
     text = README.read_text()
-    section = text[text.index("## Iterating for transport"):]
+    section = text[text.index("## Iterating for transport") :]
     section = section[: section.index("\n## ", 1)]
     blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
     assert len(blocks) == 1, "the transport section lost its example"

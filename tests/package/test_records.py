@@ -27,11 +27,18 @@ def objects() -> dict:
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
     return {
         "truncated": m,
-        "family": hv.TruncatedFamily.from_map(m, np.concatenate([-np.linspace(1, 0, 20) ** 2, [0.5, 1.0]]),
-                                              forcing=(1.0, 0.2)),
-        "harmonic": hv.Harmonic(1.3), "tan": hv.Tan(1.4, 0.7), "numerical": hv.Numerical(hv.Tan(1.1, 0.3)),
-        "bilinear": hv.Bilinear(), "polynomial": hv.Polynomial({(1, 1): 1.0, (2, 0): -0.5}),
-        "system": sys, "section": fm.section, "curve": fm.curve, "flowmap": fm,
+        "family": hv.TruncatedFamily.from_map(
+            m, np.concatenate([-(np.linspace(1, 0, 20) ** 2), [0.5, 1.0]]), forcing=(1.0, 0.2)
+        ),
+        "harmonic": hv.Harmonic(1.3),
+        "tan": hv.Tan(1.4, 0.7),
+        "numerical": hv.Numerical(hv.Tan(1.1, 0.3)),
+        "bilinear": hv.Bilinear(),
+        "polynomial": hv.Polynomial({(1, 1): 1.0, (2, 0): -0.5}),
+        "system": sys,
+        "section": fm.section,
+        "curve": fm.curve,
+        "flowmap": fm,
         "onset": hv.onset_parameters(sys, 1.0),
     }
 

@@ -39,8 +39,9 @@ def test_sigint_to_the_process_stops_iterate_and_keeps_the_partial_result():
     import signal
     import time
 
-    p = subprocess.Popen([sys.executable, "-c", SIGINT_IN_ITERATE], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", SIGINT_IN_ITERATE], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     assert p.stdout.readline().strip() == "ready"
     sent = time.perf_counter()
     p.send_signal(signal.SIGINT)

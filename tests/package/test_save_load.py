@@ -45,8 +45,13 @@ def test_result_arrays_keep_dtypes_and_enums_survive(tmp_path):
     for f in ("phi", "K", "region", "rotation", "status", "steps_done", "exit_step", "visited"):
         assert getattr(back, f).dtype == getattr(r, f).dtype, f
     assert back.count(Status.EXITED) == r.count(Status.EXITED) and back.n_orbits == r.n_orbits
-    obj = {"region": Region.ABOVE, "status": Status.EXITED, "flow": FlowStatus.GRAZING, "many": [Region.RIGHT, Region.NONE],
-           "geometry": hv.Geometry.WALL}
+    obj = {
+        "region": Region.ABOVE,
+        "status": Status.EXITED,
+        "flow": FlowStatus.GRAZING,
+        "many": [Region.RIGHT, Region.NONE],
+        "geometry": hv.Geometry.WALL,
+    }
     got = hv.load(hv.save(obj, tmp_path / "enums"))
     assert got == obj and all(got[k] is obj[k] for k in ("region", "status", "flow", "geometry"))
     assert got["many"][0] is Region.RIGHT and got["many"][1] is Region.NONE
@@ -65,7 +70,10 @@ def test_flow_result_keeps_its_itineraries_and_map(tmp_path):
 def test_result_on_a_custom_potential_is_refused_by_name(tmp_path):
     r = results()["iterate_custom"]
     target = tmp_path / "custom.npz"
-    with pytest.raises(TypeError, match=r"^root.map@.sys@.V1: cannot save quartic \(a CustomPotential\) to NPZ: its V and V. are Python code"):
+    with pytest.raises(
+        TypeError,
+        match=r"^root.map@.sys@.V1: cannot save quartic \(a CustomPotential\) to NPZ: its V and V. are Python code",
+    ):
         r.save(target)
     assert not target.exists() and os.listdir(tmp_path) == []
     # The hint of the message works: the result without its map.
@@ -78,6 +86,7 @@ def test_result_on_a_custom_potential_is_refused_by_name(tmp_path):
 
 
 # ------------------------------------------------------------------ maps and the objects they are made of
+
 
 @pytest.mark.parametrize("name", ["truncated", "truncated_capped", "family", "flow_normal", "flow_section"])
 def test_maps_are_rebuilt_bit_for_bit(name, tmp_path):
@@ -135,6 +144,7 @@ def test_systems_sections_curves_potentials_round_trip(tmp_path):
 
 
 # ------------------------------------------------------------------ the format itself
+
 
 def _write(path, doc, **arrays):
     """A hand-made file in the format (or not): the JSON document plus arrays."""
@@ -205,12 +215,20 @@ def test_files_that_are_not_results_are_value_errors(tmp_path):
     cases["fields"] = r"Theory lacks the field 'Omega0'"
     _write(tmp_path / "extra.npz", _doc({"__dataclass__": "hovering.normal.flowmap:FlowSteps", "fields": {"bogus": 1}}))
     cases["extra"] = r"FlowSteps has fields \['bogus'\] this version does not know"
-    _write(tmp_path / "record.npz", _doc({"__record__": "hovering.truncated.maps:TruncatedMap",
-                                          "data": {"__dict__": {"eps": 0.3}}}))
+    _write(
+        tmp_path / "record.npz",
+        _doc({"__record__": "hovering.truncated.maps:TruncatedMap", "data": {"__dict__": {"eps": 0.3}}}),
+    )
     cases["record"] = r"malformed result file \(TypeError: .*missing 2 required"
-    _write(tmp_path / "values.npz", _doc({"__record__": "hovering.truncated.maps:TruncatedMap",
-                                          "data": {"__dict__": dict(eps=0.3, Omega0=1.0, theta_w=4.0, tau0=1.0, tau1=0.5,
-                                                                    lam=0.5, K_max=1.0)}}))
+    _write(
+        tmp_path / "values.npz",
+        _doc(
+            {
+                "__record__": "hovering.truncated.maps:TruncatedMap",
+                "data": {"__dict__": dict(eps=0.3, Omega0=1.0, theta_w=4.0, tau0=1.0, tau1=0.5, lam=0.5, K_max=1.0)},
+            }
+        ),
+    )
     cases["values"] = r"theta_w"  # the constructor's own check
     with zipfile.ZipFile(tmp_path / "zip.npz", "w") as z:
         z.writestr("readme.txt", "not an array")
@@ -254,10 +272,17 @@ def test_tree_corner_cases(tmp_path):
     # NumPy scalars of every kind, non-finite floats, nested containers, non-string keys, and dict
     # keys that look like another entry's path (each array still comes back as itself).
     obj = {
-        "flag": np.bool_(True), "i": np.int64(-3), "f": np.float32(0.5), "inf": -np.inf, "nan": float("nan"),
-        "a.b": np.arange(3), "a": {"b": np.arange(5.0)}, "t": (1, (2.5, "x"), [None, True]),
+        "flag": np.bool_(True),
+        "i": np.int64(-3),
+        "f": np.float32(0.5),
+        "inf": -np.inf,
+        "nan": float("nan"),
+        "a.b": np.arange(3),
+        "a": {"b": np.arange(5.0)},
+        "t": (1, (2.5, "x"), [None, True]),
         "keys": {1: "one", (2, 3): np.zeros(2, dtype=np.int8), Region.UPPER: "enum key"},
-        "strings": np.array(["0", "u", "R1"], dtype=object), "empty": np.zeros((0, 4)),
+        "strings": np.array(["0", "u", "R1"], dtype=object),
+        "empty": np.zeros((0, 4)),
     }
     got = hv.load(hv.save(obj, tmp_path / "tree"))
     assert got["flag"] is True and got["i"] == -3 and got["f"] == 0.5 and got["inf"] == -np.inf and np.isnan(got["nan"])
@@ -277,10 +302,12 @@ def test_only_hovering_types_are_written(tmp_path):
     class MyHarmonic(hv.Harmonic):
         pass
 
-    for obj, msg in ((Mine(), r"cannot save a .*Mine to NPZ: only hovering's own classes"),
-                     (MyHarmonic(1.0), r"cannot save a .*MyHarmonic to NPZ"),
-                     (np.array([object()]), r"arrays of Python objects"),
-                     ({"c": 1j}, r"root.c: cannot save a complex")):
+    for obj, msg in (
+        (Mine(), r"cannot save a .*Mine to NPZ: only hovering's own classes"),
+        (MyHarmonic(1.0), r"cannot save a .*MyHarmonic to NPZ"),
+        (np.array([object()]), r"arrays of Python objects"),
+        ({"c": 1j}, r"root.c: cannot save a complex"),
+    ):
         with pytest.raises(TypeError, match=msg):
             hv.save(obj, tmp_path / "x")
     assert os.listdir(tmp_path) == []
@@ -288,6 +315,15 @@ def test_only_hovering_types_are_written(tmp_path):
 
 def test_public_api():
     assert hv.save is _serial.save and hv.load is _serial.load and {"save", "load"} <= set(hv.__all__)
-    for cls in (hv.IterateResult, hv.ReturnMapResult, hv.FlowSteps, hv.HoveringArea, hv.CriticalCurve, hv.CornerCurves,
-                hv.MapComparison, hv.Theory, hv.TangentialCurve):
+    for cls in (
+        hv.IterateResult,
+        hv.ReturnMapResult,
+        hv.FlowSteps,
+        hv.HoveringArea,
+        hv.CriticalCurve,
+        hv.CornerCurves,
+        hv.MapComparison,
+        hv.Theory,
+        hv.TangentialCurve,
+    ):
         assert issubclass(cls, _serial.Saveable) and cls.save.__doc__

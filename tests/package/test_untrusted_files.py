@@ -72,13 +72,15 @@ def _header(descr: str, shape: tuple) -> bytes:
 
 def _zeros(header: bytes, n: int, fill: bytes = b"\0"):
     """A member writer: ``header`` then n bytes of ``fill`` repeated (compresses about 1000:1)."""
+
     def write(f):
         f.write(header)
         chunk = fill * ((1 << 22) // len(fill))
         left = n
         while left:
-            f.write(chunk[:min(left, len(chunk))])
+            f.write(chunk[: min(left, len(chunk))])
             left -= min(left, len(chunk))
+
     return write
 
 
@@ -183,12 +185,16 @@ class _Payload:
 def test_pickled_object_arrays_are_refused_from_their_header(tmp_path):
     marker = tmp_path / "ran"
     member = _npy(np.array([_Payload(marker)], dtype=object))
-    pickle.loads(member[member.index(b"\x80"):])
+    pickle.loads(member[member.index(b"\x80") :])
     assert marker.is_dir()  # the payload works...
     marker.rmdir()
     path = _write(tmp_path / "pickle.npz", _doc({"__array__": "root", "object": False}), [("root.npy", member)])
-    err = _refused(hv.load, path, match=r"pickle\.npz: array 'root': dtype '\|O' is refused; allowed: booleans, "
-                                        r"integers, floats, complex numbers and text \(object arrays would need pickle\)")
+    err = _refused(
+        hv.load,
+        path,
+        match=r"pickle\.npz: array 'root': dtype '\|O' is refused; allowed: booleans, "
+        r"integers, floats, complex numbers and text \(object arrays would need pickle\)",
+    )
     assert not marker.exists() and "pickle.npz" in str(err)  # ...but is never unpickled
     # Unreferenced, the same member is not even read: the file loads as what its tree says.
     path = _write(tmp_path / "unreferenced.npz", _doc({"__list__": [1.5, "x"]}), [("root.npy", member)])
@@ -207,11 +213,18 @@ def test_flowmap_record_asking_for_an_accuracy_target_is_refused_without_measuri
     monkeypatch.setitem(hovering.interface._HOOKS, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
     assert hv.load(genuine["flowmap"]).integrator_options["stepper"] == "rk8pd" and calls == []
     # Before: this 3 KB record ran a work-precision measurement for more than 300 s (it was killed).
-    path = _craft(genuine["flowmap"], tmp_path / "accuracy.npz",
-                  lambda d: _flowmap_fields(d)["options"]["__dict__"].update(accuracy=1e-12, accuracy_returns=100000))
+    path = _craft(
+        genuine["flowmap"],
+        tmp_path / "accuracy.npz",
+        lambda d: _flowmap_fields(d)["options"]["__dict__"].update(accuracy=1e-12, accuracy_returns=100000),
+    )
     assert path.stat().st_size < 4096
-    _refused(hv.load, path, match=r"accuracy\.npz: root: the FlowMap's options \['accuracy', 'accuracy_returns'\] "
-                                  r"are not stored settings; allowed: \['atol', 'corner_tol', ")
+    _refused(
+        hv.load,
+        path,
+        match=r"accuracy\.npz: root: the FlowMap's options \['accuracy', 'accuracy_returns'\] "
+        r"are not stored settings; allowed: \['atol', 'corner_tol', ",
+    )
     assert calls == []
 
 
@@ -219,9 +232,15 @@ def test_flowmap_record_without_its_curve_is_refused_without_tracing(genuine, tm
     traced = []
     real = hv.TangentialCurve.__init__
     monkeypatch.setattr(hv.TangentialCurve, "__init__", lambda self, *a, **k: traced.append(a) or real(self, *a, **k))
-    path = _craft(genuine["flowmap"], tmp_path / "nocurve.npz", lambda d: _flowmap_fields(d).update(coordinates="normal"))
-    _refused(hv.load, path, match=r"nocurve\.npz: root: the FlowMap is in normal coordinates but the file holds no "
-                                  r"tangential curve")
+    path = _craft(
+        genuine["flowmap"], tmp_path / "nocurve.npz", lambda d: _flowmap_fields(d).update(coordinates="normal")
+    )
+    _refused(
+        hv.load,
+        path,
+        match=r"nocurve\.npz: root: the FlowMap is in normal coordinates but the file holds no "
+        r"tangential curve",
+    )
     assert traced == []
 
 
@@ -241,8 +260,11 @@ def test_redraw_draws_a_genuine_result_without_computing(genuine, tmp_path, monk
 
 def test_zip_bomb_member_the_tree_does_not_name_is_never_read(tmp_path):
     # 256 MiB of zeros in 0.25 MiB: before, load decompressed every member (a 3.1 MB bomb took 3.1 GB).
-    path = _write(tmp_path / "bomb.npz", _doc({"__dict__": {"x": 1.0, "a": {"__array__": "a"}}}),
-                  [("a.npy", _npy(np.arange(4.0))), ("junk.npy", _zeros(_header("|u1", (256 * MiB,)), 256 * MiB))])
+    path = _write(
+        tmp_path / "bomb.npz",
+        _doc({"__dict__": {"x": 1.0, "a": {"__array__": "a"}}}),
+        [("a.npy", _npy(np.arange(4.0))), ("junk.npy", _zeros(_header("|u1", (256 * MiB,)), 256 * MiB))],
+    )
     assert path.stat().st_size < 2 * MiB
     tracemalloc.start()
     t0 = time.perf_counter()
@@ -254,20 +276,32 @@ def test_zip_bomb_member_the_tree_does_not_name_is_never_read(tmp_path):
 
 
 def test_zip_bomb_member_beyond_the_memory_budget_is_refused_unread(tmp_path, monkeypatch):
-    path = _write(tmp_path / "bomb.npz", _doc({"__array__": "root"}),
-                  [("root.npy", _zeros(_header("|u1", (256 * MiB,)), 256 * MiB))])
+    path = _write(
+        tmp_path / "bomb.npz",
+        _doc({"__array__": "root"}),
+        [("root.npy", _zeros(_header("|u1", (256 * MiB,)), 256 * MiB))],
+    )
     # The budget is half of this machine's memory; a 64 MiB budget stands in for a small machine.
     monkeypatch.setattr(_untrusted, "memory_budget", lambda: 64 * MiB)
-    _refused(hv.load, path, match=r"bomb\.npz: its arrays and tree need 0\.25 GiB \(as its headers declare\), more "
-                                  r"than half of this machine's memory \(0\.125 GiB\)")
+    _refused(
+        hv.load,
+        path,
+        match=r"bomb\.npz: its arrays and tree need 0\.25 GiB \(as its headers declare\), more "
+        r"than half of this machine's memory \(0\.125 GiB\)",
+    )
 
 
 def test_huge_declared_shapes_are_refused_before_allocating(tmp_path):
     # Before: "Unable to allocate 7.28 TiB" (a raw MemoryError) from this 0.5 KB file.
-    path = _write(tmp_path / "shape.npz", _doc({"__array__": "root"}),
-                  [("root.npy", _header("<f8", (10**12,)) + bytes(64))])
-    _refused(hv.load, path, match=r"shape\.npz: array 'root': the archive declares 192 bytes, its header 128 \+ "
-                                  r"8000000000000 \(shape \(1000000000000,\), dtype <f8\)")
+    path = _write(
+        tmp_path / "shape.npz", _doc({"__array__": "root"}), [("root.npy", _header("<f8", (10**12,)) + bytes(64))]
+    )
+    _refused(
+        hv.load,
+        path,
+        match=r"shape\.npz: array 'root': the archive declares 192 bytes, its header 128 \+ "
+        r"8000000000000 \(shape \(1000000000000,\), dtype <f8\)",
+    )
     # A header beyond numpy's own limit is not parsed at all.
     long_header = b"\x93NUMPY\x02\x00" + (10**6).to_bytes(4, "little") + b" " * 64
     path = _write(tmp_path / "header.npz", _doc({"__array__": "root"}), [("root.npy", long_header)])
@@ -281,13 +315,21 @@ def test_json_document_limits(tmp_path):
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
         with z.open("__meta__.npy", "w", force_zip64=True) as f:
             _zeros(_header(f"<U{n}", ()), 4 * n, b" \0\0\0")(f)
-    _refused(hv.load, path, match=rf"long\.npz is not a hovering result file: its __meta__ entry has {n} characters; "
-                                  rf"allowed: at most {_untrusted.MAX_TREE_CHARS}")
+    _refused(
+        hv.load,
+        path,
+        match=rf"long\.npz is not a hovering result file: its __meta__ entry has {n} characters; "
+        rf"allowed: at most {_untrusted.MAX_TREE_CHARS}",
+    )
     # Nested 100,000 deep (before: a RecursionError from the decoder): refused by a scan before parsing.
     deep = '{"format": "hovering-npz-1", "tree": ' + '{"__list__": [' * 100_000 + "]}" * 100_000 + "}"
-    _refused(hv.load, _write(tmp_path / "deep.npz", deep), mb=64,  # the text itself: 11 MiB as UTF-32
-             match=r"deep\.npz is not a hovering result file: its __meta__ entry is nested 200001 levels deep; "
-                   r"allowed: at most 100")
+    _refused(
+        hv.load,
+        _write(tmp_path / "deep.npz", deep),
+        mb=64,  # the text itself: 11 MiB as UTF-32
+        match=r"deep\.npz is not a hovering result file: its __meta__ entry is nested 200001 levels deep; "
+        r"allowed: at most 100",
+    )
     cases = {
         "string": (_doc({"__list__": ["x" * 1_100_000]}), r"a string of 1100000 characters; allowed: at most 1048576"),
         "key": (_doc({"__dict__": {"k" * 1_100_000: 1}}), r"a key at .*: a string of 1100000 characters"),
@@ -295,12 +337,19 @@ def test_json_document_limits(tmp_path):
         "infinity": ('{"format": "hovering-npz-1", "tree": -Infinity}', r"holds -Infinity"),
         "overflow": ('{"format": "hovering-npz-1", "tree": 1e400}', r"1e400 is beyond the range of a double"),
         # hovering.save refuses integers beyond 10,000 bits; a longer digit string is not converted.
-        "int": ('{"format": "hovering-npz-1", "tree": ' + "9" * 5000 + "}",
-                r"has 5000 digits; allowed: integers of at most 10000 bits"),
-        "int_bits": ('{"format": "hovering-npz-1", "tree": ' + "9" * 3011 + "}",
-                     rf"has {int('9' * 3011).bit_length()} bits; allowed: at most 10000"),
-        "float_node": (_doc({"__float__": "1e5"}), r"root: malformed result file: \{'__float__': '1e5'\}; allowed: "
-                                                   r"'nan', 'inf', '-inf'"),
+        "int": (
+            '{"format": "hovering-npz-1", "tree": ' + "9" * 5000 + "}",
+            r"has 5000 digits; allowed: integers of at most 10000 bits",
+        ),
+        "int_bits": (
+            '{"format": "hovering-npz-1", "tree": ' + "9" * 3011 + "}",
+            rf"has {int('9' * 3011).bit_length()} bits; allowed: at most 10000",
+        ),
+        "float_node": (
+            _doc({"__float__": "1e5"}),
+            r"root: malformed result file: \{'__float__': '1e5'\}; allowed: "
+            r"'nan', 'inf', '-inf'",
+        ),
     }
     for name, (doc, msg) in cases.items():
         err = _refused(hv.load, _write(tmp_path / f"{name}.npz", doc), match=msg)
@@ -311,15 +360,27 @@ def test_archive_directory_and_member_names(tmp_path):
     good = _write(tmp_path / "good.npz", _doc({"__array__": "a"}), [("a.npy", _npy(np.arange(3)))])
     data = bytearray(good.read_bytes())
     # The end record declares a 2 GiB central directory: refused before Python's zipfile reads it.
-    data[-22 + 12:-22 + 16] = (2**31).to_bytes(4, "little")
+    data[-22 + 12 : -22 + 16] = (2**31).to_bytes(4, "little")
     (tmp_path / "directory.npz").write_bytes(bytes(data))
-    _refused(hv.load, tmp_path / "directory.npz", match=r"directory\.npz: an archive of 2 members and a directory of "
-                                                        r"2147483648 bytes; allowed: at most 100000 members")
+    _refused(
+        hv.load,
+        tmp_path / "directory.npz",
+        match=r"directory\.npz: an archive of 2 members and a directory of "
+        r"2147483648 bytes; allowed: at most 100000 members",
+    )
     before = sorted(os.listdir(tmp_path.parent))
-    for name, member in (("traversal", "../../../evil.npy"), ("absolute", "/tmp/evil.npy"), ("dotdot", "a/../../b.npy")):
+    for name, member in (
+        ("traversal", "../../../evil.npy"),
+        ("absolute", "/tmp/evil.npy"),
+        ("dotdot", "a/../../b.npy"),
+    ):
         path = _write(tmp_path / f"{name}.npz", _doc({"__array__": member[:-4]}), [(member, _npy(np.arange(3.0)))])
-        _refused(hv.load, path, match=rf"{name}\.npz: the archive has a member named '{member}'; a hovering result "
-                                      r"file's members are relative names without '\.\.'")
+        _refused(
+            hv.load,
+            path,
+            match=rf"{name}\.npz: the archive has a member named '{member}'; a hovering result "
+            r"file's members are relative names without '\.\.'",
+        )
     with zipfile.ZipFile(tmp_path / "dup.npz", "w") as z:
         z.writestr("__meta__.npy", _npy(np.array(json.dumps(_doc({"__array__": "a"})))))
         z.writestr("a.npy", _npy(np.arange(3)))
@@ -337,10 +398,17 @@ def test_non_utf8_and_non_unicode_text(genuine, tmp_path):
     surrogate = '{"format": "hovering-npz-1", "tree": {"__list__": ["ok", "\\udcff"]}}'
     assert hv.load(_write(tmp_path / "data.npz", surrogate)) == ["ok", "\udcff"]
     path = _craft(genuine["result"], tmp_path / "title.npz", lambda d: _scene_fields(d).update(title="t\ud800"))
-    _refused(load_result, path, match=r"title\.npz: root\.scene: tiny\.toml\.title: a lone surrogate at character 1; "
-                                      r"allowed: Unicode text")
-    path = _craft(genuine["result"], tmp_path / "label.npz",
-                  lambda d: _orbit_fields(d).update(labels={"__list__": ["a", "\udcff", "c"]}))
+    _refused(
+        load_result,
+        path,
+        match=r"title\.npz: root\.scene: tiny\.toml\.title: a lone surrogate at character 1; "
+        r"allowed: Unicode text",
+    )
+    path = _craft(
+        genuine["result"],
+        tmp_path / "label.npz",
+        lambda d: _orbit_fields(d).update(labels={"__list__": ["a", "\udcff", "c"]}),
+    )
     _refused(load_result, path, match=r"label\.npz: root\.panels\[0\]\.orbits: labels\[1\]: a lone surrogate")
     path = tmp_path / "bytes.npz"
     with zipfile.ZipFile(path, "w") as z:
@@ -357,39 +425,74 @@ def test_non_utf8_and_non_unicode_text(genuine, tmp_path):
 
 CRAFTED = {
     # name: (edit of the genuine scene result's tree, what the error names)
-    "dpi_text": (lambda d: _scene_fields(d).update(dpi="high"),
-                 r"root\.scene\.dpi must be of type int \(the type of OrbitScene\.dpi\), got str"),
+    "dpi_text": (
+        lambda d: _scene_fields(d).update(dpi="high"),
+        r"root\.scene\.dpi must be of type int \(the type of OrbitScene\.dpi\), got str",
+    ),
     "dpi_nan": (lambda d: _scene_fields(d).update(dpi={"__float__": "nan"}), r"root\.scene\.dpi must be of type int"),
-    "eps_inf": (lambda d: _scene_fields(d)["panels"]["__tuple__"][0]["fields"]["map"]["fields"].update(
-        eps={"__float__": "inf"}), r"root\.scene: tiny\.toml\.panels\[0\]\.eps must be finite, got inf"),
-    "eps_expression": (lambda d: _scene_fields(d)["panels"]["__tuple__"][0]["fields"]["map"]["fields"].update(
-        eps="2*pi"), r"root\.scene\.panels\[0\]\.map\.eps must be of type float"),
-    "kind": (lambda d: _scene_fields(d).update(rotation="birkhoff"),
-             r"root\.scene: scene\.rotation = 'birkhoff' is not what a scene file can give \(its other values give "
-             r"'mean'\)"),
-    "name": (lambda d: _scene_fields(d).update(name="other"), r"scene\.name = 'other' is not what a scene file can give"),
-    "title_long": (lambda d: _scene_fields(d).update(title="T" * (MAX_TEXT + 1)),
-                   rf"root\.scene: tiny\.toml\.title: a string of {MAX_TEXT + 1} characters; allowed: at most {MAX_TEXT}"),
-    "phi_text": (lambda d: _orbit_fields(d).update(phi="not an array"),
-                 r"root\.panels\[0\]\.orbits\.phi must be of type ndarray"),
-    "phi_shape": (lambda d: _orbit_fields(d).update(K=_orbit_fields(d)["status"]),
-                  r"root\.panels\[0\]\.orbits: K must be a 2-D array of numbers, got shape \(3,\)"),
-    "labels_int": (lambda d: _orbit_fields(d).update(labels={"__list__": [1, 2, 3]}),
-                   r"root\.panels\[0\]\.orbits: labels\[0\] must be a non-empty string, got 1"),
-    "labels_count": (lambda d: _orbit_fields(d).update(labels={"__list__": ["a"]}),
-                     r"root\.panels\[0\]\.orbits: labels must be a list of 3 strings, got a list of 1"),
-    "label_long": (lambda d: _orbit_fields(d).update(labels={"__list__": ["x" * 300, "b", "c"]}),
-                   rf"labels\[0\]: a string of 300 characters; allowed: at most {MAX_TEXT}"),
-    "colour": (lambda d: _orbit_fields(d).update(colors={"__list__": ["nocolour", "C1", "C2"]}),
-               r"root\.panels\[0\]\.orbits: colors\[0\] = 'nocolour' is not a matplotlib colour"),
-    "panels_dict": (lambda d: d["tree"]["fields"].update(panels={"__dict__": {"a": 1}}),
-                    r"root\.panels must be of type list \(the type of OrbitSceneResult\.panels\), got dict"),
-    "panels_text": (lambda d: d["tree"]["fields"]["panels"]["__list__"].__setitem__(0, "a"),
-                    r"root: panels\[0\] must be a panel result, got str"),
-    "meta_steps": (lambda d: d["tree"]["fields"]["meta"]["__dict__"].update(n_steps="x" * 60_000),
-                   r"root: meta\.n_steps must be of type int, got str"),
-    "enum": (lambda d: d["tree"]["fields"].update(meta={"__enum__": _serial._type_name(hv.Region), "value": 99}),
-             r"root\.meta: 99 is not a Region"),
+    "eps_inf": (
+        lambda d: _scene_fields(d)["panels"]["__tuple__"][0]["fields"]["map"]["fields"].update(
+            eps={"__float__": "inf"}
+        ),
+        r"root\.scene: tiny\.toml\.panels\[0\]\.eps must be finite, got inf",
+    ),
+    "eps_expression": (
+        lambda d: _scene_fields(d)["panels"]["__tuple__"][0]["fields"]["map"]["fields"].update(eps="2*pi"),
+        r"root\.scene\.panels\[0\]\.map\.eps must be of type float",
+    ),
+    "kind": (
+        lambda d: _scene_fields(d).update(rotation="birkhoff"),
+        r"root\.scene: scene\.rotation = 'birkhoff' is not what a scene file can give \(its other values give "
+        r"'mean'\)",
+    ),
+    "name": (
+        lambda d: _scene_fields(d).update(name="other"),
+        r"scene\.name = 'other' is not what a scene file can give",
+    ),
+    "title_long": (
+        lambda d: _scene_fields(d).update(title="T" * (MAX_TEXT + 1)),
+        rf"root\.scene: tiny\.toml\.title: a string of {MAX_TEXT + 1} characters; allowed: at most {MAX_TEXT}",
+    ),
+    "phi_text": (
+        lambda d: _orbit_fields(d).update(phi="not an array"),
+        r"root\.panels\[0\]\.orbits\.phi must be of type ndarray",
+    ),
+    "phi_shape": (
+        lambda d: _orbit_fields(d).update(K=_orbit_fields(d)["status"]),
+        r"root\.panels\[0\]\.orbits: K must be a 2-D array of numbers, got shape \(3,\)",
+    ),
+    "labels_int": (
+        lambda d: _orbit_fields(d).update(labels={"__list__": [1, 2, 3]}),
+        r"root\.panels\[0\]\.orbits: labels\[0\] must be a non-empty string, got 1",
+    ),
+    "labels_count": (
+        lambda d: _orbit_fields(d).update(labels={"__list__": ["a"]}),
+        r"root\.panels\[0\]\.orbits: labels must be a list of 3 strings, got a list of 1",
+    ),
+    "label_long": (
+        lambda d: _orbit_fields(d).update(labels={"__list__": ["x" * 300, "b", "c"]}),
+        rf"labels\[0\]: a string of 300 characters; allowed: at most {MAX_TEXT}",
+    ),
+    "colour": (
+        lambda d: _orbit_fields(d).update(colors={"__list__": ["nocolour", "C1", "C2"]}),
+        r"root\.panels\[0\]\.orbits: colors\[0\] = 'nocolour' is not a matplotlib colour",
+    ),
+    "panels_dict": (
+        lambda d: d["tree"]["fields"].update(panels={"__dict__": {"a": 1}}),
+        r"root\.panels must be of type list \(the type of OrbitSceneResult\.panels\), got dict",
+    ),
+    "panels_text": (
+        lambda d: d["tree"]["fields"]["panels"]["__list__"].__setitem__(0, "a"),
+        r"root: panels\[0\] must be a panel result, got str",
+    ),
+    "meta_steps": (
+        lambda d: d["tree"]["fields"]["meta"]["__dict__"].update(n_steps="x" * 60_000),
+        r"root: meta\.n_steps must be of type int, got str",
+    ),
+    "enum": (
+        lambda d: d["tree"]["fields"].update(meta={"__enum__": _serial._type_name(hv.Region), "value": 99}),
+        r"root\.meta: 99 is not a Region",
+    ),
 }
 
 
@@ -404,14 +507,20 @@ def test_wrong_types_and_values_in_a_result_name_the_file_and_field(name, genuin
 @pytest.mark.parametrize("what", ["rtol", "max_steps", "h", "sys", "forcing"])
 def test_wrong_types_and_values_in_a_flowmap_record(what, genuine, tmp_path):
     edit, msg = {
-        "rtol": (lambda d: _flowmap_fields(d)["options"]["__dict__"].update(rtol="tiny"),
-                 r"root: rtol must be a real number, got 'tiny'"),
-        "max_steps": (lambda d: _flowmap_fields(d)["options"]["__dict__"].update(max_steps=[1, 2]),
-                      r"a bare list in the tree at root@\.options\.max_steps"),
+        "rtol": (
+            lambda d: _flowmap_fields(d)["options"]["__dict__"].update(rtol="tiny"),
+            r"root: rtol must be a real number, got 'tiny'",
+        ),
+        "max_steps": (
+            lambda d: _flowmap_fields(d)["options"]["__dict__"].update(max_steps=[1, 2]),
+            r"a bare list in the tree at root@\.options\.max_steps",
+        ),
         "h": (lambda d: _flowmap_fields(d).update(h={"__float__": "nan"}), r"root: h must be finite, got nan"),
         "sys": (lambda d: _flowmap_fields(d).update(sys=3), r"root: the FlowMap's sys must be a StepSystem, got int"),
-        "forcing": (lambda d: _flowmap_fields(d).update(forcing={"__list__": [{"__float__": "inf"}]}),
-                    r"root: forcing\[0\] must be finite, got inf"),
+        "forcing": (
+            lambda d: _flowmap_fields(d).update(forcing={"__list__": [{"__float__": "inf"}]}),
+            r"root: forcing\[0\] must be finite, got inf",
+        ),
     }[what]
     _refused(hv.load, _craft(genuine["flowmap"], tmp_path / f"{what}.npz", edit), match=msg)
 
@@ -420,17 +529,25 @@ def test_wrong_types_and_values_in_a_flowmap_record(what, genuine, tmp_path):
 def test_redraw_refuses_what_the_scene_schema_refuses(case, genuine, tmp_path, capsys):
     edit, msg = {
         # Before: dpi 8000 asked for a 51200 x 38400 canvas (7.8 GB; MemoryError under an 8 GB limit).
-        "dpi": (lambda d: _scene_fields(d).update(dpi=8000),
-                r"root\.scene: tiny\.toml\.dpi = 8000 is out of range; allowed: \[30, 1200\]"),
-        "figsize": (lambda d: _scene_fields(d).update(dpi=1200, figsize={"__tuple__": [60.0, 60.0]}),
-                    r"dpi = 1200 and figsize make a figure of 60 x 60 inches, a canvas of 5184 million pixels; "
-                    r"allowed: at most 150 million"),
+        "dpi": (
+            lambda d: _scene_fields(d).update(dpi=8000),
+            r"root\.scene: tiny\.toml\.dpi = 8000 is out of range; allowed: \[30, 1200\]",
+        ),
+        "figsize": (
+            lambda d: _scene_fields(d).update(dpi=1200, figsize={"__tuple__": [60.0, 60.0]}),
+            r"dpi = 1200 and figsize make a figure of 60 x 60 inches, a canvas of 5184 million pixels; "
+            r"allowed: at most 150 million",
+        ),
         # Before: 24 s and 890 MB (a 121 x 92.6 inch canvas of 400 axes).
-        "layout": (lambda d: _scene_fields(d).update(layout={"__tuple__": [20, 20]}),
-                   r"dpi = 130 and layout make a figure of 121 x 92\.6 inches, a canvas of 189 million pixels"),
+        "layout": (
+            lambda d: _scene_fields(d).update(layout={"__tuple__": [20, 20]}),
+            r"dpi = 130 and layout make a figure of 121 x 92\.6 inches, a canvas of 189 million pixels",
+        ),
         # Before: 97 s and 360 MB of savefig.
-        "title": (lambda d: _scene_fields(d).update(title="T" * 500_000),
-                  r"root\.scene: tiny\.toml\.title: a string of 500000 characters; allowed: at most 65536"),
+        "title": (
+            lambda d: _scene_fields(d).update(title="T" * 500_000),
+            r"root\.scene: tiny\.toml\.title: a string of 500000 characters; allowed: at most 65536",
+        ),
     }[case]
     path = _craft(genuine["result"], tmp_path / f"{case}.npz", edit)
     tracemalloc.start()
@@ -477,37 +594,61 @@ def _scene(tmp_path, name, text) -> Path:
 
 TOML_CASES = {
     # Before: RecursionError tracebacks.
-    "deep_array": (TINY_SCENE.replace("K0_range = [-0.5, 0.2]", "K0_range = " + "[" * 5000 + "]" * 5000),
-                   rf"line 6: 'K0_range' nests arrays or tables more than {MAX_SCENE_DEPTH} deep"),
-    "deep_table": (TINY_SCENE + "figsize = " + "{a=" * 5000 + "1" + "}" * 5000 + "\n",
-                   r"line 13: 'figsize' nests arrays or tables more than 16 deep"),
+    "deep_array": (
+        TINY_SCENE.replace("K0_range = [-0.5, 0.2]", "K0_range = " + "[" * 5000 + "]" * 5000),
+        rf"line 6: 'K0_range' nests arrays or tables more than {MAX_SCENE_DEPTH} deep",
+    ),
+    "deep_table": (
+        TINY_SCENE + "figsize = " + "{a=" * 5000 + "1" + "}" * 5000 + "\n",
+        r"line 13: 'figsize' nests arrays or tables more than 16 deep",
+    ),
     # Before: 97 s and 8 GB (MemoryError) inside Python's TOML reader.
-    "dotted_key": (TINY_SCENE.replace('title = "tiny"', "title." + "a." * 100_000 + "b = 1"),
-                   rf"line 2: the key 'title\.a\.a.*has more than {MAX_KEY_PARTS} dotted parts"),
-    "nested_dotted": (TINY_SCENE + "[panels.zoom]\n" + "".join(f"k{i} = {{" for i in range(20)) + "x=1" + "}" * 20,
-                      r"line 14: 'k0' nests arrays or tables more than 16 deep"),
+    "dotted_key": (
+        TINY_SCENE.replace('title = "tiny"', "title." + "a." * 100_000 + "b = 1"),
+        rf"line 2: the key 'title\.a\.a.*has more than {MAX_KEY_PARTS} dotted parts",
+    ),
+    "nested_dotted": (
+        TINY_SCENE + "[panels.zoom]\n" + "".join(f"k{i} = {{" for i in range(20)) + "x=1" + "}" * 20,
+        r"line 14: 'k0' nests arrays or tables more than 16 deep",
+    ),
     # Before: OverflowError tracebacks.
-    "int_eps": (TINY_SCENE.replace("eps = 0.3", "eps = " + "9" * 350),
-                rf"int_eps\.toml\.panels\[0\]\.eps = \(an integer of {int('9' * 350).bit_length()} bits\) is out of "
-                r"range; allowed: integers"),
+    "int_eps": (
+        TINY_SCENE.replace("eps = 0.3", "eps = " + "9" * 350),
+        rf"int_eps\.toml\.panels\[0\]\.eps = \(an integer of {int('9' * 350).bit_length()} bits\) is out of "
+        r"range; allowed: integers",
+    ),
     # Before: Python's "Exceeds the limit (4300 digits) for integer string conversion", naming nothing.
-    "int_marker": (TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\nmarker_size = " + "9" * 5000),
-                   r"int_marker\.toml: line 6: 'marker_size' has a number of 5000 digits; allowed: numbers within the "
-                   r"range of a double"),
-    "int_real": (TINY_SCENE.replace("eps = 0.3", "eps = " + str(2**1024 - 1)),
-                 r"int_real\.toml\.panels\[0\]\.eps is an integer of 1024 bits, beyond the range of a double"),
+    "int_marker": (
+        TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\nmarker_size = " + "9" * 5000),
+        r"int_marker\.toml: line 6: 'marker_size' has a number of 5000 digits; allowed: numbers within the "
+        r"range of a double",
+    ),
+    "int_real": (
+        TINY_SCENE.replace("eps = 0.3", "eps = " + str(2**1024 - 1)),
+        r"int_real\.toml\.panels\[0\]\.eps is an integer of 1024 bits, beyond the range of a double",
+    ),
     # Before: 129 s of savefig and 390 MB.
-    "title_500k": (TINY_SCENE.replace('title = "tiny"', 'title = "' + "x" * 500_000 + '"'),
-                   r"title_500k\.toml\.title: a string of 500000 characters; allowed: at most 65536"),
-    "title_long": (TINY_SCENE.replace('title = "tiny"', 'title = "' + "x" * 201 + '"'),
-                   rf"title_long\.toml\.title: a string of 201 characters; allowed: at most {MAX_TEXT}"),
-    "panel_id": (TINY_SCENE.replace('id = "a"', 'id = "' + "a" * 1000 + '"'),
-                 r"panels\[0\]\.id: a string of 1000 characters; allowed: at most 200"),
+    "title_500k": (
+        TINY_SCENE.replace('title = "tiny"', 'title = "' + "x" * 500_000 + '"'),
+        r"title_500k\.toml\.title: a string of 500000 characters; allowed: at most 65536",
+    ),
+    "title_long": (
+        TINY_SCENE.replace('title = "tiny"', 'title = "' + "x" * 201 + '"'),
+        rf"title_long\.toml\.title: a string of 201 characters; allowed: at most {MAX_TEXT}",
+    ),
+    "panel_id": (
+        TINY_SCENE.replace('id = "a"', 'id = "' + "a" * 1000 + '"'),
+        r"panels\[0\]\.id: a string of 1000 characters; allowed: at most 200",
+    ),
     # Before: 25 s and 890 MB for a 121 x 92.6 inch figure.
-    "layout": (TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\nlayout = [20, 20]"),
-               r"dpi = 130 and layout make a figure of 121 x 92\.6 inches, a canvas of 189 million pixels"),
-    "dpi_figsize": (TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\ndpi = 1200\nfigsize = [12, 12]"),
-                    r"dpi = 1200 and figsize make a figure of 12 x 12 inches, a canvas of 207 million pixels"),
+    "layout": (
+        TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\nlayout = [20, 20]"),
+        r"dpi = 130 and layout make a figure of 121 x 92\.6 inches, a canvas of 189 million pixels",
+    ),
+    "dpi_figsize": (
+        TINY_SCENE.replace("n_orbits = 3", "n_orbits = 3\ndpi = 1200\nfigsize = [12, 12]"),
+        r"dpi = 1200 and figsize make a figure of 12 x 12 inches, a canvas of 207 million pixels",
+    ),
 }
 
 
@@ -559,18 +700,30 @@ def _edited(src: Path, dst_dir: Path, edit) -> Path:
 @pytest.mark.parametrize("case", ["area_text", "area_missing", "flag_number", "box_other", "row_list", "count_float"])
 def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monkeypatch):
     edit, msg = {
-        "area_text": (lambda r: r.update(area="x"), r"row\.area must be a number \(within the range of a double\), got 'x'"),
+        "area_text": (
+            lambda r: r.update(area="x"),
+            r"row\.area must be a number \(within the range of a double\), got 'x'",
+        ),
         "area_missing": (lambda r: r.pop("area"), r"row\.area is missing"),
         "flag_number": (lambda r: r.update(floor_touched=0), r"row\.floor_touched must be true or false, got 0"),
         "box_other": (lambda r: r.update(K_low=-0.5), r"row\.K_low = -0\.5 is not the point's K_low = -?0\.\d+"),
-        "row_list": (lambda r: (r.clear(), r.update(area=[1.0] * 10)), r"row\.area must be a number .*, got \[1\.0, .*\]"),
+        "row_list": (
+            lambda r: (r.clear(), r.update(area=[1.0] * 10)),
+            r"row\.area must be a number .*, got \[1\.0, .*\]",
+        ),
         "count_float": (lambda r: r.update(n_samples=2.5), r"row\.n_samples must be an integer, got 2\.5"),
     }[case]
     out = _edited(checkpoint[0], tmp_path, edit)
     computed = []
     monkeypatch.setattr(hv.TruncatedMap, "hovering_area", lambda *a, **k: computed.append(a))
-    _refused(run_scene, load_scene(HOV_SCENE), out, True, match=rf"hov\.sweep\.jsonl line 3: {msg} \(the file was "
-                                                                r"edited or damaged")
+    _refused(
+        run_scene,
+        load_scene(HOV_SCENE),
+        out,
+        True,
+        match=rf"hov\.sweep\.jsonl line 3: {msg} \(the file was "
+        r"edited or damaged",
+    )
     assert computed == [] and not out.exists()
 
 
@@ -605,8 +758,12 @@ def test_checkpoint_files_within_limits(tmp_path, monkeypatch):
     # 10,000 rows of empty lists: ~2 MB of text, ~50 MB of Python objects by the estimate.
     (tmp_path / "big.jsonl").write_text(head + (json.dumps({"key": {"a": 1}, "row": {"r": [[]] * 10_000}}) + "\n") * 10)
     monkeypatch.setattr(_untrusted, "memory_budget", lambda: 4 * MiB)
-    _refused(Checkpoint, tmp_path / "big.jsonl", match=r"big\.jsonl: a checkpoint of \d+ bytes, whose rows would take "
-                                                       r"up to [\d.e-]+ GiB, more than half of this machine's memory")
+    _refused(
+        Checkpoint,
+        tmp_path / "big.jsonl",
+        match=r"big\.jsonl: a checkpoint of \d+ bytes, whose rows would take "
+        r"up to [\d.e-]+ GiB, more than half of this machine's memory",
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -645,11 +802,12 @@ def test_every_result_type_round_trips_its_checks(tmp_path):
     # The field-type checks accept everything hovering writes (results of every type, maps).
     from helpers.pickle_helpers import maps, results
 
-    for name, r in {**{k: v for k, v in results().items() if k != "iterate_custom"},
-                    **{f"map_{k}": v[0] for k, v in maps().items() if k != "flow_custom"}}.items():
+    for name, r in {
+        **{k: v for k, v in results().items() if k != "iterate_custom"},
+        **{f"map_{k}": v[0] for k, v in maps().items() if k != "flow_custom"},
+    }.items():
         back = hv.load(hv.save(r, tmp_path / name))
         assert type(back) is type(r), name
-
 
 
 def test_what_save_writes_load_reads(tmp_path):
@@ -659,14 +817,20 @@ def test_what_save_writes_load_reads(tmp_path):
     assert np.array_equal(back[key], np.arange(3.0)) and back["t"] == "x" * 1000
     with zipfile.ZipFile(tmp_path / "names.npz") as z:
         assert all(_untrusted.safe_member_name(n) for n in z.namelist())
-    with pytest.raises(ValueError, match=r"cannot save: the file would not read back: .*a string of 1100000 "
-                                         r"characters; allowed: at most 1048576"):
+    with pytest.raises(
+        ValueError,
+        match=r"cannot save: the file would not read back: .*a string of 1100000 "
+        r"characters; allowed: at most 1048576",
+    ):
         hv.save({"note": "x" * 1_100_000}, tmp_path / "long")
     deep = 1.0
     for _ in range(60):
         deep = [deep]
-    with pytest.raises(ValueError, match=r"cannot save: the file would not read back: the tree is nested 121 levels "
-                                         r"deep; allowed: at most 100"):
+    with pytest.raises(
+        ValueError,
+        match=r"cannot save: the file would not read back: the tree is nested 121 levels "
+        r"deep; allowed: at most 100",
+    ):
         hv.save(deep, tmp_path / "deep")
     with pytest.raises(TypeError, match=r"root: arrays of dtype datetime64\[D\] cannot be saved"):
         hv.save(np.array(["2020-01-01"], dtype="M8[D]"), tmp_path / "dates")

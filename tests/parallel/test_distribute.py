@@ -32,6 +32,7 @@ def single():
 @pytest.fixture(scope="module")
 def cluster():
     import distributed
+
     c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
     client = distributed.Client(c)
     yield client
@@ -87,7 +88,9 @@ def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_p
     assert key["map"]["data"]["__dict__"]["eps"] == M.eps and key["n_steps"] == KW["n_steps"]
     assert sorted(p["key"]["hovering_area_piece"]["lo"] for p in _points(ck))[0] == 0
     # a rerun reads all four pieces back: the progress callback sees every unit done, no new line
-    again = hovering_area(M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck), progress=lambda d, t: seen.append((d, t)))
+    again = hovering_area(
+        M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck), progress=lambda d, t: seen.append((d, t))
+    )
     same(single, again)
     assert len(_points(ck)) == 4 and seen[-1][0] == seen[-1][1]
     # another parameter (n_steps) is another key: four new pieces
@@ -102,20 +105,28 @@ def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_p
     assert redo.area == hovering_area(M, **{**KW, "n_steps": 400}).area
 
 
-@pytest.mark.parametrize("bad, match", [
-    (0, r"workers must be an integer in \[1, 4096\], got 0"),
-    (True, "executor must be None, a worker count, .* got True"),
-    (2.0, "executor must be None, a worker count, .* got 2.0"),
-    ("", "scheduler must be an address"),
-    (dict(client="tcp://nowhere"), "client must be a distributed.Client, got 'tcp://nowhere'"),
-    (dict(workers=2, pieces=0), "pieces must be an integer"),
-    (dict(client=None, scheduler="tcp://a:1", dask=True), "dask=True makes a LocalCluster"),
-    (dict(workers=2, dask="yes"), "dask must be True or False, got 'yes'"),
-    (dict(pool="threads"), "pool must be a concurrent.futures.Executor, got 'threads'"),
-    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), workers=2), "brings its own workers"),
-    (dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), scheduler="tcp://a:1"),
-     "at most one of client, scheduler and pool"),
-])
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        (0, r"workers must be an integer in \[1, 4096\], got 0"),
+        (True, "executor must be None, a worker count, .* got True"),
+        (2.0, "executor must be None, a worker count, .* got 2.0"),
+        ("", "scheduler must be an address"),
+        (dict(client="tcp://nowhere"), "client must be a distributed.Client, got 'tcp://nowhere'"),
+        (dict(workers=2, pieces=0), "pieces must be an integer"),
+        (dict(client=None, scheduler="tcp://a:1", dask=True), "dask=True makes a LocalCluster"),
+        (dict(workers=2, dask="yes"), "dask must be True or False, got 'yes'"),
+        (dict(pool="threads"), "pool must be a concurrent.futures.Executor, got 'threads'"),
+        (
+            dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), workers=2),
+            "brings its own workers",
+        ),
+        (
+            dict(pool=__import__("concurrent.futures").futures.ThreadPoolExecutor(1), scheduler="tcp://a:1"),
+            "at most one of client, scheduler and pool",
+        ),
+    ],
+)
 def test_bad_executors_are_named_before_any_work(bad, match):
     with pytest.raises(ValueError, match=match):
         hovering_area(M, **KW, executor=Executor(**bad) if isinstance(bad, dict) else bad)
@@ -193,10 +204,26 @@ def test_cli_workers_flags(tmp_path):
 
     root = __import__("pathlib").Path(__file__).resolve().parents[2]
     scene = root / "examples" / "scenes" / "fig_hov_vs_eps.toml"
-    p = subprocess.run([sys.executable, "-m", "hovering", "scene", str(scene), "--quick", "--workers", "2", "--out",
-                        str(tmp_path / "h.png")], capture_output=True, text=True, timeout=300)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "hovering",
+            "scene",
+            str(scene),
+            "--quick",
+            "--workers",
+            "2",
+            "--out",
+            str(tmp_path / "h.png"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "h.sweep.jsonl").exists()
-    bad = subprocess.run([sys.executable, "-m", "hovering", "scene", str(scene), "--dask"], capture_output=True,
-                         text=True, timeout=60)
+    bad = subprocess.run(
+        [sys.executable, "-m", "hovering", "scene", str(scene), "--dask"], capture_output=True, text=True, timeout=60
+    )
     assert bad.returncode == 2 and "--dask needs --workers" in bad.stderr

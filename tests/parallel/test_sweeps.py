@@ -22,7 +22,10 @@ def test_checkpoint_roundtrip_and_torn_line(tmp_path):
     assert c.put({"n": 4, "eps": 0.2}, {"area": 2.5})
     assert not c.put({"eps": 0.2, "n": 4}, {"area": 9.9})  # a point is written once
     lines = path.read_text().splitlines()
-    assert lines[0] == '{"format":"hovering-checkpoint","version":1}' and json.loads(lines[1])["provenance"]["program"] == "python"
+    assert (
+        lines[0] == '{"format":"hovering-checkpoint","version":1}'
+        and json.loads(lines[1])["provenance"]["program"] == "python"
+    )
     # Non-finite numbers are strings in the file (JSON has none) and floats again when read.
     assert '"agree":"NaN"' in lines[2] and '"top":"-Infinity"' in lines[2] and len(lines) == 4
     with open(path, "a") as f:
@@ -39,14 +42,23 @@ def test_checkpoint_roundtrip_and_torn_line(tmp_path):
     assert canonical({"b": [1.0, float("inf")], "a": 1}) == '{"a":1,"b":[1.0,"Infinity"]}'
 
 
-@pytest.mark.parametrize("text, where", [
-    ('{"format":"hovering-checkpoint","version":1}\n{"key":{},"row":{}}\nnot json\n{"key":{"a":1},"row":{}}\n', "line 3"),
-    ('{"format":"hovering-checkpoint","version":1}\n{"key":{"a":NaN},"row":{}}\n', "line 2"),
-    ('{"format":"hovering-checkpoint","version":1}\n{"key":{},"row":{},"more":1}\n', "line 2"),
-    ('{"format":"hovering-checkpoint","version":2}\n', "line 1: a checkpoint of version 2"),
-    ('{"key": {"eps": 0.1}, "provenance": {}, "row": {"area": 1.0}}\n', "line 1: a checkpoint of an older hovering"),
-    ('area,error\n1,2\n', "line 1: not a line of JSON"),
-])
+@pytest.mark.parametrize(
+    "text, where",
+    [
+        (
+            '{"format":"hovering-checkpoint","version":1}\n{"key":{},"row":{}}\nnot json\n{"key":{"a":1},"row":{}}\n',
+            "line 3",
+        ),
+        ('{"format":"hovering-checkpoint","version":1}\n{"key":{"a":NaN},"row":{}}\n', "line 2"),
+        ('{"format":"hovering-checkpoint","version":1}\n{"key":{},"row":{},"more":1}\n', "line 2"),
+        ('{"format":"hovering-checkpoint","version":2}\n', "line 1: a checkpoint of version 2"),
+        (
+            '{"key": {"eps": 0.1}, "provenance": {}, "row": {"area": 1.0}}\n',
+            "line 1: a checkpoint of an older hovering",
+        ),
+        ("area,error\n1,2\n", "line 1: not a line of JSON"),
+    ],
+)
 def test_damaged_or_foreign_checkpoints_are_refused_untouched(text, where, tmp_path):
     path = tmp_path / "c.jsonl"
     path.write_text(text)

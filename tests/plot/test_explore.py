@@ -39,8 +39,15 @@ def tmap():
 
 
 def _system(eps=-0.05):
-    return hovering.StepSystem(V1=hovering.Harmonic(omega=1.0), V2=hovering.Tan(omega=1.4, alpha=0.7),
-                               coupling=hovering.Bilinear(), eps=eps, qw1=-1.0, qw2=-0.5, geometry="step")
+    return hovering.StepSystem(
+        V1=hovering.Harmonic(omega=1.0),
+        V2=hovering.Tan(omega=1.4, alpha=0.7),
+        coupling=hovering.Bilinear(),
+        eps=eps,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +138,7 @@ def test_flow_map_in_section_coordinates_shows_theta_I_over_its_band():
 
 
 def test_truncated_family(tmap):
-    Kg = np.concatenate([-np.linspace(3.0, 0.0, 61) ** 2 / 3.0, np.linspace(0.05, 1.0, 20)])
+    Kg = np.concatenate([-(np.linspace(3.0, 0.0, 61) ** 2) / 3.0, np.linspace(0.05, 1.0, 20)])
     fam = hovering.TruncatedFamily.from_map(tmap, Kg, forcing=(1.0, -0.2))
     ex = hovering.explore(fam, n_steps=200)
     assert ex.n_steps == 200
@@ -226,8 +233,14 @@ def test_interrupted_orbit_is_drawn_and_the_interrupt_propagates():
             phi, K, reg = res.phi.copy(), res.K.copy(), res.region.copy()
             phi[:, 8:], K[:, 8:], reg[:, 7:] = np.nan, np.nan, int(Region.NONE)
             exc = KeyboardInterrupt("interrupted")
-            exc.partial = dataclasses.replace(res, phi=phi, K=K, region=reg, steps_done=np.array([7]),
-                                              status=np.array([int(Status.INTERRUPTED)], dtype=np.int8))
+            exc.partial = dataclasses.replace(
+                res,
+                phi=phi,
+                K=K,
+                region=reg,
+                steps_done=np.array([7]),
+                status=np.array([int(Status.INTERRUPTED)], dtype=np.int8),
+            )
             raise exc
 
     ex = hovering.explore(Interrupting(eps=0.3, **PAPER), n_steps=100)
@@ -307,16 +320,19 @@ def test_bad_n_steps_is_a_value_error_naming_it(tmap, bad):
     assert plt.get_fignums() == figs  # refused before any figure was made
 
 
-@pytest.mark.parametrize("kw, name", [
-    (dict(K_range=(0.1, -0.1)), "K_range"),
-    (dict(K_range=(float("nan"), 0.1)), "K_range"),
-    (dict(K_range=(0.0, 1.0, 2.0)), "K_range"),
-    (dict(K_range="ab"), "K_range"),
-    (dict(K_range=(0.0, "1")), "K_range"),
-    (dict(marker_size=0.0), "marker_size"),
-    (dict(max_points=0), "max_points"),
-    (dict(ax="axes"), "ax"),
-])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        (dict(K_range=(0.1, -0.1)), "K_range"),
+        (dict(K_range=(float("nan"), 0.1)), "K_range"),
+        (dict(K_range=(0.0, 1.0, 2.0)), "K_range"),
+        (dict(K_range="ab"), "K_range"),
+        (dict(K_range=(0.0, "1")), "K_range"),
+        (dict(marker_size=0.0), "marker_size"),
+        (dict(max_points=0), "max_points"),
+        (dict(ax="axes"), "ax"),
+    ],
+)
 def test_bad_options_are_value_errors_naming_them(tmap, kw, name):
     figs = plt.get_fignums()
     with pytest.raises(ValueError, match=name):
@@ -375,7 +391,9 @@ def test_a_scene_path_explores_its_first_panels_map(tmp_path):
 
 
 def test_a_hovering_area_scene_explores_its_first_series_at_its_first_eps(tmp_path):
-    p = _scene(tmp_path, """
+    p = _scene(
+        tmp_path,
+        """
 kind = "hovering_area"
 output = "OUT"
 n_steps = 100
@@ -384,7 +402,8 @@ eps = [0.15, 0.3]
 label = "a"
 Omega0 = 2.0
 theta_w = 2.5
-""")
+""",
+    )
     m = hovering.explore(p).map
     assert (m.eps, m.Omega0, m.theta_w) == (0.15, 2.0, 2.5)
 

@@ -69,5 +69,3 @@ def test_plot_orbits_rejects_missing_records_and_bad_colouring():
             primitives.plot_orbits(ax, r, color_by="x")
     finally:
         plt.close(fig)
-
-

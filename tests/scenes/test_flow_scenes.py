@@ -66,8 +66,10 @@ def _artists(fig):
             x, y = ln.get_data()
             data[(i, "line", j, ln.get_gid(), ln.get_label())] = (np.asarray(x, float), np.asarray(y, float))
         for j, c in enumerate(ax.collections):
-            data[(i, "coll", j, c.get_gid(), c.get_label())] = (np.asarray(c.get_offsets(), float),
-                                                                np.asarray(c.get_facecolor(), float))
+            data[(i, "coll", j, c.get_gid(), c.get_label())] = (
+                np.asarray(c.get_offsets(), float),
+                np.asarray(c.get_facecolor(), float),
+            )
         data[(i, "axes")] = (ax.get_xlabel(), ax.get_ylabel(), ax.get_title(), ax.get_xlim(), ax.get_ylim())
     return data
 
@@ -86,6 +88,7 @@ def test_every_flow_scene_file_loads_and_names_its_effects():
 @pytest.mark.parametrize("name", FLOW_FILES)
 def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, monkeypatch):
     s = runs[name]
+
     # Drawing must not iterate anything: make every map's iterate fail while redrawing.
     def refuse(*a, **k):
         raise AssertionError("redraw computed")
@@ -305,14 +308,17 @@ def test_flow_schema_errors_name_the_key(name, path, value, text):
 
 
 @pytest.mark.e2e
-@pytest.mark.parametrize("case,text", [
-    ("unwritable", "is not a directory"),
-    ("format", "matplotlib cannot write '.xyz' files"),
-    ("expression", "expression of 359 characters; allowed: at most 200"),
-    ("deep", "expression of 303 characters; allowed: at most 200"),
-    ("code", "cannot evaluate"),
-    ("colour", "is not a matplotlib colour"),
-])
+@pytest.mark.parametrize(
+    "case,text",
+    [
+        ("unwritable", "is not a directory"),
+        ("format", "matplotlib cannot write '.xyz' files"),
+        ("expression", "expression of 359 characters; allowed: at most 200"),
+        ("deep", "expression of 303 characters; allowed: at most 200"),
+        ("code", "cannot evaluate"),
+        ("colour", "is not a matplotlib colour"),
+    ],
+)
 def test_bad_flow_scene_fails_in_the_cli_before_computing(tmp_path, case, text):
     src = (SCENE_DIR / "flow_portrait.toml").read_text()
     if case == "unwritable":
@@ -321,13 +327,13 @@ def test_bad_flow_scene_fails_in_the_cli_before_computing(tmp_path, case, text):
         blocker.write_text("x")
         src = src.replace('output = "out/flow_portrait.png"', f'output = "{blocker}/sub/x.png"')
     elif case == "format":
-        src = src.replace('out/flow_portrait.png', 'out/flow_portrait.xyz')
+        src = src.replace("out/flow_portrait.png", "out/flow_portrait.xyz")
     elif case == "expression":
         src = src.replace("\neps = -0.05", '\neps = "' + "+".join(["0.001"] * 60) + '"')
     elif case == "deep":  # 150 nested parentheses: refused by length before the parser sees them
         src = src.replace("\neps = -0.05", '\neps = "' + "(" * 150 + "0.1" + ")" * 150 + '"')
     elif case == "code":
-        src = src.replace("\neps = -0.05", '\neps = "__import__(\'os\').getcwd()"')
+        src = src.replace("\neps = -0.05", "\neps = \"__import__('os').getcwd()\"")
     else:  # the flow's hovering scene has no colour key; the truncated ones do
         src = (SCENE_DIR / "fig_hov_vs_eps.toml").read_text()
         src = src.replace("output = ", 'output = "x.png"\n#', 1)
@@ -335,8 +341,9 @@ def test_bad_flow_scene_fails_in_the_cli_before_computing(tmp_path, case, text):
     p = tmp_path / "bad.toml"
     p.write_text(src)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    r = subprocess.run([sys.executable, "-m", "hovering", "scene", str(p)], capture_output=True, text=True,
-                       cwd=tmp_path, timeout=120)
+    r = subprocess.run(
+        [sys.executable, "-m", "hovering", "scene", str(p)], capture_output=True, text=True, cwd=tmp_path, timeout=120
+    )
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     assert r.returncode == 2 and r.stderr.startswith("error: ") and "Traceback" not in r.stderr
@@ -368,8 +375,12 @@ def test_scene_progress_reaches_its_total(tmp_path):
     calls = []
     d = _small("flow_hov_vs_eps")
     d.update(eps=[-0.1, 0.05], samples=100, n_steps=100, models=["onset"])
-    scenes.compute(parse_scene(d, "h.toml"), quick=True, progress=lambda done, total: calls.append((done, total)),
-                   checkpoint=tmp_path / "h.jsonl")
+    scenes.compute(
+        parse_scene(d, "h.toml"),
+        quick=True,
+        progress=lambda done, total: calls.append((done, total)),
+        checkpoint=tmp_path / "h.jsonl",
+    )
     assert calls and calls[-1] == (2, 2) and all(a <= b for (a, _), (b, _) in zip(calls, calls[1:]))
     calls.clear()
     d = _small("flow_portrait")

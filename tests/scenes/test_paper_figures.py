@@ -26,9 +26,9 @@ import tomllib
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-from matplotlib.colors import to_rgb
 import numpy as np
 import pytest
+from matplotlib.colors import to_rgb
 
 import hovering
 from hovering import Region, pipeline
@@ -37,8 +37,17 @@ from hovering.flow.system import StepSystem
 from hovering.normal.corners import corner_curves
 from hovering.scenes import compute, load_scene, parse_scene
 from hovering.scenes.compute import _circle_boundaries
-from hovering.scenes.wall import (DIRECTIONS, WallFlow, corner_energy, corner_speed, corner_states, rho_w_max,
-                                  tangent_action, wall_states, wall_tangency_action)
+from hovering.scenes.wall import (
+    DIRECTIONS,
+    WallFlow,
+    corner_energy,
+    corner_speed,
+    corner_states,
+    rho_w_max,
+    tangent_action,
+    wall_states,
+    wall_tangency_action,
+)
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 FILES = ("fig_corner_directions", "fig_sigma0_wall", "fig_wallsection")
@@ -49,8 +58,15 @@ RTOL = 1e-12
 
 def _system(eps: float) -> StepSystem:
     """The example scenes' system (README's), uncoupled at eps = 0."""
-    return StepSystem(V1=hovering.Harmonic(1.0), V2=hovering.Tan(1.4, 0.7),
-                      coupling=hovering.Bilinear() if eps else None, eps=eps, qw1=-1.0, qw2=-0.5, geometry="step")
+    return StepSystem(
+        V1=hovering.Harmonic(1.0),
+        V2=hovering.Tan(1.4, 0.7),
+        coupling=hovering.Bilinear() if eps else None,
+        eps=eps,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry="step",
+    )
 
 
 def _flow(sys: StepSystem) -> WallFlow:
@@ -78,20 +94,38 @@ def _small(name: str) -> dict:
 
 
 BAD = [
-    ("fig_corner_directions", ("p1w_fractions",), [0.3, 1.2], "p1w_fractions[1] = 1.2 is out of range; allowed: (0.0, 1.0)"),
+    (
+        "fig_corner_directions",
+        ("p1w_fractions",),
+        [0.3, 1.2],
+        "p1w_fractions[1] = 1.2 is out of range; allowed: (0.0, 1.0)",
+    ),
     ("fig_corner_directions", ("p1w_fractions",), [], "p1w_fractions must be a list of 1 to 12 numbers in (0, 1)"),
     ("fig_corner_directions", ("p1w_fractions",), [0.5, 0.5], "p1w_fractions = [0.5, 0.5] lists a value twice"),
     ("fig_corner_directions", ("n_curve",), 2, "n_curve = 2 is out of range; allowed: [4, 2000]"),
     ("fig_corner_directions", ("system", "geometry"), "wall", "system.geometry = 'wall'"),
-    ("fig_corner_directions", ("outputs", "record"), ["regions"], "outputs.record = 'regions' is not allowed; "
-                                                                   "allowed: 'trajectory'"),
+    (
+        "fig_corner_directions",
+        ("outputs", "record"),
+        ["regions"],
+        "outputs.record = 'regions' is not allowed; allowed: 'trajectory'",
+    ),
     ("fig_corner_directions", ("outputs", "record"), [], "outputs.record = [] lacks ['trajectory']"),
     # above h_0^w = 0.766 but below h_eps^w = 0.766 + 0.05 * qw1 qw2 = 0.791: no orbit reaches the corner
-    ("fig_corner_directions", ("section", "h"), 0.78, "section.h = 0.78 is out of range; allowed: above the energy at "
-                                                      "rest at the corner V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = 0.791492"),
+    (
+        "fig_corner_directions",
+        ("section", "h"),
+        0.78,
+        "section.h = 0.78 is out of range; allowed: above the energy at "
+        "rest at the corner V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = 0.791492",
+    ),
     ("fig_corner_directions", ("bogus",), 1, "unknown key(s) 'bogus'"),
-    ("fig_sigma0_wall", ("system",), dict(eps=0.05, coupling="bilinear"),
-     "system.eps = 0.05: fig:Sigma_0_wall draws the unperturbed tangency line; allowed: eps = 0"),
+    (
+        "fig_sigma0_wall",
+        ("system",),
+        dict(eps=0.05, coupling="bilinear"),
+        "system.eps = 0.05: fig:Sigma_0_wall draws the unperturbed tangency line; allowed: eps = 0",
+    ),
     ("fig_sigma0_wall", ("grid",), [10], "grid must be [n_theta, n_rho]"),
     ("fig_sigma0_wall", ("grid",), [4, 10], "grid[0] = 4 is out of range; allowed: [8, 2000]"),
     ("fig_sigma0_wall", ("n_points",), 3, "n_points = 3 is out of range; allowed: [16, 100000]"),
@@ -128,8 +162,11 @@ def test_wall_section_refuses_an_eps_without_a_tangency_line_near_the_unperturbe
     # [I_tan / 2, 3 I_tan / 2] solves eq:XiwallepsI: refused when the scene is read, naming eps.
     d = copy.deepcopy(_raw("fig_wallsection"))
     d["system"].update(coupling=[[1.0, 0, 1]], eps=1.5)
-    with pytest.raises(ValueError, match=r"system.eps = 1.5: the wall's tangency line has no action in "
-                                         r"\[I_tan/2, 3 I_tan/2\] at theta = .*allowed: an eps small enough"):
+    with pytest.raises(
+        ValueError,
+        match=r"system.eps = 1.5: the wall's tangency line has no action in "
+        r"\[I_tan/2, 3 I_tan/2\] at theta = .*allowed: an eps small enough",
+    ):
         parse_scene(d, "w.toml")
 
 
@@ -234,7 +271,7 @@ def test_corner_curves_traced_from_the_corner_are_the_bisected_boundaries():
     assert (K < 0).all()
     cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=RTOL)
     for j, ab in enumerate(DIRECTIONS):
-        measured = getattr(cc, f"phi_{ab}")[3 * j: 3 * j + 3]
+        measured = getattr(cc, f"phi_{ab}")[3 * j : 3 * j + 3]
         assert np.abs(wrap(measured - traced[ab][0])).max() < 5e-9, (ab, measured - traced[ab][0])
 
 
@@ -507,8 +544,11 @@ def test_wall_section_at_small_eps_keeps_the_order_symmetry_and_corner_segments(
     b, ci = res.boundaries, res.circle
     assert b["R0"] < 0 < b["01"] < b["1R"] and b["1R"] == pytest.approx(-b["R0"], abs=1e-8)
     th = ci["theta"]
-    want = np.where((th > b["R0"]) & (th < b["01"]), int(Region.ABOVE),
-                    np.where((th > b["01"]) & (th < b["1R"]), int(Region.UPPER), int(Region.RIGHT)))
+    want = np.where(
+        (th > b["R0"]) & (th < b["01"]),
+        int(Region.ABOVE),
+        np.where((th > b["01"]) & (th < b["1R"]), int(Region.UPPER), int(Region.RIGHT)),
+    )
     np.testing.assert_array_equal(ci["region"], want)
     z = np.column_stack([np.full(th.size, sys.qw1), ci["p1"], ci["q2"], ci["p2"]])
     np.testing.assert_allclose(sys.core.energy(z), H, atol=1e-13)
@@ -529,19 +569,43 @@ def _seg(d, i=0):
 
 
 TAMPERED = [
-    ("fig_wallsection", "segment_kind", lambda d: _seg(d).update(kind="R2"),
-     r"root\.segments\[0\]: kind = 'R2' is not allowed; allowed: 'R', '0', '1', 'R0', '01', '1R'"),
+    (
+        "fig_wallsection",
+        "segment_kind",
+        lambda d: _seg(d).update(kind="R2"),
+        r"root\.segments\[0\]: kind = 'R2' is not allowed; allowed: 'R', '0', '1', 'R0', '01', '1R'",
+    ),
     ("fig_wallsection", "segment_status", lambda d: _seg(d).update(status="FINE"), r"root\.segments\[0\]: status"),
-    ("fig_wallsection", "boundaries", lambda d: d["tree"]["fields"]["boundaries"]["__dict__"].pop("01"),
-     r"root: boundaries must map \['R0', '01', '1R'\] to numbers"),
-    ("fig_wallsection", "circle_keys", lambda d: d["tree"]["fields"]["circle"]["__dict__"].pop("p1"),
-     r"root: circle must hold the arrays \['p1', 'p2', 'q2', 'region', 'theta'\]"),
-    ("fig_sigma0_wall", "point_number", lambda d: d["tree"]["fields"]["points"]["__list__"][0]["fields"].update(number=9),
-     r"root\.points\[0\]: number = 9 is out of range; allowed: 1 to 7"),
-    ("fig_corner_directions", "direction", lambda d: d["tree"]["fields"]["trajectories"]["__list__"][0]["fields"].update(
-        direction="10"), r"root\.trajectories\[0\]: direction = '10' is not allowed"),
-    ("fig_corner_directions", "curves", lambda d: d["tree"]["fields"]["curves"]["__dict__"].pop("1R"),
-     r"root: curves must have the keys \['R0', '01', '1R'\]"),
+    (
+        "fig_wallsection",
+        "boundaries",
+        lambda d: d["tree"]["fields"]["boundaries"]["__dict__"].pop("01"),
+        r"root: boundaries must map \['R0', '01', '1R'\] to numbers",
+    ),
+    (
+        "fig_wallsection",
+        "circle_keys",
+        lambda d: d["tree"]["fields"]["circle"]["__dict__"].pop("p1"),
+        r"root: circle must hold the arrays \['p1', 'p2', 'q2', 'region', 'theta'\]",
+    ),
+    (
+        "fig_sigma0_wall",
+        "point_number",
+        lambda d: d["tree"]["fields"]["points"]["__list__"][0]["fields"].update(number=9),
+        r"root\.points\[0\]: number = 9 is out of range; allowed: 1 to 7",
+    ),
+    (
+        "fig_corner_directions",
+        "direction",
+        lambda d: d["tree"]["fields"]["trajectories"]["__list__"][0]["fields"].update(direction="10"),
+        r"root\.trajectories\[0\]: direction = '10' is not allowed",
+    ),
+    (
+        "fig_corner_directions",
+        "curves",
+        lambda d: d["tree"]["fields"]["curves"]["__dict__"].pop("1R"),
+        r"root: curves must have the keys \['R0', '01', '1R'\]",
+    ),
 ]
 
 
@@ -593,8 +657,10 @@ def _artists(fig) -> dict:
             x, y = ln.get_data()
             data[(i, "line", j, ln.get_gid(), ln.get_label())] = (np.asarray(x, float), np.asarray(y, float))
         for j, c in enumerate(ax.collections):
-            data[(i, "coll", j, c.get_gid(), c.get_label())] = (np.asarray(c.get_offsets(), float),
-                                                                np.asarray(c.get_facecolor(), float))
+            data[(i, "coll", j, c.get_gid(), c.get_label())] = (
+                np.asarray(c.get_offsets(), float),
+                np.asarray(c.get_facecolor(), float),
+            )
         data[(i, "axes")] = (ax.get_xlabel(), ax.get_ylabel(), ax.get_title(), ax.get_xlim(), ax.get_ylim())
     return data
 
@@ -633,15 +699,26 @@ def test_a_quick_run_writes_png_npz_json(runs, name):
             c = a.get_color() if hasattr(a, "get_xdata") else a.get_facecolor()[0]
             return np.array(to_rgb(c))
 
-        named = {"red": lambda r, g, b: r > 0.6 and g < 0.3 and b < 0.3,
-                 "blue": lambda r, g, b: b > 0.6 and r < 0.3 and g < 0.3,
-                 "green": lambda r, g, b: g > 0.35 and r < 0.35 and b < 0.2,
-                 "black": lambda r, g, b: max(r, g, b) < 0.1,
-                 "yellow": lambda r, g, b: r > 0.8 and g > 0.6 and b < 0.3,
-                 "gray": lambda r, g, b: 0.4 < r < 0.8 and abs(r - g) < 0.05 and abs(r - b) < 0.05,
-                 "cyan": lambda r, g, b: r < 0.3 and g > 0.7 and b > 0.7}
-        want = {"curve:R0": "red", "curve:01": "blue", "curve:1R": "green", "arc:R": "yellow", "arc:0": "gray",
-                "arc:1": "cyan", "segment:R0:6": "red", "segment:01:7": "blue", "segment:1R:8": "black"}
+        named = {
+            "red": lambda r, g, b: r > 0.6 and g < 0.3 and b < 0.3,
+            "blue": lambda r, g, b: b > 0.6 and r < 0.3 and g < 0.3,
+            "green": lambda r, g, b: g > 0.35 and r < 0.35 and b < 0.2,
+            "black": lambda r, g, b: max(r, g, b) < 0.1,
+            "yellow": lambda r, g, b: r > 0.8 and g > 0.6 and b < 0.3,
+            "gray": lambda r, g, b: 0.4 < r < 0.8 and abs(r - g) < 0.05 and abs(r - b) < 0.05,
+            "cyan": lambda r, g, b: r < 0.3 and g > 0.7 and b > 0.7,
+        }
+        want = {
+            "curve:R0": "red",
+            "curve:01": "blue",
+            "curve:1R": "green",
+            "arc:R": "yellow",
+            "arc:0": "gray",
+            "arc:1": "cyan",
+            "segment:R0:6": "red",
+            "segment:01:7": "blue",
+            "segment:1R:8": "black",
+        }
         for gid, name in want.items():
             assert named[name](*rgb(gid)), (gid, name, rgb(gid))
 

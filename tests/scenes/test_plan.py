@@ -32,8 +32,9 @@ def flow_scene():
 
 
 def run_exe(exe, plan: Path, out: Path, *extra) -> subprocess.CompletedProcess:
-    r = subprocess.run([exe, "--plan", str(plan), "--out", str(out), *extra], capture_output=True, text=True,
-                       timeout=600)
+    r = subprocess.run(
+        [exe, "--plan", str(plan), "--out", str(out), *extra], capture_output=True, text=True, timeout=600
+    )
     assert r.returncode == 0, r.stderr
     return r
 
@@ -169,7 +170,9 @@ def test_plan_command(tmp_path, capsys, monkeypatch):
     assert "a plan is a TOML file" in capsys.readouterr().err
     (tmp_path / "mine.toml").write_text("x = 1\n")
     assert main(["plan", str(TRUNC), "-o", "mine.toml"]) == 2
-    assert "was not written by hovering" in capsys.readouterr().err and (tmp_path / "mine.toml").read_text() == "x = 1\n"
+    assert (
+        "was not written by hovering" in capsys.readouterr().err and (tmp_path / "mine.toml").read_text() == "x = 1\n"
+    )
     # A plan hovering wrote is replaced (a new plan of the full counts).
     assert main(["plan", str(TRUNC), "-o", "fig_hov_vs_eps.plan.toml"]) == 0
     assert tomllib.loads((tmp_path / "fig_hov_vs_eps.plan.toml").read_text())["points"][0]["n_steps"] == 20000

@@ -386,7 +386,7 @@ def test_epsbig_panels_islands_zoom_and_flipped_eps(runs):
         assert np.all((p >= w["xlim"][0]) & (p <= w["xlim"][1]) & (k >= w["ylim"][0]) & (k <= w["ylim"][1]))
     np.testing.assert_allclose(fig.axes[2].get_xlim(), w["xlim"])
     # leading curve k_{eps,2} on the negative-eps panels
-    for ax, pid in ((fig.axes[3], "d"), (fig.axes[4], "e")):
+    for ax, _panel in ((fig.axes[3], "d"), (fig.axes[4], "e")):
         (lead,) = [ln for ln in ax.lines if ln.get_gid() == "leading_curve"]
         assert r"k_{\varepsilon,2}" in lead.get_label()
 
@@ -426,9 +426,15 @@ def test_zoom_window_rules_on_synthetic_orbits():
     # critical rule: the orbit K = -0.1 cos(phi - 1) dips below 0 on (1 - pi/2, 1 + pi/2)
     phi = np.linspace(-np.pi, np.pi, 20001)[:-1]
     K = -0.1 * np.cos(phi - 1.0)
-    orbits = SimpleNamespace(phi=phi[None, :], K=K[None, :], region=np.full((1, phi.size - 1), int(Region.ABOVE)),
-                             status=np.array([int(Status.OK)]), steps_done=np.array([phi.size - 1]), labels=["x"],
-                             kinds=["extra"])
+    orbits = SimpleNamespace(
+        phi=phi[None, :],
+        K=K[None, :],
+        region=np.full((1, phi.size - 1), int(Region.ABOVE)),
+        status=np.array([int(Status.OK)]),
+        steps_done=np.array([phi.size - 1]),
+        labels=["x"],
+        kinds=["extra"],
+    )
     w = zoom_window_critical(orbits, None, pad=0.1)
     np.testing.assert_allclose(w["xlim"], [1 - np.pi / 2 - 0.1 * np.pi, 1 + np.pi / 2 + 0.1 * np.pi], atol=1e-3)
     np.testing.assert_allclose(w["ylim"], [-0.11, 0.01], atol=1e-8)
@@ -438,8 +444,9 @@ def test_zoom_window_rules_on_synthetic_orbits():
     reg[0, [2, 5]] = int(Region.RIGHT)
     p = np.array([[0.0, 0.5, 3.1, 1.0, 2.0, -3.1, 0.3, 0.2, 0.1, 0.0]])
     k = np.array([[-0.5, -0.4, -0.2, -0.9, -0.8, -0.1, -0.3, -0.3, -0.3, -0.3]])
-    orbits = SimpleNamespace(phi=p, K=k, region=reg, status=np.array([0]), steps_done=np.array([9]), labels=["isl"],
-                             kinds=["extra"])
+    orbits = SimpleNamespace(
+        phi=p, K=k, region=reg, status=np.array([0]), steps_done=np.array([9]), labels=["isl"], kinds=["extra"]
+    )
     w = zoom_window_islands(orbits, ["isl"], pad=0.0)
     np.testing.assert_allclose(w["ylim"], [-0.2, -0.1])
     assert w["xlim"] == [pytest.approx(3.1), np.pi]  # the box (3.1, 3.1 + 0.083) is clipped at pi

@@ -89,7 +89,8 @@ def test_tables_may_be_callables():
     fam = TruncatedFamily.from_map(m, grid)
     s = lambda k: np.sqrt(max(-k, 0.0))  # noqa: E731
     fam_c = TruncatedFamily(
-        m.eps, grid,
+        m.eps,
+        grid,
         Omega=lambda k: m.Omega0 + m.tau0 * k,
         JR=lambda k: 2 * (np.pi - m.theta_w) + m.tau1 * min(k, 0.0),
         J1=lambda k: 2 * m.lam * s(k),
@@ -248,7 +249,9 @@ def _table():
     m = make_map(PARAM_SETS["paper_eps+0.3"])
     s = np.sqrt(np.maximum(-K, 0.0))
     return dict(
-        eps=0.3, K=K, Omega=m.Omega0 + K,
+        eps=0.3,
+        K=K,
+        Omega=m.Omega0 + K,
         JR=2 * (np.pi - m.theta_w) + 0.5 * np.minimum(K, 0.0),
         J1=2 * 0.5 * s,
     )
@@ -266,6 +269,7 @@ def _set(key, i, v):
         a = np.array(t[key], dtype=float)
         a[i] = v
         return a
+
     return f
 
 
@@ -273,7 +277,10 @@ I0 = 29  # index of K = 0 in _table()'s grid
 
 BAD_TABLES = [
     (_with(K=lambda t: np.concatenate([t["K"][:3], t["K"][2:3], t["K"][4:]])), r"grid must be strictly increasing"),
-    (_with(K=lambda t: np.concatenate([t["K"][:2], t["K"][3:4], t["K"][2:3], t["K"][4:]])), r"grid must be strictly increasing, but K\[3\]"),
+    (
+        _with(K=lambda t: np.concatenate([t["K"][:2], t["K"][3:4], t["K"][2:3], t["K"][4:]])),
+        r"grid must be strictly increasing, but K\[3\]",
+    ),
     (_with(J1=_set("J1", I0, 0.1)), r"J1 must vanish at K = 0"),
     (_with(Omega=_set("Omega", 5, np.nan)), r"Omega\[5\] must be finite"),
     (_with(JR=_set("JR", 3, np.inf)), r"JR\[3\] must be finite"),
@@ -281,10 +288,24 @@ BAD_TABLES = [
     (_with(K=_set("K", 1, np.nan)), r"K\[1\] must be finite"),
     (_with(eps=lambda t: np.nan), r"eps must be finite"),
     (_with(K=lambda t: t["K"] + 0.01), r"the K grid must contain K = 0 exactly"),
-    (_with(K=lambda t: t["K"][I0 - 1:], Omega=lambda t: t["Omega"][I0 - 1:], JR=lambda t: t["JR"][I0 - 1:],
-           J1=lambda t: t["J1"][I0 - 1:]), r"at least 3 points with K <= 0, got 2"),
-    (_with(K=lambda t: t["K"][: I0 + 1], Omega=lambda t: t["Omega"][: I0 + 1], JR=lambda t: t["JR"][: I0 + 1],
-           J1=lambda t: t["J1"][: I0 + 1]), r"the K grid must extend above K = 0"),
+    (
+        _with(
+            K=lambda t: t["K"][I0 - 1 :],
+            Omega=lambda t: t["Omega"][I0 - 1 :],
+            JR=lambda t: t["JR"][I0 - 1 :],
+            J1=lambda t: t["J1"][I0 - 1 :],
+        ),
+        r"at least 3 points with K <= 0, got 2",
+    ),
+    (
+        _with(
+            K=lambda t: t["K"][: I0 + 1],
+            Omega=lambda t: t["Omega"][: I0 + 1],
+            JR=lambda t: t["JR"][: I0 + 1],
+            J1=lambda t: t["J1"][: I0 + 1],
+        ),
+        r"the K grid must extend above K = 0",
+    ),
     (_with(JR=lambda t: t["JR"][:-1]), r"JR must have the shape of K"),
     (_with(K=lambda t: t["K"].reshape(1, -1)), r"K must be a 1-D grid"),
     (_with(JR=lambda t: -np.ones_like(t["JR"])), r"no valid band below K = 0"),

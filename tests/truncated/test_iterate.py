@@ -200,7 +200,11 @@ def test_thread_count_does_not_change_results(kernel, rng):
     assert np.count_nonzero(r1.status == Status.ESCAPED) > 0  # chunks of different lengths
     for r in (r2, r0):
         for attr in ("phi", "K", "region", "rotation", "phi_final", "K_final", "status", "steps_done", "exit_step"):
-            assert np.array_equal(getattr(r1, attr), getattr(r, attr), equal_nan=attr not in ("region", "status", "steps_done", "exit_step")), attr
+            assert np.array_equal(
+                getattr(r1, attr),
+                getattr(r, attr),
+                equal_nan=attr not in ("region", "status", "steps_done", "exit_step"),
+            ), attr
 
 
 # ------------------------------------------------------------------------------------------------
@@ -267,7 +271,7 @@ def test_escape_through_band_floor(paper_map, kernel):
         k = res.steps_done[i]
         assert res.K[i, k] == res.K_final[i] and res.K_final[i] <= lo
         assert np.all(res.K[i, :k] > lo)
-        assert np.all(np.isnan(res.K[i, k + 1:]))
+        assert np.all(np.isnan(res.K[i, k + 1 :]))
     ok = res.status == Status.OK
     assert np.all(res.steps_done[ok] == n) and np.all(np.isfinite(res.K[ok]))
 
@@ -310,7 +314,9 @@ def _first_exit(region, allowed):
 
 
 @pytest.mark.parametrize("kernel", KERNELS)
-@pytest.mark.parametrize("allowed_names,allowed", [({"0u", "0"}, {0, 1}), (["RIGHT"], {3}), ({"BESIDE", "1", 3}, {0, 2, 3})])
+@pytest.mark.parametrize(
+    "allowed_names,allowed", [({"0u", "0"}, {0, 1}), (["RIGHT"], {3}), ({"BESIDE", "1", 3}, {0, 2, 3})]
+)
 def test_exit_step_and_stop_on_exit(any_map, rng, kernel, allowed_names, allowed):
     m = any_map
     n = 60
@@ -338,11 +344,11 @@ def test_exit_step_and_stop_on_exit(any_map, rng, kernel, allowed_names, allowed
     for i in rows:
         k = expected[i]
         assert np.array_equal(st.phi[i, : k + 1], res.phi[i, : k + 1])
-        assert np.all(np.isnan(st.phi[i, k + 1:]))
+        assert np.all(np.isnan(st.phi[i, k + 1 :]))
         # the exiting return is recorded (its region, outside the set), though not taken; after it, padding
         assert np.array_equal(st.region[i, : k + 1], res.region[i, : k + 1])
         assert int(st.region[i, k]) not in allowed
-        assert np.all(st.region[i, k + 1:] == Region.NONE)
+        assert np.all(st.region[i, k + 1 :] == Region.NONE)
         if k > 0:  # mean omega over the k steps taken (1e-12: k <= 60 terms summed in another order)
             assert st.rotation[i] == pytest.approx(m.rotation(res.phi[i, :k], res.K[i, :k]).mean(), abs=1e-12)
         else:
@@ -369,9 +375,15 @@ BAD_ITERATE = [
     (dict(n_steps=2.5), r"n_steps must be an integer >= 0, got 2\.5"),
     (dict(n_steps="3"), r"n_steps must be an integer >= 0"),
     (dict(n_steps=None), r"n_steps must be an integer >= 0"),
-    (dict(record=("orbit", "foo")), r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited', 'extrema', 'residence'\]"),
+    (
+        dict(record=("orbit", "foo")),
+        r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited', 'extrema', 'residence'\]",
+    ),
     (dict(record="orbits"), r"record: unknown key\(s\) \['orbits'\]; allowed"),
-    (dict(exit_regions=["X"]), r"unknown region 'X'; allowed: BESIDE \('0u'\), ABOVE \('0'\), UPPER \('1'\), RIGHT \('R'\), MULTI \('m'\)"),
+    (
+        dict(exit_regions=["X"]),
+        r"unknown region 'X'; allowed: BESIDE \('0u'\), ABOVE \('0'\), UPPER \('1'\), RIGHT \('R'\), MULTI \('m'\)",
+    ),
     (dict(exit_regions=[9]), r"unknown region 9; allowed"),
     (dict(exit_regions=[]), r"exit_regions must name at least one region"),
     (dict(stop_on_exit=True), r"stop_on_exit needs exit_regions"),

@@ -32,8 +32,12 @@ def test_hovering_sign_and_area_for_every_omega(Omega0, eps):
     if hovers:
         # eq:hovsetsize: 0.2546 for eps = 0.1 at the paper's parameters; measured 0.2519 +- 0.0033
         # (1e5 samples); here 2e4 samples: within the error bar plus the O(eps^2) ~ 0.3 eps^2.
-        assert th.area == pytest.approx(abs(eps) * (math.sin(3 * math.pi / 4) - 3 * math.pi / 4 * math.cos(3 * math.pi / 4))
-                                        / abs(math.sin(Omega0 / 2)), rel=1e-12)
+        assert th.area == pytest.approx(
+            abs(eps)
+            * (math.sin(3 * math.pi / 4) - 3 * math.pi / 4 * math.cos(3 * math.pi / 4))
+            / abs(math.sin(Omega0 / 2)),
+            rel=1e-12,
+        )
         assert abs(hv_area.area - th.area) < hv_area.error + 0.3 * eps**2
         assert th.K_crit < 0 and th.K_crit == pytest.approx(m.K_crit(), rel=1e-12)
         assert th.rho_crit == pytest.approx(m.rho_crit(), rel=1e-12)
@@ -72,11 +76,15 @@ def test_multimode_theory_reduces_to_the_closed_forms():
     assert multi.area == pytest.approx(base.area, rel=1e-5)
     assert multi.K_crit == pytest.approx(base.K_crit, rel=1e-6)
     assert multi.rho_crit == pytest.approx(base.rho_crit, rel=1e-6)
-    assert base.area == pytest.approx(0.08 * (math.sin(2.2) - 2.2 * math.cos(2.2)) / math.sin(hv.OMEGA_G / 2), rel=1e-14)
+    assert base.area == pytest.approx(
+        0.08 * (math.sin(2.2) - 2.2 * math.cos(2.2)) / math.sin(hv.OMEGA_G / 2), rel=1e-14
+    )
     # and its hovering set against brute force on a TruncatedFamily with that forcing
-    fam = hv.TruncatedFamily.from_map(hv.TruncatedMap(eps=0.1, Omega0=hv.OMEGA_G, theta_w=2.2),
-                                      np.concatenate([-np.linspace(1.0, 0.0, 81) ** 2, np.linspace(0.02, 1.0, 30)]),
-                                      forcing=(0.8, 0.15))
+    fam = hv.TruncatedFamily.from_map(
+        hv.TruncatedMap(eps=0.1, Omega0=hv.OMEGA_G, theta_w=2.2),
+        np.concatenate([-(np.linspace(1.0, 0.0, 81) ** 2), np.linspace(0.02, 1.0, 30)]),
+        forcing=(0.8, 0.15),
+    )
     th = fam.theory()
     assert th.hovers and th.forcing == (0.8, 0.15)
     meas = fam.hovering_area(n_steps=4000, samples=20_000)

@@ -224,8 +224,9 @@ def band_point(data, m):
     inside = [k for k in (np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf), np.nextafter(0.0, -1.0)) if lo < k < hi]
     if not inside:
         return None
-    K = data.draw(st.one_of(st.floats(lo, hi, exclude_min=True, exclude_max=True, allow_infinity=False),
-                            st.sampled_from(inside)))
+    K = data.draw(
+        st.one_of(st.floats(lo, hi, exclude_min=True, exclude_max=True, allow_infinity=False), st.sampled_from(inside))
+    )
     return data.draw(st.floats(-1e6, 1e6)), K
 
 
@@ -327,7 +328,9 @@ def test_simd_kernel_follows_the_convention_at_the_arc_ends(name, rng):
 def test_step_inverse_accepts_every_image_near_the_band_edges(name, rng):
     m = make(name)
     lo, hi = m.valid_band()
-    edges = [np.nextafter(lo, np.inf)] + [lo + d * max(1.0, abs(lo)) for d in (1e-16, 3e-16, 1e-15, 1e-14, 1e-13, 1e-12)]
+    edges = [np.nextafter(lo, np.inf)] + [
+        lo + d * max(1.0, abs(lo)) for d in (1e-16, 3e-16, 1e-15, 1e-14, 1e-13, 1e-12)
+    ]
     if np.isfinite(hi):
         edges += [np.nextafter(hi, -np.inf)] + [hi - d * max(1.0, abs(hi)) for d in (1e-16, 1e-15, 1e-14, 1e-12)]
     K = np.repeat([k for k in edges if lo < k < hi], 500)
@@ -401,8 +404,7 @@ def test_every_simd_step_is_step_of_its_own_state(name, rng):
         if isinstance(m, TruncatedMap):
             bound = sine_bound(m.eps, sp, sk, 1.0)
         else:  # f = sin(phi) + 0.25 sin(2 phi): each mode's sine bound, and one more sum rounding
-            bound = (sine_bound(m.eps, sp, sk, 1.0) + sine_bound(m.eps * 0.25, 2 * sp, sk, 1.0)
-                     + ulp(m.eps * np.sin(sp)))
+            bound = sine_bound(m.eps, sp, sk, 1.0) + sine_bound(m.eps * 0.25, 2 * sp, sk, 1.0) + ulp(m.eps * np.sin(sp))
         assert np.all(np.abs(sk - r.K[i, 1 : n + 1]) <= bound)
 
 
@@ -416,8 +418,9 @@ def test_long_orbits_never_leave_the_circle_or_the_reals(name, kernel, rng):
     m = make(name)
     lo, hi = m.valid_band()
     # In the band: near the floor, around the tangency circle, at the arc starts, and anywhere.
-    K0 = np.concatenate([[np.nextafter(lo, np.inf), lo + 1e-12, -1e-12, 0.0, 1e-12],
-                         rng.uniform(max(lo, -5.0), min(hi, 2.0), 11)])
+    K0 = np.concatenate(
+        [[np.nextafter(lo, np.inf), lo + 1e-12, -1e-12, 0.0, 1e-12], rng.uniform(max(lo, -5.0), min(hi, 2.0), 11)]
+    )
     phi0 = np.concatenate([m.corner_curves(np.array([-0.3]))["1R"], rng.uniform(-PI, PI, 15)])
     r = m.iterate(phi0, K0, 100_000, kernel=kernel, record=("orbit",))
     for i in range(K0.size):

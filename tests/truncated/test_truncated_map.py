@@ -142,7 +142,11 @@ def test_area_preservation(name, rng):
     assert tol.max() < 1e-5
     # The FD Jacobian matches the analytic one (a wrong omega'(K) would be caught here as well).
     s = np.sqrt(np.maximum(-K, 0.0))
-    wprime = p["tau0"] + np.where(reg == ref.UPPER, p["tau1"], 0.0) + np.where(reg == ref.RIGHT, p["lam"] / np.where(s > 0, s, 1.0), 0.0)
+    wprime = (
+        p["tau0"]
+        + np.where(reg == ref.UPPER, p["tau1"], 0.0)
+        + np.where(reg == ref.RIGHT, p["lam"] / np.where(s > 0, s, 1.0), 0.0)
+    )
     assert np.all(np.abs(j12 - wprime) <= e + 1e-12)
 
 

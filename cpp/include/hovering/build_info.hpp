@@ -9,8 +9,8 @@ namespace hovering {
 
 /// One fact of a build: its name and its value as text (`number`: the text is an integer).
 struct BuildFact {
-    std::string name;   ///< e.g. "gsl"
-    std::string value;  ///< e.g. "2.7.1"
+    std::string name;     ///< e.g. "gsl"
+    std::string value;    ///< e.g. "2.7.1"
     bool number = false;  ///< whether value is an integer (written without quotes in JSON)
 };
 

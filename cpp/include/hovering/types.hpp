@@ -36,9 +36,13 @@ enum class Status : std::int8_t {
 };
 
 /// States recorded per orbit with every = e: x_0, x_e, ..., x_{e floor(n_steps / e)}.
-inline std::int64_t recorded_states(std::int64_t n_steps, std::int64_t every) { return n_steps / every + 1; }
+inline std::int64_t recorded_states(std::int64_t n_steps, std::int64_t every) {
+    return n_steps / every + 1;
+}
 /// Returns recorded per orbit with every = e: those from the recorded states x_n with n < n_steps.
-inline std::int64_t recorded_returns(std::int64_t n_steps, std::int64_t every) { return (n_steps + every - 1) / every; }
+inline std::int64_t recorded_returns(std::int64_t n_steps, std::int64_t every) {
+    return (n_steps + every - 1) / every;
+}
 
 /// Which implementation of one map step a batch iteration uses.
 enum class Kernel : std::int8_t {

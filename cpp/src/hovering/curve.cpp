@@ -50,7 +50,9 @@ std::vector<double> second_derivatives(const std::vector<double>& y) {
     return x;
 }
 
-double horner(const double* c, double s) { return c[0] + s * (c[1] + s * (c[2] + s * c[3])); }
+double horner(const double* c, double s) {
+    return c[0] + s * (c[1] + s * (c[2] + s * c[3]));
+}
 
 }  // namespace
 
@@ -98,7 +100,8 @@ Curve::Curve(std::vector<double> K) : n_(std::int64_t(K.size())), samples_(std::
     }
     if (!(std::isfinite(lo) && std::isfinite(hi) && std::isfinite(size)))
         bad("curve samples too large for a spline (its coefficients overflow); the largest |K| is " +
-            fmt(*std::max_element(samples_.begin(), samples_.end(), [](double x, double y) { return std::fabs(x) < std::fabs(y); })));
+            fmt(*std::max_element(samples_.begin(), samples_.end(),
+                                  [](double x, double y) { return std::fabs(x) < std::fabs(y); })));
     // Horner rounds each of its 6 operations; the extremes are found to within their rounding too
     // (the polynomial is flat there): 1e-12 of the coefficients' size covers both many times over.
     const double margin = 1e-12 * (1.0 + size);

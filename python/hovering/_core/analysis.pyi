@@ -1,6 +1,6 @@
 """Type stubs of hovering._core.analysis (use hovering.hovering_area): the hovering area's numerics."""
 
-from typing import Callable, Optional, Union
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -9,12 +9,24 @@ from .normal import FlowMap
 from .truncated import TruncatedFamily, TruncatedMap
 
 def sample_grid(samples: int, K_low: float) -> tuple[int, int]: ...
-def stratified_samples(samples: int, K_low: float, seed: int, lo: int = ...,
-                       hi: Optional[int] = ...) -> tuple[np.ndarray, np.ndarray]: ...
-def hovering_outcomes(m: Union[TruncatedMap, TruncatedFamily, FlowMap], *args: object,
-                      progress: Optional[Callable[[int, int], object]] = ..., **kwargs: object) -> dict[str, object]: ...
-def hovering_estimate(status_F0: npt.NDArray[np.int8], status: npt.NDArray[np.int8], steps_done: npt.NDArray[np.int64],
-                      visited: npt.NDArray[np.int8], K: npt.NDArray[np.float64], n_steps: int, K_low: float,
-                      keep_points: bool = ...) -> dict[str, object]: ...
+def stratified_samples(
+    samples: int, K_low: float, seed: int, lo: int = ..., hi: int | None = ...
+) -> tuple[np.ndarray, np.ndarray]: ...
+def hovering_outcomes(
+    m: TruncatedMap | TruncatedFamily | FlowMap,
+    *args: object,
+    progress: Callable[[int, int], object] | None = ...,
+    **kwargs: object,
+) -> dict[str, object]: ...
+def hovering_estimate(
+    status_F0: npt.NDArray[np.int8],
+    status: npt.NDArray[np.int8],
+    steps_done: npt.NDArray[np.int64],
+    visited: npt.NDArray[np.int8],
+    K: npt.NDArray[np.float64],
+    n_steps: int,
+    K_low: float,
+    keep_points: bool = ...,
+) -> dict[str, object]: ...
 def default_depth(eps: float, Omega0: float, forcing: list[float]) -> float: ...
 def first_order_shape(forcing: list[float], Omega0: float, psi: npt.NDArray[np.float64]) -> np.ndarray: ...

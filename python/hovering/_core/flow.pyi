@@ -1,6 +1,6 @@
 """Type stubs of hovering._core.flow (use hovering.StepSystem, Section and the potentials)."""
 
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -45,7 +45,9 @@ class Numerical(Potential):
     def base(self) -> Potential: ...
 
 class _CallablePotential(Potential):
-    def __init__(self, V: Callable[[float], float], dV: Callable[[float], float], q_limit: float, name: str) -> None: ...
+    def __init__(
+        self, V: Callable[[float], float], dV: Callable[[float], float], q_limit: float, name: str
+    ) -> None: ...
     @property
     def V_callable(self) -> Callable[[float], float]: ...
     @property
@@ -61,7 +63,9 @@ class OnsetParameters:
     theta_w: float
     I_tan: float
 
-def _onset_parameters(V1: Potential, V2: Potential, qw1: float, qw2: float, h: float, rtol: float = 1e-6) -> OnsetParameters: ...
+def _onset_parameters(
+    V1: Potential, V2: Potential, qw1: float, qw2: float, h: float, rtol: float = 1e-6
+) -> OnsetParameters: ...
 def _onset_parameters_closed_form(
     omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float, rtol: float = 1e-6
 ) -> OnsetParameters: ...
@@ -72,10 +76,17 @@ def _onset_estimate_closed_form(
     omega1: float, alpha1: float, omega2: float, alpha2: float, qw1: float, qw2: float, h: float, rtol: float = 1e-6
 ) -> tuple[OnsetParameters, OnsetParameters]: ...
 
-
 class FlowSystem:
-    def __init__(self, V1: Potential, V2: Potential, terms: list[tuple[float, float, float]], eps: float, qw1: float,
-                 qw2: float, geometry: Geometry) -> None: ...
+    def __init__(
+        self,
+        V1: Potential,
+        V2: Potential,
+        terms: list[tuple[float, float, float]],
+        eps: float,
+        qw1: float,
+        qw2: float,
+        geometry: Geometry,
+    ) -> None: ...
     eps: float
     qw1: float
     qw2: float
@@ -83,14 +94,27 @@ class FlowSystem:
     @property
     def terms(self) -> list[tuple[float, float, float]]: ...
     def energy(self, z: npt.NDArray[np.float64]) -> np.ndarray: ...
-    def __getstate__(self) -> tuple[Potential, Potential, list[tuple[float, float, float]], float, float, float, Geometry]: ...
-    def __setstate__(self, state: tuple[Potential, Potential, list[tuple[float, float, float]], float, float, float, Geometry]) -> None: ...
+    def __getstate__(
+        self,
+    ) -> tuple[Potential, Potential, list[tuple[float, float, float]], float, float, float, Geometry]: ...
+    def __setstate__(
+        self, state: tuple[Potential, Potential, list[tuple[float, float, float]], float, float, float, Geometry]
+    ) -> None: ...
 
 STEPPERS: tuple[str, ...]
 
 class FlowOptions:
-    def __init__(self, stepper: str = ..., rtol: float = ..., atol: float = ..., event_tol: float = ..., max_steps: int = ...,
-                 max_impacts: int = ..., grazing_tol: float = ..., corner_tol: float = ...) -> None: ...
+    def __init__(
+        self,
+        stepper: str = ...,
+        rtol: float = ...,
+        atol: float = ...,
+        event_tol: float = ...,
+        max_steps: int = ...,
+        max_impacts: int = ...,
+        grazing_tol: float = ...,
+        corner_tol: float = ...,
+    ) -> None: ...
     def __getstate__(self) -> tuple[str, float, float, float, int, int, float, float]: ...
     def __setstate__(self, state: tuple[str, float, float, float, int, int, float, float]) -> None: ...
     def validate_for(self, system: FlowSystem) -> None: ...
@@ -103,9 +127,16 @@ class FlowOptions:
     grazing_tol: float
     corner_tol: float
 
-def section_points(system: FlowSystem, h: float, theta: npt.NDArray[np.float64],
-                   I: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray, list[str]]: ...
+def section_points(
+    system: FlowSystem, h: float, theta: npt.NDArray[np.float64], I: npt.NDArray[np.float64]
+) -> tuple[np.ndarray, np.ndarray, list[str]]: ...
 def section_coordinates(system: FlowSystem, z: npt.NDArray[np.float64]) -> np.ndarray: ...
-def return_maps(system: FlowSystem, z0: npt.NDArray[np.float64], options: FlowOptions, n_threads: int,
-                trajectory_dt: float = ..., max_points_per_orbit: int = ...,
-                progress: Optional[Callable[[int, int], object]] = ...) -> dict[str, object]: ...
+def return_maps(
+    system: FlowSystem,
+    z0: npt.NDArray[np.float64],
+    options: FlowOptions,
+    n_threads: int,
+    trajectory_dt: float = ...,
+    max_points_per_orbit: int = ...,
+    progress: Callable[[int, int], object] | None = ...,
+) -> dict[str, object]: ...

@@ -1,6 +1,6 @@
 """Type stubs of hovering._core.normal (use hovering.TangentialCurve and hovering.FlowMap)."""
 
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -30,14 +30,33 @@ class TangentialCurve:
     I: np.ndarray
 
 class FlowMap:
-    def __init__(self, system: FlowSystem, h: float, options: FlowOptions, curve: Optional[TangentialCurve],
-                 lift: Optional[tuple[float, float, float, float, float]]) -> None: ...
-    def steps(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], inverse: bool, n_threads: int) -> dict[str, object]: ...
-    def iterate(self, x0: npt.NDArray[np.float64], y0: npt.NDArray[np.float64], n_steps: int, record: set[str],
-                exit_mask: int, stop_on_exit: bool, n_threads: int, trajectory_dt: float = ...,
-                max_points_per_orbit: int = ...,
-                progress: Optional[Callable[[int, int], object]] = ..., every: int = ..., stop_side: int = ...,
-                stop_curve: Optional[object] = ...) -> dict[str, object]: ...
+    def __init__(
+        self,
+        system: FlowSystem,
+        h: float,
+        options: FlowOptions,
+        curve: TangentialCurve | None,
+        lift: tuple[float, float, float, float, float] | None,
+    ) -> None: ...
+    def steps(
+        self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], inverse: bool, n_threads: int
+    ) -> dict[str, object]: ...
+    def iterate(
+        self,
+        x0: npt.NDArray[np.float64],
+        y0: npt.NDArray[np.float64],
+        n_steps: int,
+        record: set[str],
+        exit_mask: int,
+        stop_on_exit: bool,
+        n_threads: int,
+        trajectory_dt: float = ...,
+        max_points_per_orbit: int = ...,
+        progress: Callable[[int, int], object] | None = ...,
+        every: int = ...,
+        stop_side: int = ...,
+        stop_curve: object | None = ...,
+    ) -> dict[str, object]: ...
     def to_section(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
     def from_section(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
     h: float

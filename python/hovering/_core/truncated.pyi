@@ -1,6 +1,6 @@
 """Type stubs of hovering._core.truncated (use hovering.TruncatedMap / TruncatedFamily)."""
 
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -10,8 +10,12 @@ class _MapCore:
     def eps(self) -> float: ...
     def valid_band(self) -> tuple[float, float]: ...
     def _step(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
-    def _step_inverse(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray]: ...
-    def _region_rotation(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64], who: str) -> tuple[np.ndarray, np.ndarray]: ...
+    def _step_inverse(
+        self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]
+    ) -> tuple[np.ndarray, np.ndarray]: ...
+    def _region_rotation(
+        self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64], who: str
+    ) -> tuple[np.ndarray, np.ndarray]: ...
     def _arcs(self, K: npt.NDArray[np.float64]) -> np.ndarray: ...
     def _iterate(
         self,
@@ -27,16 +31,18 @@ class _MapCore:
         kernel: str,
         sin_ulp: float,
         record_visited: bool = ...,
-        progress: Optional[Callable[[int, int], object]] = ...,
+        progress: Callable[[int, int], object] | None = ...,
         every: int = ...,
         stop_side: int = ...,
-        stop_curve: Optional[object] = ...,
+        stop_curve: object | None = ...,
         record_extrema: bool = ...,
         record_residence: bool = ...,
     ) -> dict[str, object]: ...
 
 class TruncatedMap(_MapCore):
-    def __init__(self, eps: float, Omega0: float, theta_w: float, tau0: float, tau1: float, lam: float, K_max: float) -> None: ...
+    def __init__(
+        self, eps: float, Omega0: float, theta_w: float, tau0: float, tau1: float, lam: float, K_max: float
+    ) -> None: ...
     @property
     def Omega0(self) -> float: ...
     @property
@@ -53,14 +59,22 @@ class TruncatedMap(_MapCore):
 
 class TruncatedFamily(_MapCore):
     def __init__(
-        self, eps: float, K: list[float], Omega: list[float], JR: list[float], J1: list[float], forcing: list[float], K_max: float
+        self,
+        eps: float,
+        K: list[float],
+        Omega: list[float],
+        JR: list[float],
+        J1: list[float],
+        forcing: list[float],
+        K_max: float,
     ) -> None: ...
     @property
     def forcing(self) -> list[float]: ...
     # Pickling: (eps, K, Omega, JR, J1, forcing, K_max), the tables read back from the splines.
     def __getstate__(self) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]: ...
-    def __setstate__(self, state: tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]) -> None: ...
+    def __setstate__(
+        self, state: tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]
+    ) -> None: ...
 
 def simd_is_avx2() -> bool: ...
 def simd_width() -> int: ...
-

@@ -4,8 +4,15 @@ and regularity, the hovering set HOV(eps), and the critical invariant curve."""
 from ..interface import register
 from .critical import CriticalCurve, critical_curve, max_angular_gap
 from .hovering import HoveringArea, hovering_area
-from .orbits import (ConeCrossing, OrbitClasses, classify_orbits, cone_crossing, converse_kam, cyclic_order_violations,
-                     rank_rotation)
+from .orbits import (
+    ConeCrossing,
+    OrbitClasses,
+    classify_orbits,
+    cone_crossing,
+    converse_kam,
+    cyclic_order_violations,
+    rank_rotation,
+)
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
 
 __all__ = [

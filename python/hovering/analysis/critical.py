@@ -6,16 +6,16 @@ searched along L1 (or L2), next to the leading-order predictions (eq:kcrit, eq:r
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional, Sequence
 
 import numpy as np
 
 from .._checks import is_choice, real_array
-from .._enums import Region, REGION_LABELS, region_mask, Status
-from ..interface import require_map
-from .._serial import Saveable
+from .._enums import REGION_LABELS, Region, Status, region_mask
 from .._progress import check_progress, progress_bar
+from .._serial import Saveable
+from ..interface import require_map
 from .rotation import regularity, rotation_number
 
 __all__ = ["CriticalCurve", "critical_curve", "max_angular_gap"]
@@ -89,9 +89,19 @@ class CriticalCurve(Saveable):
     note: str = ""
 
 
-def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] = None,
-                   regions=("0u", "0"), line=None, grid: int = 64, digits: Optional[float] = None,
-                   tol: float = 1e-6, n_threads: int = 0, search: str = "lowest", progress=False) -> CriticalCurve:
+def critical_curve(
+    m,
+    n_steps: int = 20_000,
+    K_range: Sequence[float] | None = None,
+    regions=("0u", "0"),
+    line=None,
+    grid: int = 64,
+    digits: float | None = None,
+    tol: float = 1e-6,
+    n_threads: int = 0,
+    search: str = "lowest",
+    progress=False,
+) -> CriticalCurve:
     """Search the lowest invariant curve that stays in ``regions``, along the line L1 (or L2).
 
     A start ``(L(K), K)`` passes when its orbit stays in ``regions`` for ``n_steps``, its
@@ -197,32 +207,47 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
     K_range = (K_a, K_b)
     if not (lo < K_a < K_b < hi):
         raise ValueError(f"K_range must be increasing inside the band ({lo}, {hi}), got {K_range}")
-    if not (isinstance(tol, (int, float, np.floating)) and math.isfinite(tol) and tol >= 1e-14 * max(abs(K_a), abs(K_b))):
-        raise ValueError(f"tol must be finite and >= 1e-14 x the scale of K_range ({1e-14 * max(abs(K_a), abs(K_b)):.3g}), "
-                         f"got {tol!r}")
+    if not (
+        isinstance(tol, (int, float, np.floating)) and math.isfinite(tol) and tol >= 1e-14 * max(abs(K_a), abs(K_b))
+    ):
+        raise ValueError(
+            f"tol must be finite and >= 1e-14 x the scale of K_range ({1e-14 * max(abs(K_a), abs(K_b)):.3g}), "
+            f"got {tol!r}"
+        )
     flow = hasattr(m, "step_rotations")
     record = ("orbit", "regions") if flow else ("orbit",)
     # Work of the whole search: the grid, the bisection from one grid spacing down to tol, the final orbit.
     spacing = (K_b - K_a) / (grid - 1)
     n_bisect = max(0, math.ceil(math.log2(spacing / tol))) if spacing > tol else 0
-    with progress_bar(progress, (grid + n_bisect + 1) * n_steps, desc="critical_curve",
-                      unit=getattr(m, "_progress_unit", "step")) as bar:
+    with progress_bar(
+        progress, (grid + n_bisect + 1) * n_steps, desc="critical_curve", unit=getattr(m, "_progress_unit", "step")
+    ) as bar:
         done = 0
 
         def test(K0s):
             nonlocal done
             K0s = np.atleast_1d(np.asarray(K0s, dtype=float))
-            res = m.iterate(line_fn(K0s), K0s, n_steps, record=record, exit_regions=regions, stop_on_exit=True,
-                            n_threads=n_threads, progress=bar.part(done))
+            res = m.iterate(
+                line_fn(K0s),
+                K0s,
+                n_steps,
+                record=record,
+                exit_regions=regions,
+                stop_on_exit=True,
+                n_threads=n_threads,
+                progress=bar.part(done),
+            )
             done += K0s.size * n_steps
             stayed = res.status == Status.OK
             dig = np.where(stayed, regularity(res), 0.0)
-            circle = np.array([stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps
-                               for i in range(res.n_orbits)])
+            circle = np.array(
+                [stayed[i] and max_angular_gap(res.phi[i]) < 20 * 2 * np.pi / n_steps for i in range(res.n_orbits)]
+            )
             return stayed & (dig >= digits) & circle, res, dig
 
-        K_pass, K_fail, res, dig = _search(test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits,
-                                           hover_search, th)
+        K_pass, K_fail, res, dig = _search(
+            test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits, hover_search, th
+        )
         bar.set_total(done)  # the bisection may have been shorter than its bound
     rho_w = rotation_number(res, "birkhoff")[0]
     rho_m = rotation_number(res, "mean")[0]
@@ -230,7 +255,9 @@ def critical_curve(m, n_steps: int = 20_000, K_range: Optional[Sequence[float]] 
         K_pred, rho_pred = th.K_crit, th.rho_crit
     else:  # k^{u0}: crosses L2 at its minimum ~0, and L1 at K_lowest
         K_pred = 0.0 if line == "L2" else th.K_lowest
-        rho_pred = th.Omega0 + th.tau0 * (th.K_lowest + m.eps * float(np.mean(th.G(np.linspace(-np.pi, np.pi, 4096, endpoint=False)))))
+        rho_pred = th.Omega0 + th.tau0 * (
+            th.K_lowest + m.eps * float(np.mean(th.G(np.linspace(-np.pi, np.pi, 4096, endpoint=False))))
+        )
     return CriticalCurve(
         K0=float(K_pass),
         K_min=float(np.min(res.K[0])),
@@ -258,7 +285,8 @@ def _search(test, K_a, K_b, grid, tol, search, regions, line, n_steps, digits, h
         why = f"; {th.note}" if hover_search and not th.hovers else "; widen K_range"
         raise RuntimeError(
             f"no invariant curve in regions {tuple(regions)} found on {line} for K0 in [{K_a}, {K_b}] "
-            f"with {n_steps} steps and {digits} digits{why}")
+            f"with {n_steps} steps and {digits} digits{why}"
+        )
     if search == "lowest":
         j = int(np.argmax(ok))
         K_pass = K_grid[j]

@@ -11,18 +11,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 
 from .. import _core
 from .._checks import check_memory, flag, integer, real_number, thread_count
-from ..interface import require_map
+from .._progress import check_progress, progress_bar
 from .._serial import Saveable
+from ..interface import require_map
 from ..parallel.checkpoint import Checkpoint
 from ..parallel.executor import Executor, from_old_arguments, run_pieces
 from ..parallel.executor import executor as open_executor
-from .._progress import check_progress, progress_bar
 
 __all__ = ["HoveringArea", "hovering_area"]
 
@@ -81,14 +80,13 @@ class HoveringArea(Saveable):
     floor_touched: bool
     area_both_sides: float = float("nan")
     unresolved: int = 0
-    phi: Optional[np.ndarray] = field(default=None, repr=False)
-    K: Optional[np.ndarray] = field(default=None, repr=False)
-    hovering: Optional[np.ndarray] = field(default=None, repr=False)
-    both_sides: Optional[np.ndarray] = field(default=None, repr=False)
+    phi: np.ndarray | None = field(default=None, repr=False)
+    K: np.ndarray | None = field(default=None, repr=False)
+    hovering: np.ndarray | None = field(default=None, repr=False)
+    both_sides: np.ndarray | None = field(default=None, repr=False)
 
 
-
-def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: Optional[int] = None) -> tuple:
+def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | None = None) -> tuple:
     """Samples lo..hi-1 ``(phi, K)`` of the box ``[-pi, pi) x [K_low, 0)``: one uniform point per cell
     of a near-square grid, jittered by ``numpy.random.default_rng(seed)`` (the core draws that
     stream: ``hovering._core.analysis.stratified_samples``).
@@ -116,8 +114,9 @@ def _outcomes(m, phi, K, n_steps: int, n_threads: int, progress=False) -> tuple:
     with early exit from {J_0u, J_0}, by the core; KeyboardInterrupt on Ctrl-C."""
     if hasattr(m, "_core") and not isinstance(m, (_core.truncated.TruncatedMap, _core.truncated.TruncatedFamily)):
         m0 = m.with_eps(0.0)  # the flow's F_0: the eps = 0 flow on its own normal coordinates
-        d = _core.analysis.hovering_outcomes(m._core, m0._core, phi, K, int(n_steps), _flow_threads(m, n_threads),
-                                             progress or None)
+        d = _core.analysis.hovering_outcomes(
+            m._core, m0._core, phi, K, int(n_steps), _flow_threads(m, n_threads), progress or None
+        )
     else:
         d = _core.analysis.hovering_outcomes(m, phi, K, int(n_steps), int(n_threads), progress or None)
     if d["interrupted"]:
@@ -141,21 +140,34 @@ def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> dict:
     options, measured curve), the counts, the box, the seed and the piece's range."""
     from .._serial import record_key
 
-    return {"hovering_area_piece": {"map": record_key(m), "n_steps": int(n_steps), "K_low": float(K_low),
-                                    "seed": int(seed), "samples": int(samples), "lo": int(lo), "hi": int(hi)}}
+    return {
+        "hovering_area_piece": {
+            "map": record_key(m),
+            "n_steps": int(n_steps),
+            "K_low": float(K_low),
+            "seed": int(seed),
+            "samples": int(samples),
+            "lo": int(lo),
+            "hi": int(hi),
+        }
+    }
 
 
 def _piece_arrays(row, n: int) -> tuple:
     """A checkpointed piece (untrusted): four lists of n integers, each within its array's dtype."""
     names, dtypes = ("status_F0", "status", "steps_done", "visited"), (np.int8, np.int8, np.int64, np.int8)
     if not isinstance(row, dict) or not isinstance(row.get("outcomes"), list) or len(row["outcomes"]) != 4:
-        raise ValueError("row.outcomes must be a list of 4 lists (statuses under F_0 and F_eps, steps done, regions "
-                         "visited)")
+        raise ValueError(
+            "row.outcomes must be a list of 4 lists (statuses under F_0 and F_eps, steps done, regions visited)"
+        )
     out = []
     for name, a, dt in zip(names, row["outcomes"], dtypes):
         arr = np.asarray(a) if isinstance(a, list) else np.zeros(0, dtype=object)
-        if arr.shape != (n,) or arr.dtype.kind not in "iu" or (n and not (np.iinfo(dt).min <= arr.min() and
-                                                                           arr.max() <= np.iinfo(dt).max)):
+        if (
+            arr.shape != (n,)
+            or arr.dtype.kind not in "iu"
+            or (n and not (np.iinfo(dt).min <= arr.min() and arr.max() <= np.iinfo(dt).max))
+        ):
             raise ValueError(f"row.outcomes.{name} must be {n} integers within {np.dtype(dt).name}")
         out.append(arr.astype(dt))
     return tuple(out)
@@ -183,20 +195,37 @@ def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Exec
             lo, hi = bounds[i]
             out[i] = res
             if store is not None:
-                store.put(_piece_key(m, n_steps, K_low, seed, samples, lo, hi),
-                          {"outcomes": [np.asarray(a).tolist() for a in res]})
+                store.put(
+                    _piece_key(m, n_steps, K_low, seed, samples, lo, hi),
+                    {"outcomes": [np.asarray(a).tolist() for a in res]},
+                )
             bar.advance(2 * (hi - lo) * n_steps)
 
-        for _ in run_pieces(ex, _piece, [(m, samples, K_low, seed, *bounds[i], n_steps, threads) for i in todo],
-                            on_result=done):
+        for _ in run_pieces(
+            ex, _piece, [(m, samples, K_low, seed, *bounds[i], n_steps, threads) for i in todo], on_result=done
+        ):
             pass
     return tuple(np.concatenate([o[j] for o in out]) for j in range(4))
 
 
-def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optional[float] = None, seed: int = 0,
-                  n_threads: int = 0, keep_points: bool = False, progress=False, *, executor=None,
-                  workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False,
-                  pieces: Optional[int] = None, checkpoint=None) -> HoveringArea:
+def hovering_area(
+    m,
+    n_steps: int = 10_000,
+    samples: int = 100_000,
+    K_low: float | None = None,
+    seed: int = 0,
+    n_threads: int = 0,
+    keep_points: bool = False,
+    progress=False,
+    *,
+    executor=None,
+    workers: int | None = None,
+    client=None,
+    scheduler: str | None = None,
+    dask: bool = False,
+    pieces: int | None = None,
+    checkpoint=None,
+) -> HoveringArea:
     """Area of the hovering set HOV(eps) of a map, by its definition.
 
     HOV(eps) is the set of points that impact under F_0 (some iterate leaves J_0 u J_0u) and never
@@ -259,8 +288,9 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     check_memory(f"hovering_area with {samples} samples", 64 * samples)
     lo = m.valid_band()[0]
     if not lo < 0:
-        raise ValueError(f"this map's band has no part below K = 0 (lower end {lo}): no point impacts under F_0, "
-                         f"nothing can hover")
+        raise ValueError(
+            f"this map's band has no part below K = 0 (lower end {lo}): no point impacts under F_0, nothing can hover"
+        )
     if K_low is None:
         depth = default_depth(m) if m.eps != 0 else 0.1
         K_low = max(-depth, lo * (1 - 1e-9))
@@ -270,8 +300,11 @@ def hovering_area(m, n_steps: int = 10_000, samples: int = 100_000, K_low: Optio
     phi, K = _stratified(samples, K_low, seed)
     n = phi.size
     unit = getattr(m, "_progress_unit", "step")
-    spec = from_old_arguments("hovering_area", executor, dict(workers=workers, client=client, scheduler=scheduler,
-                                                              dask=dask, pieces=pieces, checkpoint=checkpoint))
+    spec = from_old_arguments(
+        "hovering_area",
+        executor,
+        dict(workers=workers, client=client, scheduler=scheduler, dask=dask, pieces=pieces, checkpoint=checkpoint),
+    )
     with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
         if spec is not None:
             s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec)

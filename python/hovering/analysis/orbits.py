@@ -23,8 +23,15 @@ from .._enums import Region
 from ..interface import IterateResult
 from ..truncated import TruncatedMap
 
-__all__ = ["OrbitClasses", "classify_orbits", "cyclic_order_violations", "rank_rotation", "ConeCrossing",
-           "cone_crossing", "converse_kam"]
+__all__ = [
+    "OrbitClasses",
+    "classify_orbits",
+    "cyclic_order_violations",
+    "rank_rotation",
+    "ConeCrossing",
+    "cone_crossing",
+    "converse_kam",
+]
 
 _TWO_PI = 2.0 * math.pi
 #: The classes :func:`classify_orbits` gives, in the order its tests try them.
@@ -260,8 +267,17 @@ def _rows(name, a) -> np.ndarray:
     return arr
 
 
-def classify_orbits(phi, K=None, *, pieces: int = 3, tol: float = 1e-9, min_points: int = 256, max_period: int = 64,
-                    graph_max: float = 0.5, chaos_dimension: float = 1.5) -> OrbitClasses:
+def classify_orbits(
+    phi,
+    K=None,
+    *,
+    pieces: int = 3,
+    tol: float = 1e-9,
+    min_points: int = 256,
+    max_period: int = 64,
+    graph_max: float = 0.5,
+    chaos_dimension: float = 1.5,
+) -> OrbitClasses:
     """Classify recorded orbits as rotational circles, island chains or chaotic layers by order statistics.
 
     No smoothness is needed: the tests use the cyclic order of the points, so they hold for
@@ -439,8 +455,16 @@ class ConeCrossing:
         return self.status == "crossing"
 
 
-def cone_crossing(step: Callable, jacobian: Callable, phi, K, n_steps: int, twist: float = 1.0,
-                  in_domain: Callable | None = None, tol: float = 1e-9) -> ConeCrossing:
+def cone_crossing(
+    step: Callable,
+    jacobian: Callable,
+    phi,
+    K,
+    n_steps: int,
+    twist: float = 1.0,
+    in_domain: Callable | None = None,
+    tol: float = 1e-9,
+) -> ConeCrossing:
     """MacKay-Percival cone crossing for any map that is smooth and twist on a domain.
 
     Push the vertical vector (0, 1) forward along the orbit by the Jacobian. On a rotational
@@ -574,9 +598,11 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
         is not smooth twist there) or outside the band.
     """
     if not isinstance(m, TruncatedMap):
-        raise ValueError(f"converse_kam needs a TruncatedMap (smooth twist map with a closed-form Jacobian on its "
-                         f"no-impact regions), got {type(m).__name__}; for other maps call cone_crossing with "
-                         f"your own step and Jacobian")
+        raise ValueError(
+            f"converse_kam needs a TruncatedMap (smooth twist map with a closed-form Jacobian on its "
+            f"no-impact regions), got {type(m).__name__}; for other maps call cone_crossing with "
+            f"your own step and Jacobian"
+        )
     if m.tau0 == 0:
         raise ValueError("converse_kam needs a twist map: tau0 must be nonzero, got 0")
     p, k = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
@@ -589,9 +615,11 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
     reg = np.asarray(m.region(p.ravel(), k.ravel()))
     if not np.all(np.isin(reg, smooth)):
         j = int(np.argmax(~np.isin(reg, smooth)))
-        raise ValueError(f"start point (phi, K) = ({p.ravel()[j]}, {k.ravel()[j]}) lies in region "
-                         f"{Region(int(reg[j])).name}, where the map impacts and is not a smooth twist map; "
-                         f"converse_kam applies on J_0u and J_0 only")
+        raise ValueError(
+            f"start point (phi, K) = ({p.ravel()[j]}, {k.ravel()[j]}) lies in region "
+            f"{Region(int(reg[j])).name}, where the map impacts and is not a smooth twist map; "
+            f"converse_kam applies on J_0u and J_0 only"
+        )
     eps, Om, t0 = float(m.eps), float(m.Omega0), float(m.tau0)
 
     def jac(ph, kk):

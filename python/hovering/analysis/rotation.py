@@ -43,7 +43,7 @@ def birkhoff_weights(n: int) -> np.ndarray:
     return w / w.sum()
 
 
-def birkhoff_average(values, axis: int = -1) -> "np.ndarray | float":
+def birkhoff_average(values, axis: int = -1) -> np.ndarray | float:
     """Weighted Birkhoff average of a time series along ``axis``.
 
     Parameters
@@ -59,9 +59,15 @@ def birkhoff_average(values, axis: int = -1) -> "np.ndarray | float":
         The weighted average (the time axis removed).
     """
     v = real_array("values", values)
-    if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, (int, np.integer)) or not -max(v.ndim, 1) <= axis < max(v.ndim, 1):
-        raise ValueError(f"axis must be an integer in [-{max(v.ndim, 1)}, {max(v.ndim, 1) - 1}] (values has {v.ndim} "
-                         f"dimension(s)), got {axis!r}")
+    if (
+        isinstance(axis, (bool, np.bool_))
+        or not isinstance(axis, (int, np.integer))
+        or not -max(v.ndim, 1) <= axis < max(v.ndim, 1)
+    ):
+        raise ValueError(
+            f"axis must be an integer in [-{max(v.ndim, 1)}, {max(v.ndim, 1) - 1}] (values has {v.ndim} "
+            f"dimension(s)), got {axis!r}"
+        )
     if v.ndim == 0:
         raise ValueError("values must be a time series (at least 1-D), got a number")
     v = np.moveaxis(v, int(axis), -1)
@@ -152,5 +158,3 @@ def regularity(res) -> np.ndarray:
         d = abs(birkhoff_average(w[:h]) - birkhoff_average(w[h : 2 * h]))
         out[i] = 16.0 if d == 0 else min(16.0, -math.log10(d))
     return out
-
-

@@ -7,5 +7,12 @@ from .references import heyoka_return_map, scipy_return_map
 from .tolerance import choose_setting
 from .work_precision import FLOW_STEPPERS_DEFAULT, WorkPrecision, exact_available, work_precision
 
-__all__ = ["WorkPrecision", "work_precision", "choose_setting", "exact_available", "FLOW_STEPPERS_DEFAULT",
-           "scipy_return_map", "heyoka_return_map"]
+__all__ = [
+    "WorkPrecision",
+    "work_precision",
+    "choose_setting",
+    "exact_available",
+    "FLOW_STEPPERS_DEFAULT",
+    "scipy_return_map",
+    "heyoka_return_map",
+]

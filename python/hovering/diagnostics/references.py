@@ -59,8 +59,16 @@ def scipy_return_map(sys, z0, rtol: float):
     # period, as at eps = 0 without impact) can be missed there and is filtered at the next start.
     T = 1.37 * 2 * np.pi / max(V1.frequency(max(1e-12, 0.5 * z[1] ** 2 + V1.V(z[0]))), 1e-3)
     for _ in range(50):
-        sol = solve_ivp(rhs, (t, t + T), z, method="DOP853", rtol=rtol, atol=rtol * 1e-2,
-                        events=[right, upper, p1], dense_output=False)
+        sol = solve_ivp(
+            rhs,
+            (t, t + T),
+            z,
+            method="DOP853",
+            rtol=rtol,
+            atol=rtol * 1e-2,
+            events=[right, upper, p1],
+            dense_output=False,
+        )
         evs = []
         for k in range(3):
             for te, ye in zip(sol.t_events[k], sol.y_events[k]):
@@ -117,10 +125,12 @@ def heyoka_return_map(sys, z0_list, rtol: float):
                 f1 = f1 + sys.eps * c * i * q1 ** (i - 1) * q2**j
             if j:
                 f2 = f2 + sys.eps * c * j * q1**i * q2 ** (j - 1)
-    ev = [hy.t_event(q1 - sys.qw1, direction=hy.event_direction.negative),
-          hy.t_event(p1, direction=hy.event_direction.negative),
-          hy.t_event(p1, direction=hy.event_direction.positive),
-          hy.t_event(q2 - sys.qw2, direction=hy.event_direction.negative)]
+    ev = [
+        hy.t_event(q1 - sys.qw1, direction=hy.event_direction.negative),
+        hy.t_event(p1, direction=hy.event_direction.negative),
+        hy.t_event(p1, direction=hy.event_direction.positive),
+        hy.t_event(q2 - sys.qw2, direction=hy.event_direction.negative),
+    ]
     ta = hy.taylor_adaptive([(q1, p1), (p1, -f1), (q2, p2), (p2, -f2)], list(z0_list[0]), t_events=ev, tol=rtol)
     walls, step = sys.geometry != "none", sys.geometry == "step"
     out = []

@@ -8,7 +8,7 @@ imports the measuring harness.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -20,8 +20,14 @@ __all__ = ["choose_setting"]
 
 
 @register("choose_setting")
-def choose_setting(section, accuracy: float, returns: int = 1, steppers: Sequence[str] = ("rk8pd", "rkck"),
-                   n_points: int = 16, seed: int = 0) -> dict:
+def choose_setting(
+    section,
+    accuracy: float,
+    returns: int = 1,
+    steppers: Sequence[str] = ("rk8pd", "rkck"),
+    n_points: int = 16,
+    seed: int = 0,
+) -> dict:
     """The fastest integrator setting measured to reach an accuracy target on this section.
 
     The closed-form flow (``stepper="exact"``) where the system has one and the target is not
@@ -58,22 +64,48 @@ def choose_setting(section, accuracy: float, returns: int = 1, steppers: Sequenc
     accuracy = real_number("accuracy", accuracy, 0, True, 1, True)
     returns = integer("accuracy_returns", returns, 1, 100_000)
     if exact_available(section) and accuracy >= _EXACT_ERROR:
-        t, _ = _best_time(lambda: section.return_map(np.zeros(n_points), _default_actions(
-            section, n_points, np.random.default_rng(seed)), stepper="exact", n_threads=1), 2)
-        return {"method": "exact", "tolerance": 1e-10, "error": _EXACT_ERROR, "seconds": t / n_points,
-                "unit": "return", "options": {"stepper": "exact"}, "reference": "exact (closed-form flow)",
-                "returns": returns}
-    tols = tuple(10.0 ** -k for k in range(3, 15))
-    wp = _flow(section, tols, tuple(steppers), n_points, [1, returns] if returns > 1 else [1], 2, seed, 1, False,
-               reversal=False)
+        t, _ = _best_time(
+            lambda: section.return_map(
+                np.zeros(n_points),
+                _default_actions(section, n_points, np.random.default_rng(seed)),
+                stepper="exact",
+                n_threads=1,
+            ),
+            2,
+        )
+        return {
+            "method": "exact",
+            "tolerance": 1e-10,
+            "error": _EXACT_ERROR,
+            "seconds": t / n_points,
+            "unit": "return",
+            "options": {"stepper": "exact"},
+            "reference": "exact (closed-form flow)",
+            "returns": returns,
+        }
+    tols = tuple(10.0**-k for k in range(3, 15))
+    wp = _flow(
+        section,
+        tols,
+        tuple(steppers),
+        n_points,
+        [1, returns] if returns > 1 else [1],
+        2,
+        seed,
+        1,
+        False,
+        reversal=False,
+    )
     best = wp.fastest(accuracy, None if returns == 1 else returns)
     if best is None:
         key = (lambda r: r["error"]) if returns == 1 else (lambda r: r["error_after"].get(returns, math.inf))
         top = min(wp.rows, key=key)
-        raise ValueError(f"accuracy {accuracy:g} after {returns} return(s) is not reached by any of {list(steppers)} at "
-                         f"rtol 1e-3 .. 1e-14: the best measured is {key(top):.3g} ({top['method']} at "
-                         f"{top['tolerance']:g}; reference {wp.reference['method']}, own error "
-                         f"{wp.reference['error']:.2g})")
+        raise ValueError(
+            f"accuracy {accuracy:g} after {returns} return(s) is not reached by any of {list(steppers)} at "
+            f"rtol 1e-3 .. 1e-14: the best measured is {key(top):.3g} ({top['method']} at "
+            f"{top['tolerance']:g}; reference {wp.reference['method']}, own error "
+            f"{wp.reference['error']:.2g})"
+        )
     out = dict(best)
     if returns > 1:
         out["error"] = best["error_after"][returns]

@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional, Sequence
 
 import numpy as np
 
@@ -95,10 +95,13 @@ class WorkPrecision:
         rs = [r for r in self.rows if r["method"] == method]
         if not rs:
             raise ValueError(f"no method {method!r}; measured: {self.methods()}")
-        return (np.array([r["tolerance"] for r in rs], dtype=object), np.array([r["error"] for r in rs], float),
-                np.array([r["seconds"] for r in rs], float))
+        return (
+            np.array([r["tolerance"] for r in rs], dtype=object),
+            np.array([r["error"] for r in rs], float),
+            np.array([r["seconds"] for r in rs], float),
+        )
 
-    def fastest(self, error: float, returns: Optional[int] = None) -> Optional[dict]:
+    def fastest(self, error: float, returns: int | None = None) -> dict | None:
         """The fastest row whose error is at most ``error`` (after ``returns`` returns: flow only), or None.
 
         Parameters
@@ -125,18 +128,26 @@ class WorkPrecision:
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         for r in self.rows:
             tol = r["tolerance"]
-            cells = [r["method"], tol if isinstance(tol, str) else f"{tol:.3g}", f"{r['error']:.3g}", f"{r['seconds']:.3g}"]
+            cells = [
+                r["method"],
+                tol if isinstance(tol, str) else f"{tol:.3g}",
+                f"{r['error']:.3g}",
+                f"{r['seconds']:.3g}",
+            ]
             cells += [f"{r.get('error_after', {}).get(m, math.nan):.3g}" for m in extra]
             cells += [f"{r.get('reversal_after', {}).get(m, math.nan):.3g}" for m in rev]
             lines.append("| " + " | ".join(cells) + " |")
         ref = self.reference
         lines.append("")
-        lines.append(f"reference: {ref['method']} (own error {ref['error']:.2g}){'; ' + ref['note'] if ref.get('note') else ''}")
+        lines.append(
+            f"reference: {ref['method']} (own error {ref['error']:.2g}){'; ' + ref['note'] if ref.get('note') else ''}"
+        )
         lines += self.notes
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
         """Plain data (JSON-ready): kind, rows, reference, target, n_points, notes."""
+
         def plain(v):
             if isinstance(v, dict):
                 return {str(k): plain(x) for k, x in v.items()}
@@ -145,8 +156,17 @@ class WorkPrecision:
             if isinstance(v, (np.floating, np.integer)):
                 return v.item()
             return v
-        return plain({"kind": self.kind, "rows": self.rows, "reference": self.reference, "target": self.target,
-                      "n_points": self.n_points, "notes": self.notes})
+
+        return plain(
+            {
+                "kind": self.kind,
+                "rows": self.rows,
+                "reference": self.reference,
+                "target": self.target,
+                "n_points": self.n_points,
+                "notes": self.notes,
+            }
+        )
 
     def plot(self, fig=None):
         """Draw the diagram: error vs time per unit, one curve per method (tolerances labelled);
@@ -175,16 +195,33 @@ class WorkPrecision:
             floor = np.maximum(err, 1e-17)  # an exact 0 still shows, on the axis floor
             ax.loglog(sec, floor, "o-", color=f"C{k}", label=m, gid=f"method:{m}")
             for t, e, s in zip(tol, floor, sec):
-                ax.annotate(t if isinstance(t, str) else f"{t:.0e}", (s, e), fontsize=6, xytext=(3, 2),
-                            textcoords="offset points", color=f"C{k}")
+                ax.annotate(
+                    t if isinstance(t, str) else f"{t:.0e}",
+                    (s, e),
+                    fontsize=6,
+                    xytext=(3, 2),
+                    textcoords="offset points",
+                    color=f"C{k}",
+                )
         ref = self.reference
         if ref["error"] > 0:
-            ax.axhline(ref["error"], color="0.5", ls=":", lw=1, gid="reference_error",
-                       label=f"reference's own error ({ref['method']})")
+            ax.axhline(
+                ref["error"],
+                color="0.5",
+                ls=":",
+                lw=1,
+                gid="reference_error",
+                label=f"reference's own error ({ref['method']})",
+            )
         unit = self.rows[0]["unit"] if self.rows else "call"
         ax.set_xlabel(f"seconds per {unit} (one thread)")
-        ax.set_ylabel({"flow": "max error of one return (section coordinates)",
-                       "rotation": "rotation-number error", "hovering_area": "|area - reference|"}[self.kind])
+        ax.set_ylabel(
+            {
+                "flow": "max error of one return (section coordinates)",
+                "rotation": "rotation-number error",
+                "hovering_area": "|area - reference|",
+            }[self.kind]
+        )
         fig.suptitle(f"{self.target}; reference: {ref['method']}", fontsize=8)
         ax.legend(fontsize=7)
         ax.grid(True, which="both", alpha=0.2)
@@ -196,12 +233,24 @@ class WorkPrecision:
                     continue
                 r = min(rs, key=lambda r: r["tolerance"])
                 ms = sorted(r["error_after"])
-                ax2.loglog(ms, np.maximum([r["error_after"][x] for x in ms], 1e-17), "o-", color=f"C{k}",
-                           label=f"{m} {r['tolerance']:.0e}", gid=f"long:{m}")
+                ax2.loglog(
+                    ms,
+                    np.maximum([r["error_after"][x] for x in ms], 1e-17),
+                    "o-",
+                    color=f"C{k}",
+                    label=f"{m} {r['tolerance']:.0e}",
+                    gid=f"long:{m}",
+                )
                 rv = sorted(r.get("reversal_after", {}))
                 if rv:
-                    ax2.loglog(rv, np.maximum([r["reversal_after"][x] for x in rv], 1e-17), "s--", color=f"C{k}",
-                               alpha=0.6, gid=f"reversal:{m}")
+                    ax2.loglog(
+                        rv,
+                        np.maximum([r["reversal_after"][x] for x in rv], 1e-17),
+                        "s--",
+                        color=f"C{k}",
+                        alpha=0.6,
+                        gid=f"reversal:{m}",
+                    )
             ax2.set_xlabel("returns m")
             ax2.set_ylabel("error after m returns (solid), reversal error (dashed)")
             ax2.set_title("long orbits (each method at its tightest tolerance)", fontsize=8)
@@ -235,8 +284,9 @@ def _section_distance(th_a, I_a, th_b, I_b) -> np.ndarray:
 def exact_available(section) -> bool:
     """Whether the flow of this section's system has the closed-form ``stepper="exact"``."""
     try:
-        section.return_map([0.0], [_default_actions(section, 1, np.random.default_rng(0))[0]], stepper="exact",
-                           n_threads=1)
+        section.return_map(
+            [0.0], [_default_actions(section, 1, np.random.default_rng(0))[0]], stepper="exact", n_threads=1
+        )
     except ValueError:  # not a stepper of this build, or no closed form for this system
         return False
     return True
@@ -266,8 +316,13 @@ def _reference_run(section, theta, I, n_threads):
     r2 = section.return_map(theta, I, rtol=1e-13, atol=1e-13, n_threads=n_threads)
     ok = (r.status == 0) & (r2.status == 0)
     est = float(np.max(_section_distance(r.theta[ok], r.I[ok], r2.theta[ok], r2.I[ok]), initial=0.0))
-    return r, {"method": "rk8pd rtol 1e-14", "error": est, "stepper": "rk8pd", "rtol": 1e-14,
-               "note": "own error estimated as its distance to rk8pd at rtol 1e-13"}
+    return r, {
+        "method": "rk8pd rtol 1e-14",
+        "error": est,
+        "stepper": "rk8pd",
+        "rtol": 1e-14,
+        "note": "own error estimated as its distance to rk8pd at rtol 1e-13",
+    }
 
 
 def _iterate_final(fm, theta, I, m: int, n_threads: int):
@@ -289,8 +344,9 @@ def _reverse(fm, theta, I, m: int, n_threads: int):
 # the flow
 
 
-def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_threads, progress, reversal=True,
-          external=()):
+def _flow(
+    section, tolerances, steppers, n_points, returns, repeat, seed, n_threads, progress, reversal=True, external=()
+):
 
     rng = np.random.default_rng(seed)
     theta = rng.uniform(-np.pi, np.pi, n_points)
@@ -305,9 +361,16 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
     n_long = min(theta.size, 4)
     ref_long = {}
     if long_ms:
-        ref_fm = FlowMap(section.sys, section.h, coordinates="section",
-                         **({"stepper": "exact"} if refinfo["stepper"] == "exact" else
-                            {"rtol": refinfo["rtol"], "atol": refinfo["rtol"]}))
+        ref_fm = FlowMap(
+            section.sys,
+            section.h,
+            coordinates="section",
+            **(
+                {"stepper": "exact"}
+                if refinfo["stepper"] == "exact"
+                else {"rtol": refinfo["rtol"], "atol": refinfo["rtol"]}
+            ),
+        )
         for m in long_ms:
             ref_long[m] = _iterate_final(ref_fm, theta[:n_long], I[:n_long], m, n_threads)
     rows = []
@@ -315,35 +378,57 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
     done = 0
     for st in steppers:
         for tol in tolerances:
-            sec, r = _best_time(lambda: section.return_map(theta, I, rtol=tol, atol=tol, stepper=st,
-                                                           n_threads=n_threads), repeat)
+            sec, r = _best_time(
+                lambda: section.return_map(theta, I, rtol=tol, atol=tol, stepper=st, n_threads=n_threads), repeat
+            )
             ok = r.status == 0
             # an error below the reference's own cannot be resolved: it is reported as that error
-            err = max(float(np.max(_section_distance(r.theta[ok], r.I[ok], ref_th[ok], ref_I[ok]), initial=0.0)),
-                      refinfo["error"]) if ok.any() else math.nan  # no return: no error to speak of
-            row = {"method": st, "tolerance": float(tol), "error": err, "seconds": sec / theta.size, "unit": "return",
-                   "failed": int(np.count_nonzero(~ok)), "steps": float(np.mean(r.steps))}
+            err = (
+                max(
+                    float(np.max(_section_distance(r.theta[ok], r.I[ok], ref_th[ok], ref_I[ok]), initial=0.0)),
+                    refinfo["error"],
+                )
+                if ok.any()
+                else math.nan
+            )  # no return: no error to speak of
+            row = {
+                "method": st,
+                "tolerance": float(tol),
+                "error": err,
+                "seconds": sec / theta.size,
+                "unit": "return",
+                "failed": int(np.count_nonzero(~ok)),
+                "steps": float(np.mean(r.steps)),
+            }
             if long_ms:
                 fm = FlowMap(section.sys, section.h, coordinates="section", rtol=tol, atol=tol, stepper=st)
                 row["error_after"] = {1: err}
                 if reversal:
                     bt, bi, alive = _reverse(fm, r.theta, r.I, 1, n_threads)
                     good = ok & alive
-                    row["reversal_after"] = {1: float(np.max(_section_distance(bt[good], bi[good], theta[good], I[good]),
-                                                             initial=0.0))}
+                    row["reversal_after"] = {
+                        1: float(np.max(_section_distance(bt[good], bi[good], theta[good], I[good]), initial=0.0))
+                    }
                 for m in long_ms:
                     pf, kf, s = _iterate_final(fm, theta[:n_long], I[:n_long], m, n_threads)
                     rp, rk, rs = ref_long[m]
                     good = (s == 0) & (rs == 0)
-                    row["error_after"][m] = float(np.max(_section_distance(pf[good], kf[good], rp[good], rk[good]),
-                                                         initial=math.nan if not good.any() else 0.0))
+                    row["error_after"][m] = float(
+                        np.max(
+                            _section_distance(pf[good], kf[good], rp[good], rk[good]),
+                            initial=math.nan if not good.any() else 0.0,
+                        )
+                    )
                     if not reversal:
                         continue
                     bt, bi, alive = _reverse(fm, pf, kf, m, n_threads)
                     good &= alive
-                    row["reversal_after"][m] = float(np.max(
-                        _section_distance(bt[good], bi[good], theta[:n_long][good], I[:n_long][good]),
-                        initial=math.nan if not good.any() else 0.0))
+                    row["reversal_after"][m] = float(
+                        np.max(
+                            _section_distance(bt[good], bi[good], theta[:n_long][good], I[:n_long][good]),
+                            initial=math.nan if not good.any() else 0.0,
+                        )
+                    )
             rows.append(row)
             done += 1
             if callable(progress):
@@ -354,11 +439,14 @@ def _flow(section, tolerances, steppers, n_points, returns, repeat, seed, n_thre
         rows += extra
         notes.append(note)
     s = section.sys
-    target = (f"flow {s.V1!r} + {s.V2!r}, eps={s.eps:g}, geometry={s.geometry}, qw=({s.qw1:g}, {s.qw2:g}), "
-              f"h={section.h:g}")
+    target = (
+        f"flow {s.V1!r} + {s.V2!r}, eps={s.eps:g}, geometry={s.geometry}, qw=({s.qw1:g}, {s.qw2:g}), h={section.h:g}"
+    )
     if long_ms:
-        notes.append(f"long orbits: {n_long} points; the error after m returns is against the reference's own "
-                     "m returns (at eps != 0 chaotic orbits separate exponentially, whatever the method)")
+        notes.append(
+            f"long orbits: {n_long} points; the error after m returns is against the reference's own "
+            "m returns (at eps != 0 chaotic orbits separate exponentially, whatever the method)"
+        )
     return WorkPrecision("flow", rows, refinfo, target, int(theta.size), notes)
 
 
@@ -370,7 +458,6 @@ def _external_rows(name, section, theta, I, ref_th, ref_I, tolerances, n_max: in
     """Rows of an independent implementation (``"scipy"`` or ``"heyoka"``) on the first n_max points,
     and a note (what it is, or why it is missing)."""
     import importlib.util
-
 
     if importlib.util.find_spec(name) is None:
         return [], f"{name} not installed: no {name} curve (pip install {name})"
@@ -386,8 +473,12 @@ def _external_rows(name, section, theta, I, ref_th, ref_I, tolerances, n_max: in
 
     run, method, note = {
         "scipy": (run_scipy, "scipy DOP853", "scipy DOP853 (solve_ivp with events, Python field)"),
-        "heyoka": (run_heyoka, "heyoka.py Taylor", "heyoka.py Taylor + events (its Python-side cost per "
-                                                   "propagate_until call included, JIT compilation not)")}[name]
+        "heyoka": (
+            run_heyoka,
+            "heyoka.py Taylor",
+            "heyoka.py Taylor + events (its Python-side cost per propagate_until call included, JIT compilation not)",
+        ),
+    }[name]
     rows = []
     for tol in tolerances:
         try:
@@ -396,10 +487,21 @@ def _external_rows(name, section, theta, I, ref_th, ref_I, tolerances, n_max: in
             return [], f"no {name} curve: {e}"
         ok = np.array([o is not None for o in out])
         c = section.coordinates(np.array([o if o is not None else np.full(4, np.nan) for o in out]))
-        err = float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]),
-                              initial=0.0)) if ok.any() else math.nan
-        rows.append({"method": method, "tolerance": float(tol), "error": err, "seconds": sec / len(z0), "unit": "return",
-                     "failed": int(np.count_nonzero(~ok))})
+        err = (
+            float(np.nanmax(_section_distance(c[ok, 0], c[ok, 1], ref_th[:n_max][ok], ref_I[:n_max][ok]), initial=0.0))
+            if ok.any()
+            else math.nan
+        )
+        rows.append(
+            {
+                "method": method,
+                "tolerance": float(tol),
+                "error": err,
+                "seconds": sec / len(z0),
+                "unit": "return",
+                "failed": int(np.count_nonzero(~ok)),
+            }
+        )
     return rows, f"{note}: {len(z0)} points"
 
 
@@ -426,11 +528,26 @@ def _rotation(m, tolerances, steppers, n_points, repeat, seed, n_threads, progre
             sec, r = _best_time(lambda: m.iterate(phi0, K0, int(n), record=rec, n_threads=n_threads, sin_ulp=u), repeat)
             for est in ("mean", "birkhoff"):
                 err = float(np.nanmax(np.abs(rotation_number(r, est) - ref)))
-                rows.append({"method": f"{est}, sin_ulp={u:g}", "tolerance": int(n), "error": err,
-                             "seconds": sec / (n * n_points), "unit": "iteration"})
-    return WorkPrecision("rotation", rows, {"method": f"weighted Birkhoff after {n_ref} iterations", "error": ref_err,
-                                            "note": f"own error: its change from {n_ref // 2} iterations"},
-                         repr(m), n_points)
+                rows.append(
+                    {
+                        "method": f"{est}, sin_ulp={u:g}",
+                        "tolerance": int(n),
+                        "error": err,
+                        "seconds": sec / (n * n_points),
+                        "unit": "iteration",
+                    }
+                )
+    return WorkPrecision(
+        "rotation",
+        rows,
+        {
+            "method": f"weighted Birkhoff after {n_ref} iterations",
+            "error": ref_err,
+            "note": f"own error: its change from {n_ref // 2} iterations",
+        },
+        repr(m),
+        n_points,
+    )
 
 
 def _hovering(m, tolerances, n_points, repeat, seed, n_threads, progress):
@@ -438,24 +555,54 @@ def _hovering(m, tolerances, n_points, repeat, seed, n_threads, progress):
     settings = sorted(tolerances, key=lambda t: t[0] * t[1])
     runs = []
     for samples, n in settings:
-        sec, a = _best_time(lambda: hovering_area(m, n_steps=int(n), samples=int(samples), seed=seed,
-                                                  n_threads=n_threads), repeat)
+        sec, a = _best_time(
+            lambda: hovering_area(m, n_steps=int(n), samples=int(samples), seed=seed, n_threads=n_threads), repeat
+        )
         runs.append((samples, n, sec, a))
     ref = runs[-1][3]
-    rows = [{"method": "hovering_area", "tolerance": f"{s}x{n}", "error": abs(a.area - ref.area), "seconds": sec,
-             "unit": "call", "stated_error": a.error, "area": a.area} for s, n, sec, a in runs[:-1]]
-    return WorkPrecision("hovering_area", rows, {"method": f"hovering_area {runs[-1][0]}x{runs[-1][1]}",
-                                                 "error": float(ref.error), "note": "its own stated error bar"},
-                         repr(m), int(runs[-1][0]))
+    rows = [
+        {
+            "method": "hovering_area",
+            "tolerance": f"{s}x{n}",
+            "error": abs(a.area - ref.area),
+            "seconds": sec,
+            "unit": "call",
+            "stated_error": a.error,
+            "area": a.area,
+        }
+        for s, n, sec, a in runs[:-1]
+    ]
+    return WorkPrecision(
+        "hovering_area",
+        rows,
+        {
+            "method": f"hovering_area {runs[-1][0]}x{runs[-1][1]}",
+            "error": float(ref.error),
+            "note": "its own stated error bar",
+        },
+        repr(m),
+        int(runs[-1][0]),
+    )
 
 
 # ------------------------------------------------------------------------------------------------
 
 
-def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Optional[Sequence] = None, *,
-                   quantity: str = "auto", n_points: Optional[int] = None, returns: Sequence[int] = (1, 100, 10_000),
-                   quick: bool = False, repeat: int = 2, seed: int = 0, n_threads: int = 1,
-                   external: Sequence[str] = (), progress=False) -> WorkPrecision:
+def work_precision(
+    target,
+    tolerances: Sequence | None = None,
+    steppers: Sequence | None = None,
+    *,
+    quantity: str = "auto",
+    n_points: int | None = None,
+    returns: Sequence[int] = (1, 100, 10_000),
+    quick: bool = False,
+    repeat: int = 2,
+    seed: int = 0,
+    n_threads: int = 1,
+    external: Sequence[str] = (),
+    progress=False,
+) -> WorkPrecision:
     """Measure what accuracy costs in time for a target (see the module docstring).
 
     Parameters
@@ -516,11 +663,16 @@ def work_precision(target, tolerances: Optional[Sequence] = None, steppers: Opti
     is_flow = isinstance(target, (Section, FlowMap))
     if quantity == "hovering_area":
         if tolerances is None:
-            tolerances = [(400, 250), (1600, 500), (6400, 1000)] if quick else \
-                [(400, 250), (1600, 500), (6400, 1000), (25600, 2000)]
+            tolerances = (
+                [(400, 250), (1600, 500), (6400, 1000)]
+                if quick
+                else [(400, 250), (1600, 500), (6400, 1000), (25600, 2000)]
+            )
         tolerances = [(integer("samples", s, 16, 10**9), integer("n_steps", n, 1, 10**9)) for s, n in tolerances]
         if len(tolerances) < 2:
-            raise ValueError("hovering_area needs at least two (samples, n_steps) settings (the largest is the reference)")
+            raise ValueError(
+                "hovering_area needs at least two (samples, n_steps) settings (the largest is the reference)"
+            )
         return _hovering(target, tolerances, None, repeat, seed, n_threads, progress)
     if is_flow:
         if quantity not in ("auto", "return"):

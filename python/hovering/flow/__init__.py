@@ -4,7 +4,17 @@ system and its onset parameters, the section Sigma_h and the return map of the i
 from .._enums import TrajectoryPoint
 from .potentials import CustomPotential, check_potential
 from .section import STEPPERS, FlowStatus, ReturnMapResult, Section, flow_options
-from .system import Bilinear, Harmonic, Numerical, OnsetParameters, Polynomial, Potential, StepSystem, Tan, onset_parameters
+from .system import (
+    Bilinear,
+    Harmonic,
+    Numerical,
+    OnsetParameters,
+    Polynomial,
+    Potential,
+    StepSystem,
+    Tan,
+    onset_parameters,
+)
 
 __all__ = [
     "Potential",

@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 import math
 import pickle
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
@@ -76,17 +76,21 @@ def _check(V: Callable, dV: Callable, q_limit: float, label: str, extent: float)
         bad = ~np.isfinite(arr)
         if bad.any():
             i = int(np.argmax(bad))
-            raise ValueError(f"{label}: {name}({q[i]!r}) = {arr[i]!r}; V and V' must be finite {where}, "
-                             f"|q| < q_limit = {q_limit!r}")
+            raise ValueError(
+                f"{label}: {name}({q[i]!r}) = {arr[i]!r}; V and V' must be finite {where}, |q| < q_limit = {q_limit!r}"
+            )
     sign = q * ders
     if not (sign > 0).all():
         i = int(np.argmax(~(sign > 0)))
-        raise ValueError(f"{label}: not a single well: q V'(q) must be > 0 for 0 < |q| < q_limit = {q_limit!r}, "
-                         f"got V'({q[i]!r}) = {ders[i]!r}")
+        raise ValueError(
+            f"{label}: not a single well: q V'(q) must be > 0 for 0 < |q| < q_limit = {q_limit!r}, "
+            f"got V'({q[i]!r}) = {ders[i]!r}"
+        )
     if not (vals > v0).all():
         i = int(np.argmax(~(vals > v0)))
-        raise ValueError(f"{label}: not a single well: V(q) must be > V(0) = {v0!r} for q != 0, "
-                         f"got V({q[i]!r}) = {vals[i]!r}")
+        raise ValueError(
+            f"{label}: not a single well: V(q) must be > V(0) = {v0!r} for q != 0, got V({q[i]!r}) = {vals[i]!r}"
+        )
     # V' against V: Richardson central differences at a few points well inside the well. The step
     # starts at 1e-2 |q| and shrinks 4x (truncation error 256x) until the estimate matches dV; only
     # an estimate that has settled (two in a row agree) away from dV is a mismatch, so steep wells
@@ -105,8 +109,10 @@ def _check(V: Callable, dV: Callable, q_limit: float, label: str, extent: float)
             if abs(est - der) <= tol:
                 break
             if prev is not None and abs(est - prev) <= tol:
-                raise ValueError(f"{label}: dV is not the derivative of V: dV({x!r}) = {der!r}, but V changes "
-                                 f"at the rate {est!r} there (relative tolerance {_DV_RTOL:g})")
+                raise ValueError(
+                    f"{label}: dV is not the derivative of V: dV({x!r}) = {der!r}, but V changes "
+                    f"at the rate {est!r} there (relative tolerance {_DV_RTOL:g})"
+                )
             prev, d = est, 0.25 * d
 
 
@@ -202,8 +208,14 @@ class CustomPotential(_CallablePotential):
     4.5483303981
     """
 
-    def __init__(self, V: Callable[[float], float], dV: Callable[[float], float], q_limit: float = math.inf,
-                 name: Optional[str] = None, check_extent: float = 10.0):
+    def __init__(
+        self,
+        V: Callable[[float], float],
+        dV: Callable[[float], float],
+        q_limit: float = math.inf,
+        name: str | None = None,
+        check_extent: float = 10.0,
+    ):
         for what, f in (("V", V), ("dV", dV)):
             if not callable(f):
                 raise ValueError(f"{what} must be callable ({what}(q) -> float), got {f!r}")
@@ -221,8 +233,13 @@ class CustomPotential(_CallablePotential):
         """Equal to a CustomPotential of the same class with the same callables (``is``), q_limit and name."""
         if not isinstance(other, Potential):
             return NotImplemented
-        return (type(self) is type(other) and self.V_callable is other.V_callable
-                and self.dV_callable is other.dV_callable and self.q_limit == other.q_limit and self.name == other.name)
+        return (
+            type(self) is type(other)
+            and self.V_callable is other.V_callable
+            and self.dV_callable is other.dV_callable
+            and self.q_limit == other.q_limit
+            and self.name == other.name
+        )
 
     def __hash__(self) -> int:
         """Hash of the callables' identities, q_limit and name (consistent with ``==``)."""
@@ -251,14 +268,17 @@ class CustomPotential(_CallablePotential):
                         f"cannot pickle {self.name}: its {what} = {f!r} cannot be pickled ({type(e).__name__}: {e}); "
                         "pickle stores functions by their importable name: define V and dV at module level (not as "
                         "lambdas or local functions), or pass picklable callables (e.g. functools.partial of "
-                        "module-level functions); cloudpickle (Dask's pickler) also stores lambdas") from e
+                        "module-level functions); cloudpickle (Dask's pickler) also stores lambdas"
+                    ) from e
         return _restore_custom, (type(self), V, dV, self.q_limit, self.name, dict(self.__dict__))
 
-    def __copy__(self) -> "CustomPotential":
+    def __copy__(self) -> CustomPotential:
         """A new potential with the same callables (no checks run; any callable can be copied)."""
-        return _restore_custom(type(self), self.V_callable, self.dV_callable, self.q_limit, self.name, dict(self.__dict__))
+        return _restore_custom(
+            type(self), self.V_callable, self.dV_callable, self.q_limit, self.name, dict(self.__dict__)
+        )
 
-    def __deepcopy__(self, memo) -> "CustomPotential":
+    def __deepcopy__(self, memo) -> CustomPotential:
         """A new potential with deep copies of the callables (functions are their own deep copies)."""
         V, dV, attrs = copy.deepcopy((self.V_callable, self.dV_callable, dict(self.__dict__)), memo)
         return _restore_custom(type(self), V, dV, self.q_limit, self.name, attrs)
@@ -274,10 +294,12 @@ class CustomPotential(_CallablePotential):
         raise TypeError(_NOT_SAVEABLE.format(what=f"{self.name} (a CustomPotential)"))
 
 
-_NOT_SAVEABLE = ("cannot save {what} to NPZ: its V and V' are Python code, which the NPZ format (written without "
-                 "pickle, so that reading a file never runs code) cannot hold; pickle the object instead (with "
-                 "module-level V and dV), or save a result without its map, e.g. "
-                 "dataclasses.replace(result, map=None).save(path)")
+_NOT_SAVEABLE = (
+    "cannot save {what} to NPZ: its V and V' are Python code, which the NPZ format (written without "
+    "pickle, so that reading a file never runs code) cannot hold; pickle the object instead (with "
+    "module-level V and dV), or save a result without its map, e.g. "
+    "dataclasses.replace(result, map=None).save(path)"
+)
 
 
 def _restore_custom(cls, V, dV, q_limit, name, attrs):
@@ -296,4 +318,3 @@ def _python_potential_record(self) -> dict:
 # The base class answers for Python subclasses; the compiled potentials define their own records
 # (hovering.flow.system).
 Potential._to_record = _python_potential_record
-

@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 
 from .. import _core
 from .._checks import integer, is_choice, real_array, real_number, thread_count
-from .._enums import status_code
-from .._enums import FlowStatus
-from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
-from .._progress import check_progress, progress_bar
+from .._enums import FlowStatus, status_code
 from .._pickle import reduce_record
+from .._progress import check_progress, progress_bar
 from .._serial import Saveable
+from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
@@ -25,9 +23,16 @@ __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS
 STEPPERS = tuple(_core.flow.STEPPERS)
 
 
-def flow_options(rtol: Optional[float] = None, atol: Optional[float] = None, stepper: Optional[str] = None,
-                 event_tol: Optional[float] = None, max_steps: Optional[int] = None, max_impacts: Optional[int] = None,
-                 grazing_tol: Optional[float] = None, corner_tol: Optional[float] = None) -> "_core.flow.FlowOptions":
+def flow_options(
+    rtol: float | None = None,
+    atol: float | None = None,
+    stepper: str | None = None,
+    event_tol: float | None = None,
+    max_steps: int | None = None,
+    max_impacts: int | None = None,
+    grazing_tol: float | None = None,
+    corner_tol: float | None = None,
+) -> _core.flow.FlowOptions:
     """Integrator settings of the flow, validated with errors that name the value and its range.
 
     Parameters
@@ -45,17 +50,29 @@ def flow_options(rtol: Optional[float] = None, atol: Optional[float] = None, ste
     kw = {}
     if stepper is not None:
         if not is_choice(stepper, STEPPERS):
-            raise ValueError(f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
-                             f"solvers, and this flow is not stiff), got {stepper!r}")
+            raise ValueError(
+                f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
+                f"solvers, and this flow is not stiff), got {stepper!r}"
+            )
         kw["stepper"] = stepper
-    checks = dict(rtol=lambda v: real_number("rtol", v, 1e-16, False, 1, True), atol=lambda v: real_number("atol", v, 0),
-                  event_tol=lambda v: real_number("event_tol", v, 0),
-                  max_steps=lambda v: integer("max_steps", v, 1, 2**62),
-                  max_impacts=lambda v: integer("max_impacts", v, 1, 1_000_000),
-                  grazing_tol=lambda v: real_number("grazing_tol", v, 0, False),
-                  corner_tol=lambda v: real_number("corner_tol", v, 0, False))
-    given = dict(rtol=rtol, atol=atol, event_tol=event_tol, max_steps=max_steps, max_impacts=max_impacts,
-                 grazing_tol=grazing_tol, corner_tol=corner_tol)
+    checks = dict(
+        rtol=lambda v: real_number("rtol", v, 1e-16, False, 1, True),
+        atol=lambda v: real_number("atol", v, 0),
+        event_tol=lambda v: real_number("event_tol", v, 0),
+        max_steps=lambda v: integer("max_steps", v, 1, 2**62),
+        max_impacts=lambda v: integer("max_impacts", v, 1, 1_000_000),
+        grazing_tol=lambda v: real_number("grazing_tol", v, 0, False),
+        corner_tol=lambda v: real_number("corner_tol", v, 0, False),
+    )
+    given = dict(
+        rtol=rtol,
+        atol=atol,
+        event_tol=event_tol,
+        max_steps=max_steps,
+        max_impacts=max_impacts,
+        grazing_tol=grazing_tol,
+        corner_tol=corner_tol,
+    )
     kw.update({k: checks[k](v) for k, v in given.items() if v is not None})
     return _core.flow.FlowOptions(**kw)
 
@@ -109,12 +126,12 @@ class ReturnMapResult(Saveable):
     status: np.ndarray
     energy_error: np.ndarray
     steps: np.ndarray
-    region: Optional[np.ndarray] = None
-    work: Optional[dict] = None
-    trajectory: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_index: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_kind: Optional[np.ndarray] = field(default=None, repr=False)
-    trajectory_truncated: Optional[np.ndarray] = field(default=None, repr=False)
+    region: np.ndarray | None = None
+    work: dict | None = None
+    trajectory: np.ndarray | None = field(default=None, repr=False)
+    trajectory_index: np.ndarray | None = field(default=None, repr=False)
+    trajectory_kind: np.ndarray | None = field(default=None, repr=False)
+    trajectory_truncated: np.ndarray | None = field(default=None, repr=False)
 
     def trajectory_of(self, i: int) -> np.ndarray:
         """The recorded flow of return i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
@@ -172,7 +189,7 @@ class Section:
         return {"sys": self.sys, "h": self.h}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "Section":
+    def _from_record(cls, record: dict) -> Section:
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls(record["sys"], record["h"])
 
@@ -209,9 +226,12 @@ class Section:
         try:
             t, i = np.broadcast_arrays(t, i)
         except ValueError:
-            raise ValueError(f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}") from None
-        return _core.flow.section_points(self.sys.core, self.h, np.ascontiguousarray(t.ravel()),
-                                         np.ascontiguousarray(i.ravel()))
+            raise ValueError(
+                f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}"
+            ) from None
+        return _core.flow.section_points(
+            self.sys.core, self.h, np.ascontiguousarray(t.ravel()), np.ascontiguousarray(i.ravel())
+        )
 
     def coordinates(self, z) -> np.ndarray:
         """Section coordinates (theta, I) of states z (shape (n, 4)).
@@ -232,12 +252,23 @@ class Section:
             raise ValueError(f"z must be states (q1, p1, q2, p2) of shape (n, 4), got shape {np.shape(z)}")
         return _core.flow.section_coordinates(self.sys.core, np.ascontiguousarray(z))
 
-    def return_map(self, theta, I, rtol: Optional[float] = None, atol: Optional[float] = None,
-                   stepper: Optional[str] = None, event_tol: Optional[float] = None, max_steps: Optional[int] = None,
-                   max_impacts: Optional[int] = None, grazing_tol: Optional[float] = None,
-                   corner_tol: Optional[float] = None, n_threads: int = 0,
-                   trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
-                   progress=False) -> ReturnMapResult:
+    def return_map(
+        self,
+        theta,
+        I,
+        rtol: float | None = None,
+        atol: float | None = None,
+        stepper: str | None = None,
+        event_tol: float | None = None,
+        max_steps: int | None = None,
+        max_impacts: int | None = None,
+        grazing_tol: float | None = None,
+        corner_tol: float | None = None,
+        n_threads: int = 0,
+        trajectory_dt: float | None = None,
+        max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
+        progress=False,
+    ) -> ReturnMapResult:
         """Return map of many points of Sigma_h (multi-threaded, GIL released).
 
         Parameters
@@ -309,8 +340,11 @@ class Section:
         threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
-        dt, per_orbit = (0.0, 0) if trajectory_dt is None else trajectory_arguments(trajectory_dt, max_trajectory_points,
-                                                                                      z0.shape[0])
+        dt, per_orbit = (
+            (0.0, 0)
+            if trajectory_dt is None
+            else trajectory_arguments(trajectory_dt, max_trajectory_points, z0.shape[0])
+        )
         with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
             d = _core.flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
         # The image's coordinates where there is an image: a stopped orbit's z is its last state,
@@ -318,11 +352,22 @@ class Section:
         c = np.full((z0.shape[0], 2), np.nan)
         ok = d["status"] == FlowStatus.OK
         c[ok] = self.coordinates(d["z"][ok])
-        res = ReturnMapResult(theta=c[:, 0], I=c[:, 1], z=d["z"], time=d["time"], itinerary=d["itinerary"],
-                              status=d["status"], energy_error=d["energy_error"], steps=d["steps"], region=d["region"],
-                              work=d["work"], trajectory=d.get("trajectory"), trajectory_index=d.get("trajectory_index"),
-                              trajectory_kind=d.get("trajectory_kind"),
-                              trajectory_truncated=d.get("trajectory_truncated"))
+        res = ReturnMapResult(
+            theta=c[:, 0],
+            I=c[:, 1],
+            z=d["z"],
+            time=d["time"],
+            itinerary=d["itinerary"],
+            status=d["status"],
+            energy_error=d["energy_error"],
+            steps=d["steps"],
+            region=d["region"],
+            work=d["work"],
+            trajectory=d.get("trajectory"),
+            trajectory_index=d.get("trajectory_index"),
+            trajectory_kind=d.get("trajectory_kind"),
+            trajectory_truncated=d.get("trajectory_truncated"),
+        )
         if d["interrupted"]:
             exc = KeyboardInterrupt("return map interrupted; the finished returns are in .partial")
             exc.partial = res

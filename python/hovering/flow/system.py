@@ -5,15 +5,14 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+from dataclasses import dataclass
 
 import numpy as np
-from dataclasses import dataclass
-from typing import Optional
 
 from .. import _core
 from .._checks import is_choice, real_number
-from .._enums import Geometry
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
+from .._enums import Geometry
 from .._pickle import reduce_record
 
 __all__ = [
@@ -34,6 +33,7 @@ _GEOMETRIES = ("none", "wall", "step")
 # ---------------------------------------------------------------- the compiled potentials' values
 # Pickling is the compiled classes' own (bind_potential.cpp: their constructor arguments); these
 # add equality by value and the records :func:`hovering.save` writes (no pickle in the file).
+
 
 def _potential_eq(self, other):
     """Equal to a potential of the same class with the same parameters (for Numerical: an equal base)."""
@@ -115,7 +115,7 @@ class Bilinear:
         return {}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "Bilinear":
+    def _from_record(cls, record: dict) -> Bilinear:
         """Inverse of :meth:`_to_record`."""
         return cls()
 
@@ -167,7 +167,7 @@ class Polynomial:
         return {"terms": [[int(i), int(j), float(c)] for (i, j), c in self.coefficients.items()]}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "Polynomial":
+    def _from_record(cls, record: dict) -> Polynomial:
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls({(i, j): c for i, j, c in record["terms"]})
 
@@ -211,7 +211,7 @@ class StepSystem:
 
     V1: Potential
     V2: Potential
-    coupling: Optional[object] = None
+    coupling: object | None = None
     eps: float = 0.0
     qw1: float = -1.0
     qw2: float = -0.5
@@ -221,13 +221,17 @@ class StepSystem:
         for name in ("V1", "V2"):
             pot = getattr(self, name)
             if not isinstance(pot, Potential):
-                raise ValueError(f"{name} must be a hovering potential (Harmonic, Tan, CustomPotential, ...), got {pot!r}")
+                raise ValueError(
+                    f"{name} must be a hovering potential (Harmonic, Tan, CustomPotential, ...), got {pot!r}"
+                )
             # The core computes Harmonic and Tan forces from their parameters: a Python override of
             # V or dV in a subclass of them would be silently ignored by the flow.
             for base in (Harmonic, Tan):
                 if isinstance(pot, base) and any(getattr(type(pot), f) is not getattr(base, f) for f in ("V", "dV")):
-                    raise ValueError(f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "
-                                     "core would ignore; subclass hovering.Potential (or use CustomPotential) instead")
+                    raise ValueError(
+                        f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "
+                        "core would ignore; subclass hovering.Potential (or use CustomPotential) instead"
+                    )
         for name in ("eps", "qw1", "qw2"):
             object.__setattr__(self, name, real_number(name, getattr(self, name)))
         if not math.isfinite(self.eps):
@@ -248,11 +252,14 @@ class StepSystem:
 
         geometry = {"none": Geometry.NONE, "wall": Geometry.WALL, "step": Geometry.STEP}[self.geometry]
         # The core's validated copy, built once (frozen: set through object.__setattr__).
-        object.__setattr__(self, "_core", _core.flow.FlowSystem(self.V1, self.V2, _terms(self.coupling), self.eps,
-                                                                self.qw1, self.qw2, geometry))
+        object.__setattr__(
+            self,
+            "_core",
+            _core.flow.FlowSystem(self.V1, self.V2, _terms(self.coupling), self.eps, self.qw1, self.qw2, geometry),
+        )
 
     @property
-    def core(self) -> "_core.flow.FlowSystem":
+    def core(self) -> _core.flow.FlowSystem:
         """The core's FlowSystem of this system (what the compiled flow integrates)."""
         return self._core
 
@@ -264,10 +271,12 @@ class StepSystem:
     @property
     def python_defined(self) -> bool:
         """Whether V1 or V2 calls back into Python (CustomPotential or a Python subclass)."""
-        return any(isinstance(p, _core.flow._CallablePotential) or not type(p).__module__.startswith("hovering._core")
-                   for p in (self.V1, self.V2))
+        return any(
+            isinstance(p, _core.flow._CallablePotential) or not type(p).__module__.startswith("hovering._core")
+            for p in (self.V1, self.V2)
+        )
 
-    def replace(self, **changes) -> "StepSystem":
+    def replace(self, **changes) -> StepSystem:
         """A copy with some fields changed (e.g. ``eps=0.0``, ``geometry="wall"``), validated again.
 
         Parameters
@@ -279,8 +288,15 @@ class StepSystem:
         -------
         StepSystem
         """
-        fields = dict(V1=self.V1, V2=self.V2, coupling=self.coupling, eps=self.eps, qw1=self.qw1, qw2=self.qw2,
-                      geometry=self.geometry)
+        fields = dict(
+            V1=self.V1,
+            V2=self.V2,
+            coupling=self.coupling,
+            eps=self.eps,
+            qw1=self.qw1,
+            qw2=self.qw2,
+            geometry=self.geometry,
+        )
         unknown = set(changes) - set(fields)
         if unknown:
             raise ValueError(f"unknown StepSystem field(s) {sorted(unknown)}; allowed: {sorted(fields)}")
@@ -297,13 +313,12 @@ class StepSystem:
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "StepSystem":
+    def _from_record(cls, record: dict) -> StepSystem:
         """Inverse of :meth:`_to_record` (validated again)."""
         return cls(**record)
 
 
-def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rtol: float = 1e-6,
-                     errors: bool = False):
+def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rtol: float = 1e-6, errors: bool = False):
     """Onset parameters Omega0, tau0, tau1, lam, theta_w (sec:parametersdef) at energy h.
 
     Every parameter comes with an estimate of its absolute error: the potentials' own error
@@ -361,6 +376,7 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rto
     elif method == "quadrature":
         r = _core.flow._onset_estimate(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, h, rtol)
     elif method == "closed_form":
+
         def wa(p):
             if isinstance(p, Tan):
                 return p.omega, p.alpha

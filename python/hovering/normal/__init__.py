@@ -3,7 +3,14 @@ flow's return map as a map on (phi, K), its corner-singularity curves, and trunc
 from and compared with it."""
 
 from .compare import MapComparison, compare_maps, truncated_from_flow
-from .coordinates import TangentialCurve, forcing_coefficients, forcing_function, from_normal, tangential_curve, to_normal
+from .coordinates import (
+    TangentialCurve,
+    forcing_coefficients,
+    forcing_function,
+    from_normal,
+    tangential_curve,
+    to_normal,
+)
 from .corners import CornerCurves, corner_curves
 from .flowmap import FLOW_RECORD_KEYS, FlowMap, FlowSteps
 

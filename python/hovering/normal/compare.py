@@ -132,11 +132,9 @@ def compare_maps(sec: Section, curve: TangentialCurve, trunc, phi, K, rtol: floa
     reg = np.asarray(trunc.region(ph, Kk))
     letter = {int(Region.RIGHT): "R", int(Region.UPPER): "1", int(Region.ABOVE): "0", int(Region.BESIDE): "u"}
     rt = np.array([letter[int(r)] for r in reg], dtype=object)
-    ok = (lab == rt)
+    ok = lab == rt
     dphi = np.where(ok, wrap(np.asarray(pt) - pb), np.nan)
     dK = np.where(ok, np.asarray(Kt) - Kb, np.nan)
     f = trunc.forcing_at(pb) if hasattr(trunc, "forcing_at") else np.sin(pb)
     GK = np.where(ok, Kb - Kk - trunc.eps * f, np.nan)
     return MapComparison(phi=ph, K=Kk, dphi=dphi, dK=dK, GK=GK, region_full=lab, region_trunc=rt)
-
-

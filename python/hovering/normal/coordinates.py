@@ -13,18 +13,24 @@
 from __future__ import annotations
 
 import operator
-from typing import Optional
 
 import numpy as np
 
 from .. import _core
-from .._checks import integer, MAX_MODES, real_array, require_angles, require_finite, require_type
+from .._checks import MAX_MODES, integer, real_array, require_angles, require_finite, require_type
 from .._enums import wrap
 from .._pickle import reduce_record
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 
-__all__ = ["TangentialCurve", "tangential_curve", "forcing_function", "forcing_coefficients", "to_normal", "from_normal"]
+__all__ = [
+    "TangentialCurve",
+    "tangential_curve",
+    "forcing_function",
+    "forcing_coefficients",
+    "to_normal",
+    "from_normal",
+]
 
 _TWO_PI = 2 * np.pi
 
@@ -112,7 +118,7 @@ class TangentialCurve(Saveable):
         return dict(zip(_CURVE_STATE, self._c.__getstate__()), checked=not np.isnan(self.interpolation_error))
 
     @classmethod
-    def _from_samples(cls, sec: Section, samples: dict) -> "TangentialCurve":
+    def _from_samples(cls, sec: Section, samples: dict) -> TangentialCurve:
         """The curve of ``sec`` with the samples of :meth:`_samples` (no trace of the flow; validated)."""
         sec = _section("sec", sec)
         try:
@@ -120,8 +126,9 @@ class TangentialCurve(Saveable):
         except (KeyError, TypeError):
             raise ValueError(f"a tangential curve's samples need the entries {_CURVE_STATE}, got {samples!r}") from None
         if state[0] != sec.h:
-            raise ValueError(f"the tangential curve's samples were measured at h = {state[0]}, not at the section's "
-                             f"h = {sec.h}")
+            raise ValueError(
+                f"the tangential curve's samples were measured at h = {state[0]}, not at the section's h = {sec.h}"
+            )
         c = _core.normal.TangentialCurve.__new__(_core.normal.TangentialCurve)
         c.__setstate__(state)
         obj = cls.__new__(cls)
@@ -133,21 +140,34 @@ class TangentialCurve(Saveable):
         return {"sec": self.sec, "samples": self._samples()}
 
     @classmethod
-    def _from_record(cls, record: dict) -> "TangentialCurve":
+    def _from_record(cls, record: dict) -> TangentialCurve:
         """Inverse of :meth:`_to_record` (the interpolants are rebuilt bit for bit, the flow is not traced)."""
         return cls._from_samples(record["sec"], record["samples"])
 
     #: What the record rebuilds (the rest of the instance dict is pickled as it is).
-    _OWN = frozenset({"sec", "_c", "s", "theta", "values", "interpolation_error", "interpolation_error_theta",
-                      "is_graph", "min_slope"})
+    _OWN = frozenset(
+        {
+            "sec",
+            "_c",
+            "s",
+            "theta",
+            "values",
+            "interpolation_error",
+            "interpolation_error_theta",
+            "is_graph",
+            "min_slope",
+        }
+    )
 
     def __reduce__(self):
         """Pickle as the record: the section and the measured samples."""
         return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in self._OWN})
 
     def __repr__(self) -> str:
-        return (f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "
-                f"interpolation_error={self.interpolation_error:.2g})")
+        return (
+            f"TangentialCurve(h={self.sec.h}, eps={self.sec.sys.eps}, n={self.s.size}, graph={self.is_graph}, "
+            f"interpolation_error={self.interpolation_error:.2g})"
+        )
 
     @property
     def I_tan0(self) -> float:
@@ -210,7 +230,7 @@ class TangentialCurve(Saveable):
         require_angles("phi", ph)
         return (self(-ph) - self(ph)) / eps
 
-    def forcing_coefficients(self, n_modes: Optional[int] = None, n_phi: Optional[int] = None) -> np.ndarray:
+    def forcing_coefficients(self, n_modes: int | None = None, n_phi: int | None = None) -> np.ndarray:
         """Sine coefficients ``b_1 .. b_n_modes`` of f (eq:defoff), fitted on n_phi angles.
 
         The core's one fit of the measured forcing (``hovering._core.normal``): f sampled at the
@@ -253,16 +273,18 @@ def _section(name: str, sec) -> Section:
     return require_type(name, sec, Section, "a hovering.Section (hovering.Section(system, h))")
 
 
-def _curve_of(sec: Section, curve) -> "TangentialCurve":
+def _curve_of(sec: Section, curve) -> TangentialCurve:
     """The tangential curve of sec (measured if None); a ValueError for any other object or the
     curve of another system or energy (whose normal coordinates mean something else)."""
     if curve is None:
         return TangentialCurve(sec)
     if not isinstance(curve, TangentialCurve) or curve.sec.sys != sec.sys or curve.sec.h != sec.h:
-        raise ValueError(f"curve must be the TangentialCurve of this section (same system, h = {sec.h}), got "
-                         f"{curve!r}" if not isinstance(curve, TangentialCurve) else
-                         f"curve must be the TangentialCurve of this section (same system, h = {sec.h}); it belongs "
-                         f"to h = {curve.sec.h}" + ("" if curve.sec.sys == sec.sys else " of another system"))
+        raise ValueError(
+            f"curve must be the TangentialCurve of this section (same system, h = {sec.h}), got {curve!r}"
+            if not isinstance(curve, TangentialCurve)
+            else f"curve must be the TangentialCurve of this section (same system, h = {sec.h}); it belongs "
+            f"to h = {curve.sec.h}" + ("" if curve.sec.sys == sec.sys else " of another system")
+        )
     return curve
 
 
@@ -288,8 +310,10 @@ def _section_pair(theta, I):
 def _positive_action(I, K):
     if np.any(I <= 0):
         i = int(np.argmax(np.ravel(I) <= 0))
-        raise ValueError(f"K = {np.ravel(K)[i]} gives the action I = {np.ravel(I)[i]} <= 0: no point of Sigma_h "
-                         "(K must exceed -I_tan(phi))")
+        raise ValueError(
+            f"K = {np.ravel(K)[i]} gives the action I = {np.ravel(I)[i]} <= 0: no point of Sigma_h "
+            "(K must exceed -I_tan(phi))"
+        )
 
 
 def _wall_section(sec: Section) -> Section:
@@ -356,8 +380,10 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         if crosses(lo).all() and not crosses(hi).any():
             break
         if bracket is not None or rel >= 0.95:
-            raise ValueError(f"the tangency is not inside I_tan (1 +- {rel}) for every theta (eps = {sec.sys.eps}); "
-                             "the curve may not be a graph: see hovering.TangentialCurve")
+            raise ValueError(
+                f"the tangency is not inside I_tan (1 +- {rel}) for every theta (eps = {sec.sys.eps}); "
+                "the curve may not be a graph: see hovering.TangentialCurve"
+            )
         rel = min(0.95, 2 * rel)
     for _ in range(int(iterations)):
         mid = 0.5 * (lo + hi)
@@ -391,8 +417,7 @@ def forcing_function(sec: Section, phi, **kwargs) -> np.ndarray:
     return (both[: p.size] - both[p.size :]) / sec.sys.eps
 
 
-def forcing_coefficients(sec: Section, n_modes: Optional[int] = None, n_phi: Optional[int] = None,
-                         **kwargs) -> np.ndarray:
+def forcing_coefficients(sec: Section, n_modes: int | None = None, n_phi: int | None = None, **kwargs) -> np.ndarray:
     """Sine coefficients ``b_k`` of the measured forcing f (eq:defoff), f by :func:`forcing_function`.
 
     The same fit as :meth:`TangentialCurve.forcing_coefficients` (the core's, on the same midpoint

@@ -6,7 +6,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
 
@@ -67,8 +66,9 @@ class CornerCurves(Saveable):
     resolution: float
 
 
-def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_phi: int = 256,
-                  bisections: int = 36, rtol: float = 1e-12) -> CornerCurves:
+def corner_curves(
+    sec: Section, K, curve: TangentialCurve | None = None, n_phi: int = 256, bisections: int = 36, rtol: float = 1e-12
+) -> CornerCurves:
     """Measure the corner-singularity curves of the flow's return map on circles ``K = const``.
 
     On each circle, ``n_phi`` equispaced points are mapped by the flow; each change of itinerary
@@ -159,7 +159,14 @@ def corner_curves(sec: Section, K, curve: Optional[TangentialCurve] = None, n_ph
     J0 = np.where(Ks < 0, gap(res["phi_R0"], res["phi_01"]), _TWO_PI)
     J1 = np.where(Ks < 0, gap(res["phi_01"], res["phi_1R"]), 0.0)
     other = np.array([np.sum(~np.isin(lab[i], ["0", "u", "R", "1"])) for i in range(nK)])
-    return CornerCurves(K=Ks, JR=JR, J0=J0, J1=J1, Omega=Omega, Omega_spread=spread, other=other,
-                        resolution=_TWO_PI / n_phi / 2.0 ** bisections, **res)
-
-
+    return CornerCurves(
+        K=Ks,
+        JR=JR,
+        J0=J0,
+        J1=J1,
+        Omega=Omega,
+        Omega_spread=spread,
+        other=other,
+        resolution=_TWO_PI / n_phi / 2.0**bisections,
+        **res,
+    )

@@ -9,21 +9,29 @@ unchanged. Iterations run in C++ on the core's thread pool with no Python betwee
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Iterable, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
-from .._checks import check_memory, flag, forcing_array, integer, is_choice, MAX_MODES, point_pair
+from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, point_pair
 from .._enums import Region, wrap
-from ..interface import iterate_arguments, MAX_TRAJECTORY_POINTS, recorded_counts, trajectory_arguments, transport_arguments
-from .._progress import check_progress, progress_bar
-from ..interface import IterateResult, MapAnalyses, hook
 from .._pickle import reduce_record
+from .._progress import check_progress, progress_bar
 from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
+from ..interface import (
+    MAX_TRAJECTORY_POINTS,
+    IterateResult,
+    MapAnalyses,
+    hook,
+    iterate_arguments,
+    recorded_counts,
+    trajectory_arguments,
+    transport_arguments,
+)
 from ..truncated import theory as _theory  # the module (hovering.truncated does not export the function)
 from ..truncated.maps import TruncatedFamily, TruncatedMap
 from .coordinates import TangentialCurve
@@ -31,8 +39,21 @@ from .coordinates import TangentialCurve
 __all__ = ["FlowMap", "FlowSteps", "FLOW_RECORD_KEYS"]
 
 #: What :meth:`FlowMap.iterate` can record (nothing else is computed or stored).
-FLOW_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "section", "states", "times", "energy_error", "steps",
-                    "itinerary", "trajectory", "extrema", "residence")
+FLOW_RECORD_KEYS = (
+    "orbit",
+    "regions",
+    "rotation",
+    "visited",
+    "section",
+    "states",
+    "times",
+    "energy_error",
+    "steps",
+    "itinerary",
+    "trajectory",
+    "extrema",
+    "residence",
+)
 
 
 @dataclass(frozen=True)
@@ -130,9 +151,19 @@ class FlowMap(MapAnalyses):
     #: rotation averages): the integration error of each return caps invariant curves at 7-9.
     regularity_digits = 6.0
 
-    def __init__(self, sys: StepSystem, h: float = 1.0, coordinates: str = "normal", rtol: Optional[float] = None,
-                 atol: Optional[float] = None, stepper: Optional[str] = None, curve: Optional[TangentialCurve] = None,
-                 accuracy: Optional[float] = None, accuracy_returns: int = 1, **options):
+    def __init__(
+        self,
+        sys: StepSystem,
+        h: float = 1.0,
+        coordinates: str = "normal",
+        rtol: float | None = None,
+        atol: float | None = None,
+        stepper: str | None = None,
+        curve: TangentialCurve | None = None,
+        accuracy: float | None = None,
+        accuracy_returns: int = 1,
+        **options,
+    ):
         if not isinstance(sys, StepSystem):
             raise ValueError(f"sys must be a hovering.StepSystem, got {sys!r}")
         if not is_choice(coordinates, ("normal", "section")):
@@ -141,8 +172,10 @@ class FlowMap(MapAnalyses):
         self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
         unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
         if unknown:
-            raise ValueError(f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
-                             "grazing_tol, corner_tol")
+            raise ValueError(
+                f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
+                "grazing_tol, corner_tol"
+            )
         #: What an ``accuracy`` target chose (None without one): the row of the measurement.
         self.accuracy_choice = None
         if accuracy is not None:
@@ -188,8 +221,20 @@ class FlowMap(MapAnalyses):
     # for bit as the original. Other instance attributes (the forcing cache, a subclass's own) are
     # restored as they were.
 
-    _OWN = frozenset({"section", "sys", "h", "coordinates", "_options", "integrator_options", "onset", "onset_error",
-                      "curve", "_core"})
+    _OWN = frozenset(
+        {
+            "section",
+            "sys",
+            "h",
+            "coordinates",
+            "_options",
+            "integrator_options",
+            "onset",
+            "onset_error",
+            "curve",
+            "_core",
+        }
+    )
 
     def __reduce__(self):
         """Pickle as the record (system, h, coordinates, integrator options, the curve's samples, the
@@ -199,8 +244,14 @@ class FlowMap(MapAnalyses):
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: system, h, coordinates, integrator options, the curve's samples
         (not its system again: it is this map's) and the forcing cache."""
-        return {"sys": self.sys, "h": self.h, "coordinates": self.coordinates, "options": dict(self.integrator_options),
-                "curve": None if self.curve is None else self.curve._samples(), "forcing": self._forcing}
+        return {
+            "sys": self.sys,
+            "h": self.h,
+            "coordinates": self.coordinates,
+            "options": dict(self.integrator_options),
+            "curve": None if self.curve is None else self.curve._samples(),
+            "forcing": self._forcing,
+        }
 
     #: Entries of the record derived from the others (the forcing fit of the curve): not part of
     #: the map's identity in a checkpoint key (:func:`hovering._serial.record_key`).
@@ -208,11 +259,12 @@ class FlowMap(MapAnalyses):
 
     #: The integrator options a saved FlowMap holds (:attr:`integrator_options`): a file's options
     #: are these or nothing, never an ``accuracy`` target (that would measure, i.e. compute, on load).
-    _RECORD_OPTIONS = frozenset({"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol",
-                                 "corner_tol"})
+    _RECORD_OPTIONS = frozenset(
+        {"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
+    )
 
     @classmethod
-    def _from_record(cls, record: dict) -> "FlowMap":
+    def _from_record(cls, record: dict) -> FlowMap:
         """Inverse of :meth:`_to_record`: validated again, and rebuilt from the stored values only (no
         flow is traced, no accuracy target measured: a record asking for either is refused)."""
         sys, h = record["sys"], record["h"]
@@ -223,17 +275,21 @@ class FlowMap(MapAnalyses):
             raise ValueError(f"the FlowMap's options must be a dict, got {type(options).__name__}")
         unknown = sorted(set(options) - cls._RECORD_OPTIONS)
         if unknown:
-            raise ValueError(f"the FlowMap's options {unknown} are not stored settings; allowed: "
-                             f"{sorted(cls._RECORD_OPTIONS)} (a saved map holds the setting an accuracy target chose, "
-                             f"never the target: reading a file does not measure)")
+            raise ValueError(
+                f"the FlowMap's options {unknown} are not stored settings; allowed: "
+                f"{sorted(cls._RECORD_OPTIONS)} (a saved map holds the setting an accuracy target chose, "
+                f"never the target: reading a file does not measure)"
+            )
         if not is_choice(record["coordinates"], ("normal", "section")):
             raise ValueError(f"the FlowMap's coordinates must be 'normal' or 'section', got {record['coordinates']!r}")
         curve = None
         if record["curve"] is not None:
             curve = TangentialCurve._from_samples(Section(sys, h), record["curve"])
         elif record["coordinates"] == "normal":
-            raise ValueError("the FlowMap is in normal coordinates but the file holds no tangential curve (a saved "
-                             "map holds its measured curve; reading a file does not measure one)")
+            raise ValueError(
+                "the FlowMap is in normal coordinates but the file holds no tangential curve (a saved "
+                "map holds its measured curve; reading a file does not measure one)"
+            )
         forcing = record["forcing"]
         if forcing is not None:
             forcing = np.asarray(forcing_array(forcing), dtype=float)
@@ -269,10 +325,23 @@ class FlowMap(MapAnalyses):
             On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
         """
         p, k, _ = point_pair(phi, K, "returns")
-        d = self._core.steps(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel()), flag("inverse", inverse),
-                             _threads(n_threads, self.sys.python_defined))
-        res = FlowSteps(phi=d["x"], K=d["y"], status=d["status"], region=d["region"], itinerary=d["itinerary"],
-                        time=d["time"], energy_error=d["energy_error"], steps=d["steps"], z=d["z"])
+        d = self._core.steps(
+            np.ascontiguousarray(p.ravel()),
+            np.ascontiguousarray(k.ravel()),
+            flag("inverse", inverse),
+            _threads(n_threads, self.sys.python_defined),
+        )
+        res = FlowSteps(
+            phi=d["x"],
+            K=d["y"],
+            status=d["status"],
+            region=d["region"],
+            itinerary=d["itinerary"],
+            time=d["time"],
+            energy_error=d["energy_error"],
+            steps=d["steps"],
+            z=d["z"],
+        )
         if d["interrupted"]:
             exc = KeyboardInterrupt("returns interrupted; the finished ones are in .partial")
             exc.partial = res
@@ -331,10 +400,21 @@ class FlowMap(MapAnalyses):
         r = self.returns(p, k).region.reshape(p.shape)
         return Region(int(r)) if scalar else r
 
-    def iterate(self, phi0, K0, n_steps: int, record: Sequence[str] = ("orbit", "regions", "rotation"),
-                exit_regions: Optional[Iterable] = None, stop_on_exit: bool = False, n_threads: int = 0,
-                trajectory_dt: Optional[float] = None, max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
-                progress=False, every: int = 1, stop=None) -> IterateResult:
+    def iterate(
+        self,
+        phi0,
+        K0,
+        n_steps: int,
+        record: Sequence[str] = ("orbit", "regions", "rotation"),
+        exit_regions: Iterable | None = None,
+        stop_on_exit: bool = False,
+        n_threads: int = 0,
+        trajectory_dt: float | None = None,
+        max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
+        progress=False,
+        every: int = 1,
+        stop=None,
+    ) -> IterateResult:
         """Iterate many orbits in C++ (the core's thread pool, GIL released, no Python between returns).
 
         Parameters
@@ -416,41 +496,83 @@ class FlowMap(MapAnalyses):
         p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
         n_states, n_returns = recorded_counts(n_steps, every)
         per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
-        per_return = 8 * sum(key in record for key in ("times", "energy_error", "steps")) + ("regions" in record) + \
-            64 * ("itinerary" in record)
+        per_return = (
+            8 * sum(key in record for key in ("times", "energy_error", "steps"))
+            + ("regions" in record)
+            + 64 * ("itinerary" in record)
+        )
         thinned = f" (every {every})" if every > 1 else ""
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} returns{thinned}",
-                     8 * per_point * p.size * n_states + per_return * p.size * n_returns)
+        check_memory(
+            f"recording {record} for {p.size} orbits x {n_steps} returns{thinned}",
+            8 * per_point * p.size * n_states + per_return * p.size * n_returns,
+        )
         dt, per_orbit = 0.0, 0
         if "trajectory" in record:
             if trajectory_dt is None:
-                raise ValueError("trajectory_dt (the sample spacing) must be a number in (0, inf) with record 'trajectory', "
-                                 "got None")
+                raise ValueError(
+                    "trajectory_dt (the sample spacing) must be a number in (0, inf) with record 'trajectory', got None"
+                )
             dt, per_orbit = trajectory_arguments(trajectory_dt, max_trajectory_points, p.size)
         elif trajectory_dt is not None:
-            raise ValueError(f"trajectory_dt = {trajectory_dt!r} is only used with record 'trajectory'; add it to record "
-                             "or leave trajectory_dt out")
+            raise ValueError(
+                f"trajectory_dt = {trajectory_dt!r} is only used with record 'trajectory'; add it to record "
+                "or leave trajectory_dt out"
+            )
         threads = _threads(n_threads, self.sys.python_defined)
         with progress_bar(progress, p.size * n_steps, desc="FlowMap.iterate", unit="return") as bar:
-            d = self._core.iterate(p, k, n_steps, set(record), mask, bool(stop_on_exit), threads, dt, per_orbit,
-                                   bar.part(0) or None, every, stop_side, stop_curve)
-        res = IterateResult(phi=d.get("x"), K=d.get("y"), region=d.get("region"), rotation=d.get("rotation"),
-                            phi_final=d["x_final"], K_final=d["y_final"], status=d["status"], steps_done=d["steps_done"],
-                            exit_step=d.get("exit_step"), n_steps=n_steps, map=self, theta=d.get("theta"), I=d.get("I"),
-                            z=d.get("z"), time=d.get("time"), energy_error=d.get("energy_error"),
-                            integrator_steps=d.get("integrator_steps"), itinerary=d.get("itinerary"),
-                            visited=d.get("visited"), trajectory=d.get("trajectory"),
-                            trajectory_index=d.get("trajectory_index"), trajectory_kind=d.get("trajectory_kind"),
-                            trajectory_truncated=d.get("trajectory_truncated"), work=d["work"],
-                            stop_step=d.get("stop_step"), K_min=d.get("y_min"), K_max=d.get("y_max"),
-                            residence=d.get("residence"), every=every)
+            d = self._core.iterate(
+                p,
+                k,
+                n_steps,
+                set(record),
+                mask,
+                bool(stop_on_exit),
+                threads,
+                dt,
+                per_orbit,
+                bar.part(0) or None,
+                every,
+                stop_side,
+                stop_curve,
+            )
+        res = IterateResult(
+            phi=d.get("x"),
+            K=d.get("y"),
+            region=d.get("region"),
+            rotation=d.get("rotation"),
+            phi_final=d["x_final"],
+            K_final=d["y_final"],
+            status=d["status"],
+            steps_done=d["steps_done"],
+            exit_step=d.get("exit_step"),
+            n_steps=n_steps,
+            map=self,
+            theta=d.get("theta"),
+            I=d.get("I"),
+            z=d.get("z"),
+            time=d.get("time"),
+            energy_error=d.get("energy_error"),
+            integrator_steps=d.get("integrator_steps"),
+            itinerary=d.get("itinerary"),
+            visited=d.get("visited"),
+            trajectory=d.get("trajectory"),
+            trajectory_index=d.get("trajectory_index"),
+            trajectory_kind=d.get("trajectory_kind"),
+            trajectory_truncated=d.get("trajectory_truncated"),
+            work=d["work"],
+            stop_step=d.get("stop_step"),
+            K_min=d.get("y_min"),
+            K_max=d.get("y_max"),
+            residence=d.get("residence"),
+            every=every,
+        )
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
             exc.partial = res
             raise exc
         return res
 
-    def with_eps(self, eps: float) -> "FlowMap":
+    def with_eps(self, eps: float) -> FlowMap:
         """The same system, section and integrator at another eps (its own tangential curve).
 
         Used for the hovering set's F_0: a point is carried to eps = 0 by its normal coordinates.
@@ -479,12 +601,13 @@ class FlowMap(MapAnalyses):
 
     def _require_onset(self):
         if self.onset is None:
-            raise ValueError(f"no onset parameters at h = {self.h} (step energy {self.sys.step_energy}): "
-                             f"{self.onset_error}")
+            raise ValueError(
+                f"no onset parameters at h = {self.h} (step energy {self.sys.step_energy}): {self.onset_error}"
+            )
         if self.coordinates != "normal":
             raise ValueError("the theory and the model live in normal coordinates: use coordinates='normal'")
 
-    def forcing_coefficients(self, n_modes: Optional[int] = None) -> np.ndarray:
+    def forcing_coefficients(self, n_modes: int | None = None) -> np.ndarray:
         """Sine coefficients of the measured forcing f (eq:defoff) of this section (cached).
 
         The core's one fit (:meth:`TangentialCurve.forcing_coefficients`, ``n_modes`` default
@@ -504,7 +627,7 @@ class FlowMap(MapAnalyses):
                 self._forcing = tiny.forcing_coefficients(n_modes)
         return self._forcing
 
-    def theory(self) -> "_theory.Theory":
+    def theory(self) -> _theory.Theory:
         """Leading-order predictions with this system's onset parameters and measured forcing.
 
         Returns
@@ -530,7 +653,7 @@ class FlowMap(MapAnalyses):
         self._require_onset()
         return _theory.L2(K, self.onset.Omega0, self.onset.tau0)
 
-    def truncated(self, forcing: str = "measured", n_modes: Optional[int] = None):
+    def truncated(self, forcing: str = "measured", n_modes: int | None = None):
         """The truncated model of this system (eq:trunceps1eps2), with no hand scaling.
 
         The arcs are the onset parameters' (eq:omegaofalead); the forcing is the measured f of
@@ -560,7 +683,7 @@ class FlowMap(MapAnalyses):
             return m
         depth = min(0.95 * -m.valid_band()[0], 1.0)
         s = np.linspace(math.sqrt(depth), 0.0, 121)
-        Kgrid = np.concatenate([-s**2, np.linspace(depth / 60, depth, 40)])
+        Kgrid = np.concatenate([-(s**2), np.linspace(depth / 60, depth, 40)])
         return TruncatedFamily.from_map(m.with_eps(self.eps), Kgrid, forcing=tuple(b))
 
     def upper_tangent_K(self) -> float:
@@ -603,8 +726,9 @@ class FlowMap(MapAnalyses):
             Ku, d = self.upper_tangent_K(), 0.05 + 2 * abs(self.eps)
             lo = self.valid_band()[0]
             K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3))
-        return hook("critical_curve")(self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi),
-                              search="highest", **kwargs)
+        return hook("critical_curve")(
+            self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi), search="highest", **kwargs
+        )
 
     def step_rotations(self, res: IterateResult, i: int) -> np.ndarray:
         """The rotation of each return of orbit i of ``res``: the angle advance ``phi_{n+1} - phi_n``

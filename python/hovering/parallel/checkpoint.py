@@ -35,8 +35,9 @@ import fcntl
 import json
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any
 
 from .. import _untrusted
 from .._output import write_error
@@ -106,7 +107,7 @@ def canonical(key: Any) -> str:
 
 
 def _reject_constant(name: str):
-    raise ValueError(f"the number {name} is not JSON (a non-finite number is written as the string \"{name}\")")
+    raise ValueError(f'the number {name} is not JSON (a non-finite number is written as the string "{name}")')
 
 
 class Checkpoint:
@@ -174,9 +175,11 @@ class Checkpoint:
     def _check_size(self, nbytes: int, need: int) -> None:
         budget = _untrusted.memory_budget()
         if need > budget:
-            raise ValueError(f"{self.path}: a checkpoint of {nbytes} bytes, whose rows would take up to "
-                             f"{need / 2**30:.3g} GiB, more than half of this machine's memory "
-                             f"({2 * budget / 2**30:.3g} GiB)")
+            raise ValueError(
+                f"{self.path}: a checkpoint of {nbytes} bytes, whose rows would take up to "
+                f"{need / 2**30:.3g} GiB, more than half of this machine's memory "
+                f"({2 * budget / 2**30:.3g} GiB)"
+            )
 
     def _scan(self, fd: int, cut: bool) -> None:
         size = os.fstat(fd).st_size
@@ -201,8 +204,10 @@ class Checkpoint:
     def _damaged(self, why: str) -> ValueError:
         if self._lines == 1:
             return ValueError(f"{self.path} line 1: {why}; use another checkpoint file, or move this one away")
-        return ValueError(f"{self.path} line {self._lines}: {why}: the file was edited or damaged; fix or remove "
-                          "that line (its point is recomputed), or use another checkpoint file")
+        return ValueError(
+            f"{self.path} line {self._lines}: {why}: the file was edited or damaged; fix or remove "
+            "that line (its point is recomputed), or use another checkpoint file"
+        )
 
     def _take(self, raw: bytes) -> None:
         try:
@@ -219,11 +224,15 @@ class Checkpoint:
                 old = "key" in rec and "row" in rec
                 raise self._damaged(
                     "a checkpoint of an older hovering (no format header): its points were keyed otherwise and "
-                    "cannot be reused" if old else
-                    f'the first line is not the header {{"format":"{FORMAT}","version":{VERSION}}}: another '
-                    "program's file")
+                    "cannot be reused"
+                    if old
+                    else f'the first line is not the header {{"format":"{FORMAT}","version":{VERSION}}}: another '
+                    "program's file"
+                )
             if not (type(rec["version"]) is int and rec["version"] == VERSION):
-                raise self._damaged(f"a checkpoint of version {rec['version']!r}; this hovering reads version {VERSION}")
+                raise self._damaged(
+                    f"a checkpoint of version {rec['version']!r}; this hovering reads version {VERSION}"
+                )
             return
         if set(rec) == {"provenance"} and isinstance(rec["provenance"], dict):
             return
@@ -232,8 +241,9 @@ class Checkpoint:
             if k not in self._rows:  # the first line of a point wins (a later one cannot differ but in timing)
                 self._rows[k], self._line[k] = rec["row"], self._lines
             return
-        raise self._damaged('neither a point {"key": {...}, "row": {...}} nor a provenance record '
-                            '{"provenance": {...}}')
+        raise self._damaged(
+            'neither a point {"key": {...}, "row": {...}} nor a provenance record {"provenance": {...}}'
+        )
 
     def refresh(self) -> None:
         """Read the lines other processes appended since the last look (under a shared lock)."""
@@ -246,7 +256,7 @@ class Checkpoint:
     def __contains__(self, key: Any) -> bool:
         return canonical(key) in self._rows
 
-    def get(self, key: Any, check: Optional[Callable] = None) -> Optional[Any]:
+    def get(self, key: Any, check: Callable | None = None) -> Any | None:
         """The stored row for ``key`` (non-finite numbers as floats again), or None.
 
         Parameters
@@ -275,13 +285,15 @@ class Checkpoint:
             try:
                 check(row)
             except ValueError as e:
-                raise ValueError(f"{self.path} line {self._line.get(k, '?')}: {e} (the file was edited or damaged: "
-                                 "remove that line to recompute the point)") from None
+                raise ValueError(
+                    f"{self.path} line {self._line.get(k, '?')}: {e} (the file was edited or damaged: "
+                    "remove that line to recompute the point)"
+                ) from None
         return row
 
     # ------------------------------------------------------------ writing
 
-    def put(self, key: Any, row: Any, threads: Optional[int] = None) -> bool:
+    def put(self, key: Any, row: Any, threads: int | None = None) -> bool:
         """Store a finished point durably (locked append, fsync) before returning.
 
         Lines appended by others since the last read are read first, under the same lock: if one
@@ -326,7 +338,7 @@ class Checkpoint:
             try:
                 view = memoryview(data)
                 while view:
-                    view = view[os.write(fd, view):]
+                    view = view[os.write(fd, view) :]
                 os.fsync(fd)
             except OSError:
                 try:
@@ -393,5 +405,9 @@ def check_row(row, fields: dict, where: str = "row") -> None:
 
 
 def _clip(value) -> str:
-    r = repr(value) if not isinstance(value, int) or value.bit_length() < 256 else f"an integer of {value.bit_length()} bits"
+    r = (
+        repr(value)
+        if not isinstance(value, int) or value.bit_length() < 256
+        else f"an integer of {value.bit_length()} bits"
+    )
     return r if len(r) <= 60 else r[:57] + "..."

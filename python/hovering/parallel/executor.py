@@ -20,9 +20,9 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing
 import os
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable, Iterable, Iterator, Optional
 
 from .._checks import integer
 from .._deprecated import renamed_argument
@@ -63,11 +63,11 @@ class Executor:
         of ``client``, ``scheduler`` and ``pool``, or ``dask`` with one of them.
     """
 
-    workers: Optional[int] = None
+    workers: int | None = None
     dask: bool = False
     client: object = None
-    scheduler: Optional[str] = None
-    pieces: Optional[int] = None
+    scheduler: str | None = None
+    pieces: int | None = None
     checkpoint: object = None
     pool: object = None
 
@@ -102,11 +102,13 @@ class Executor:
 
 
 def _not_an_executor(value) -> ValueError:
-    return ValueError(f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
-                      f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}")
+    return ValueError(
+        f"executor must be None, a worker count, a scheduler address, a distributed.Client, a "
+        f"concurrent.futures.Executor or a hovering.parallel.Executor, got {value!r}"
+    )
 
 
-def as_executor(value) -> Optional[Executor]:
+def as_executor(value) -> Executor | None:
     """The :class:`Executor` an ``executor=`` argument stands for (``None``: this process).
 
     Parameters
@@ -143,7 +145,7 @@ def as_executor(value) -> Optional[Executor]:
 OLD_ARGUMENTS = ("workers", "client", "scheduler", "dask", "pieces", "checkpoint")
 
 
-def from_old_arguments(func: str, executor_value, old: dict, allowed=OLD_ARGUMENTS) -> Optional[Executor]:
+def from_old_arguments(func: str, executor_value, old: dict, allowed=OLD_ARGUMENTS) -> Executor | None:
     """``executor=`` of a function that also still takes the old separate arguments.
 
     Each old argument that was given warns (DeprecationWarning naming ``executor=`` and the release
@@ -252,8 +254,7 @@ def _share(workers: int) -> int:
 
 
 @contextmanager
-def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False,
-             pool=None):
+def executor(workers: int | None = None, client=None, scheduler: str | None = None, dask: bool = False, pool=None):
     """Where pieces run.
 
     Parameters
@@ -294,8 +295,9 @@ def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str
             ex = _Dask(distributed.Client(scheduler), own=True)
         else:
             n = spec.workers if spec.workers is not None else 2
-            cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                               dashboard_address=":0")
+            cluster = distributed.LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+            )
             ex = _Dask(distributed.Client(cluster), own=True, cluster=cluster)
     else:
         ex = _Local(spec.workers if spec.workers is not None else 2)
@@ -305,7 +307,7 @@ def executor(workers: Optional[int] = None, client=None, scheduler: Optional[str
         ex.close()
 
 
-def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Optional[Callable] = None) -> Iterator:
+def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Callable | None = None) -> Iterator:
     """Submit ``fn(*args)`` for each piece and yield ``(index, result)`` as pieces finish.
 
     Parameters

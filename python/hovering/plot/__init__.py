@@ -5,8 +5,8 @@
 computing side).
 """
 
+from .._style import REGION_COLORS, SPECIAL_COLORS, SPECIAL_LABELS
 from .figures import render
 from .primitives import draw_geometry, plot_orbits
-from .._style import REGION_COLORS, SPECIAL_COLORS, SPECIAL_LABELS
 
 __all__ = ["render", "draw_geometry", "plot_orbits", "REGION_COLORS", "SPECIAL_COLORS", "SPECIAL_LABELS"]

@@ -12,21 +12,48 @@ content without looking at pixels.
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Optional
 
 import numpy as np
 
 from .._enums import Region
-from ..scenes.results import (CornerDirectionsResult, FlowHoveringResult, FlowPortraitResult, HoveringAreaResult,
-                              OrbitPanelResult, OrbitSceneResult, SigmaStructureResult, TangentToriResult,
-                              WallSectionResult, WallTangencyResult)
+from .._style import (
+    CORNER_COLORS,
+    GEOMETRY_COLOR,
+    QUICK_MARK,
+    REGION_COLORS,
+    REGION_LABELS,
+    SPECIAL_LABELS,
+    WALL_REGION_COLORS,
+)
+from ..scenes.results import (
+    CornerDirectionsResult,
+    FlowHoveringResult,
+    FlowPortraitResult,
+    HoveringAreaResult,
+    OrbitPanelResult,
+    OrbitSceneResult,
+    SigmaStructureResult,
+    TangentToriResult,
+    WallSectionResult,
+    WallTangencyResult,
+)
 from ..scenes.spec import QUICK_FACTOR, figure_inches
 from .primitives import draw_geometry, plot_orbits
-from .._style import CORNER_COLORS, GEOMETRY_COLOR, QUICK_MARK, REGION_COLORS, REGION_LABELS, SPECIAL_LABELS, WALL_REGION_COLORS
 
-__all__ = ["render", "panel_title", "orbit_label", "orbit_figure", "hovering_area_figure", "flow_portrait_figure",
-           "flow_hovering_figure", "tangent_tori_figure", "sigma_structure_figure", "corner_directions_figure",
-           "wall_tangency_figure", "wall_section_figure"]
+__all__ = [
+    "render",
+    "panel_title",
+    "orbit_label",
+    "orbit_figure",
+    "hovering_area_figure",
+    "flow_portrait_figure",
+    "flow_hovering_figure",
+    "tangent_tori_figure",
+    "sigma_structure_figure",
+    "corner_directions_figure",
+    "wall_tangency_figure",
+    "wall_section_figure",
+]
 
 
 def panel_title(tag: str, params: dict) -> str:
@@ -44,8 +71,10 @@ def panel_title(tag: str, params: dict) -> str:
     str
     """
     p = params
-    s = (rf"({tag}) $\varepsilon={p['eps']:g}$, $\Omega_0={p['Omega0']:.4f}$, $\theta_w={p['theta_w']:.4f}$, "
-         rf"$\tau_0={p['tau0']:g}$, $\tau_1={p['tau1']:g}$, $\lambda={p['lam']:g}$")
+    s = (
+        rf"({tag}) $\varepsilon={p['eps']:g}$, $\Omega_0={p['Omega0']:.4f}$, $\theta_w={p['theta_w']:.4f}$, "
+        rf"$\tau_0={p['tau0']:g}$, $\tau_1={p['tau1']:g}$, $\lambda={p['lam']:g}$"
+    )
     if p.get("golden_c") is not None:
         ge = p.get("golden_eps")
         at = "" if ge is None or ge == p["eps"] else rf" at $\varepsilon={ge:g}$"
@@ -53,7 +82,7 @@ def panel_title(tag: str, params: dict) -> str:
     return s
 
 
-def orbit_label(label: str, kind: str, K0: float, rho: Optional[float]) -> str:
+def orbit_label(label: str, kind: str, K0: float, rho: float | None) -> str:
     """Legend text of one orbit: who it is, where it starts, and its rotation number.
 
     Parameters
@@ -80,10 +109,6 @@ def orbit_label(label: str, kind: str, K0: float, rho: Optional[float]) -> str:
     else:
         head = label
     return head if rho is None else rf"{head}: $\rho={rho:.3f}$"
-
-
-
-
 
 
 def _grid(n: int, layout, figsize, sharey: bool = False):
@@ -139,8 +164,9 @@ def _draw_orbit_panel(ax, p: OrbitPanelResult, scene, quick: str) -> None:
         title += "\n(critical curve not found)"
     ax.set_title(title + quick, fontsize=8)
     if handles:
-        leg = ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=7,
-                        frameon=False)
+        leg = ax.legend(
+            handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=7, frameon=False
+        )
         for h in leg.legend_handles:
             if hasattr(h, "set_sizes"):
                 h.set_sizes([25.0])  # legible legend dots whatever the marker size of the orbits
@@ -161,9 +187,13 @@ def _draw_zoom_panel(ax, z, src: OrbitPanelResult, scene, quick: str) -> None:
     ax.set_ylim(y0, y1)
     ax.set_xlabel(r"$\phi$")
     ax.set_ylabel(r"$K$")
-    what = {"critical": "the hovering set under the critical curve", "islands": "islands", "fixed": "fixed window"}[z.on]
-    ax.set_title(f"({z.id}) zoom of ({z.of}): {what}\n" + rf"$\phi\in[{x0:.3f}, {x1:.3f}]$, $K\in[{y0:.4f}, {y1:.4f}]$"
-                 + quick, fontsize=8)
+    what = {"critical": "the hovering set under the critical curve", "islands": "islands", "fixed": "fixed window"}[
+        z.on
+    ]
+    ax.set_title(
+        f"({z.id}) zoom of ({z.of}): {what}\n" + rf"$\phi\in[{x0:.3f}, {x1:.3f}]$, $K\in[{y0:.4f}, {y1:.4f}]$" + quick,
+        fontsize=8,
+    )
 
 
 def orbit_figure(result: OrbitSceneResult):
@@ -212,21 +242,38 @@ def hovering_area_figure(result: HoveringAreaResult):
     fig, (ax, axr) = _grid(2, (1, 2), figure_inches(scene))
     any_floor = False
     for s in result.series:
-        eb = ax.errorbar(s.eps, s.area, yerr=s.error, fmt="o", ms=4, capsize=3, color=s.color,
-                         label=f"{s.label} (measured)")
+        eb = ax.errorbar(
+            s.eps, s.area, yerr=s.error, fmt="o", ms=4, capsize=3, color=s.color, label=f"{s.label} (measured)"
+        )
         eb[0].set_gid(f"measured:{s.label}")
         if s.floor_touched.any():
             any_floor = True
             f = s.floor_touched
             ax.plot(s.eps[f], s.area[f], "o", ms=8, mfc="none", mec="k", mew=0.8, zorder=5)
         if s.theory_eps.size:
-            (ln,) = ax.plot(s.theory_eps, s.theory_curve, "-", color=s.color, lw=1.0, alpha=0.8,
-                            label=f"{s.label}: theory eq:hovsetsize")
+            (ln,) = ax.plot(
+                s.theory_eps,
+                s.theory_curve,
+                "-",
+                color=s.color,
+                lw=1.0,
+                alpha=0.8,
+                label=f"{s.label}: theory eq:hovsetsize",
+            )
             ln.set_gid(f"theory:{s.label}")
         pos = (s.eps > 0) & (s.theory > 0)
         if pos.any():
-            axr.errorbar(s.eps[pos], s.area[pos] / s.theory[pos], yerr=s.error[pos] / s.theory[pos], fmt="o-", ms=4,
-                         capsize=3, color=s.color, lw=0.8, label=s.label)
+            axr.errorbar(
+                s.eps[pos],
+                s.area[pos] / s.theory[pos],
+                yerr=s.error[pos] / s.theory[pos],
+                fmt="o-",
+                ms=4,
+                capsize=3,
+                color=s.color,
+                lw=0.8,
+                label=s.label,
+            )
     if any_floor:
         ax.plot([], [], "o", ms=8, mfc="none", mec="k", mew=0.8, label="hovering points at the box floor")
     ax.axhline(0.0, color="0.6", lw=0.8)
@@ -251,8 +298,10 @@ def _system_text(scene) -> str:
     def pot(p):
         return f"{p.kind}({p.omega:g}" + (f", {p.alpha:g})" if p.alpha is not None else ")")
 
-    return (rf"$V_1$={pot(s.V1)}, $V_2$={pot(s.V2)}, $\varepsilon={s.eps:g}$, $q_w=({s.qw1:g}, {s.qw2:g})$, "
-            rf"$h={scene.h:g}$, {scene.integrator.stepper} rtol {scene.integrator.rtol:g}")
+    return (
+        rf"$V_1$={pot(s.V1)}, $V_2$={pot(s.V2)}, $\varepsilon={s.eps:g}$, $q_w=({s.qw1:g}, {s.qw2:g})$, "
+        rf"$h={scene.h:g}$, {scene.integrator.stepper} rtol {scene.integrator.rtol:g}"
+    )
 
 
 def flow_portrait_figure(result: FlowPortraitResult):
@@ -275,14 +324,18 @@ def flow_portrait_figure(result: FlowPortraitResult):
     scene, q = result.scene, _quick(result)
     fig, axes = _grid(2, (1, 2), figure_inches(scene), sharey=True)
     o = result.onset
-    titles = (f"(a) full return map (flow), {result.meta.get('n_steps')} returns",
-              f"(b) truncated model ({result.model_name} forcing), onset arcs "
-              rf"$\Omega_0={o['Omega0']:.4f}$, $\theta_w={o['theta_w']:.4f}$")
-    for ax, orbits, geom, title in zip(axes, (result.flow, result.model), (result.flow_geometry,
-                                                                             result.model_geometry), titles):
+    titles = (
+        f"(a) full return map (flow), {result.meta.get('n_steps')} returns",
+        f"(b) truncated model ({result.model_name} forcing), onset arcs "
+        rf"$\Omega_0={o['Omega0']:.4f}$, $\theta_w={o['theta_w']:.4f}$",
+    )
+    for ax, orbits, geom, title in zip(
+        axes, (result.flow, result.model), (result.flow_geometry, result.model_geometry), titles
+    ):
         by_region = orbits.region is not None
-        colls = plot_orbits(ax, orbits, color_by="region" if by_region else "orbit", s=scene.marker_size,
-                            colors=orbits.colors)
+        colls = plot_orbits(
+            ax, orbits, color_by="region" if by_region else "orbit", s=scene.marker_size, colors=orbits.colors
+        )
         if by_region:
             _region_legend(ax, colls)
         else:
@@ -317,18 +370,40 @@ def flow_hovering_figure(result: FlowHoveringResult):
     fig, (ax, axa) = _grid(2, (1, 2), figure_inches(scene))
     e = result.eps
     order = np.argsort(e)
-    eb = ax.errorbar(e[order], result.flow_area[order], yerr=result.flow_error[order], fmt="o", ms=5, capsize=3,
-                     color="k", label="full flow (FlowMap)")
+    eb = ax.errorbar(
+        e[order],
+        result.flow_area[order],
+        yerr=result.flow_error[order],
+        fmt="o",
+        ms=5,
+        capsize=3,
+        color="k",
+        label="full flow (FlowMap)",
+    )
     eb[0].set_gid("measured:flow")
-    (lb,) = ax.plot(e[order], result.flow_both_sides[order], "x", color="0.3", ms=6,
-                    label="flow, orbits visiting $J_0$ and $J_{0u}$")
+    (lb,) = ax.plot(
+        e[order],
+        result.flow_both_sides[order],
+        "x",
+        color="0.3",
+        ms=6,
+        label="flow, orbits visiting $J_0$ and $J_{0u}$",
+    )
     lb.set_gid("measured:flow_both_sides")
     names = {"onset": "model, onset arcs", "measured": "model, arcs measured on the flow"}
     for k, (m, cols) in enumerate(result.models.items()):
         c = f"C{k}"
         shift = 0.004 * (k + 1) * (np.ptp(e) or 1.0)  # side by side: the error bars overlap otherwise
-        eb = ax.errorbar(e[order] + shift, cols["area"][order], yerr=cols["error"][order], fmt="s", ms=4, capsize=3,
-                         color=c, label=names.get(m, m))
+        eb = ax.errorbar(
+            e[order] + shift,
+            cols["area"][order],
+            yerr=cols["error"][order],
+            fmt="s",
+            ms=4,
+            capsize=3,
+            color=c,
+            label=names.get(m, m),
+        )
         eb[0].set_gid(f"measured:{m}")
         (la,) = axa.plot(e[order], 100 * cols["agree"][order], "s-", color=c, lw=0.8, label=names.get(m, m))
         la.set_gid(f"agree:{m}")
@@ -338,8 +413,9 @@ def flow_hovering_figure(result: FlowHoveringResult):
     ax.axvline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel(r"$\varepsilon$")
     ax.set_ylabel(r"$|\mathrm{HOV}(\varepsilon)|$")
-    ax.set_title(f"(a) hovering set, {result.meta.get('n_steps')} returns, {result.meta.get('samples')} points",
-                 fontsize=9)
+    ax.set_title(
+        f"(a) hovering set, {result.meta.get('n_steps')} returns, {result.meta.get('samples')} points", fontsize=9
+    )
     ax.legend(fontsize=7, loc="upper left")
     axa.set_xlabel(r"$\varepsilon$")
     axa.set_ylabel("verdicts equal to the flow's (%)")
@@ -421,9 +497,11 @@ def sigma_structure_figure(result: SigmaStructureResult):
     scene = result.scene
     fig, axes = _grid(6, (3, 2), figure_inches(scene))
     s = scene.marker_size
-    rows = (("q2", "p2", "q21", "p21", r"$q_2$", r"$p_2$"),
-            ("theta", "I", "theta1", "I1", r"$\theta$", r"$I$"),
-            ("phi", "K", "phi1", "K1", r"$\phi$", r"$K$"))
+    rows = (
+        ("q2", "p2", "q21", "p21", r"$q_2$", r"$p_2$"),
+        ("theta", "I", "theta1", "I1", r"$\theta$", r"$I$"),
+        ("phi", "K", "phi1", "K1", r"$\phi$", r"$K$"),
+    )
     tg = result.tangency
     for r, (x, y, x1, y1, xl, yl) in enumerate(rows):
         for c, (xa, ya) in enumerate(((x, y), (x1, y1))):
@@ -433,8 +511,15 @@ def sigma_structure_figure(result: SigmaStructureResult):
             for reg, col in REGION_COLORS.items():
                 sel = (result.region == int(reg)) & np.isfinite(X) & np.isfinite(Y)
                 if sel.any():
-                    h = ax.scatter(X[sel], Y[sel], s=s, c=col, lw=0, rasterized=True,
-                                   label=("" if c == 0 else "image of ") + REGION_LABELS[reg])
+                    h = ax.scatter(
+                        X[sel],
+                        Y[sel],
+                        s=s,
+                        c=col,
+                        lw=0,
+                        rasterized=True,
+                        label=("" if c == 0 else "image of ") + REGION_LABELS[reg],
+                    )
                     h.set_gid(f"region:{Region(reg).label}")
                     handles.append(h)
             key = {"q2": "q2", "theta": "theta", "phi": "phi", "q21": "q21", "theta1": "theta1", "phi1": "phi1"}[xa]
@@ -459,11 +544,15 @@ def sigma_structure_figure(result: SigmaStructureResult):
 
 
 #: Legend text of each incoming direction (eq:p2corner).
-_DIRECTION_LABELS = {"R0": r"$p_{R0}=(-p_1^w, P_2)$", "01": r"$p_{01}=(p_1^w, -P_2)$",
-                     "1R": r"$p_{1R}=(-p_1^w, -P_2)$"}
+_DIRECTION_LABELS = {"R0": r"$p_{R0}=(-p_1^w, P_2)$", "01": r"$p_{01}=(p_1^w, -P_2)$", "1R": r"$p_{1R}=(-p_1^w, -P_2)$"}
 #: Legend text of the wall-section regions in the paper's colours.
-_WALL_LABELS = {Region.RIGHT: r"$J_R$", Region.ABOVE: r"$J_0$", Region.UPPER: r"$J_1$",
-                Region.BESIDE: r"$J_{0u}$", Region.MULTI: "2+ impacts"}
+_WALL_LABELS = {
+    Region.RIGHT: r"$J_R$",
+    Region.ABOVE: r"$J_0$",
+    Region.UPPER: r"$J_1$",
+    Region.BESIDE: r"$J_{0u}$",
+    Region.MULTI: "2+ impacts",
+}
 #: Region of each arc label of a wall segment.
 _ARC_REGION = {"R": Region.RIGHT, "0": Region.ABOVE, "1": Region.UPPER}
 
@@ -504,8 +593,11 @@ def corner_directions_figure(result: CornerDirectionsResult):
     scene = result.scene
     fig, (axa, axb, axc, axd) = _grid(4, (2, 2), figure_inches(scene))
     qw1, qw2 = result.qw1, result.qw2
-    allq = np.concatenate([t.trajectory[:, [1, 3]] for t in result.trajectories]) if result.trajectories else \
-        np.array([[qw1, qw2]])
+    allq = (
+        np.concatenate([t.trajectory[:, [1, 3]] for t in result.trajectories])
+        if result.trajectories
+        else np.array([[qw1, qw2]])
+    )
     lo1, lo2 = min(allq[:, 0].min(), qw1) - 0.2, min(allq[:, 1].min(), qw2) - 0.2
     hi1, hi2 = allq[:, 0].max() + 0.1, allq[:, 1].max() + 0.1
     zoom = 0.12 * max(hi1 - lo1, hi2 - lo2)
@@ -525,8 +617,12 @@ def corner_directions_figure(result: CornerDirectionsResult):
                 st.set_gid(f"start:{t.direction}:{i}")
             else:
                 p = t.arrival[[1, 3]] / result.p1w_max * 0.6 * zoom
-                arr = ax.annotate("", xy=(qw1, qw2), xytext=(qw1 - p[0], qw2 - p[1]),
-                                  arrowprops=dict(arrowstyle="-|>", color=c, lw=1.2))
+                arr = ax.annotate(
+                    "",
+                    xy=(qw1, qw2),
+                    xytext=(qw1 - p[0], qw2 - p[1]),
+                    arrowprops=dict(arrowstyle="-|>", color=c, lw=1.2),
+                )
                 arr.set_gid(f"arrival:{t.direction}:{i}")
         ax.set_xlabel(r"$q_1$")
         ax.set_ylabel(r"$q_2$")
@@ -538,8 +634,13 @@ def corner_directions_figure(result: CornerDirectionsResult):
     axb.set_xlim(qw1 - zoom, qw1 + zoom)
     axb.set_ylim(qw2 - zoom, qw2 + zoom)
     for d, (dx, dy) in (("R0", (0.25, -0.55)), ("01", (-0.75, 0.45)), ("1R", (0.25, 0.5))):
-        axb.text(qw1 + dx * zoom, qw2 + dy * zoom, _DIRECTION_LABELS[d].split("=")[0] + "$",
-                 color=CORNER_COLORS[d], fontsize=11)
+        axb.text(
+            qw1 + dx * zoom,
+            qw2 + dy * zoom,
+            _DIRECTION_LABELS[d].split("=")[0] + "$",
+            color=CORNER_COLORS[d],
+            fontsize=11,
+        )
     axb.set_title("(b) at the corner: the arrival momenta (arrows)", fontsize=9)
     r = result.p1w_max
     a = np.linspace(0, 2 * np.pi, 361)
@@ -562,8 +663,16 @@ def corner_directions_figure(result: CornerDirectionsResult):
     axc.set_title(rf"(c) incoming momenta, $|p|=\sqrt{{2(h-h^w_\varepsilon)}}={r:.4f}$ (dots: measured)", fontsize=9)
     for d, c in result.curves.items():
         ok = c["reached"]
-        (ln,) = axd.plot(np.where(ok, c["phi"], np.nan), np.where(ok, c["K"], np.nan), "-", color=CORNER_COLORS[d],
-                         lw=1.2, marker=".", ms=3, label=rf"$\sigma_{{{d}}}$ ({int(ok.sum())}/{ok.size} reach the corner)")
+        (ln,) = axd.plot(
+            np.where(ok, c["phi"], np.nan),
+            np.where(ok, c["K"], np.nan),
+            "-",
+            color=CORNER_COLORS[d],
+            lw=1.2,
+            marker=".",
+            ms=3,
+            label=rf"$\sigma_{{{d}}}$ ({int(ok.sum())}/{ok.size} reach the corner)",
+        )
         ln.set_gid(f"curve:{d}")
         if (~ok & np.isfinite(c["phi"])).any():
             axd.plot(c["phi"][~ok], c["K"][~ok], "x", color=CORNER_COLORS[d], ms=4)
@@ -606,17 +715,29 @@ def wall_tangency_figure(result: WallTangencyResult):
     scene = result.scene
     fig, (axw, axq, axz) = _grid(3, (1, 3), figure_inches(scene))
     ln_, out = result.line, result.outer
-    band = axw.fill(np.concatenate([out["q2"], ln_["q2"][::-1]]), np.concatenate([out["p2"], ln_["p2"][::-1]]),
-                    color=WALL_REGION_COLORS[Region.BESIDE], lw=0, zorder=0,
-                    label=r"$\Sigma_h^{>}$: turns back before $q_1=q_1^w$ ($J_{0u}$)")
+    band = axw.fill(
+        np.concatenate([out["q2"], ln_["q2"][::-1]]),
+        np.concatenate([out["p2"], ln_["p2"][::-1]]),
+        color=WALL_REGION_COLORS[Region.BESIDE],
+        lw=0,
+        zorder=0,
+        label=r"$\Sigma_h^{>}$: turns back before $q_1=q_1^w$ ($J_{0u}$)",
+    )
     band[0].set_gid("band")
     g = result.grid
     handles = [band[0]]
     for reg, col in WALL_REGION_COLORS.items():
         sel = (g["region"] == int(reg)) & np.isfinite(g["q2"])
         if sel.any():
-            h = axw.scatter(g["q2"][sel], g["p2"][sel], s=scene.marker_size, c=col, lw=0, rasterized=True,
-                            label=_WALL_LABELS[reg] + " (the flow's label)")
+            h = axw.scatter(
+                g["q2"][sel],
+                g["p2"][sel],
+                s=scene.marker_size,
+                c=col,
+                lw=0,
+                rasterized=True,
+                label=_WALL_LABELS[reg] + " (the flow's label)",
+            )
             h.set_gid(f"region:{Region(reg).label}")
             handles.append(h)
     (lt,) = axw.plot(ln_["q2"], ln_["p2"], color="k", lw=1.2, label=r"tangency line $\Xi^0_{wall}$ ($p_1=0$)")
@@ -642,24 +763,40 @@ def wall_tangency_figure(result: WallTangencyResult):
     axw.set_title(r"(a) the wall section $\Sigma_h^{*,-}$ ($q_1=q_1^w$); dashed: $q_2=q_2^w$", fontsize=9)
     allq = np.concatenate([p.trajectory[:, [1, 3]] for p in result.points])
     lo1, lo2 = min(allq[:, 0].min(), result.qw1) - 0.2, min(allq[:, 1].min(), result.qw2) - 0.2
-    where = {1: "above the corner", 2: "at the corner", 3: "right wall", 4: "right wall", 5: "right wall",
-             6: "at the corner", 7: "above the corner"}
+    where = {
+        1: "above the corner",
+        2: "at the corner",
+        3: "right wall",
+        4: "right wall",
+        5: "right wall",
+        6: "at the corner",
+        7: "above the corner",
+    }
     for ax in (axq, axz):
         _draw_step(ax, result.qw1, result.qw2, lo1, lo2)
         ax.axvline(result.qw1, color="k", lw=0.6, ls=":")
         for p in result.points:
             c = colors(p.number)
             lab = f"{p.number}: {where[p.number]} (step system: {p.status.lower()})" if ax is axq else None
-            (ln,) = ax.plot(p.trajectory[:, 1], p.trajectory[:, 3], color=c, lw=1.0, ls="-" if p.p2 <= 0 else "--",
-                            label=lab)
+            (ln,) = ax.plot(
+                p.trajectory[:, 1], p.trajectory[:, 3], color=c, lw=1.0, ls="-" if p.p2 <= 0 else "--", label=lab
+            )
             ln.set_gid(f"trajectory:{p.number}")
             ax.plot(result.qw1, p.q2, "o", color=c, ms=5, mec="k", mew=0.5, zorder=4)
         ax.set_xlabel(r"$q_1$")
         ax.set_ylabel(r"$q_2$")
     for q2 in sorted({round(p.q2, 9) for p in result.points}):
         nums = ", ".join(str(p.number) for p in result.points if round(p.q2, 9) == q2)
-        axz.annotate(nums, (result.qw1, q2), xytext=(-8, 0), textcoords="offset points", fontsize=9, weight="bold",
-                     va="center", ha="right")
+        axz.annotate(
+            nums,
+            (result.qw1, q2),
+            xytext=(-8, 0),
+            textcoords="offset points",
+            fontsize=9,
+            weight="bold",
+            va="center",
+            ha="right",
+        )
     axq.set_xlim(lo1, allq[:, 0].max() + 0.1)
     axq.set_ylim(lo2, allq[:, 1].max() + 0.1)
     axq.legend(fontsize=6.5, loc="lower right", framealpha=0.9)
@@ -696,8 +833,13 @@ def wall_section_figure(result: WallSectionResult):
     fig, (axw, axq, axr, axz) = _grid(4, (2, 2), figure_inches(scene))
     tg, ci, cu = result.tangency, result.circle, result.curves
     order = np.argsort(result.tangency["theta"])
-    (lt,) = axw.plot(np.append(tg["q2"][order], tg["q2"][order][0]), np.append(tg["p2"][order], tg["p2"][order][0]),
-                     color="k", lw=1.0, label=r"tangency line $\rho_w=0$")
+    (lt,) = axw.plot(
+        np.append(tg["q2"][order], tg["q2"][order][0]),
+        np.append(tg["p2"][order], tg["p2"][order][0]),
+        color="k",
+        lw=1.0,
+        label=r"tangency line $\rho_w=0$",
+    )
     lt.set_gid("tangency")
     axr.axhline(0.0, color="k", lw=1.0)
     axw.axvline(result.qw2, color="k", lw=0.8, ls="--")
@@ -713,8 +855,9 @@ def wall_section_figure(result: WallSectionResult):
             handles.append(h)
     for d in ("R0", "01", "1R"):
         c = CORNER_COLORS[d]
-        (lw,) = axw.plot(cu[f"q2_{d}"], cu[f"p2_{d}"], "-", color=c, lw=1.2, marker=".", ms=4,
-                         label=rf"$\sigma^-_{{{d}}}$")
+        (lw,) = axw.plot(
+            cu[f"q2_{d}"], cu[f"p2_{d}"], "-", color=c, lw=1.2, marker=".", ms=4, label=rf"$\sigma^-_{{{d}}}$"
+        )
         lw.set_gid(f"curve:{d}")
         (lr,) = axr.plot(cu[f"theta_{d}"], cu["rho_w"], "-", color=c, lw=1.2, marker=".", ms=4)
         lr.set_gid(f"curve:{d}")
@@ -734,8 +877,11 @@ def wall_section_figure(result: WallSectionResult):
     axr.set_xlabel(r"$\theta$ (wall angle)")
     axr.set_ylabel(r"$\rho_w$")
     b = result.boundaries
-    axr.set_title(rf"(c) wall coordinates: $\theta_{{R0}}={b['R0']:.4f}$, $\theta_{{01}}={b['01']:.4f}$, "
-                  rf"$\theta_{{1R}}={b['1R']:.4f}$", fontsize=9)
+    axr.set_title(
+        rf"(c) wall coordinates: $\theta_{{R0}}={b['R0']:.4f}$, $\theta_{{01}}={b['01']:.4f}$, "
+        rf"$\theta_{{1R}}={b['1R']:.4f}$",
+        fontsize=9,
+    )
     segs = [g.trajectory[:, [1, 3]] for g in result.segments]
     allq = np.concatenate(segs) if segs else np.array([[result.qw1, result.qw2]])
     lo1, lo2 = min(allq[:, 0].min(), result.qw1) - 0.2, min(allq[:, 1].min(), result.qw2) - 0.2
@@ -749,14 +895,20 @@ def wall_section_figure(result: WallSectionResult):
             lab = None
             if ax is axq and (g.kind, g.itinerary, g.status) not in labelled:
                 labelled.add((g.kind, g.itinerary, g.status))
-                lab = (rf"on $\sigma^-_{{{g.kind}}}$" if g.kind in CORNER_COLORS else
-                       _WALL_LABELS[_ARC_REGION[g.kind]]) + f": {g.itinerary or g.status.lower()}"
+                lab = (
+                    rf"on $\sigma^-_{{{g.kind}}}$" if g.kind in CORNER_COLORS else _WALL_LABELS[_ARC_REGION[g.kind]]
+                ) + f": {g.itinerary or g.status.lower()}"
             # At eps = 0 the segment on sigma_1R leaves the corner (after the upper wall) along the one
             # on sigma_01 reversed, and the one on sigma_R0 (after the right wall) along the one on
             # sigma_1R reversed (the same |p1| and H2): widths, dashes and order keep all visible.
             style = _CORNER_SEGMENT_STYLE.get(g.kind, dict(lw=1.0, ls="-", zorder=2))
-            (ln,) = ax.plot(g.trajectory[:, 1], g.trajectory[:, 3], color=c if g.kind in CORNER_COLORS else
-                            _darker(c), label=lab, **style)
+            (ln,) = ax.plot(
+                g.trajectory[:, 1],
+                g.trajectory[:, 3],
+                color=c if g.kind in CORNER_COLORS else _darker(c),
+                label=lab,
+                **style,
+            )
             ln.set_gid(f"segment:{g.kind}:{i}")
             (pt,) = ax.plot(g.wall[0], g.wall[2], "o", color=c, ms=6, mec="k", mew=0.6, zorder=4)
             pt.set_gid(f"dot:{g.kind}:{i}")
@@ -776,8 +928,11 @@ def wall_section_figure(result: WallSectionResult):
 
 
 #: Line styles of the segments at the corner-singularity crossings (drawn over the others).
-_CORNER_SEGMENT_STYLE = {"R0": dict(lw=3.5, ls="-", zorder=3), "1R": dict(lw=1.8, ls="-", zorder=3.5),
-                         "01": dict(lw=1.4, ls=(0, (4, 2)), zorder=3.8)}
+_CORNER_SEGMENT_STYLE = {
+    "R0": dict(lw=3.5, ls="-", zorder=3),
+    "1R": dict(lw=1.8, ls="-", zorder=3.5),
+    "01": dict(lw=1.4, ls=(0, (4, 2)), zorder=3.8),
+}
 
 
 def _darker(color: str) -> tuple:
@@ -816,5 +971,3 @@ def render(result):
     if fn is None:
         raise ValueError(f"no figure for a {type(result).__name__}")
     return fn(result)
-
-

@@ -63,8 +63,17 @@ def draw_geometry(ax, geom, corner_curves: bool = True, lines: bool = True) -> l
         for key, style in CORNER_STYLES.items():
             phi = geom.corners.get(key)
             if phi is not None and len(phi):
-                artists += ax.plot(break_seam(phi), geom.K_corner, color="k", lw=0.8, ls=style, marker=marker, ms=2,
-                                   zorder=2, label=f"phi_{key}")
+                artists += ax.plot(
+                    break_seam(phi),
+                    geom.K_corner,
+                    color="k",
+                    lw=0.8,
+                    ls=style,
+                    marker=marker,
+                    ms=2,
+                    zorder=2,
+                    label=f"phi_{key}",
+                )
     return artists
 
 

@@ -38,17 +38,50 @@ from .compute import compute
 from .report import format_summary
 from .results import SceneResult, load_result, summarize
 from .schema import MAX_PANELS, MAX_SCENE_BYTES, MAX_SERIES_POINTS, load_scene, parse_scene
-from .spec import (FLOW_KINDS, KINDS, QUICK_FACTOR, SPECIAL_ORBITS, TRUNCATED_KINDS, CriticalSpec, MapSpec, OrbitSpec,
-                   PanelSpec, Scene, SceneSpec, SeriesSpec, ZoomSpec)
+from .spec import (
+    FLOW_KINDS,
+    KINDS,
+    QUICK_FACTOR,
+    SPECIAL_ORBITS,
+    TRUNCATED_KINDS,
+    CriticalSpec,
+    MapSpec,
+    OrbitSpec,
+    PanelSpec,
+    Scene,
+    SceneSpec,
+    SeriesSpec,
+    ZoomSpec,
+)
 
 #: The kinds that checkpoint their points (``<output>.sweep.jsonl``).
 SWEEP_KINDS = ("hovering_area", "flow_hovering_area")
 
 __all__ = [
-    "KINDS", "TRUNCATED_KINDS", "FLOW_KINDS", "SPECIAL_ORBITS", "QUICK_FACTOR", "MAX_PANELS", "MAX_SERIES_POINTS",
-    "MAX_SCENE_BYTES", "MapSpec", "OrbitSpec", "CriticalSpec", "ZoomSpec", "PanelSpec", "SeriesSpec", "Scene",
-    "SceneSpec", "SceneResult", "load_scene", "parse_scene", "compute", "load_result",
-    "summarize", "format_summary", "packaged_scene",
+    "KINDS",
+    "TRUNCATED_KINDS",
+    "FLOW_KINDS",
+    "SPECIAL_ORBITS",
+    "QUICK_FACTOR",
+    "MAX_PANELS",
+    "MAX_SERIES_POINTS",
+    "MAX_SCENE_BYTES",
+    "MapSpec",
+    "OrbitSpec",
+    "CriticalSpec",
+    "ZoomSpec",
+    "PanelSpec",
+    "SeriesSpec",
+    "Scene",
+    "SceneSpec",
+    "SceneResult",
+    "load_scene",
+    "parse_scene",
+    "compute",
+    "load_result",
+    "summarize",
+    "format_summary",
+    "packaged_scene",
 ]
 
 

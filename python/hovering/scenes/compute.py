@@ -13,16 +13,18 @@ from __future__ import annotations
 import math
 import os
 import time
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
 from .._enums import FlowStatus, Region, Status, wrap
-from .._style import SPECIAL_COLORS, orbit_color
 from .._progress import check_progress, progress_bar
+from .._style import SPECIAL_COLORS, orbit_color
 from .._version import __version__
 from ..analysis import rotation_number
 from ..diagnostics.work_precision import _reverse
+from ..flow.section import Section
+from ..normal.coordinates import TangentialCurve
 from ..normal.corners import corner_curves
 from ..normal.flowmap import FlowMap
 from ..parallel.checkpoint import Checkpoint, check_row
@@ -30,21 +32,66 @@ from ..parallel.executor import Executor, from_old_arguments, run_pieces
 from ..parallel.executor import executor as open_executor
 from ..truncated.maps import TruncatedFamily, TruncatedMap
 from ..truncated.theory import golden_family, hovering_area_theory
-from ..flow.section import Section
-from ..normal.coordinates import TangentialCurve
 from .plan import build_system, plan_points, point_key
-from .results import (CornerDirectionsResult, CornerTrajectory, FlowHoveringResult, FlowPortraitResult, Geometry,
-                      HoveringAreaResult, OrbitPanelResult, OrbitSceneResult, OrbitSet, SceneResult, SeriesResult,
-                      SigmaStructureResult, TangentToriResult, TorusResult, WallPoint, WallSectionResult, WallSegment,
-                      WallTangencyResult, ZoomPanelResult)
-from .spec import (QUICK_FACTOR, CornerDirectionsScene, FlowHoveringScene, FlowPortraitScene, HoveringAreaScene,
-                   OrbitScene, PanelSpec, SceneSpec, SigmaStructureScene, TangentToriScene, WallSectionScene,
-                   WallTangencyScene)
-from .wall import (DIRECTIONS, WallFlow, corner_energy, corner_speed, corner_states, rho_w_max, tangent_action, wall_states,
-                   wall_tangency_action)
+from .results import (
+    CornerDirectionsResult,
+    CornerTrajectory,
+    FlowHoveringResult,
+    FlowPortraitResult,
+    Geometry,
+    HoveringAreaResult,
+    OrbitPanelResult,
+    OrbitSceneResult,
+    OrbitSet,
+    SceneResult,
+    SeriesResult,
+    SigmaStructureResult,
+    TangentToriResult,
+    TorusResult,
+    WallPoint,
+    WallSectionResult,
+    WallSegment,
+    WallTangencyResult,
+    ZoomPanelResult,
+)
+from .spec import (
+    QUICK_FACTOR,
+    CornerDirectionsScene,
+    FlowHoveringScene,
+    FlowPortraitScene,
+    HoveringAreaScene,
+    OrbitScene,
+    PanelSpec,
+    SceneSpec,
+    SigmaStructureScene,
+    TangentToriScene,
+    WallSectionScene,
+    WallTangencyScene,
+)
+from .wall import (
+    DIRECTIONS,
+    WallFlow,
+    corner_energy,
+    corner_speed,
+    corner_states,
+    rho_w_max,
+    tangent_action,
+    wall_states,
+    wall_tangency_action,
+)
 
-__all__ = ["compute", "map_geometry", "flow_geometry", "zoom_window_critical", "zoom_window_islands",
-           "leading_curve", "special_starts", "hovering_orbits", "scaled", "scene_map"]
+__all__ = [
+    "compute",
+    "map_geometry",
+    "flow_geometry",
+    "zoom_window_critical",
+    "zoom_window_islands",
+    "leading_curve",
+    "special_starts",
+    "hovering_orbits",
+    "scaled",
+    "scene_map",
+]
 
 
 def scaled(n: int, quick: bool, floor: int = 100) -> int:
@@ -100,8 +147,13 @@ def map_geometry(m, K_range, n: int = 400, corner_curves: bool = True, lines: bo
     if corner_curves and Kn.size:
         cc = m.corner_curves(Kn)
         corners = {k: np.asarray(cc[k], dtype=float) for k in ("01", "1R", "R0")}
-    return Geometry(K=K, L1=np.asarray(m.L1(K), dtype=float) if lines else None,
-                    L2=np.asarray(m.L2(K), dtype=float) if lines else None, K_corner=Kn, corners=corners)
+    return Geometry(
+        K=K,
+        L1=np.asarray(m.L1(K), dtype=float) if lines else None,
+        L2=np.asarray(m.L2(K), dtype=float) if lines else None,
+        K_corner=Kn,
+        corners=corners,
+    )
 
 
 def flow_geometry(fm, K_range, n_circles: int, rtol: float, n: int = 200) -> Geometry:
@@ -133,11 +185,17 @@ def flow_geometry(fm, K_range, n_circles: int, rtol: float, n: int = 200) -> Geo
         if Kc.size:
             cc = corner_curves(fm.section, Kc, fm.curve, n_phi=256, bisections=30, rtol=max(rtol, 1e-13))
             corners = {"01": cc.phi_01, "1R": cc.phi_1R, "R0": cc.phi_R0}
-    return Geometry(K=K, L1=np.asarray(fm.L1(K), dtype=float), L2=np.asarray(fm.L2(K), dtype=float), K_corner=Kc,
-                    corners=corners, measured=True)
+    return Geometry(
+        K=K,
+        L1=np.asarray(fm.L1(K), dtype=float),
+        L2=np.asarray(fm.L2(K), dtype=float),
+        K_corner=Kc,
+        corners=corners,
+        measured=True,
+    )
 
 
-def leading_curve(m, n: int = 721, window: Optional[tuple] = None) -> tuple:
+def leading_curve(m, n: int = 721, window: tuple | None = None) -> tuple:
     """The leading-order upper critical curve: ``k_{eps,1}(phi; 0)`` (eps >= 0) or ``k_{eps,2}`` (eps < 0).
 
     Parameters
@@ -246,8 +304,12 @@ def zoom_window_critical(orbits: OrbitSet, m, pad: float = 0.5) -> dict:
     else:
         c, Kc = m.L1(0.0), min(m.K_crit(), -0.05 * abs(m.eps))
         w, h = 2 * m.theta_w, -Kc
-        return dict(xlim=_clip_x(c - m.theta_w - pad * w, c + m.theta_w + pad * w),
-                    ylim=[Kc - pad * h, pad * h], rule="predicted dip (no hovering orbit)", orbit=None)
+        return dict(
+            xlim=_clip_x(c - m.theta_w - pad * w, c + m.theta_w + pad * w),
+            ylim=[Kc - pad * h, pad * h],
+            rule="predicted dip (no hovering orbit)",
+            orbit=None,
+        )
     phi, K = orbits.phi[i], orbits.K[i]
     ok = np.isfinite(K)
     phi, K = phi[ok], K[ok]
@@ -257,8 +319,12 @@ def zoom_window_critical(orbits: OrbitSet, m, pad: float = 0.5) -> dict:
     a, b = float(d[below].min()), float(d[below].max())
     w, h = b - a, -float(K[j])
     x0 = float(phi[j])
-    return dict(xlim=_clip_x(x0 + a - pad * w, x0 + b + pad * w), ylim=[-h - pad * h, pad * h],
-                rule=f"dip of orbit '{orbits.labels[i]}' below K=0, pad {pad:g}", orbit=orbits.labels[i])
+    return dict(
+        xlim=_clip_x(x0 + a - pad * w, x0 + b + pad * w),
+        ylim=[-h - pad * h, pad * h],
+        rule=f"dip of orbit '{orbits.labels[i]}' below K=0, pad {pad:g}",
+        orbit=orbits.labels[i],
+    )
 
 
 def zoom_window_islands(orbits: OrbitSet, names, pad: float = 0.3) -> dict:
@@ -296,8 +362,12 @@ def zoom_window_islands(orbits: OrbitSet, names, pad: float = 0.3) -> dict:
     d = wrap(phi - c)
     a, b = c + float(d.min()), c + float(d.max())
     w, h = b - a, float(K.max() - K.min())
-    return dict(xlim=_clip_x(a - pad * w, b + pad * w), ylim=[float(K.min()) - pad * h, float(K.max()) + pad * h],
-                rule=rule, orbits=list(names))
+    return dict(
+        xlim=_clip_x(a - pad * w, b + pad * w),
+        ylim=[float(K.min()) - pad * h, float(K.max()) + pad * h],
+        rule=rule,
+        orbits=list(names),
+    )
 
 
 def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, progress) -> tuple:
@@ -308,8 +378,9 @@ def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, pro
         line = m.L1 if scene.line == "L1" else m.L2
         record = ("orbit", "regions") if scene.color_by == "region" else ("orbit",)
         res = m.iterate(line(K0), K0, n_steps, record=record, **_progress_kw(progress))
-        orbits = OrbitSet.of(res, [f"K0={k:.4g}" for k in K0], [orbit_color(i) for i in range(p.n_orbits)],
-                             ["fan"] * p.n_orbits)
+        orbits = OrbitSet.of(
+            res, [f"K0={k:.4g}" for k in K0], [orbit_color(i) for i in range(p.n_orbits)], ["fan"] * p.n_orbits
+        )
     else:
         starts = special_starts(m, p.special)
         labels, colors, kinds = list(p.special), [SPECIAL_COLORS[n] for n in p.special], list(p.special)
@@ -328,9 +399,16 @@ def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, pro
             except RuntimeError as e:
                 critical = dict(found=False, reason=str(e))
             else:
-                critical = dict(found=True, K0=c.K0, K_min=c.K_min, rotation=c.rotation,
-                                rotation_mean=c.rotation_mean, K_pred=c.K_pred, rotation_pred=c.rotation_pred,
-                                digits=c.digits)
+                critical = dict(
+                    found=True,
+                    K0=c.K0,
+                    K_min=c.K_min,
+                    rotation=c.rotation,
+                    rotation_mean=c.rotation_mean,
+                    K_pred=c.K_pred,
+                    rotation_pred=c.rotation_pred,
+                    digits=c.digits,
+                )
                 line = m.L1 if p.critical.line == "L1" else m.L2
                 starts.append((line(c.K0), c.K0))
                 labels.append("critical")
@@ -347,9 +425,19 @@ def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, quick: bool, pro
     xlim = tuple(p.xlim) if p.xlim else (-np.pi, np.pi)
     geom = map_geometry(m, ylim, corner_curves=scene.corner_curves)
     lead = leading_curve(m) if scene.leading_curve else None
-    panel = OrbitPanelResult(id=p.id, params=p.map.as_dict(), orbits=orbits, geometry=geom, leading=lead,
-                             K_crit=float(m.K_crit()), rho_crit=float(m.rho_crit()), band_floor=float(band_floor),
-                             xlim=xlim, ylim=ylim, critical=critical)
+    panel = OrbitPanelResult(
+        id=p.id,
+        params=p.map.as_dict(),
+        orbits=orbits,
+        geometry=geom,
+        leading=lead,
+        K_crit=float(m.K_crit()),
+        rho_crit=float(m.rho_crit()),
+        band_floor=float(band_floor),
+        xlim=xlim,
+        ylim=ylim,
+        critical=critical,
+    )
     return panel, m
 
 
@@ -389,8 +477,9 @@ def _theory_line(spec, eps_all: np.ndarray) -> tuple:
     e_lo = min(float(eps_all.min()), 0.0)
     eg = np.linspace(0.0, e_hi, 200)[1:]
     if spec.golden_c is not None:
-        tg = np.array([hovering_area_theory(x, tw, O) for x in eg
-                       for O, tw in [golden_family(x, spec.golden_c, spec.tau0)]])
+        tg = np.array(
+            [hovering_area_theory(x, tw, O) for x in eg for O, tw in [golden_family(x, spec.golden_c, spec.tau0)]]
+        )
     else:
         tg = np.asarray(hovering_area_theory(eg, spec.theta_w, spec.Omega0), dtype=float)
     return np.concatenate([[e_lo, 0.0], eg]), np.concatenate([[0.0, 0.0], tg])
@@ -445,16 +534,39 @@ def run_point(kind: str, point: dict, n_threads: int = 0) -> dict:
 
 def _area_row(h) -> dict:
     N = sorted(h.areas)
-    return dict(area=h.area, error=h.error, sampling_error=h.sampling_error, iteration_error=h.iteration_error,
-                area_N4=h.areas[N[0]], area_N2=h.areas[N[1]], area_both_sides=h.area_both_sides,
-                impact_fraction_F0=h.impact_fraction_F0, floor_touched=bool(h.floor_touched), unresolved=int(h.unresolved),
-                n_samples=int(h.n_samples), K_low=float(h.box[2]))
+    return dict(
+        area=h.area,
+        error=h.error,
+        sampling_error=h.sampling_error,
+        iteration_error=h.iteration_error,
+        area_N4=h.areas[N[0]],
+        area_N2=h.areas[N[1]],
+        area_both_sides=h.area_both_sides,
+        impact_fraction_F0=h.impact_fraction_F0,
+        floor_touched=bool(h.floor_touched),
+        unresolved=int(h.unresolved),
+        n_samples=int(h.n_samples),
+        K_low=float(h.box[2]),
+    )
 
 
 #: The fields of a point's row that the sweeps read (what a checkpointed row must have).
-_ROW = dict(area=float, error=float, sampling_error=float, iteration_error=float, area_N4=float, area_N2=float,
-            area_both_sides=float, impact_fraction_F0=float, floor_touched=bool, unresolved=int, n_samples=int,
-            K_low=float, theory=float, seconds=float)
+_ROW = dict(
+    area=float,
+    error=float,
+    sampling_error=float,
+    iteration_error=float,
+    area_N4=float,
+    area_N2=float,
+    area_both_sides=float,
+    impact_fraction_F0=float,
+    floor_touched=bool,
+    unresolved=int,
+    n_samples=int,
+    K_low=float,
+    theory=float,
+    seconds=float,
+)
 _MODEL_ROW = dict(area=float, error=float, agree=float, K_low=float)
 
 
@@ -468,10 +580,11 @@ def _row_check(kind: str, point: dict) -> Callable:
         check_row(row, fields)
         if row["K_low"] != point["K_low"]:
             raise ValueError(f"row.K_low = {row['K_low']!r} is not the point's K_low = {point['K_low']!r}")
+
     return check
 
 
-def _sweep(kind: str, points: list, ckpt, bar, where: Optional[Executor]) -> tuple:
+def _sweep(kind: str, points: list, ckpt, bar, where: Executor | None) -> tuple:
     """Rows of a plan's points in order: from the checkpoint (each row checked first: the file is
     untrusted), or computed (here, or as pieces on the executor ``where``) and
     checkpointed as each arrives (a point another process wrote meanwhile is not written again).
@@ -511,8 +624,9 @@ def _call(fn, args):
     return fn(*args)
 
 
-def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint,
-                    where=None) -> HoveringAreaResult:
+def _hovering_scene(
+    scene: HoveringAreaScene, quick: bool, progress, meta: dict, checkpoint, where=None
+) -> HoveringAreaResult:
     points = plan_points(scene, quick)
     meta.update(n_steps=points[0]["n_steps"], samples=points[0]["samples"])
     # Each measured point is on disk at once; a rerun resumes where an interrupted one stopped and
@@ -526,18 +640,32 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
     out = []
     ne = len(scene.eps)
     for k, s in enumerate(scene.series):
-        rows = all_rows[k * ne:(k + 1) * ne]
-        pts = points[k * ne:(k + 1) * ne]
-        reused = sum(from_ckpt[k * ne:(k + 1) * ne])
+        rows = all_rows[k * ne : (k + 1) * ne]
+        pts = points[k * ne : (k + 1) * ne]
+        reused = sum(from_ckpt[k * ne : (k + 1) * ne])
         fam = (s.golden_c, s.Omega0, s.theta_w, s.tau0)
         te, tc = _theory_line(s, eps_all) if fam not in drawn else (np.zeros(0), np.zeros(0))
         drawn.add(fam)
         col = lambda c, dt=float: np.array([r[c] for r in rows], dtype=dt)  # noqa: E731
         par = lambda c: np.array([p["map"][c] for p in pts], dtype=float)  # noqa: E731
-        out.append(SeriesResult(label=s.label, color=s.color or orbit_color(k), eps=par("eps"), area=col("area"),
-                                error=col("error"), theory=col("theory"), floor_touched=col("floor_touched", bool),
-                                K_low=col("K_low"), Omega0=par("Omega0"), theta_w=par("theta_w"), theory_eps=te,
-                                theory_curve=tc, golden_c=s.golden_c, reused=reused))
+        out.append(
+            SeriesResult(
+                label=s.label,
+                color=s.color or orbit_color(k),
+                eps=par("eps"),
+                area=col("area"),
+                error=col("error"),
+                theory=col("theory"),
+                floor_touched=col("floor_touched", bool),
+                K_low=col("K_low"),
+                Omega0=par("Omega0"),
+                theta_w=par("theta_w"),
+                theory_eps=te,
+                theory_curve=tc,
+                golden_c=s.golden_c,
+                reused=reused,
+            )
+        )
     meta["points_reused"] = sum(from_ckpt)
     return HoveringAreaResult(scene=scene, meta=meta, series=out)
 
@@ -546,7 +674,7 @@ def _hovering_scene(scene: HoveringAreaScene, quick: bool, progress, meta: dict,
 # The physical flow
 
 
-def _flowmap(scene, eps: Optional[float] = None, coordinates: str = "normal"):
+def _flowmap(scene, eps: float | None = None, coordinates: str = "normal"):
     return FlowMap(scene.system.build(eps=eps), h=scene.h, coordinates=coordinates, **scene.integrator.options())
 
 
@@ -588,9 +716,18 @@ def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) 
     mg = map_geometry(tm, (lo, hi), corner_curves=scene.corner_K > 0)
     p = fm.onset
     onset = dict(Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
-    return FlowPortraitResult(scene=scene, meta=meta, flow=flow, model=model, flow_geometry=fg, model_geometry=mg,
-                              onset=onset, forcing=np.asarray(fm.forcing_coefficients()), model_name=scene.model,
-                              work=_work(fres))
+    return FlowPortraitResult(
+        scene=scene,
+        meta=meta,
+        flow=flow,
+        model=model,
+        flow_geometry=fg,
+        model_geometry=mg,
+        onset=onset,
+        forcing=np.asarray(fm.forcing_coefficients()),
+        model_name=scene.model,
+        work=_work(fres),
+    )
 
 
 def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
@@ -599,8 +736,12 @@ def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
     start (phi, K) is the reversal error. It needs no reference, and like the error it grows as
     m^2 with the number of returns (``hovering.work_precision``)."""
     ok = np.flatnonzero(res.steps_done >= m)[:n_orbits]
-    out = {"integrator": {k: v for k, v in fm.integrator_options.items()}, "reversal_returns": int(m),
-           "reversal_orbits": int(ok.size), "reversal_error": float("nan")}
+    out = {
+        "integrator": {k: v for k, v in fm.integrator_options.items()},
+        "reversal_returns": int(m),
+        "reversal_orbits": int(ok.size),
+        "reversal_error": float("nan"),
+    }
     if ok.size and m > 0:
         bt, bk, alive = _reverse(fm, res.phi[ok, m], res.K[ok, m], m, 0)
         d = np.maximum(np.abs((bt - res.phi[ok, 0] + np.pi) % (2 * np.pi) - np.pi), np.abs(bk - res.K[ok, 0]))
@@ -610,8 +751,9 @@ def _reversal_check(fm, res, m: int, n_orbits: int = 2) -> dict:
     return out
 
 
-def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint,
-                   where=None) -> FlowHoveringResult:
+def _flow_hovering(
+    scene: FlowHoveringScene, quick: bool, progress, meta: dict, checkpoint, where=None
+) -> FlowHoveringResult:
     points = plan_points(scene, quick)
     meta.update(n_steps=points[0]["n_steps"], samples=points[0]["samples"])
     ckpt = Checkpoint(checkpoint)
@@ -620,13 +762,28 @@ def _flow_hovering(scene: FlowHoveringScene, quick: bool, progress, meta: dict, 
         rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where)
     reused = sum(from_ckpt)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
-    models = {name: {k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")}
-              for name in scene.models}
+    models = {
+        name: {
+            k: np.array([r["models"][name][k] for r in rows], dtype=float) for k in ("area", "error", "agree", "K_low")
+        }
+        for name in scene.models
+    }
     meta["points_reused"] = reused
-    return FlowHoveringResult(scene=scene, meta=meta, eps=np.array([p["system"]["eps"] for p in points], dtype=float),
-                              flow_area=col("area"), flow_error=col("error"), flow_both_sides=col("area_both_sides"),
-                              models=models, theory=col("theory"), K_low=col("K_low"), b1=col("b1"),
-                              seconds=col("seconds"), unresolved=col("unresolved"), reused=reused)
+    return FlowHoveringResult(
+        scene=scene,
+        meta=meta,
+        eps=np.array([p["system"]["eps"] for p in points], dtype=float),
+        flow_area=col("area"),
+        flow_error=col("error"),
+        flow_both_sides=col("area_both_sides"),
+        models=models,
+        theory=col("theory"),
+        K_low=col("K_low"),
+        b1=col("b1"),
+        seconds=col("seconds"),
+        unresolved=col("unresolved"),
+        reused=reused,
+    )
 
 
 def _circle(V, e: float, n: int) -> tuple:
@@ -649,12 +806,29 @@ def _tangent_tori(scene: TangentToriScene, quick: bool, progress, meta: dict) ->
         # A point of Sigma_h on this torus: (theta, I) with H2(I) = h2; theta = 0 (p2 = 0, q2 at
         # its maximum) starts the segment at a clean corner of the configuration-space box.
         I = float(sys.V2.action(h2))
-        res = fm.iterate([0.0], [I], scene.n_returns, record=("trajectory",),
-                         trajectory_dt=scene.outputs.trajectory_dt, **_progress_kw(progress))
+        res = fm.iterate(
+            [0.0],
+            [I],
+            scene.n_returns,
+            record=("trajectory",),
+            trajectory_dt=scene.outputs.trajectory_dt,
+            **_progress_kw(progress),
+        )
         meta.setdefault("status", {})[name] = Status(int(res.status[0])).name
         meta.setdefault("work", {})[name] = _work(res)
-        tori.append(TorusResult(name=name, h1=h1, h2=h2, q1=q1, p1=p1, q2=q2, p2=p2,
-                                trajectory=np.asarray(res.trajectory_of(0)), color=color))
+        tori.append(
+            TorusResult(
+                name=name,
+                h1=h1,
+                h2=h2,
+                q1=q1,
+                p1=p1,
+                q2=q2,
+                p2=p2,
+                trajectory=np.asarray(res.trajectory_of(0)),
+                color=color,
+            )
+        )
     return TangentToriResult(scene=scene, meta=meta, tori=tori, qw1=sys.qw1, qw2=sys.qw2)
 
 
@@ -667,24 +841,52 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
     lo = max(scene.K_range[0], 0.95 * fm.valid_band()[0])
     P, KK = np.meshgrid(-np.pi + 2 * np.pi * (np.arange(nphi) + 0.5) / nphi, np.linspace(lo, scene.K_range[1], nK))
     t = time.perf_counter()
-    res = fm.iterate(P.ravel(), KK.ravel(), 1, record=("orbit", "regions", "section", "states"),
-                     **_progress_kw(progress))
+    res = fm.iterate(
+        P.ravel(), KK.ravel(), 1, record=("orbit", "regions", "section", "states"), **_progress_kw(progress)
+    )
     meta["timings"]["returns"] = time.perf_counter() - t
     ok = np.isfinite(res.theta[:, 0])  # points with a point of Sigma_h
     z = res.z
     # The tangency circle K = 0 and its image (K = eps f(phi) to leading order).
     ph = np.linspace(-np.pi, np.pi, 721, endpoint=False)
     tg = fm.iterate(ph, np.zeros_like(ph), 1, record=("orbit", "section", "states"))
-    tangency = dict(phi=ph, theta=tg.theta[:, 0], I=tg.I[:, 0], q2=tg.z[:, 0, 2], p2=tg.z[:, 0, 3],
-                    phi1=tg.phi[:, 1], K1=tg.K[:, 1], theta1=tg.theta[:, 1], I1=tg.I[:, 1], q21=tg.z[:, 1, 2],
-                    p21=tg.z[:, 1, 3])
+    tangency = dict(
+        phi=ph,
+        theta=tg.theta[:, 0],
+        I=tg.I[:, 0],
+        q2=tg.z[:, 0, 2],
+        p2=tg.z[:, 0, 3],
+        phi1=tg.phi[:, 1],
+        K1=tg.K[:, 1],
+        theta1=tg.theta[:, 1],
+        I1=tg.I[:, 1],
+        q21=tg.z[:, 1, 2],
+        p21=tg.z[:, 1, 3],
+    )
     t = time.perf_counter()
-    corners = flow_geometry(fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10))
+    corners = flow_geometry(
+        fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10)
+    )
     meta["timings"]["corner curves"] = time.perf_counter() - t
     return SigmaStructureResult(
-        scene=scene, meta=meta, phi=res.phi[ok, 0], K=res.K[ok, 0], region=res.region[ok, 0],
-        theta=res.theta[ok, 0], I=res.I[ok, 0], q2=z[ok, 0, 2], p2=z[ok, 0, 3], phi1=res.phi[ok, 1], K1=res.K[ok, 1],
-        theta1=res.theta[ok, 1], I1=res.I[ok, 1], q21=z[ok, 1, 2], p21=z[ok, 1, 3], tangency=tangency, corners=corners)
+        scene=scene,
+        meta=meta,
+        phi=res.phi[ok, 0],
+        K=res.K[ok, 0],
+        region=res.region[ok, 0],
+        theta=res.theta[ok, 0],
+        I=res.I[ok, 0],
+        q2=z[ok, 0, 2],
+        p2=z[ok, 0, 3],
+        phi1=res.phi[ok, 1],
+        K1=res.K[ok, 1],
+        theta1=res.theta[ok, 1],
+        I1=res.I[ok, 1],
+        q21=z[ok, 1, 2],
+        p21=z[ok, 1, 3],
+        tangency=tangency,
+        corners=corners,
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -746,14 +948,33 @@ def _corner_directions(scene: CornerDirectionsScene, quick: bool, progress, meta
         for i in range(pw.size):
             tr = r["trajectories"][i]
             k = int(np.argmin(np.abs(tr[:, 0] - T[i])))  # the sample at T, or where the run stopped
-            trajectories.append(CornerTrajectory(
-                direction=ab, p1w=float(pw[i]), start=z0[i].copy(), theta=float(c[i, 0]), I=float(c[i, 1]),
-                phi=float(phi[i]), K=float(K[i]), flight_time=float(T[i]), trajectory=tr[: k + 1].copy(),
-                status=FlowStatus(int(r["status"][i])).name, arrival=tr[k, 1:].copy()))
+            trajectories.append(
+                CornerTrajectory(
+                    direction=ab,
+                    p1w=float(pw[i]),
+                    start=z0[i].copy(),
+                    theta=float(c[i, 0]),
+                    I=float(c[i, 1]),
+                    phi=float(phi[i]),
+                    K=float(K[i]),
+                    flight_time=float(T[i]),
+                    trajectory=tr[: k + 1].copy(),
+                    status=FlowStatus(int(r["status"][i])).name,
+                    arrival=tr[k, 1:].copy(),
+                )
+            )
     meta["timings"]["trajectories"] = time.perf_counter() - t
     meta["work"] = flow.work
-    return CornerDirectionsResult(scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, step_energy=corner_energy(sys),
-                                  p1w_max=p1max, curves=curves, trajectories=trajectories)
+    return CornerDirectionsResult(
+        scene=scene,
+        meta=meta,
+        qw1=sys.qw1,
+        qw2=sys.qw2,
+        step_energy=corner_energy(sys),
+        p1w_max=p1max,
+        curves=curves,
+        trajectories=trajectories,
+    )
 
 
 def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) -> WallTangencyResult:
@@ -769,8 +990,9 @@ def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) 
     t_1R, t_R0 = sys.V2.angle_of_point(sys.qw2, -P, E2), sys.V2.angle_of_point(sys.qw2, P, E2)
     up = t_1R - t_R0  # the arc above the step, through theta = 0
     low = 2 * np.pi - up
-    thetas = wrap(np.array([t_1R - up / 4, t_1R, t_1R + low / 4, t_1R + low / 2, t_1R + 3 * low / 4, t_R0,
-                            t_R0 + up / 4]))
+    thetas = wrap(
+        np.array([t_1R - up / 4, t_1R, t_1R + low / 4, t_1R + low / 2, t_1R + 3 * low / 4, t_R0, t_R0 + up / 4])
+    )
     t = time.perf_counter()
     # Each point's segment starts where the tangential curve (traced back from the wall by the core)
     # puts it on Sigma_h; the smooth flow draws it (it only touches the walls), the step system says
@@ -780,10 +1002,18 @@ def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) 
     z0 = Section(sys, h).point(th0, I0)
     sm = flow.returns(z0, trajectory_dt=scene.outputs.trajectory_dt, smooth=True)
     st = flow.returns(z0)
-    points = [WallPoint(number=i + 1, theta=float(thetas[i]), q2=float(q2), p2=float(p2),
-                        trajectory=sm["trajectories"][i], status=FlowStatus(int(st["status"][i])).name,
-                        itinerary=st["itinerary"][i])
-              for i, (q2, p2) in enumerate(sys.V2.point_at(float(x), E2) for x in thetas)]
+    points = [
+        WallPoint(
+            number=i + 1,
+            theta=float(thetas[i]),
+            q2=float(q2),
+            p2=float(p2),
+            trajectory=sm["trajectories"][i],
+            status=FlowStatus(int(st["status"][i])).name,
+            itinerary=st["itinerary"][i],
+        )
+        for i, (q2, p2) in enumerate(sys.V2.point_at(float(x), E2) for x in thetas)
+    ]
     meta["timings"]["points"] = time.perf_counter() - t
     t = time.perf_counter()
     n_th, n_rho = scene.grid
@@ -797,9 +1027,15 @@ def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) 
     meta["timings"]["regions"] = time.perf_counter() - t
     meta["work"] = flow.work
     return WallTangencyResult(
-        scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, line=dict(theta=line_theta, q2=line[:, 0], p2=line[:, 1]),
-        outer=dict(q2=outer[:, 0], p2=outer[:, 1]), points=points,
-        grid=dict(theta=TH.ravel(), rho_w=RHO.ravel(), q2=zw[:, 2], p2=zw[:, 3], region=region))
+        scene=scene,
+        meta=meta,
+        qw1=sys.qw1,
+        qw2=sys.qw2,
+        line=dict(theta=line_theta, q2=line[:, 0], p2=line[:, 1]),
+        outer=dict(q2=outer[:, 0], p2=outer[:, 1]),
+        points=points,
+        grid=dict(theta=TH.ravel(), rho_w=RHO.ravel(), q2=zw[:, 2], p2=zw[:, 3], region=region),
+    )
 
 
 #: Label changes with increasing wall angle and the corner-singularity curve each one is (lemma:border).
@@ -895,16 +1131,32 @@ def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) ->
         keep = np.flatnonzero(ok)
         r = flow.returns(z0[keep], trajectory_dt=scene.outputs.trajectory_dt)
         for j, i in enumerate(keep):
-            segments.append(WallSegment(kind=picks[i][0], theta=float(angles[i]), wall=zw[i].copy(),
-                                        trajectory=r["trajectories"][j], status=FlowStatus(int(r["status"][j])).name,
-                                        itinerary=r["itinerary"][j]))
+            segments.append(
+                WallSegment(
+                    kind=picks[i][0],
+                    theta=float(angles[i]),
+                    wall=zw[i].copy(),
+                    trajectory=r["trajectories"][j],
+                    status=FlowStatus(int(r["status"][j])).name,
+                    itinerary=r["itinerary"][j],
+                )
+            )
     meta["timings"]["segments"] = time.perf_counter() - t
     meta["work"] = flow.work
     return WallSectionResult(
-        scene=scene, meta=meta, qw1=sys.qw1, qw2=sys.qw2, rho_w=rho, rho_max=rmax,
+        scene=scene,
+        meta=meta,
+        qw1=sys.qw1,
+        qw2=sys.qw2,
+        rho_w=rho,
+        rho_max=rmax,
         tangency=dict(theta=th, q2=tangency[:, 2], p2=tangency[:, 3]),
-        circle=dict(theta=th, q2=zc[:, 2], p2=zc[:, 3], p1=zc[:, 1], region=region), boundaries=boundaries,
-        curves=curves, segments=segments, resolution=2 * np.pi / max(n_theta // 4, 64) / 2**scene.bisections)
+        circle=dict(theta=th, q2=zc[:, 2], p2=zc[:, 3], p1=zc[:, 1], region=region),
+        boundaries=boundaries,
+        curves=curves,
+        segments=segments,
+        resolution=2 * np.pi / max(n_theta // 4, 64) / 2**scene.bisections,
+    )
 
 
 def scene_map(scene: SceneSpec):
@@ -931,8 +1183,9 @@ def scene_map(scene: SceneSpec):
         return _flowmap(scene, eps=scene.eps[0])
     if isinstance(scene, TangentToriScene):
         return _flowmap(scene, coordinates="section")
-    if isinstance(scene, (FlowPortraitScene, SigmaStructureScene, CornerDirectionsScene, WallTangencyScene,
-                          WallSectionScene)):
+    if isinstance(
+        scene, (FlowPortraitScene, SigmaStructureScene, CornerDirectionsScene, WallTangencyScene, WallSectionScene)
+    ):
         return _flowmap(scene)
     raise ValueError(f"scene {scene.name!r} defines no map")
 
@@ -940,9 +1193,18 @@ def scene_map(scene: SceneSpec):
 # ------------------------------------------------------------------------------------------------
 
 
-def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: Optional[os.PathLike] = None,
-            workers: Optional[int] = None, client=None, scheduler: Optional[str] = None, dask: bool = False, *,
-            executor=None) -> SceneResult:
+def compute(
+    scene: SceneSpec,
+    quick: bool = False,
+    progress=False,
+    checkpoint: os.PathLike | None = None,
+    workers: int | None = None,
+    client=None,
+    scheduler: str | None = None,
+    dask: bool = False,
+    *,
+    executor=None,
+) -> SceneResult:
     """Run a scene's simulation and return its typed result (nothing is drawn or written).
 
     Parameters
@@ -977,11 +1239,17 @@ def compute(scene: SceneSpec, quick: bool = False, progress=False, checkpoint: O
     meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
     t0 = time.perf_counter()
     ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
-    where = from_old_arguments("compute", executor, dict(workers=workers, client=client, scheduler=scheduler,
-                                                         dask=dask), allowed=("workers", "client", "scheduler", "dask"))
+    where = from_old_arguments(
+        "compute",
+        executor,
+        dict(workers=workers, client=client, scheduler=scheduler, dask=dask),
+        allowed=("workers", "client", "scheduler", "dask"),
+    )
     if where is not None and (where.pieces is not None or where.checkpoint is not None):
-        raise ValueError("compute: a scene's points are its pieces and checkpoint= its checkpoint; give an Executor "
-                         "without pieces and checkpoint")
+        raise ValueError(
+            "compute: a scene's points are its pieces and checkpoint= its checkpoint; give an Executor "
+            "without pieces and checkpoint"
+        )
     if isinstance(scene, OrbitScene):
         out = _orbit_scene(scene, quick, progress, meta)
     elif isinstance(scene, HoveringAreaScene):

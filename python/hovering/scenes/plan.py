@@ -21,7 +21,6 @@ import dataclasses
 import math
 import os
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
@@ -82,8 +81,17 @@ def _truncated_points(scene: HoveringAreaScene, quick: bool) -> list:
                 depth = default_depth(m) if e != 0 else 0.1
                 K_low = max(-depth, m.valid_band()[0] * (1 - 1e-9))
             mp = {k: float(getattr(ms, k)) for k in ("eps", "Omega0", "theta_w", "tau0", "tau1", "lam")}
-            out.append({"label": s.label, "n_steps": int(n_steps), "samples": int(samples), "seed": int(scene.seed),
-                        "K_low": float(K_low), "theory": float(m.theory().area), "map": mp})
+            out.append(
+                {
+                    "label": s.label,
+                    "n_steps": int(n_steps),
+                    "samples": int(samples),
+                    "seed": int(scene.seed),
+                    "K_low": float(K_low),
+                    "theory": float(m.theory().area),
+                    "map": mp,
+                }
+            )
     return out
 
 
@@ -98,8 +106,15 @@ def _system(spec, eps: float) -> dict:
     terms: dict = {}
     for c, i, j in spec.coupling:
         terms[(int(i), int(j))] = float(c)
-    return {"V1": pot(spec.V1), "V2": pot(spec.V2), "coupling": [[c, i, j] for (i, j), c in terms.items()],
-            "eps": float(eps), "qw1": float(spec.qw1), "qw2": float(spec.qw2), "geometry": spec.geometry}
+    return {
+        "V1": pot(spec.V1),
+        "V2": pot(spec.V2),
+        "coupling": [[c, i, j] for (i, j), c in terms.items()],
+        "eps": float(eps),
+        "qw1": float(spec.qw1),
+        "qw2": float(spec.qw2),
+        "geometry": spec.geometry,
+    }
 
 
 def build_system(system: dict):
@@ -115,12 +130,20 @@ def build_system(system: dict):
     -------
     StepSystem
     """
+
     def pot(p):
         return Harmonic(p["omega"]) if p["kind"] == "harmonic" else Tan(p["omega"], p["alpha"])
 
     c = Polynomial({(int(i), int(j)): float(v) for v, i, j in system["coupling"]}) if system["coupling"] else None
-    return StepSystem(V1=pot(system["V1"]), V2=pot(system["V2"]), coupling=c, eps=system["eps"], qw1=system["qw1"],
-                      qw2=system["qw2"], geometry=system["geometry"])
+    return StepSystem(
+        V1=pot(system["V1"]),
+        V2=pot(system["V2"]),
+        coupling=c,
+        eps=system["eps"],
+        qw1=system["qw1"],
+        qw2=system["qw2"],
+        geometry=system["geometry"],
+    )
 
 
 def _model(name: str, tm, K_low: float) -> dict:
@@ -141,7 +164,7 @@ def _measured_model(fm, K_low: float):
     """
     depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
     s = np.linspace(math.sqrt(depth), 0.0, 17)[:-1]
-    K = np.concatenate([-s**2, [0.01, 0.03, 0.05]])
+    K = np.concatenate([-(s**2), [0.01, 0.03, 0.05]])
     cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=1e-12)
     ok = (K > 0) | (np.isfinite(cc.JR) & np.isfinite(cc.J1) & np.isfinite(cc.Omega))
     first = int(np.argmax(np.cumprod(ok[::-1])[::-1])) if not ok.all() else 0
@@ -149,8 +172,13 @@ def _measured_model(fm, K_low: float):
     keep[first:] = True
     keep &= ok
     if not keep.all():
-        cc = dataclasses.replace(cc, **{f: getattr(cc, f)[keep] for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1",
-                                                              "Omega", "Omega_spread", "other")})
+        cc = dataclasses.replace(
+            cc,
+            **{
+                f: getattr(cc, f)[keep]
+                for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1", "Omega", "Omega_spread", "other")
+            },
+        )
     return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
 
 
@@ -170,9 +198,18 @@ def _flow_point(scene: FlowHoveringScene, e: float, n_steps: int, samples: int) 
     # samples its own box: its points are not the flow's.
     models = [_model(name, tm, max(K_low, tm.valid_band()[0] * (1 - 1e-9))) for name, tm in tms.items()]
     th = fm.theory()
-    return {"n_steps": int(n_steps), "samples": int(samples), "seed": int(scene.seed),
-            "K_low": float(K_low), "theory": float(th.area), "b1": float(th.forcing[0]), "h": float(scene.h),
-            "system": system, "integrator": integrator, "models": models}
+    return {
+        "n_steps": int(n_steps),
+        "samples": int(samples),
+        "seed": int(scene.seed),
+        "K_low": float(K_low),
+        "theory": float(th.area),
+        "b1": float(th.forcing[0]),
+        "h": float(scene.h),
+        "system": system,
+        "integrator": integrator,
+        "models": models,
+    }
 
 
 def plan_points(scene: SceneSpec, quick: bool = False) -> list:
@@ -200,8 +237,10 @@ def plan_points(scene: SceneSpec, quick: bool = False) -> list:
     if isinstance(scene, FlowHoveringScene):
         n_steps, samples = sweep_counts(scene, quick)
         return [_flow_point(scene, e, n_steps, samples) for e in scene.eps]
-    raise ValueError(f"scene {scene.name!r} is of kind {scene.kind!r}; a plan is made of the sweep kinds "
-                     "'hovering_area' and 'flow_hovering_area'")
+    raise ValueError(
+        f"scene {scene.name!r} is of kind {scene.kind!r}; a plan is made of the sweep kinds "
+        "'hovering_area' and 'flow_hovering_area'"
+    )
 
 
 def point_key(kind: str, point: dict) -> dict:
@@ -256,7 +295,7 @@ def _toml(v) -> str:
     raise TypeError(f"cannot write {type(v).__name__} to a plan")
 
 
-def plan_text(scene: SceneSpec, quick: bool = False, points: Optional[list] = None, checkpoint: str = "") -> str:
+def plan_text(scene: SceneSpec, quick: bool = False, points: list | None = None, checkpoint: str = "") -> str:
     """The plan of a sweep scene as TOML text.
 
     Parameters
@@ -277,11 +316,15 @@ def plan_text(scene: SceneSpec, quick: bool = False, points: Optional[list] = No
     from .. import __version__  # the package's own version (its __init__ is loaded by then)
 
     pts = plan_points(scene, quick) if points is None else points
-    lines = [f"# The resolved sweep plan of {scene.name}{' (--quick)' if quick else ''}: every number explicit "
-             "(docs/sweep-plan.md).",
-             f"# Written by hovering {__version__} (python -m hovering plan); run it with hovering_sweep --plan FILE.",
-             f"format = {_toml(FORMAT)}", f"version = {VERSION}", f"kind = {_toml(scene.kind)}",
-             f"name = {_toml(scene.name)}"]
+    lines = [
+        f"# The resolved sweep plan of {scene.name}{' (--quick)' if quick else ''}: every number explicit "
+        "(docs/sweep-plan.md).",
+        f"# Written by hovering {__version__} (python -m hovering plan); run it with hovering_sweep --plan FILE.",
+        f"format = {_toml(FORMAT)}",
+        f"version = {VERSION}",
+        f"kind = {_toml(scene.kind)}",
+        f"name = {_toml(scene.name)}",
+    ]
     if checkpoint:
         lines.append(f"checkpoint = {_toml(checkpoint)}")
     for p in pts:
@@ -297,7 +340,7 @@ def plan_text(scene: SceneSpec, quick: bool = False, points: Optional[list] = No
     return "\n".join(lines) + "\n"
 
 
-def write_plan(scene: SceneSpec, path: os.PathLike, quick: bool = False, checkpoint: Optional[str] = None) -> str:
+def write_plan(scene: SceneSpec, path: os.PathLike, quick: bool = False, checkpoint: str | None = None) -> str:
     """Write the plan of a sweep scene to ``path`` (atomically).
 
     Parameters
@@ -323,6 +366,7 @@ def write_plan(scene: SceneSpec, path: os.PathLike, quick: bool = False, checkpo
         # python -m hovering scene's checkpoint (the output, relative to the working directory),
         # as seen from the plan's folder: both programs then append to one file.
         ck = Path(scene.output).with_suffix(".sweep.jsonl")
-        checkpoint = os.path.relpath(ck if ck.is_absolute() else Path.cwd() / ck,
-                                     os.path.dirname(os.path.abspath(path)))
+        checkpoint = os.path.relpath(
+            ck if ck.is_absolute() else Path.cwd() / ck, os.path.dirname(os.path.abspath(path))
+        )
     return write_text(path, plan_text(scene, quick, checkpoint=checkpoint))

@@ -13,7 +13,6 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
@@ -28,10 +27,27 @@ from .spec import SceneSpec
 SIDECAR_FORMAT = "hovering-scene-1"
 
 __all__ = [
-    "Geometry", "OrbitSet", "OrbitPanelResult", "ZoomPanelResult", "SeriesResult", "TorusResult",
-    "SceneResult", "OrbitSceneResult", "HoveringAreaResult", "FlowPortraitResult", "FlowHoveringResult",
-    "TangentToriResult", "SigmaStructureResult", "CornerTrajectory", "CornerDirectionsResult", "WallPoint",
-    "WallTangencyResult", "WallSegment", "WallSectionResult", "load_result", "jsonable",
+    "Geometry",
+    "OrbitSet",
+    "OrbitPanelResult",
+    "ZoomPanelResult",
+    "SeriesResult",
+    "TorusResult",
+    "SceneResult",
+    "OrbitSceneResult",
+    "HoveringAreaResult",
+    "FlowPortraitResult",
+    "FlowHoveringResult",
+    "TangentToriResult",
+    "SigmaStructureResult",
+    "CornerTrajectory",
+    "CornerDirectionsResult",
+    "WallPoint",
+    "WallTangencyResult",
+    "WallSegment",
+    "WallSectionResult",
+    "load_result",
+    "jsonable",
 ]
 
 
@@ -70,17 +86,19 @@ def jsonable(x):
 # and colours get the scene schema's checks.
 
 
-def _texts(where: str, values, n: Optional[int] = None, color: bool = False) -> None:
+def _texts(where: str, values, n: int | None = None, color: bool = False) -> None:
     from .schema import _color, _str
 
     if not isinstance(values, list) or (n is not None and len(values) != n):
-        raise ValueError(f"{where} must be a list of {n if n is not None else 'some'} strings, got "
-                         f"{'a list of ' + str(len(values)) if isinstance(values, list) else type(values).__name__}")
+        raise ValueError(
+            f"{where} must be a list of {n if n is not None else 'some'} strings, got "
+            f"{'a list of ' + str(len(values)) if isinstance(values, list) else type(values).__name__}"
+        )
     for i, v in enumerate(values):
         (_color if color else _str)(f"{where}[{i}]", v)
 
 
-def _array(where: str, a, ndim: int, kinds: str = "iuf", shape: Optional[tuple] = None) -> None:
+def _array(where: str, a, ndim: int, kinds: str = "iuf", shape: tuple | None = None) -> None:
     if not isinstance(a, np.ndarray) or a.ndim != ndim or a.dtype.kind not in kinds:
         got = f"shape {a.shape} dtype {a.dtype}" if isinstance(a, np.ndarray) else type(a).__name__
         raise ValueError(f"{where} must be a {ndim}-D array of numbers, got {got}")
@@ -108,8 +126,8 @@ class Geometry:
     """
 
     K: np.ndarray
-    L1: Optional[np.ndarray]
-    L2: Optional[np.ndarray]
+    L1: np.ndarray | None
+    L2: np.ndarray | None
     K_corner: np.ndarray
     corners: dict
     measured: bool = False
@@ -149,13 +167,13 @@ class OrbitSet:
 
     phi: np.ndarray
     K: np.ndarray
-    region: Optional[np.ndarray]
+    region: np.ndarray | None
     status: np.ndarray
     steps_done: np.ndarray
     labels: list
     colors: list
     kinds: list
-    rho: Optional[np.ndarray] = None
+    rho: np.ndarray | None = None
 
     def _validate_loaded(self) -> None:
         _array("phi", self.phi, 2)
@@ -172,7 +190,7 @@ class OrbitSet:
             _array("rho", self.rho, 1, shape=(n,))
 
     @classmethod
-    def of(cls, res, labels, colors, kinds, rho=None) -> "OrbitSet":
+    def of(cls, res, labels, colors, kinds, rho=None) -> OrbitSet:
         """From an :class:`~hovering.IterateResult` (``"orbit"`` recorded).
 
         Parameters
@@ -188,9 +206,17 @@ class OrbitSet:
         -------
         OrbitSet
         """
-        return cls(np.asarray(res.phi), np.asarray(res.K), None if res.region is None else np.asarray(res.region),
-                   np.asarray(res.status), np.asarray(res.steps_done), list(labels), list(colors), list(kinds),
-                   None if rho is None else np.asarray(rho, dtype=float))
+        return cls(
+            np.asarray(res.phi),
+            np.asarray(res.K),
+            None if res.region is None else np.asarray(res.region),
+            np.asarray(res.status),
+            np.asarray(res.steps_done),
+            list(labels),
+            list(colors),
+            list(kinds),
+            None if rho is None else np.asarray(rho, dtype=float),
+        )
 
     @property
     def n_orbits(self) -> int:
@@ -226,13 +252,13 @@ class OrbitPanelResult:
     params: dict
     orbits: OrbitSet
     geometry: Geometry
-    leading: Optional[tuple]
+    leading: tuple | None
     K_crit: float
     rho_crit: float
     band_floor: float
     xlim: tuple
     ylim: tuple
-    critical: Optional[dict] = None
+    critical: dict | None = None
 
 
 @dataclass
@@ -256,7 +282,7 @@ class ZoomPanelResult:
     on: str
     window: dict
     geometry: Geometry
-    leading: Optional[tuple] = None
+    leading: tuple | None = None
 
 
 @dataclass
@@ -293,7 +319,7 @@ class SeriesResult:
     theta_w: np.ndarray
     theory_eps: np.ndarray
     theory_curve: np.ndarray
-    golden_c: Optional[float] = None
+    golden_c: float | None = None
     reused: int = 0
 
     def _validate_loaded(self) -> None:
@@ -372,8 +398,9 @@ class SceneResult:
             if v is not None and (not isinstance(v, kind) or (kind is int and isinstance(v, bool))):
                 raise ValueError(f"meta.{key} must be of type {kind.__name__}, got {type(v).__name__}")
         if len(self.meta.get("version") or "") > MAX_TEXT:
-            raise ValueError(f"meta.version: a string of {len(self.meta['version'])} characters; allowed: at most "
-                             f"{MAX_TEXT}")
+            raise ValueError(
+                f"meta.version: a string of {len(self.meta['version'])} characters; allowed: at most {MAX_TEXT}"
+            )
         for k, v in (self.meta.get("timings") or {}).items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise ValueError(f"meta.timings.{k} must be a number of seconds, got {type(v).__name__}")
@@ -412,9 +439,13 @@ class SceneResult:
         npz = _serial.save(self, path, meta=jsonable(self.meta))
         side = str(Path(npz).with_suffix(".json"))
         # "format" first: it is how a later run recognises the file as one it may replace.
-        doc = dict(format=SIDECAR_FORMAT, provenance=provenance(seed=getattr(self.scene, "seed", None)),
-                   scene=jsonable(_serial.to_tree(self.scene, {})), meta=jsonable(self.meta),
-                   summary=jsonable(self.summary()))
+        doc = dict(
+            format=SIDECAR_FORMAT,
+            provenance=provenance(seed=getattr(self.scene, "seed", None)),
+            scene=jsonable(_serial.to_tree(self.scene, {})),
+            meta=jsonable(self.meta),
+            summary=jsonable(self.summary()),
+        )
         write_text(side, json.dumps(doc, indent=1, allow_nan=False))
         return npz, side
 
@@ -441,8 +472,9 @@ class OrbitSceneResult(SceneResult):
                 raise ValueError(f"panels[{i}] must be a panel result, got {type(p).__name__}")
             ids.append(p.id)
         for i, p in enumerate(self.panels):
-            if isinstance(p, ZoomPanelResult) and not any(q.id == p.of and isinstance(q, OrbitPanelResult)
-                                                          for q in self.panels):
+            if isinstance(p, ZoomPanelResult) and not any(
+                q.id == p.of and isinstance(q, OrbitPanelResult) for q in self.panels
+            ):
                 raise ValueError(f"panels[{i}].of = {p.of!r} names no orbit panel; panels: {ids}")
 
     def panel(self, id: str):
@@ -872,10 +904,12 @@ class WallSectionResult(SceneResult):
         _same_length("tangency", self.tangency, ("theta", "q2", "p2"))
         _same_length("circle", self.circle, ("theta", "q2", "p2", "p1", "region"))
         if set(self.boundaries) != set(_DIRECTIONS) or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.boundaries.values()):
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.boundaries.values()
+        ):
             raise ValueError(f"boundaries must map {list(_DIRECTIONS)} to numbers")
-        _same_length("curves", self.curves, ("rho_w",) + tuple(f"{c}_{d}" for c in ("theta", "q2", "p2")
-                                                                for d in _DIRECTIONS))
+        _same_length(
+            "curves", self.curves, ("rho_w",) + tuple(f"{c}_{d}" for c in ("theta", "q2", "p2") for d in _DIRECTIONS)
+        )
         for i, p in enumerate(self.segments):
             if not isinstance(p, WallSegment):
                 raise ValueError(f"segments[{i}] must be a WallSegment, got {type(p).__name__}")
@@ -900,8 +934,10 @@ def load_result(path: os.PathLike) -> SceneResult:
     """
     obj = _serial.load(path)
     if not isinstance(obj, SceneResult):
-        raise ValueError(f"{os.fspath(path)} holds a {type(obj).__name__}, not a scene result "
-                         "(written by `python -m hovering scene`)")
+        raise ValueError(
+            f"{os.fspath(path)} holds a {type(obj).__name__}, not a scene result "
+            "(written by `python -m hovering scene`)"
+        )
     return obj
 
 
@@ -909,14 +945,23 @@ def _orbits(o: OrbitSet) -> list:
     out = []
     for i, lab in enumerate(o.labels):
         K = o.K[i]
-        d = dict(label=lab, kind=o.kinds[i], phi0=float(o.phi[i, 0]), K0=float(K[0]), K_min=float(np.nanmin(K)),
-                 K_max=float(np.nanmax(K)), status=Status(int(o.status[i])).name, steps=int(o.steps_done[i]))
+        d = dict(
+            label=lab,
+            kind=o.kinds[i],
+            phi0=float(o.phi[i, 0]),
+            K0=float(K[0]),
+            K_min=float(np.nanmin(K)),
+            K_max=float(np.nanmax(K)),
+            status=Status(int(o.status[i])).name,
+            steps=int(o.steps_done[i]),
+        )
         if o.rho is not None:
             d["rho"] = float(o.rho[i])
         if o.region is not None:
             reg = o.region[i]
-            d["impacts"] = int(np.count_nonzero((reg == int(Region.UPPER)) | (reg == int(Region.RIGHT))
-                                                | (reg == int(Region.MULTI))))
+            d["impacts"] = int(
+                np.count_nonzero((reg == int(Region.UPPER)) | (reg == int(Region.RIGHT)) | (reg == int(Region.MULTI)))
+            )
             d["hovering"] = bool(d["impacts"] == 0 and d["K_min"] < 0 and o.status[i] == int(Status.OK))
         out.append(d)
     return out
@@ -946,8 +991,13 @@ def summarize(result) -> dict:
         and ``regions`` (wall_tangency), ``boundaries``, ``arcs`` and ``segments`` (wall_section).
     """
     sc, meta = result.scene, result.meta
-    s = dict(scene=sc.name, kind=sc.kind, title=sc.title, quick=bool(meta.get("quick")),
-             runtime_s=float(meta.get("timings", {}).get("total", float("nan"))))
+    s = dict(
+        scene=sc.name,
+        kind=sc.kind,
+        title=sc.title,
+        quick=bool(meta.get("quick")),
+        runtime_s=float(meta.get("timings", {}).get("total", float("nan"))),
+    )
     for k in ("n_steps", "samples", "points_reused", "checkpoint", "grid", "accuracy"):
         if k in meta:
             s[k] = meta[k]
@@ -955,9 +1005,18 @@ def summarize(result) -> dict:
         panels = []
         for p in result.panels:
             if isinstance(p, OrbitPanelResult):
-                info = dict(id=p.id, params=p.params, K_crit=p.K_crit, rho_crit=p.rho_crit, band_floor=p.band_floor,
-                            orbits=_orbits(p.orbits), n_escaped=int(np.count_nonzero(p.orbits.status == int(Status.ESCAPED))),
-                            xlim=list(p.xlim), ylim=list(p.ylim), n_orbits_drawn=p.orbits.n_orbits)
+                info = dict(
+                    id=p.id,
+                    params=p.params,
+                    K_crit=p.K_crit,
+                    rho_crit=p.rho_crit,
+                    band_floor=p.band_floor,
+                    orbits=_orbits(p.orbits),
+                    n_escaped=int(np.count_nonzero(p.orbits.status == int(Status.ESCAPED))),
+                    xlim=list(p.xlim),
+                    ylim=list(p.ylim),
+                    n_orbits_drawn=p.orbits.n_orbits,
+                )
                 if p.critical is not None:
                     info["critical"] = p.critical
             else:
@@ -965,60 +1024,116 @@ def summarize(result) -> dict:
             panels.append(info)
         s["panels"] = panels
     elif isinstance(result, HoveringAreaResult):
-        s["series"] = [dict(label=r.label, golden_c=r.golden_c, points=[
-            dict(eps=float(e), area=float(a), error=float(er), theory=float(t), floor_touched=bool(f), K_low=float(kl),
-                 Omega0=float(O), theta_w=float(tw))
-            for e, a, er, t, f, kl, O, tw in zip(r.eps, r.area, r.error, r.theory, r.floor_touched, r.K_low, r.Omega0,
-                                                 r.theta_w)]) for r in result.series]
+        s["series"] = [
+            dict(
+                label=r.label,
+                golden_c=r.golden_c,
+                points=[
+                    dict(
+                        eps=float(e),
+                        area=float(a),
+                        error=float(er),
+                        theory=float(t),
+                        floor_touched=bool(f),
+                        K_low=float(kl),
+                        Omega0=float(O),
+                        theta_w=float(tw),
+                    )
+                    for e, a, er, t, f, kl, O, tw in zip(
+                        r.eps, r.area, r.error, r.theory, r.floor_touched, r.K_low, r.Omega0, r.theta_w
+                    )
+                ],
+            )
+            for r in result.series
+        ]
     elif isinstance(result, FlowPortraitResult):
         s.update(onset=result.onset, forcing=result.forcing[:3], model_name=result.model_name, work=result.work)
         for name, o in (("flow", result.flow), ("model", result.model)):
-            s[name] = dict(orbits=_orbits(o), regions=_region_counts(o.region),
-                           statuses={Status(int(v)).name: int(np.count_nonzero(o.status == v))
-                                     for v in np.unique(o.status)})
+            s[name] = dict(
+                orbits=_orbits(o),
+                regions=_region_counts(o.region),
+                statuses={Status(int(v)).name: int(np.count_nonzero(o.status == v)) for v in np.unique(o.status)},
+            )
     elif isinstance(result, FlowHoveringResult):
         pts = []
         for i, e in enumerate(result.eps):
-            d = dict(eps=float(e), flow=float(result.flow_area[i]), flow_error=float(result.flow_error[i]),
-                     flow_both_sides=float(result.flow_both_sides[i]), theory=float(result.theory[i]),
-                     K_low=float(result.K_low[i]), b1=float(result.b1[i]), seconds=float(result.seconds[i]),
-                     unresolved=int(result.unresolved[i]))
+            d = dict(
+                eps=float(e),
+                flow=float(result.flow_area[i]),
+                flow_error=float(result.flow_error[i]),
+                flow_both_sides=float(result.flow_both_sides[i]),
+                theory=float(result.theory[i]),
+                K_low=float(result.K_low[i]),
+                b1=float(result.b1[i]),
+                seconds=float(result.seconds[i]),
+                unresolved=int(result.unresolved[i]),
+            )
             d["models"] = {m: {k: float(v[i]) for k, v in cols.items()} for m, cols in result.models.items()}
             pts.append(d)
         s["points"] = pts
     elif isinstance(result, TangentToriResult):
-        s["tori"] = [dict(name=t.name, h1=t.h1, h2=t.h2, trajectory_points=int(t.trajectory.shape[0]),
-                          q1_min=float(np.nanmin(t.trajectory[:, 1])) if t.trajectory.size else None,
-                          q2_min=float(np.nanmin(t.trajectory[:, 3])) if t.trajectory.size else None)
-                     for t in result.tori]
+        s["tori"] = [
+            dict(
+                name=t.name,
+                h1=t.h1,
+                h2=t.h2,
+                trajectory_points=int(t.trajectory.shape[0]),
+                q1_min=float(np.nanmin(t.trajectory[:, 1])) if t.trajectory.size else None,
+                q2_min=float(np.nanmin(t.trajectory[:, 3])) if t.trajectory.size else None,
+            )
+            for t in result.tori
+        ]
         s.update(qw1=result.qw1, qw2=result.qw2, status=meta.get("status", {}), work=meta.get("work", {}))
     elif isinstance(result, SigmaStructureResult):
         s["regions"] = _region_counts(result.region)
         s["points"] = int(result.phi.size)
     elif isinstance(result, CornerDirectionsResult):
         s.update(corner=[result.qw1, result.qw2], step_energy=result.step_energy, p1w_max=result.p1w_max)
-        s["curves"] = {k: dict(points=int(c["p1w"].size), reached=int(np.count_nonzero(c["reached"])),
-                               max_error=float(np.nanmax(c["error"])) if np.isfinite(c["error"]).any() else None,
-                               K_range=[float(np.nanmin(c["K"])), float(np.nanmax(c["K"]))]
-                               if np.isfinite(c["K"]).any() else None)
-                       for k, c in result.curves.items()}
-        s["arrivals"] = [dict(direction=t.direction, p1w=t.p1w, status=t.status, phi=t.phi, K=t.K,
-                              flight_time=t.flight_time,
-                              error=float(np.hypot(t.arrival[0] - result.qw1, t.arrival[2] - result.qw2)),
-                              momentum=[float(t.arrival[1]), float(t.arrival[3])])
-                         for t in result.trajectories]
+        s["curves"] = {
+            k: dict(
+                points=int(c["p1w"].size),
+                reached=int(np.count_nonzero(c["reached"])),
+                max_error=float(np.nanmax(c["error"])) if np.isfinite(c["error"]).any() else None,
+                K_range=[float(np.nanmin(c["K"])), float(np.nanmax(c["K"]))] if np.isfinite(c["K"]).any() else None,
+            )
+            for k, c in result.curves.items()
+        }
+        s["arrivals"] = [
+            dict(
+                direction=t.direction,
+                p1w=t.p1w,
+                status=t.status,
+                phi=t.phi,
+                K=t.K,
+                flight_time=t.flight_time,
+                error=float(np.hypot(t.arrival[0] - result.qw1, t.arrival[2] - result.qw2)),
+                momentum=[float(t.arrival[1]), float(t.arrival[3])],
+            )
+            for t in result.trajectories
+        ]
     elif isinstance(result, WallTangencyResult):
-        s["tangency_points"] = [dict(number=p.number, theta=p.theta, q2=p.q2, p2=p.p2, status=p.status, itinerary=p.itinerary)
-                       for p in result.points]
+        s["tangency_points"] = [
+            dict(number=p.number, theta=p.theta, q2=p.q2, p2=p.p2, status=p.status, itinerary=p.itinerary)
+            for p in result.points
+        ]
         s["regions"] = _region_counts(result.grid["region"])
     elif isinstance(result, WallSectionResult):
         b = result.boundaries
         two_pi = 2 * math.pi
-        s.update(rho_w=result.rho_w, rho_max=result.rho_max, boundaries=b, resolution=result.resolution,
-                 arcs={"R": (b["R0"] - b["1R"]) % two_pi, "0": (b["01"] - b["R0"]) % two_pi,
-                       "1": (b["1R"] - b["01"]) % two_pi},
-                 circle_regions=_region_counts(result.circle["region"]),
-                 curve_points={k: int(np.count_nonzero(np.isfinite(result.curves[f"theta_{k}"]))) for k in _DIRECTIONS},
-                 segments=[dict(kind=g.kind, theta=g.theta, status=g.status, itinerary=g.itinerary)
-                           for g in result.segments])
+        s.update(
+            rho_w=result.rho_w,
+            rho_max=result.rho_max,
+            boundaries=b,
+            resolution=result.resolution,
+            arcs={
+                "R": (b["R0"] - b["1R"]) % two_pi,
+                "0": (b["01"] - b["R0"]) % two_pi,
+                "1": (b["1R"] - b["01"]) % two_pi,
+            },
+            circle_regions=_region_counts(result.circle["region"]),
+            curve_points={k: int(np.count_nonzero(np.isfinite(result.curves[f"theta_{k}"]))) for k in _DIRECTIONS},
+            segments=[
+                dict(kind=g.kind, theta=g.theta, status=g.status, itinerary=g.itinerary) for g in result.segments
+            ],
+        )
     return jsonable(s)

@@ -17,21 +17,54 @@ import os
 import re
 import tomllib
 from pathlib import Path
-from typing import Optional
 
 from .._output import output_path
 from ..flow.section import STEPPERS
-from ..truncated.theory import OMEGA_G, golden_family
 from ..interface import register
-from .spec import figure_inches
-from .spec import (FLOW_KINDS, KINDS, SPECIAL_ORBITS, CornerDirectionsScene, CriticalSpec, FlowHoveringScene,
-                   FlowPortraitScene, HoveringAreaScene, IntegratorSpec, MapSpec, OrbitScene, OrbitSpec, OutputsSpec,
-                   PanelSpec, PotentialSpec, SceneSpec, SeriesSpec, SigmaStructureScene, SystemSpec, TangentToriScene,
-                   WallSectionScene, WallTangencyScene, ZoomSpec)
+from ..truncated.theory import OMEGA_G, golden_family
+from .spec import (
+    FLOW_KINDS,
+    KINDS,
+    SPECIAL_ORBITS,
+    CornerDirectionsScene,
+    CriticalSpec,
+    FlowHoveringScene,
+    FlowPortraitScene,
+    HoveringAreaScene,
+    IntegratorSpec,
+    MapSpec,
+    OrbitScene,
+    OrbitSpec,
+    OutputsSpec,
+    PanelSpec,
+    PotentialSpec,
+    SceneSpec,
+    SeriesSpec,
+    SigmaStructureScene,
+    SystemSpec,
+    TangentToriScene,
+    WallSectionScene,
+    WallTangencyScene,
+    ZoomSpec,
+    figure_inches,
+)
 from .wall import corner_energy, wall_tangency_action
 
-__all__ = ["load_scene", "parse_scene", "check_spec", "scene_table", "MAX_PANELS", "MAX_SERIES_POINTS",
-           "MAX_SCENE_BYTES", "MAX_TEXT", "MAX_PATH_CHARS", "MAX_SCENE_STRING", "MAX_SCENE_DEPTH", "MAX_KEY_PARTS", "MAX_CANVAS_PIXELS"]
+__all__ = [
+    "load_scene",
+    "parse_scene",
+    "check_spec",
+    "scene_table",
+    "MAX_PANELS",
+    "MAX_SERIES_POINTS",
+    "MAX_SCENE_BYTES",
+    "MAX_TEXT",
+    "MAX_PATH_CHARS",
+    "MAX_SCENE_STRING",
+    "MAX_SCENE_DEPTH",
+    "MAX_KEY_PARTS",
+    "MAX_CANVAS_PIXELS",
+]
 
 _MAP_KEYS = ("Omega0", "theta_w", "tau0", "tau1", "lam")
 _MAP_DEFAULTS = {"tau0": 1.0, "tau1": 0.5, "lam": 0.5}
@@ -41,8 +74,13 @@ _COMMON_KEYS = ("kind", "title", "output", "dpi", "figsize")
 
 
 _NAMES = {"pi": math.pi, "OMEGA_G": OMEGA_G}
-_BINOPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
-           ast.Pow: operator.pow}
+_BINOPS = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.Pow: operator.pow,
+}
 _UNOPS = {ast.USub: operator.neg, ast.UAdd: operator.pos}
 _FUNCS = {"sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "acos": math.acos}
 
@@ -58,8 +96,13 @@ def _eval_expr(node):
         return _BINOPS[type(node.op)](_eval_expr(node.left), _eval_expr(node.right))
     if isinstance(node, ast.UnaryOp) and type(node.op) in _UNOPS:
         return _UNOPS[type(node.op)](_eval_expr(node.operand))
-    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in _FUNCS
-            and len(node.args) == 1 and not node.keywords):
+    if (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id in _FUNCS
+        and len(node.args) == 1
+        and not node.keywords
+    ):
         return _FUNCS[node.func.id](_eval_expr(node.args[0]))
     raise ValueError("unsupported expression")
 
@@ -113,13 +156,16 @@ def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> 
         except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError, RecursionError, MemoryError):
             raise ValueError(
                 f"{where}: cannot evaluate {value!r}; allowed: a number or an expression of numbers, "
-                f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos") from None
+                f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos"
+            ) from None
     elif isinstance(value, (int, float)):
         try:
             v = float(value)
         except OverflowError:
-            raise ValueError(f"{where} is an integer of {value.bit_length()} bits, beyond the range of a double; "
-                             f"allowed: a finite number") from None
+            raise ValueError(
+                f"{where} is an integer of {value.bit_length()} bits, beyond the range of a double; "
+                f"allowed: a finite number"
+            ) from None
     else:
         raise ValueError(f"{where} must be a number, got {value!r}")
     if not math.isfinite(v):
@@ -169,8 +215,9 @@ def _color(where: str, value) -> str:
 
     v = _str(where, value)
     if not is_color_like(v):
-        raise ValueError(f"{where} = {value!r} is not a matplotlib colour; allowed: a name ('red'), 'C0'..'C9', "
-                         f"or hex '#rrggbb'")
+        raise ValueError(
+            f"{where} = {value!r} is not a matplotlib colour; allowed: a name ('red'), 'C0'..'C9', or hex '#rrggbb'"
+        )
     return v
 
 
@@ -213,8 +260,9 @@ def _eps_list(where: str, value, **bounds) -> tuple:
 def _check_keys(where: str, table: dict, allowed, required=()) -> None:
     unknown = [k for k in table if k not in allowed]
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(repr(k) for k in unknown)}; "
-                         f"allowed keys: {', '.join(allowed)}")
+        raise ValueError(
+            f"{where}: unknown key(s) {', '.join(repr(k) for k in unknown)}; allowed keys: {', '.join(allowed)}"
+        )
     for k in required:
         if k not in table:
             raise ValueError(f"{where}: missing required key {k!r}; allowed keys: {', '.join(allowed)}")
@@ -223,8 +271,13 @@ def _check_keys(where: str, table: dict, allowed, required=()) -> None:
 def _map_params(where: str, table: dict) -> dict:
     """The map keys present in a table, checked (theta_w in (0, pi), lam > 0)."""
     out = {}
-    ranges = {"Omega0": {}, "tau0": {}, "tau1": {}, "theta_w": dict(lo=0.0, hi=math.pi, lo_open=True, hi_open=True),
-              "lam": dict(lo=0.0, lo_open=True)}
+    ranges = {
+        "Omega0": {},
+        "tau0": {},
+        "tau1": {},
+        "theta_w": dict(lo=0.0, hi=math.pi, lo_open=True, hi_open=True),
+        "lam": dict(lo=0.0, lo_open=True),
+    }
     for k in _MAP_KEYS:
         if k in table:
             out[k] = _real(f"{where}.{k}", table[k], **ranges[k])
@@ -251,16 +304,19 @@ def _resolve_map(where: str, scene_map: dict, panel: dict) -> MapSpec:
     if "golden" in panel:
         for k in ("Omega0", "theta_w"):
             if k in panel:
-                raise ValueError(f"{where}: give either 'golden' or {k!r}, not both "
-                                 f"(the golden family sets Omega0 and theta_w)")
+                raise ValueError(
+                    f"{where}: give either 'golden' or {k!r}, not both (the golden family sets Omega0 and theta_w)"
+                )
         c, ge, O, tw = _golden(f"{where}.golden", panel["golden"], eps, vals["tau0"])
         vals.update(Omega0=O, theta_w=tw)
         spec = MapSpec(eps=eps, **{k: vals[k] for k in _MAP_KEYS}, golden_c=c, golden_eps=ge)
     else:
         for k in ("Omega0", "theta_w"):
             if k not in vals:
-                raise ValueError(f"{where}: missing required key {k!r} (in [map] or the panel), "
-                                 f"or a 'golden' table; allowed keys: {', '.join(_MAP_KEYS)}, golden")
+                raise ValueError(
+                    f"{where}: missing required key {k!r} (in [map] or the panel), "
+                    f"or a 'golden' table; allowed keys: {', '.join(_MAP_KEYS)}, golden"
+                )
         spec = MapSpec(eps=eps, **{k: vals[k] for k in _MAP_KEYS})
     try:
         spec.build()
@@ -273,11 +329,29 @@ def _resolve_map(where: str, scene_map: dict, panel: dict) -> MapSpec:
 # Parsing
 
 
-_PORTRAIT_KEYS = _COMMON_KEYS + ("map", "n_steps", "n_orbits", "K0_range", "line", "color_by", "marker_size",
-                                 "corner_curves", "layout", "panels")
+_PORTRAIT_KEYS = _COMMON_KEYS + (
+    "map",
+    "n_steps",
+    "n_orbits",
+    "K0_range",
+    "line",
+    "color_by",
+    "marker_size",
+    "corner_curves",
+    "layout",
+    "panels",
+)
 _PORTRAIT_PANEL_KEYS = ("id", "eps", "golden", "n_orbits", "K0_range", "xlim", "ylim") + _MAP_KEYS
-_CRIT_KEYS = _COMMON_KEYS + ("map", "n_steps", "rotation", "marker_size", "corner_curves", "leading_curve",
-                             "layout", "panels")
+_CRIT_KEYS = _COMMON_KEYS + (
+    "map",
+    "n_steps",
+    "rotation",
+    "marker_size",
+    "corner_curves",
+    "leading_curve",
+    "layout",
+    "panels",
+)
 _CRIT_PANEL_KEYS = ("id", "eps", "golden", "special", "orbits", "critical", "xlim", "ylim") + _MAP_KEYS
 _ZOOM_PANEL_KEYS = ("id", "zoom")
 _ZOOM_KEYS = ("of", "on", "orbits", "pad", "xlim", "ylim")
@@ -297,16 +371,25 @@ _FLOW_KEYS = {
     "wall_tangency": _FLOW_COMMON + ("grid", "n_points", "marker_size"),
     "wall_section": _FLOW_COMMON + ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments"),
 }
-_FLOW_REQUIRED = {"flow_portrait": ("n_steps",), "flow_hovering_area": ("n_steps", "eps"), "tangent_tori": (),
-                  "sigma_structure": (), "corner_directions": (), "wall_tangency": (), "wall_section": ()}
+_FLOW_REQUIRED = {
+    "flow_portrait": ("n_steps",),
+    "flow_hovering_area": ("n_steps", "eps"),
+    "tangent_tori": (),
+    "sigma_structure": (),
+    "corner_directions": (),
+    "wall_tangency": (),
+    "wall_section": (),
+}
 #: The scene's own keys of each kind, as ``scene_table`` writes them back (after the common ones).
-_KIND_KEYS = {"flow_portrait": ("n_steps", "n_orbits", "K0_range", "model", "corner_K", "marker_size"),
-              "flow_hovering_area": ("n_steps", "eps", "samples", "seed", "models"),
-              "tangent_tori": ("n_returns", "n_points"),
-              "sigma_structure": ("grid", "K_range", "marker_size"),
-              "corner_directions": ("p1w_fractions", "n_curve"),
-              "wall_tangency": ("grid", "n_points", "marker_size"),
-              "wall_section": ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments")}
+_KIND_KEYS = {
+    "flow_portrait": ("n_steps", "n_orbits", "K0_range", "model", "corner_K", "marker_size"),
+    "flow_hovering_area": ("n_steps", "eps", "samples", "seed", "models"),
+    "tangent_tori": ("n_returns", "n_points"),
+    "sigma_structure": ("grid", "K_range", "marker_size"),
+    "corner_directions": ("p1w_fractions", "n_curve"),
+    "wall_tangency": ("grid", "n_points", "marker_size"),
+    "wall_section": ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments"),
+}
 # (allowed, required) records per kind: a figure's own needs are required, the rest optional.
 _FLOW_RECORDS = {
     "flow_portrait": (("regions",), ()),
@@ -325,7 +408,7 @@ _OUTPUTS_KEYS = ("record", "trajectory_dt")
 _STEPPERS = STEPPERS
 
 
-def output_dirs(path: Optional[os.PathLike]) -> tuple:
+def output_dirs(path: os.PathLike | None) -> tuple:
     """Where a scene's own ``output`` may lie: under the scene file's folder or the working
     directory (a scene from elsewhere cannot make hovering write anywhere else; ``--out`` can).
 
@@ -341,7 +424,7 @@ def output_dirs(path: Optional[os.PathLike]) -> tuple:
     return (Path.cwd(),) + ((Path(path).parent,) if path is not None else ())
 
 
-def parse_scene(data: dict, path: Optional[os.PathLike] = None, check_output: bool = True) -> SceneSpec:
+def parse_scene(data: dict, path: os.PathLike | None = None, check_output: bool = True) -> SceneSpec:
     """Validate a scene given as a dict (the parsed TOML) and build its spec.
 
     Parameters
@@ -384,8 +467,10 @@ def _check_document(where: str, data) -> None:
         node, at, depth = stack.pop()
         if isinstance(node, (dict, list)):
             if depth > MAX_SCENE_DEPTH:
-                raise ValueError(f"{at}: tables and arrays nested more than {MAX_SCENE_DEPTH} deep; allowed: at most "
-                                 f"{MAX_SCENE_DEPTH} levels")
+                raise ValueError(
+                    f"{at}: tables and arrays nested more than {MAX_SCENE_DEPTH} deep; allowed: at most "
+                    f"{MAX_SCENE_DEPTH} levels"
+                )
             items = node.items() if isinstance(node, dict) else enumerate(node)
             for k, v in items:
                 if isinstance(k, str) and len(k) > MAX_SCENE_STRING:
@@ -394,8 +479,10 @@ def _check_document(where: str, data) -> None:
         elif isinstance(node, str) and len(node) > MAX_SCENE_STRING:
             raise ValueError(f"{at}: a string of {len(node)} characters; allowed: at most {MAX_SCENE_STRING}")
         elif isinstance(node, int) and not isinstance(node, bool) and node.bit_length() > _MAX_INT_BITS:
-            raise ValueError(f"{at} = (an integer of {node.bit_length()} bits) is out of range; allowed: integers in "
-                             f"[-2**63, 2**63 - 1] (TOML's 64-bit integers)")
+            raise ValueError(
+                f"{at} = (an integer of {node.bit_length()} bits) is out of range; allowed: integers in "
+                f"[-2**63, 2**63 - 1] (TOML's 64-bit integers)"
+            )
 
 
 def _check_canvas(where: str, spec: SceneSpec) -> None:
@@ -404,14 +491,21 @@ def _check_canvas(where: str, spec: SceneSpec) -> None:
     w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
     pixels = (spec.dpi * w) * (spec.dpi * h)
     if pixels > MAX_CANVAS_PIXELS:
-        given = ("figsize" if spec.figsize is not None else "layout" if getattr(spec, "layout", None) is not None
-                 else "the default figure size")
-        raise ValueError(f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
-                         f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
-                         f"(lower dpi or figsize)")
+        given = (
+            "figsize"
+            if spec.figsize is not None
+            else "layout"
+            if getattr(spec, "layout", None) is not None
+            else "the default figure size"
+        )
+        raise ValueError(
+            f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
+            f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
+            f"(lower dpi or figsize)"
+        )
 
 
-def _parse_scene(data, p: Optional[Path], where: str, check_output: bool) -> SceneSpec:
+def _parse_scene(data, p: Path | None, where: str, check_output: bool) -> SceneSpec:
     name = p.stem if p is not None else "scene"
     data = _table(where, data)
     if "kind" not in data:
@@ -428,9 +522,13 @@ def _parse_scene(data, p: Optional[Path], where: str, check_output: bool) -> Sce
         name=name,
         kind=kind,
         title=_str(f"{where}.title", data["title"]) if "title" in data else name,
-        output=(output_path(f"{where}.output", _str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS),
-                            within=output_dirs(p))
-                if check_output else Path(_str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS))),
+        output=(
+            output_path(
+                f"{where}.output", _str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS), within=output_dirs(p)
+            )
+            if check_output
+            else Path(_str(f"{where}.output", data["output"], limit=MAX_PATH_CHARS))
+        ),
         dpi=_int(f"{where}.dpi", data["dpi"], 30, 1200) if "dpi" in data else 130,
         figsize=_size(f"{where}.figsize", data["figsize"]) if "figsize" in data else None,
     )
@@ -486,10 +584,15 @@ def _parse_orbit_scene(where: str, kind: str, data: dict, scene_map: dict, commo
             if kr is None:
                 raise ValueError(f"{pw}: missing required key 'K0_range' (in the scene or the panel)")
             _check_band(f"{pw}.K0_range", m, kr)
-            panels.append(PanelSpec(
-                id=_str(f"{pw}.id", pt["id"]), map=m,
-                n_orbits=_int(f"{pw}.n_orbits", pt["n_orbits"], 1, 10_000) if "n_orbits" in pt else n_orbits,
-                K0_range=kr, **_limits(pw, pt)))
+            panels.append(
+                PanelSpec(
+                    id=_str(f"{pw}.id", pt["id"]),
+                    map=m,
+                    n_orbits=_int(f"{pw}.n_orbits", pt["n_orbits"], 1, 10_000) if "n_orbits" in pt else n_orbits,
+                    K0_range=kr,
+                    **_limits(pw, pt),
+                )
+            )
         elif "zoom" in pt:
             _check_keys(pw, pt, _ZOOM_PANEL_KEYS, ("id", "zoom"))
             panels.append(PanelSpec(id=_str(f"{pw}.id", pt["id"]), zoom=_parse_zoom(f"{pw}.zoom", pt["zoom"])))
@@ -509,8 +612,9 @@ def _check_band(where: str, m: MapSpec, K) -> None:
     lo = m.build().valid_band()[0]
     Kmin = min(K)
     if not Kmin > lo:
-        raise ValueError(f"{where}: K0 = {Kmin} lies below the band floor {lo:.6g} of this panel's map; "
-                         f"allowed: K0 > {lo:.6g}")
+        raise ValueError(
+            f"{where}: K0 = {Kmin} lies below the band floor {lo:.6g} of this panel's map; allowed: K0 > {lo:.6g}"
+        )
 
 
 def _parse_crit_panel(pw: str, pt: dict, scene_map: dict, n_steps: int) -> PanelSpec:
@@ -566,12 +670,20 @@ def _parse_crit_panel(pw: str, pt: dict, scene_map: dict, n_steps: int) -> Panel
     labels = list(special) + [o.label for o in orbits] + (["critical"] if critical else [])
     dup = {x for x in labels if labels.count(x) > 1}
     if dup:
-        raise ValueError(f"{pw}: orbit label(s) {sorted(dup)} used twice (labels must be unique, and "
-                         f"{list(SPECIAL_ORBITS) + ['critical']} are reserved)")
+        raise ValueError(
+            f"{pw}: orbit label(s) {sorted(dup)} used twice (labels must be unique, and "
+            f"{list(SPECIAL_ORBITS) + ['critical']} are reserved)"
+        )
     if not labels:
         raise ValueError(f"{pw}: the panel draws no orbit (special = [] and no orbits or critical)")
-    return PanelSpec(id=_str(f"{pw}.id", pt["id"]), map=m, special=special, orbits=tuple(orbits),
-                     critical=critical, **_limits(pw, pt))
+    return PanelSpec(
+        id=_str(f"{pw}.id", pt["id"]),
+        map=m,
+        special=special,
+        orbits=tuple(orbits),
+        critical=critical,
+        **_limits(pw, pt),
+    )
 
 
 def _parse_zoom(zw: str, zt) -> ZoomSpec:
@@ -589,12 +701,18 @@ def _parse_zoom(zw: str, zt) -> ZoomSpec:
         raise ValueError(f"{zw}: 'orbits' is only used with on = 'islands', got on = {on!r}")
     lims = {k: _pair(f"{zw}.{k}", zt[k]) for k in ("xlim", "ylim") if k in zt}
     if on == "fixed" and len(lims) != 2:
-        raise ValueError(f"{zw}: missing required key(s) {[k for k in ('xlim', 'ylim') if k not in lims]} "
-                         f"for on = 'fixed'")
+        raise ValueError(
+            f"{zw}: missing required key(s) {[k for k in ('xlim', 'ylim') if k not in lims]} for on = 'fixed'"
+        )
     if on != "fixed" and lims:
         raise ValueError(f"{zw}: 'xlim'/'ylim' need on = 'fixed' (the window is otherwise chosen from the data)")
-    return ZoomSpec(of=_str(f"{zw}.of", zt["of"]), on=on, orbits=orbits,
-                    pad=_real(f"{zw}.pad", zt["pad"], lo=0.0, hi=5.0) if "pad" in zt else 0.5, **lims)
+    return ZoomSpec(
+        of=_str(f"{zw}.of", zt["of"]),
+        on=on,
+        orbits=orbits,
+        pad=_real(f"{zw}.pad", zt["pad"], lo=0.0, hi=5.0) if "pad" in zt else 0.5,
+        **lims,
+    )
 
 
 def _check_panel_refs(where: str, panels) -> None:
@@ -642,25 +760,31 @@ def _parse_hovering_area(where: str, data: dict, scene_map: dict, common: dict) 
                     raise ValueError(f"{sw}: give either 'golden_c' or {k!r}, not both")
             c = _real(f"{sw}.golden_c", st["golden_c"])
             if not abs(c) < abs(vals["tau0"]):
-                raise ValueError(f"{sw}.golden_c = {st['golden_c']!r} is out of range; "
-                                 f"allowed: |c| < |tau0| = {abs(vals['tau0'])}")
+                raise ValueError(
+                    f"{sw}.golden_c = {st['golden_c']!r} is out of range; allowed: |c| < |tau0| = {abs(vals['tau0'])}"
+                )
             vals["Omega0"] = vals["theta_w"] = None
         else:
             for k in ("Omega0", "theta_w"):
                 if k not in vals:
                     raise ValueError(f"{sw}: missing required key {k!r} (in [map] or the series), or 'golden_c'")
-        s = SeriesSpec(label=_str(f"{sw}.label", st["label"]), golden_c=c,
-                       color=_color(f"{sw}.color", st["color"]) if "color" in st else None,
-                       K_low=_real(f"{sw}.K_low", st["K_low"], hi=0.0, hi_open=True) if "K_low" in st else None,
-                       **{k: vals[k] for k in _MAP_KEYS})
+        s = SeriesSpec(
+            label=_str(f"{sw}.label", st["label"]),
+            golden_c=c,
+            color=_color(f"{sw}.color", st["color"]) if "color" in st else None,
+            K_low=_real(f"{sw}.K_low", st["K_low"], hi=0.0, hi_open=True) if "K_low" in st else None,
+            **{k: vals[k] for k in _MAP_KEYS},
+        )
         for e in eps:
             try:
                 m = s.map_at(e).build()
             except ValueError as err:
                 raise ValueError(f"{sw} at eps = {e}: {err}") from None
             if s.K_low is not None and not s.K_low > m.valid_band()[0]:
-                raise ValueError(f"{sw}.K_low = {st['K_low']!r} lies below the band floor {m.valid_band()[0]:.6g} "
-                                 f"of the map at eps = {e}; allowed: ({m.valid_band()[0]:.6g}, 0)")
+                raise ValueError(
+                    f"{sw}.K_low = {st['K_low']!r} lies below the band floor {m.valid_band()[0]:.6g} "
+                    f"of the map at eps = {e}; allowed: ({m.valid_band()[0]:.6g}, 0)"
+                )
         series.append(s)
     return HoveringAreaScene(
         eps=eps,
@@ -693,8 +817,9 @@ def _coupling(where: str, value) -> tuple:
     if value == "none":
         return ()
     if not isinstance(value, list) or not value or len(value) > 64:
-        raise ValueError(f"{where} must be 'bilinear', 'none' or a list of 1..64 terms [c, i, j] "
-                         f"(c q1^i q2^j), got {value!r}")
+        raise ValueError(
+            f"{where} must be 'bilinear', 'none' or a list of 1..64 terms [c, i, j] (c q1^i q2^j), got {value!r}"
+        )
     terms = []
     for k, term in enumerate(value):
         tw = f"{where}[{k}]"
@@ -736,8 +861,10 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
     # Normal coordinates (every flow figure but the tori) need the tangential band: h above the
     # step energy; the tori need both tangent tori, which exist for the same h.
     if not h > hw:
-        raise ValueError(f"{where}.section.h = {h!r} is out of range; allowed: above the step energy "
-                         f"V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = {hw:.6g} (no tangency band below it)")
+        raise ValueError(
+            f"{where}.section.h = {h!r} is out of range; allowed: above the step energy "
+            f"V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = {hw:.6g} (no tangency band below it)"
+        )
     integ = IntegratorSpec()
     if "integrator" in data:
         it = _table(f"{where}.integrator", data["integrator"])
@@ -749,8 +876,10 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
         if "accuracy" in it:
             both = sorted({"stepper", "rtol", "atol"} & set(it))
             if both:
-                raise ValueError(f"{where}.integrator: 'accuracy' picks the stepper and tolerances itself; "
-                                 f"remove {both} or 'accuracy'")
+                raise ValueError(
+                    f"{where}.integrator: 'accuracy' picks the stepper and tolerances itself; "
+                    f"remove {both} or 'accuracy'"
+                )
             accuracy = _real(f"{where}.integrator.accuracy", it["accuracy"], lo=1e-13, hi=1e-2)
         integ = IntegratorSpec(stepper, rtol, atol, accuracy)
     allowed, required = _FLOW_RECORDS[kind]
@@ -780,14 +909,28 @@ def _flow_common(where: str, kind: str, data: dict) -> dict:
 def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneSpec:
     common.update(_flow_common(where, kind, data))
     system = common["system"]
-    if kind in ("flow_portrait", "flow_hovering_area", "sigma_structure", "corner_directions", "wall_tangency",
-                "wall_section") and system.geometry != "step":
-        raise ValueError(f"{where}.system.geometry = {system.geometry!r}: a {kind} scene draws the regions of "
-                         f"the step; allowed: 'step'")
+    if (
+        kind
+        in (
+            "flow_portrait",
+            "flow_hovering_area",
+            "sigma_structure",
+            "corner_directions",
+            "wall_tangency",
+            "wall_section",
+        )
+        and system.geometry != "step"
+    ):
+        raise ValueError(
+            f"{where}.system.geometry = {system.geometry!r}: a {kind} scene draws the regions of "
+            f"the step; allowed: 'step'"
+        )
     if kind == "tangent_tori" and (system.eps != 0 or system.geometry != "none"):
-        raise ValueError(f"{where}.system: the tangent tori are those of the unperturbed smooth flow; allowed: "
-                         f"eps = 0 and geometry = 'none' (got eps = {system.eps!r}, geometry = {system.geometry!r}: "
-                         f"with walls, a tangent trajectory stops as GRAZING)")
+        raise ValueError(
+            f"{where}.system: the tangent tori are those of the unperturbed smooth flow; allowed: "
+            f"eps = 0 and geometry = 'none' (got eps = {system.eps!r}, geometry = {system.geometry!r}: "
+            f"with walls, a tangent trajectory stops as GRAZING)"
+        )
     if kind == "flow_portrait":
         kr = _pair(f"{where}.K0_range", data["K0_range"]) if "K0_range" in data else (-0.1, 0.05)
         return FlowPortraitScene(
@@ -796,9 +939,13 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
             K0_range=kr,
             model=_str(f"{where}.model", data["model"], ("measured", "first_mode")) if "model" in data else "measured",
             corner_K=_int(f"{where}.corner_K", data["corner_K"], 0, 200) if "corner_K" in data else 12,
-            marker_size=(_real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
-                         if "marker_size" in data else 0.5),
-            **common)
+            marker_size=(
+                _real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
+                if "marker_size" in data
+                else 0.5
+            ),
+            **common,
+        )
     if kind == "flow_hovering_area":
         eps = _eps_list(f"{where}.eps", data["eps"], lo=-1.0, hi=1.0)
         models = ("onset", "measured")
@@ -808,15 +955,19 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
                 raise ValueError(f"{where}.models must be a list from ['onset', 'measured'], got {mv!r}")
             models = tuple(_str(f"{where}.models", m, ("onset", "measured")) for m in mv)
         return FlowHoveringScene(
-            n_steps=_int(f"{where}.n_steps", data["n_steps"], 1, 1_000_000), eps=eps,
+            n_steps=_int(f"{where}.n_steps", data["n_steps"], 1, 1_000_000),
+            eps=eps,
             samples=_int(f"{where}.samples", data["samples"], 16, 10_000_000) if "samples" in data else 1000,
             seed=_int(f"{where}.seed", data["seed"], 0, 2**63 - 1) if "seed" in data else 0,
-            models=models, **common)
+            models=models,
+            **common,
+        )
     if kind == "tangent_tori":
         return TangentToriScene(
             n_returns=_int(f"{where}.n_returns", data["n_returns"], 1, 100) if "n_returns" in data else 3,
             n_points=_int(f"{where}.n_points", data["n_points"], 16, 100_000) if "n_points" in data else 400,
-            **common)
+            **common,
+        )
     if kind in ("corner_directions", "wall_tangency", "wall_section"):
         return _parse_wall_scene(where, kind, data, common)
     grid = (240, 60)
@@ -827,10 +978,15 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
         grid = (_int(f"{where}.grid[0]", gv[0], 8, 4000), _int(f"{where}.grid[1]", gv[1], 2, 4000))
     kr = _pair(f"{where}.K_range", data["K_range"]) if "K_range" in data else (-0.12, 0.03)
     return SigmaStructureScene(
-        grid=grid, K_range=kr,
-        marker_size=(_real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
-                     if "marker_size" in data else 1.0),
-        **common)
+        grid=grid,
+        K_range=kr,
+        marker_size=(
+            _real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
+            if "marker_size" in data
+            else 1.0
+        ),
+        **common,
+    )
 
 
 def _parse_wall_scene(where: str, kind: str, data: dict, common: dict) -> SceneSpec:
@@ -838,27 +994,36 @@ def _parse_wall_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
     system, h = common["system"], common["h"]
     hw = corner_energy(system.build())
     if not h > hw:
-        raise ValueError(f"{where}.section.h = {h!r} is out of range; allowed: above the energy at rest at the corner "
-                         f"V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = {hw:.6g} (def:heps: below it no orbit reaches the "
-                         f"corner)")
+        raise ValueError(
+            f"{where}.section.h = {h!r} is out of range; allowed: above the energy at rest at the corner "
+            f"V1(qw1) + V2(qw2) + eps Vc(qw1, qw2) = {hw:.6g} (def:heps: below it no orbit reaches the "
+            f"corner)"
+        )
     if kind == "corner_directions":
         fr = (0.3, 0.7)
         if "p1w_fractions" in data:
             fv = data["p1w_fractions"]
             if not isinstance(fv, list) or not 1 <= len(fv) <= 12:
-                raise ValueError(f"{where}.p1w_fractions must be a list of 1 to 12 numbers in (0, 1) (p1w / p1w_max), "
-                                 f"got {fv!r}")
-            fr = tuple(_real(f"{where}.p1w_fractions[{i}]", v, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
-                       for i, v in enumerate(fv))
+                raise ValueError(
+                    f"{where}.p1w_fractions must be a list of 1 to 12 numbers in (0, 1) (p1w / p1w_max), got {fv!r}"
+                )
+            fr = tuple(
+                _real(f"{where}.p1w_fractions[{i}]", v, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+                for i, v in enumerate(fv)
+            )
             if len(set(fr)) != len(fr):
                 raise ValueError(f"{where}.p1w_fractions = {fv!r} lists a value twice")
         return CornerDirectionsScene(
-            p1w_fractions=fr, n_curve=_int(f"{where}.n_curve", data["n_curve"], 4, 2000) if "n_curve" in data else 48,
-            **common)
+            p1w_fractions=fr,
+            n_curve=_int(f"{where}.n_curve", data["n_curve"], 4, 2000) if "n_curve" in data else 48,
+            **common,
+        )
     if kind == "wall_tangency":
         if system.eps != 0:
-            raise ValueError(f"{where}.system.eps = {system.eps!r}: fig:Sigma_0_wall draws the unperturbed tangency "
-                             f"line; allowed: eps = 0 (the wall_section kind takes eps != 0)")
+            raise ValueError(
+                f"{where}.system.eps = {system.eps!r}: fig:Sigma_0_wall draws the unperturbed tangency "
+                f"line; allowed: eps = 0 (the wall_section kind takes eps != 0)"
+            )
         grid = (180, 40)
         if "grid" in data:
             gv = data["grid"]
@@ -866,23 +1031,32 @@ def _parse_wall_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
                 raise ValueError(f"{where}.grid must be [n_theta, n_rho], got {gv!r}")
             grid = (_int(f"{where}.grid[0]", gv[0], 8, 2000), _int(f"{where}.grid[1]", gv[1], 2, 1000))
         return WallTangencyScene(
-            grid=grid, n_points=_int(f"{where}.n_points", data["n_points"], 16, 100_000) if "n_points" in data else 400,
-            marker_size=(_real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
-                         if "marker_size" in data else 2.0),
-            **common)
+            grid=grid,
+            n_points=_int(f"{where}.n_points", data["n_points"], 16, 100_000) if "n_points" in data else 400,
+            marker_size=(
+                _real(f"{where}.marker_size", data["marker_size"], lo=0.0, hi=100.0, lo_open=True)
+                if "marker_size" in data
+                else 2.0
+            ),
+            **common,
+        )
     # wall_section: its coordinates need the tangency line I_tan^{eps,-}(theta) near the unperturbed one
     try:
         wall_tangency_action(system.build(), h, [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0])
     except ValueError as e:
         raise ValueError(f"{where}.system.eps = {system.eps!r}: {e}") from None
     return WallSectionScene(
-        rho_w_fraction=(_real(f"{where}.rho_w_fraction", data["rho_w_fraction"], lo=0.0, hi=1.0, lo_open=True)
-                        if "rho_w_fraction" in data else 0.5),
+        rho_w_fraction=(
+            _real(f"{where}.rho_w_fraction", data["rho_w_fraction"], lo=0.0, hi=1.0, lo_open=True)
+            if "rho_w_fraction" in data
+            else 0.5
+        ),
         n_theta=_int(f"{where}.n_theta", data["n_theta"], 32, 20_000) if "n_theta" in data else 720,
         n_circles=_int(f"{where}.n_circles", data["n_circles"], 2, 200) if "n_circles" in data else 16,
         bisections=_int(f"{where}.bisections", data["bisections"], 1, 50) if "bisections" in data else 30,
         segments=_int(f"{where}.segments", data["segments"], 0, 10) if "segments" in data else 2,
-        **common)
+        **common,
+    )
 
 
 def load_scene(path: os.PathLike, check_output: bool = True) -> SceneSpec:
@@ -924,18 +1098,19 @@ def load_scene(path: os.PathLike, check_output: bool = True) -> SceneSpec:
     except ValueError as e:  # TOMLDecodeError, or a number Python will not convert
         raise ValueError(f"{p.name}: not valid TOML: {e}") from None
     except RecursionError:  # _check_toml_text bounds the nesting; kept for a text it misjudged
-        raise ValueError(f"{p.name}: arrays or tables nested too deeply; allowed: at most {MAX_SCENE_DEPTH} "
-                         f"levels") from None
+        raise ValueError(
+            f"{p.name}: arrays or tables nested too deeply; allowed: at most {MAX_SCENE_DEPTH} levels"
+        ) from None
     return parse_scene(data, p, check_output=check_output)
 
 
 # TOML strings and comments, skipped when counting brackets and dots (multi-line strings first).
-_TOML_SKIP = re.compile(r'"""(?:[^"\\]|\\.|"(?!""))*"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*',
-                        re.S)
+_TOML_SKIP = re.compile(
+    r'"""(?:[^"\\]|\\.|"(?!""))*"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*', re.S
+)
 # A dotted key of more than MAX_KEY_PARTS parts, where a key can start (possessive: linear time).
 _KEY_PART = r'(?:[A-Za-z0-9_-]++|"")'
-_LONG_KEY = re.compile(rf'(?:^|[\[{{,])\[?[ \t]*+{_KEY_PART}(?:[ \t]*+\.[ \t]*+{_KEY_PART}){{{MAX_KEY_PARTS},}}',
-                       re.M)
+_LONG_KEY = re.compile(rf"(?:^|[\[{{,])\[?[ \t]*+{_KEY_PART}(?:[ \t]*+\.[ \t]*+{_KEY_PART}){{{MAX_KEY_PARTS},}}", re.M)
 
 
 # A run of digits longer than any number a double holds (2**1024 has 309); Python's own integer
@@ -959,13 +1134,17 @@ def _check_toml_text(name: str, text: str) -> None:
     m = _LONG_NUMBER.search(skel)
     if m:
         line, key = line_of(m.start())
-        raise ValueError(f"{name}: line {line}: {key!r} has a number of {len(m.group())} digits; allowed: numbers "
-                         f"within the range of a double (at most {_MAX_DIGITS} digits)")
+        raise ValueError(
+            f"{name}: line {line}: {key!r} has a number of {len(m.group())} digits; allowed: numbers "
+            f"within the range of a double (at most {_MAX_DIGITS} digits)"
+        )
     m = _LONG_KEY.search(skel)
     if m:
         line, _ = line_of(m.start())
-        raise ValueError(f"{name}: line {line}: the key {m.group().lstrip('[{, ')[:60]!r}... has more than "
-                         f"{MAX_KEY_PARTS} dotted parts; allowed: at most {MAX_KEY_PARTS}")
+        raise ValueError(
+            f"{name}: line {line}: the key {m.group().lstrip('[{, ')[:60]!r}... has more than "
+            f"{MAX_KEY_PARTS} dotted parts; allowed: at most {MAX_KEY_PARTS}"
+        )
     depth = outer = 0
     for b in re.finditer(r"[\[\]{}]", skel):
         if b.group() in "[{":
@@ -973,8 +1152,10 @@ def _check_toml_text(name: str, text: str) -> None:
             outer = b.start() if depth == 1 else outer
             if depth > MAX_SCENE_DEPTH:
                 line, key = line_of(outer)
-                raise ValueError(f"{name}: line {line}: {key!r} nests arrays or tables more than {MAX_SCENE_DEPTH} "
-                                 f"deep; allowed: at most {MAX_SCENE_DEPTH} levels")
+                raise ValueError(
+                    f"{name}: line {line}: {key!r} nests arrays or tables more than {MAX_SCENE_DEPTH} "
+                    f"deep; allowed: at most {MAX_SCENE_DEPTH} levels"
+                )
         else:
             depth = max(depth - 1, 0)
 
@@ -999,8 +1180,9 @@ def _some(**kw) -> dict:
 def _panel_table(spec, pn: PanelSpec) -> dict:
     if pn.zoom is not None:
         z = pn.zoom
-        zt = _some(of=z.of, on=z.on, pad=z.pad, orbits=z.orbits if z.on == "islands" else None,
-                   xlim=z.xlim, ylim=z.ylim)
+        zt = _some(
+            of=z.of, on=z.on, pad=z.pad, orbits=z.orbits if z.on == "islands" else None, xlim=z.xlim, ylim=z.ylim
+        )
         return {"id": pn.id, "zoom": zt}
     t = {"id": pn.id, **_map_table(pn.map), **_some(xlim=pn.xlim, ylim=pn.ylim)}
     if spec.kind == "portrait":
@@ -1016,10 +1198,22 @@ def _panel_table(spec, pn: PanelSpec) -> dict:
 
 def _system_table(s) -> dict:
     pot = lambda v: _some(kind=v.kind, omega=v.omega, alpha=v.alpha)  # noqa: E731
-    coupling = ("bilinear" if s.coupling == ((1.0, 1, 1),) else "none" if s.coupling == ()
-                else [list(term) for term in s.coupling])
-    return {"V1": pot(s.V1), "V2": pot(s.V2), "coupling": coupling, "eps": s.eps, "qw1": s.qw1, "qw2": s.qw2,
-            "geometry": s.geometry}
+    coupling = (
+        "bilinear"
+        if s.coupling == ((1.0, 1, 1),)
+        else "none"
+        if s.coupling == ()
+        else [list(term) for term in s.coupling]
+    )
+    return {
+        "V1": pot(s.V1),
+        "V2": pot(s.V2),
+        "coupling": coupling,
+        "eps": s.eps,
+        "qw1": s.qw1,
+        "qw2": s.qw2,
+        "geometry": s.geometry,
+    }
 
 
 def scene_table(spec: SceneSpec) -> dict:
@@ -1035,27 +1229,60 @@ def scene_table(spec: SceneSpec) -> dict:
     dict
         Every value written out (defaults included); expressions appear as their values.
     """
-    t = {"kind": spec.kind, "title": spec.title, "output": str(spec.output), "dpi": spec.dpi,
-         **_some(figsize=spec.figsize)}
+    t = {
+        "kind": spec.kind,
+        "title": spec.title,
+        "output": str(spec.output),
+        "dpi": spec.dpi,
+        **_some(figsize=spec.figsize),
+    }
     if isinstance(spec, OrbitScene):
-        t.update(n_steps=spec.n_steps, marker_size=spec.marker_size, corner_curves=spec.corner_curves,
-                 panels=[_panel_table(spec, pn) for pn in spec.panels], **_some(layout=spec.layout))
+        t.update(
+            n_steps=spec.n_steps,
+            marker_size=spec.marker_size,
+            corner_curves=spec.corner_curves,
+            panels=[_panel_table(spec, pn) for pn in spec.panels],
+            **_some(layout=spec.layout),
+        )
         if spec.kind == "portrait":
             t.update(line=spec.line, color_by=spec.color_by)
         else:
             t.update(rotation=spec.rotation, leading_curve=spec.leading_curve)
     elif isinstance(spec, HoveringAreaScene):
-        t.update(n_steps=spec.n_steps, eps=list(spec.eps), samples=spec.samples, seed=spec.seed,
-                 series=[_some(label=s.label, tau0=s.tau0, tau1=s.tau1, lam=s.lam, golden_c=s.golden_c,
-                               Omega0=s.Omega0, theta_w=s.theta_w, color=s.color, K_low=s.K_low) for s in spec.series])
+        t.update(
+            n_steps=spec.n_steps,
+            eps=list(spec.eps),
+            samples=spec.samples,
+            seed=spec.seed,
+            series=[
+                _some(
+                    label=s.label,
+                    tau0=s.tau0,
+                    tau1=s.tau1,
+                    lam=s.lam,
+                    golden_c=s.golden_c,
+                    Omega0=s.Omega0,
+                    theta_w=s.theta_w,
+                    color=s.color,
+                    K_low=s.K_low,
+                )
+                for s in spec.series
+            ],
+        )
     else:
         allowed, _ = _FLOW_RECORDS[spec.kind]
         ig = spec.integrator
-        t.update(system=_system_table(spec.system), section={"h": spec.h},
-                 integrator={"accuracy": ig.accuracy} if ig.accuracy is not None else
-                 {"stepper": ig.stepper, "rtol": ig.rtol, "atol": ig.atol},
-                 outputs={"record": list(spec.outputs.record),
-                          **({"trajectory_dt": spec.outputs.trajectory_dt} if "trajectory" in allowed else {})})
+        t.update(
+            system=_system_table(spec.system),
+            section={"h": spec.h},
+            integrator={"accuracy": ig.accuracy}
+            if ig.accuracy is not None
+            else {"stepper": ig.stepper, "rtol": ig.rtol, "atol": ig.atol},
+            outputs={
+                "record": list(spec.outputs.record),
+                **({"trajectory_dt": spec.outputs.trajectory_dt} if "trajectory" in allowed else {}),
+            },
+        )
         t.update(_some(**{k: getattr(spec, k) for k in _KIND_KEYS[spec.kind]}))
     return t
 

@@ -9,28 +9,54 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional
 
-from ..flow.system import Harmonic, Tan
-from ..flow.system import Bilinear, Polynomial, StepSystem
+from ..flow.system import Bilinear, Harmonic, Polynomial, StepSystem, Tan
 from ..interface import hook
 from ..truncated.maps import TruncatedMap
 from ..truncated.theory import golden_family
 
 __all__ = [
-    "KINDS", "TRUNCATED_KINDS", "FLOW_KINDS", "SPECIAL_ORBITS", "QUICK_FACTOR",
-    "MapSpec", "OrbitSpec", "CriticalSpec", "ZoomSpec", "PanelSpec", "SeriesSpec",
-    "PotentialSpec", "SystemSpec", "IntegratorSpec", "OutputsSpec",
-    "SceneSpec", "OrbitScene", "HoveringAreaScene", "FlowPortraitScene", "FlowHoveringScene",
-    "TangentToriScene", "SigmaStructureScene", "CornerDirectionsScene", "WallTangencyScene", "WallSectionScene",
-    "Scene", "figure_inches",
+    "KINDS",
+    "TRUNCATED_KINDS",
+    "FLOW_KINDS",
+    "SPECIAL_ORBITS",
+    "QUICK_FACTOR",
+    "MapSpec",
+    "OrbitSpec",
+    "CriticalSpec",
+    "ZoomSpec",
+    "PanelSpec",
+    "SeriesSpec",
+    "PotentialSpec",
+    "SystemSpec",
+    "IntegratorSpec",
+    "OutputsSpec",
+    "SceneSpec",
+    "OrbitScene",
+    "HoveringAreaScene",
+    "FlowPortraitScene",
+    "FlowHoveringScene",
+    "TangentToriScene",
+    "SigmaStructureScene",
+    "CornerDirectionsScene",
+    "WallTangencyScene",
+    "WallSectionScene",
+    "Scene",
+    "figure_inches",
 ]
 
 #: Scene kinds of the truncated map (sec:truncatedmapnum).
 TRUNCATED_KINDS = ("portrait", "critical_orbits", "hovering_area")
 #: Scene kinds of the physical flow.
-FLOW_KINDS = ("flow_portrait", "flow_hovering_area", "tangent_tori", "sigma_structure", "corner_directions",
-              "wall_tangency", "wall_section")
+FLOW_KINDS = (
+    "flow_portrait",
+    "flow_hovering_area",
+    "tangent_tori",
+    "sigma_structure",
+    "corner_directions",
+    "wall_tangency",
+    "wall_section",
+)
 #: Every kind of scene.
 KINDS = TRUNCATED_KINDS + FLOW_KINDS
 
@@ -68,8 +94,8 @@ class MapSpec:
     tau0: float = 1.0
     tau1: float = 0.5
     lam: float = 0.5
-    golden_c: Optional[float] = None
-    golden_eps: Optional[float] = None
+    golden_c: float | None = None
+    golden_eps: float | None = None
 
     def build(self):
         """The :class:`~hovering.TruncatedMap` with these parameters.
@@ -113,9 +139,9 @@ class OrbitSpec:
 
     label: str
     K0: float
-    phi0: Optional[float] = None
-    line: Optional[str] = None
-    color: Optional[str] = None
+    phi0: float | None = None
+    line: str | None = None
+    color: str | None = None
 
 
 @dataclass(frozen=True)
@@ -136,7 +162,7 @@ class CriticalSpec:
     """
 
     n_steps: int
-    K_range: Optional[tuple] = None
+    K_range: tuple | None = None
     line: str = "L1"
     color: str = "C4"
 
@@ -164,8 +190,8 @@ class ZoomSpec:
     on: str = "critical"
     orbits: tuple = ()
     pad: float = 0.5
-    xlim: Optional[tuple] = None
-    ylim: Optional[tuple] = None
+    xlim: tuple | None = None
+    ylim: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -195,15 +221,15 @@ class PanelSpec:
     """
 
     id: str
-    map: Optional[MapSpec] = None
+    map: MapSpec | None = None
     special: tuple = ()
     orbits: tuple = ()
-    critical: Optional[CriticalSpec] = None
-    zoom: Optional[ZoomSpec] = None
+    critical: CriticalSpec | None = None
+    zoom: ZoomSpec | None = None
     n_orbits: int = 0
-    K0_range: Optional[tuple] = None
-    xlim: Optional[tuple] = None
-    ylim: Optional[tuple] = None
+    K0_range: tuple | None = None
+    xlim: tuple | None = None
+    ylim: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -227,14 +253,14 @@ class SeriesSpec:
     """
 
     label: str
-    Omega0: Optional[float]
-    theta_w: Optional[float]
+    Omega0: float | None
+    theta_w: float | None
     tau0: float = 1.0
     tau1: float = 0.5
     lam: float = 0.5
-    golden_c: Optional[float] = None
-    color: Optional[str] = None
-    K_low: Optional[float] = None
+    golden_c: float | None = None
+    color: str | None = None
+    K_low: float | None = None
 
     def map_at(self, eps: float) -> MapSpec:
         """The map of this series at one eps.
@@ -274,7 +300,7 @@ class PotentialSpec:
 
     kind: str
     omega: float
-    alpha: Optional[float] = None
+    alpha: float | None = None
 
     def build(self):
         """The compiled potential.
@@ -312,7 +338,7 @@ class SystemSpec:
     qw2: float = -0.5
     geometry: str = "step"
 
-    def build(self, eps: Optional[float] = None, geometry: Optional[str] = None):
+    def build(self, eps: float | None = None, geometry: str | None = None):
         """The :class:`~hovering.StepSystem` (optionally at another eps or geometry).
 
         Parameters
@@ -332,9 +358,15 @@ class SystemSpec:
             c = Bilinear()
         else:
             c = Polynomial({(int(i), int(j)): float(v) for v, i, j in self.coupling})
-        return StepSystem(V1=self.V1.build(), V2=self.V2.build(), coupling=c,
-                          eps=self.eps if eps is None else eps, qw1=self.qw1, qw2=self.qw2,
-                          geometry=self.geometry if geometry is None else geometry)
+        return StepSystem(
+            V1=self.V1.build(),
+            V2=self.V2.build(),
+            coupling=c,
+            eps=self.eps if eps is None else eps,
+            qw1=self.qw1,
+            qw2=self.qw2,
+            geometry=self.geometry if geometry is None else geometry,
+        )
 
 
 @dataclass(frozen=True)
@@ -357,7 +389,7 @@ class IntegratorSpec:
     stepper: str = "rk8pd"
     rtol: float = 1e-10
     atol: float = 1e-10
-    accuracy: Optional[float] = None
+    accuracy: float | None = None
 
     def options(self) -> dict:
         """Keyword arguments of :class:`~hovering.FlowMap`.
@@ -415,13 +447,13 @@ class SceneSpec:
         Figure size in inches (default from the layout).
     """
 
-    path: Optional[Path] = None
+    path: Path | None = None
     name: str = "scene"
     kind: str
     title: str
     output: Path
     dpi: int = 130
-    figsize: Optional[tuple] = None
+    figsize: tuple | None = None
 
     def _validate_loaded(self) -> None:
         """A spec read from a file (:func:`hovering.load`) gets the checks a scene file gets (the
@@ -456,7 +488,7 @@ class OrbitScene(SceneSpec):
     """
 
     n_steps: int
-    layout: Optional[tuple] = None
+    layout: tuple | None = None
     panels: tuple = ()
     rotation: str = "mean"
     color_by: str = "orbit"
@@ -682,9 +714,16 @@ Scene = SceneSpec
 
 
 #: Figure size (inches) of the kinds with a fixed grid of axes, when the scene gives no ``figsize``.
-_FIGSIZE = {"hovering_area": (13.0, 5.2), "flow_portrait": (13.0, 5.6), "flow_hovering_area": (13.0, 5.2),
-            "tangent_tori": (12.0, 8.0), "sigma_structure": (12.0, 12.0), "corner_directions": (12.0, 10.0),
-            "wall_tangency": (18.0, 6.2), "wall_section": (12.0, 10.0)}
+_FIGSIZE = {
+    "hovering_area": (13.0, 5.2),
+    "flow_portrait": (13.0, 5.6),
+    "flow_hovering_area": (13.0, 5.2),
+    "tangent_tori": (12.0, 8.0),
+    "sigma_structure": (12.0, 12.0),
+    "corner_directions": (12.0, 10.0),
+    "wall_tangency": (18.0, 6.2),
+    "wall_section": (12.0, 10.0),
+}
 
 
 def figure_inches(scene, n_panels: int = 1) -> tuple:

@@ -29,8 +29,17 @@ from ..flow.section import flow_options
 from ..flow.system import StepSystem
 from ..interface import trajectory_arguments
 
-__all__ = ["DIRECTIONS", "corner_energy", "corner_speed", "corner_states", "tangent_action", "rho_w_max", "wall_tangency_action",
-           "wall_states", "WallFlow"]
+__all__ = [
+    "DIRECTIONS",
+    "corner_energy",
+    "corner_speed",
+    "corner_states",
+    "tangent_action",
+    "rho_w_max",
+    "wall_tangency_action",
+    "wall_states",
+    "WallFlow",
+]
 
 #: The incoming directions of the corner (Def:corner_curve), in the paper's order.
 DIRECTIONS = ("R0", "01", "1R")
@@ -179,9 +188,11 @@ def wall_tangency_action(sys: StepSystem, h: float, theta) -> np.ndarray:
     bad = ~((G(lo) < 0) & (G(hi) > 0))
     if bad.any():
         t = float(th[np.argmax(bad)])
-        raise ValueError(f"the wall's tangency line has no action in [I_tan/2, 3 I_tan/2] at theta = {t:.6g} "
-                         f"(eps = {sys.eps:g}); allowed: an eps small enough for the line to stay near the unperturbed "
-                         f"one")
+        raise ValueError(
+            f"the wall's tangency line has no action in [I_tan/2, 3 I_tan/2] at theta = {t:.6g} "
+            f"(eps = {sys.eps:g}); allowed: an eps small enough for the line to stay near the unperturbed "
+            f"one"
+        )
     while True:
         mid = 0.5 * (lo + hi)
         if not np.any((mid > lo) & (mid < hi) & (hi - lo > 1e-15 * It)):
@@ -217,8 +228,9 @@ def wall_states(sys: StepSystem, h: float, theta, rho_w, I_tan=None) -> np.ndarr
         the wall section).
     """
     th, rho = np.broadcast_arrays(np.atleast_1d(np.asarray(theta, dtype=float)), np.asarray(rho_w, dtype=float))
-    It = wall_tangency_action(sys, h, th) if I_tan is None else np.broadcast_to(np.asarray(I_tan, dtype=float),
-                                                                                 th.shape)
+    It = (
+        wall_tangency_action(sys, h, th) if I_tan is None else np.broadcast_to(np.asarray(I_tan, dtype=float), th.shape)
+    )
     z = np.full(th.shape + (4,), np.nan)
     E = h - sys.V1.V(sys.qw1)
     for k, (t, I) in enumerate(zip(th.ravel(), (It - rho).ravel())):
@@ -259,8 +271,9 @@ class WallFlow:
 
     def _run(self, sys: StepSystem, z, stage: str, trajectory_dt=None) -> dict:
         z = np.ascontiguousarray(np.asarray(z, dtype=float).reshape(-1, 4))
-        dt, per_orbit = (0.0, 0) if trajectory_dt is None else trajectory_arguments(
-            trajectory_dt, 2_000_000, max(z.shape[0], 1))
+        dt, per_orbit = (
+            (0.0, 0) if trajectory_dt is None else trajectory_arguments(trajectory_dt, 2_000_000, max(z.shape[0], 1))
+        )
         d = _core.flow.return_maps(sys.core, z, self.options, 0, dt, per_orbit)
         w = self.work[stage]
         for k, v in d["work"].items():
@@ -371,4 +384,3 @@ class WallFlow:
                 lab[idx] = np.where(done, np.array(r["itinerary"], dtype=object), "?")
                 region[idx] = np.where(done, r["region"], int(Region.NONE))
         return lab, region, z0
-

@@ -4,10 +4,10 @@ F_{eps1,eps2} with tabulated arcs and any odd forcing, and the closed-form theor
 from ..interface import IterateResult  # re-exported: hovering.truncated.IterateResult (its old home)
 from .maps import TruncatedFamily, TruncatedMap
 from .theory import (
-    OMEGA_G,
-    K_crit,
     L1,
     L2,
+    OMEGA_G,
+    K_crit,
     Theory,
     golden_family,
     hovering_area_theory,

@@ -9,24 +9,31 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Iterable, Optional, Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
 from .. import _core
-from .._checks import (check_memory, forcing_array, is_choice, point_pair, real_array, real_number, require_angles, require_finite, thread_count)
+from .._checks import (
+    check_memory,
+    forcing_array,
+    is_choice,
+    point_pair,
+    real_array,
+    real_number,
+    require_angles,
+    require_finite,
+    thread_count,
+)
 from .._enums import Region, wrap
-from ..interface import iterate_arguments, recorded_counts, transport_arguments
-from .._progress import check_progress, progress_bar
 from .._pickle import reduce_record
-from ..interface import IterateResult, MapAnalyses
+from .._progress import check_progress, progress_bar
+from ..interface import IterateResult, MapAnalyses, iterate_arguments, recorded_counts, transport_arguments
 from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 
 _RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "extrema", "residence")
-
-
 
 
 class _MapAPI(MapAnalyses):
@@ -203,7 +210,7 @@ class _MapAPI(MapAnalyses):
         K0,
         n_steps: int,
         record: Sequence[str] = ("orbit", "regions", "rotation"),
-        exit_regions: Optional[Iterable] = None,
+        exit_regions: Iterable | None = None,
         stop_on_exit: bool = False,
         n_threads: int = 0,
         kernel: str = "simd",
@@ -290,15 +297,21 @@ class _MapAPI(MapAnalyses):
         progress = check_progress(progress)
         if not is_choice(kernel, ("simd", "scalar")):
             raise ValueError(f"kernel must be 'simd' or 'scalar', got {kernel!r}")
-        if isinstance(sin_ulp, (bool, np.bool_)) or not isinstance(sin_ulp, numbers.Real) or float(sin_ulp) not in (1.0, 3.5):
+        if (
+            isinstance(sin_ulp, (bool, np.bool_))
+            or not isinstance(sin_ulp, numbers.Real)
+            or float(sin_ulp) not in (1.0, 3.5)
+        ):
             raise ValueError(f"sin_ulp must be 1.0 or 3.5 (max error of the SIMD sin in ulp), got {sin_ulp!r}")
         n_threads = thread_count(n_threads)
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
         p = np.asarray(wrap(p), dtype=float)  # the recorded orbit starts on [-pi, pi) like every later point
         n_states, n_returns = recorded_counts(n_steps, every)
         thinned = f" (every {every})" if every > 1 else ""
-        check_memory(f"recording {record} for {p.size} orbits x {n_steps} steps{thinned}",
-                     16 * p.size * n_states * ("orbit" in record) + p.size * n_returns * ("regions" in record))
+        check_memory(
+            f"recording {record} for {p.size} orbits x {n_steps} steps{thinned}",
+            16 * p.size * n_states * ("orbit" in record) + p.size * n_returns * ("regions" in record),
+        )
         with progress_bar(progress, p.size * n_steps, desc=f"{type(self).__name__}.iterate", unit="step") as bar:
             d = self._iterate(
                 np.ascontiguousarray(p.ravel()),
@@ -398,7 +411,9 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
     @property
     def params(self) -> dict:
         """The six parameters as a dict (``eps, Omega0, theta_w, tau0, tau1, lam``)."""
-        return dict(eps=self.eps, Omega0=self.Omega0, theta_w=self.theta_w, tau0=self.tau0, tau1=self.tau1, lam=self.lam)
+        return dict(
+            eps=self.eps, Omega0=self.Omega0, theta_w=self.theta_w, tau0=self.tau0, tau1=self.tau1, lam=self.lam
+        )
 
     def forcing_at(self, phi):
         """The forcing ``f(phi) = sin(phi)``.
@@ -434,7 +449,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         """eq:rhocrit evaluated formally (meaningful in the hovering case, see :meth:`K_crit`)."""
         return float(_geo.rho_crit(self.eps, self.theta_w, self.Omega0, self.tau0))
 
-    def theory(self) -> "_geo.Theory":
+    def theory(self) -> _geo.Theory:
         """Leading-order predictions for every Omega0: hovering sign, |HOV|, K_c, rho_c (:func:`hovering.theory`)."""
         return _geo.theory(self.eps, self.Omega0, self.theta_w, self.tau0)
 
@@ -446,7 +461,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         """Leading-order invariant curve through L2 at height K0 (eq:keps2)."""
         return _geo.k_eps2(phi, K0, self.eps, self.Omega0, self.tau0)
 
-    def with_eps(self, eps) -> "TruncatedMap":
+    def with_eps(self, eps) -> TruncatedMap:
         """The same map with another eps (e.g. the mirror map F_{-eps}).
 
         Parameters
@@ -471,7 +486,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
         return dict(self.params, K_max=self.valid_band()[1])
 
     @classmethod
-    def _from_record(cls, record: dict) -> "TruncatedMap":
+    def _from_record(cls, record: dict) -> TruncatedMap:
         """Inverse of :meth:`_to_record` (validated again; the same doubles give the same map bit for bit).
         A subclass is rebuilt through this class's constructor (its own may take other arguments)."""
         obj = cls.__new__(cls)
@@ -560,7 +575,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         theta_w = math.pi - 0.5 * float(self.arcs(-1e-300)["len_R"])
         return Om0, theta_w, tau0
 
-    def theory(self) -> "_geo.Theory":
+    def theory(self) -> _geo.Theory:
         """Leading-order predictions with the tables' onset values and this family's forcing (:func:`hovering.theory`)."""
         Om0, theta_w, tau0 = self.onset()
         return _geo.theory(self.eps, Om0, theta_w, tau0, forcing=tuple(self.forcing))
@@ -575,7 +590,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
         Om0, _, tau0 = self.onset()
         return _geo.L2(K, Om0, tau0)
 
-    def with_eps(self, eps) -> "TruncatedFamily":
+    def with_eps(self, eps) -> TruncatedFamily:
         """The same tables and forcing with another forcing amplitude (e.g. F_0).
 
         Parameters
@@ -597,20 +612,35 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
     def _to_record(self) -> dict:
         """What :func:`hovering.save` writes: eps, the tables as given, the forcing and K_max."""
         K, Om, JR, J1 = self._tables
-        return {"eps": self.eps, "K": K, "Omega": Om, "JR": JR, "J1": J1, "forcing": np.array(self.forcing, dtype=float),
-                "K_max": self._K_max}
+        return {
+            "eps": self.eps,
+            "K": K,
+            "Omega": Om,
+            "JR": JR,
+            "J1": J1,
+            "forcing": np.array(self.forcing, dtype=float),
+            "K_max": self._K_max,
+        }
 
     @classmethod
-    def _from_record(cls, record: dict) -> "TruncatedFamily":
+    def _from_record(cls, record: dict) -> TruncatedFamily:
         """Inverse of :meth:`_to_record` (validated again; the same tables give the same map bit for bit)."""
         r = dict(record)
         obj = cls.__new__(cls)
-        TruncatedFamily.__init__(obj, r.pop("eps"), r.pop("K"), r.pop("Omega"), r.pop("JR"), r.pop("J1"),
-                                 forcing=tuple(r.pop("forcing")), **r)
+        TruncatedFamily.__init__(
+            obj,
+            r.pop("eps"),
+            r.pop("K"),
+            r.pop("Omega"),
+            r.pop("JR"),
+            r.pop("J1"),
+            forcing=tuple(r.pop("forcing")),
+            **r,
+        )
         return obj
 
     @classmethod
-    def from_map(cls, m: TruncatedMap, K, forcing=(1.0,)) -> "TruncatedFamily":
+    def from_map(cls, m: TruncatedMap, K, forcing=(1.0,)) -> TruncatedFamily:
         """Tabulate the arcs of a :class:`TruncatedMap` on a grid (useful as a starting point).
 
         Parameters

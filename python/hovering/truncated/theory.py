@@ -12,8 +12,8 @@ hovers is the sign of ``sin(Omega0 / 2)``. :func:`theory` also takes any odd for
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -95,13 +95,17 @@ def _rotation(K, Omega0, tau0, name="K") -> np.ndarray:
         try:
             Om = _omega0(Omega0) + _finite("tau0", tau0) * k
         except ValueError:
-            raise ValueError(f"{name}, Omega0 and tau0 must have broadcastable shapes, got {np.shape(k)}, "
-                             f"{np.shape(Omega0)} and {np.shape(tau0)}") from None
+            raise ValueError(
+                f"{name}, Omega0 and tau0 must have broadcastable shapes, got {np.shape(k)}, "
+                f"{np.shape(Omega0)} and {np.shape(tau0)}"
+            ) from None
     if np.any(~(np.abs(Om) <= 1e6)):
         i = int(np.argmax(~(np.ravel(np.abs(Om)) <= 1e6)))
-        raise ValueError(f"{name} = {np.ravel(k + np.zeros_like(Om))[i]} gives the rotation Omega0 + tau0 {name} = "
-                         f"{np.ravel(Om)[i]:.6g}; allowed: |Omega0 + tau0 {name}| <= 1e6 (the ends of the band, where "
-                         f"angles can still be wrapped)")
+        raise ValueError(
+            f"{name} = {np.ravel(k + np.zeros_like(Om))[i]} gives the rotation Omega0 + tau0 {name} = "
+            f"{np.ravel(Om)[i]:.6g}; allowed: |Omega0 + tau0 {name}| <= 1e6 (the ends of the band, where "
+            f"angles can still be wrapped)"
+        )
     return Om
 
 
@@ -110,8 +114,10 @@ def _omega0(Omega0):
     beyond, sin(Omega0 / 2) is rounding noise (K_crit(Omega0 = 1e300) was a confident 0.24)."""
     om = _finite("Omega0", Omega0)
     if np.any(np.abs(om) > 1e6):
-        raise ValueError(f"Omega0 must lie in [-1e6, 1e6] (a larger rotation cannot be reduced mod 2 pi accurately), "
-                         f"got {np.ravel(om)[int(np.argmax(np.ravel(np.abs(om)) > 1e6))]}")
+        raise ValueError(
+            f"Omega0 must lie in [-1e6, 1e6] (a larger rotation cannot be reduced mod 2 pi accurately), "
+            f"got {np.ravel(om)[int(np.argmax(np.ravel(np.abs(om)) > 1e6))]}"
+        )
     return om if np.ndim(om) else float(om)
 
 
@@ -124,7 +130,9 @@ def _sin_half(Omega0) -> np.ndarray:
 def _wall_angle(theta_w) -> np.ndarray:
     tw = _finite("theta_w", theta_w)
     if np.any((tw <= 0) | (tw >= np.pi)):
-        raise ValueError(f"theta_w must lie in (0, pi), got {np.ravel(tw)[np.argmax(np.ravel((tw <= 0) | (tw >= np.pi)))]}")
+        raise ValueError(
+            f"theta_w must lie in (0, pi), got {np.ravel(tw)[np.argmax(np.ravel((tw <= 0) | (tw >= np.pi)))]}"
+        )
     return tw
 
 
@@ -272,7 +280,8 @@ def rho_crit(eps, theta_w, Omega0, tau0):
     """
     with np.errstate(over="ignore", invalid="ignore"):
         out = _omega0(Omega0) + _finite("eps", eps) * _finite("tau0", tau0) * np.cos(_wall_angle(theta_w)) / (
-            2.0 * _sin_half(Omega0))
+            2.0 * _sin_half(Omega0)
+        )
     return out if np.ndim(out) else float(out)
 
 
@@ -328,14 +337,18 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
     ValueError
         If ``|c| >= |tau0|`` (theta_w would leave (0, pi)) or a value is not finite.
     """
-    eps, c, tau0, Omega_G = (real_number(n, v) for n, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G)))
+    eps, c, tau0, Omega_G = (
+        real_number(n, v) for n, v in (("eps", eps), ("c", c), ("tau0", tau0), ("Omega_G", Omega_G))
+    )
     if not abs(c) < abs(tau0):
         raise ValueError(f"c must satisfy |c| < |tau0| = {abs(tau0)}, got c = {c}")
     _omega0(Omega_G)
     Omega0 = Omega_G - 0.5 * c * eps
     if not abs(Omega0) <= 1e6:
-        raise ValueError(f"eps = {eps} and c = {c} give Omega0 = Omega_G - c eps / 2 = {Omega0:.6g}; allowed: "
-                         f"|Omega0| <= 1e6 (a larger rotation cannot be reduced mod 2 pi accurately)")
+        raise ValueError(
+            f"eps = {eps} and c = {c} give Omega0 = Omega_G - c eps / 2 = {Omega0:.6g}; allowed: "
+            f"|Omega0| <= 1e6 (a larger rotation cannot be reduced mod 2 pi accurately)"
+        )
     # The C library's scalar sin/acos (not NumPy's vector loops, 1 ulp off in places): correctly
     # rounded here, and the same doubles as the C++ reader of the scene files.
     theta_w = math.acos((c / tau0) * math.sin(0.5 * Omega_G - 0.25 * c * eps))
@@ -429,24 +442,48 @@ def _first_mode(base: dict, e: float) -> Theory:
     K_c = -e * (1 - math.cos(theta_w)) / (2 * s)
     K_low = K_c if hovers else -e / s  # k_{eps,2}(phi, rho_2(0)) = -e (1 + cos psi) / (2 s) on L1
     area = abs(e) * (math.sin(theta_w) - theta_w * math.cos(theta_w)) / abs(s) if hovers else 0.0
-    sign = 1 if s * (base["forcing"][0] if base["forcing"] else 0) > 0 else -1 if s * (base["forcing"][0] if base["forcing"] else 0) < 0 else 0
+    sign = (
+        1
+        if s * (base["forcing"][0] if base["forcing"] else 0) > 0
+        else -1
+        if s * (base["forcing"][0] if base["forcing"] else 0) < 0
+        else 0
+    )
     if e == 0:
         note = "eps = 0: the hovering set is empty by definition"
     elif hovers:
-        note = (f"hovering case: eps b_1 sin(Omega0/2) = {e * s:.4g} > 0, the minima of the invariant curves lie near "
-                "L1 inside J_0 (lemma:mininj0jr)")
+        note = (
+            f"hovering case: eps b_1 sin(Omega0/2) = {e * s:.4g} > 0, the minima of the invariant curves lie near "
+            "L1 inside J_0 (lemma:mininj0jr)"
+        )
     else:
-        note = (f"impacting case: eps b_1 sin(Omega0/2) = {e * s:.4g} < 0, the minima of the invariant curves lie near "
-                "L2 inside J_R (lemma:mininj0jr): no hovering set; the lowest curve avoiding the impacts is k^{u0} >= 0")
+        note = (
+            f"impacting case: eps b_1 sin(Omega0/2) = {e * s:.4g} < 0, the minima of the invariant curves lie near "
+            "L2 inside J_R (lemma:mininj0jr): no hovering set; the lowest curve avoiding the impacts is k^{u0} >= 0"
+        )
     if tau0 == 0:
         note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
     nan = float("nan")
-    return Theory(**base, area=area, hovers=hovers, hovering_sign=sign, K_crit=K_c if hovers else nan,
-                  rho_crit=Omega0 + e * tau0 * math.cos(theta_w) / (2 * s) if hovers else nan, K_lowest=K_low, note=note)
+    return Theory(
+        **base,
+        area=area,
+        hovers=hovers,
+        hovering_sign=sign,
+        K_crit=K_c if hovers else nan,
+        rho_crit=Omega0 + e * tau0 * math.cos(theta_w) / (2 * s) if hovers else nan,
+        K_lowest=K_low,
+        note=note,
+    )
 
 
-def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing: Sequence[float] = (1.0,),
-           n_grid: int = 100_001) -> Theory:
+def theory(
+    eps: float,
+    Omega0: float,
+    theta_w: float,
+    tau0: float = 1.0,
+    forcing: Sequence[float] = (1.0,),
+    n_grid: int = 100_001,
+) -> Theory:
     """Leading-order hovering set, critical curve and its rotation for any Omega0 and odd forcing.
 
     Parameters
@@ -477,13 +514,29 @@ def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing
     nan = float("nan")
     base = dict(eps=float(eps), Omega0=float(Omega0), theta_w=float(theta_w), tau0=float(tau0), forcing=b)
     if not 0 < theta_w < math.pi:
-        return Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan,
-                      note=f"theta_w = {theta_w} outside (0, pi): no arc structure at the tangency")
+        return Theory(
+            **base,
+            area=nan,
+            hovers=False,
+            hovering_sign=0,
+            K_crit=nan,
+            rho_crit=nan,
+            K_lowest=nan,
+            note=f"theta_w = {theta_w} outside (0, pi): no arc structure at the tangency",
+        )
     res = [k + 1 for k, x in enumerate(b) if x != 0 and abs(math.sin(0.5 * (k + 1) * Omega0)) < 1e-9]
     if res:
-        return Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan,
-                      note=f"resonant: sin({res[0]} Omega0 / 2) = 0 (Omega0 = {Omega0}), the first-order "
-                           "invariant curves do not exist there")
+        return Theory(
+            **base,
+            area=nan,
+            hovers=False,
+            hovering_sign=0,
+            K_crit=nan,
+            rho_crit=nan,
+            K_lowest=nan,
+            note=f"resonant: sin({res[0]} Omega0 / 2) = 0 (Omega0 = {Omega0}), the first-order "
+            "invariant curves do not exist there",
+        )
     probe = Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan, note="")
     modes = [k + 1 for k, x in enumerate(b) if x != 0]
     if modes == [1] or not modes:
@@ -500,12 +553,24 @@ def theory(eps: float, Omega0: float, theta_w: float, tau0: float = 1.0, forcing
     if eps == 0:
         note = "eps = 0: the hovering set is empty by definition"
     elif hovers:
-        note = (f"hovering: the critical curve dips into J_0 near L1 ({first}; modes 2..{len(b)} of f shape it "
-                "at O(their size))")
+        note = (
+            f"hovering: the critical curve dips into J_0 near L1 ({first}; modes 2..{len(b)} of f shape it "
+            "at O(their size))"
+        )
     else:
-        note = (f"no hovering set: every first-order invariant curve that dips below K = 0 does so in the impacting "
-                f"arcs ({first}); the lowest curve avoiding the impacts stays in K >= 0")
+        note = (
+            f"no hovering set: every first-order invariant curve that dips below K = 0 does so in the impacting "
+            f"arcs ({first}); the lowest curve avoiding the impacts stays in K >= 0"
+        )
     if tau0 == 0:
         note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
-    return Theory(**base, area=area, hovers=hovers, hovering_sign=sign, K_crit=K_low if hovers else nan,
-                  rho_crit=Omega0 + tau0 * (K_low + eps * mean_G) if hovers else nan, K_lowest=K_low, note=note)
+    return Theory(
+        **base,
+        area=area,
+        hovers=hovers,
+        hovering_sign=sign,
+        K_crit=K_low if hovers else nan,
+        rho_crit=Omega0 + tau0 * (K_low + eps * mean_G) if hovers else nan,
+        K_lowest=K_low,
+        note=note,
+    )

@@ -18,30 +18,44 @@ PAPER = dict(Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0
 
 
 def system(eps):
-    return hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=eps, qw1=-1.0,
-                         qw2=-0.5, geometry="step")
+    return hv.StepSystem(
+        V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), coupling=hv.Bilinear(), eps=eps, qw1=-1.0, qw2=-0.5, geometry="step"
+    )
 
 
 def main():
     m = hv.TruncatedMap(eps=0.3, **PAPER)
-    grid = np.concatenate([-np.linspace(1.0, 0.0, 40) ** 2, np.linspace(0.05, 1.0, 20)])
+    grid = np.concatenate([-(np.linspace(1.0, 0.0, 40) ** 2), np.linspace(0.05, 1.0, 20)])
     objects = {
         "truncated": m,
-        "truncated_capped": hv.TruncatedMap(eps=-0.2, Omega0=1.3, theta_w=2.0, tau0=-0.7, tau1=-0.4, lam=0.7, K_max=0.4),
+        "truncated_capped": hv.TruncatedMap(
+            eps=-0.2, Omega0=1.3, theta_w=2.0, tau0=-0.7, tau1=-0.4, lam=0.7, K_max=0.4
+        ),
         "family": hv.TruncatedFamily.from_map(m, grid, forcing=(1.0, 0.25, -0.1)),
         "flow_normal": hv.FlowMap(system(-0.05), h=1.0),
         "flow_section": hv.FlowMap(system(0.05), h=1.0, coordinates="section", stepper="rkck", max_impacts=50),
-        "system_poly": hv.StepSystem(V1=hv.Tan(1.1, 0.4), V2=hv.Harmonic(1.3),
-                                     coupling=hv.Polynomial({(1, 1): 1.0, (2, 1): -0.3}), eps=0.02, qw1=-0.9,
-                                     qw2=-0.4, geometry="wall"),
+        "system_poly": hv.StepSystem(
+            V1=hv.Tan(1.1, 0.4),
+            V2=hv.Harmonic(1.3),
+            coupling=hv.Polynomial({(1, 1): 1.0, (2, 1): -0.3}),
+            eps=0.02,
+            qw1=-0.9,
+            qw2=-0.4,
+            geometry="wall",
+        ),
     }
     objects["curve"] = objects["flow_normal"].curve
     objects["section"] = objects["flow_normal"].section
     rng = np.random.default_rng(11)
     phi = rng.uniform(-np.pi, np.pi, 40)
     expected = {"phi": phi}
-    bands = {"truncated": (-0.6, 0.6), "truncated_capped": (-0.3, 0.15), "family": (-0.5, 0.5),
-             "flow_normal": (-0.1, 0.05), "flow_section": (0.25, 0.45)}
+    bands = {
+        "truncated": (-0.6, 0.6),
+        "truncated_capped": (-0.3, 0.15),
+        "family": (-0.5, 0.5),
+        "flow_normal": (-0.1, 0.05),
+        "flow_section": (0.25, 0.45),
+    }
     for name, (lo, hi) in bands.items():
         K = rng.uniform(lo, hi, phi.size)
         p1, K1 = objects[name].step(phi, K)

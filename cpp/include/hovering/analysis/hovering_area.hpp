@@ -43,14 +43,14 @@ void stratified_samples(std::int64_t samples, double K_low, std::uint64_t seed, 
 
 /// Counts and cancellation of a hovering_area measurement.
 struct HoveringAreaOptions {
-    std::int64_t n_steps = 10000;  ///< N: iterates that count as "never" (>= 4)
-    std::int64_t samples = 100000; ///< sample points asked for (the grid rounds up)
-    double K_low = -0.1;           ///< bottom of the box (inside the band, < 0)
-    std::uint64_t seed = 0;        ///< seed of the jitter (numpy's default_rng(seed))
-    int n_threads = 0;             ///< worker threads, 0 = all cores
+    std::int64_t n_steps = 10000;                   ///< N: iterates that count as "never" (>= 4)
+    std::int64_t samples = 100000;                  ///< sample points asked for (the grid rounds up)
+    double K_low = -0.1;                            ///< bottom of the box (inside the band, < 0)
+    std::uint64_t seed = 0;                         ///< seed of the jitter (numpy's default_rng(seed))
+    int n_threads = 0;                              ///< worker threads, 0 = all cores
     const std::atomic<bool>* cancel = nullptr;      ///< set to stop early (then interrupted)
     std::atomic<std::int64_t>* progress = nullptr;  ///< steps / returns done, 2 N n in all
-    bool keep_points = false;      ///< keep each sample's membership (HoveringAreaResult::hovering)
+    bool keep_points = false;                       ///< keep each sample's membership (HoveringAreaResult::hovering)
 };
 
 /// Per-sample outcomes of the two iterations: the Status under F_0 and under F_eps, the steps
@@ -64,20 +64,20 @@ struct HoveringOutcomes {
 
 /// The measured area; the fields of Python's HoveringArea that do not need the theory.
 struct HoveringAreaResult {
-    double area = 0;              ///< estimate at N
-    double error = 0;             ///< 2 sampling_error + iteration_error
-    double sampling_error = 0;    ///< one binomial sigma
-    double iteration_error = 0;   ///< estimate at N/2 minus estimate at N
+    double area = 0;                         ///< estimate at N
+    double error = 0;                        ///< 2 sampling_error + iteration_error
+    double sampling_error = 0;               ///< one binomial sigma
+    double iteration_error = 0;              ///< estimate at N/2 minus estimate at N
     double area_quarter = 0, area_half = 0;  ///< estimates at N/4 and N/2
-    std::int64_t n_samples = 0;   ///< points sampled
-    double K_low = 0;             ///< bottom of the box
-    double impact_fraction_F0 = 0;///< fraction of the box impacting under F_0 within N
-    bool floor_touched = false;   ///< a hovering point in the lowest tenth of the box
-    double area_both_sides = 0;   ///< part whose orbits visit both J_0 and J_0u
-    std::int64_t unresolved = 0;  ///< orbits of F_eps ending otherwise (corner, grazing, limits)
-    bool interrupted = false;     ///< cancelled: the numbers are not a result
-    std::vector<std::int8_t> hovering;    ///< per sample (keep_points): 1 if it hovers
-    std::vector<std::int8_t> both_sides;  ///< per sample (keep_points): 1 if it hovers visiting J_0 and J_0u
+    std::int64_t n_samples = 0;              ///< points sampled
+    double K_low = 0;                        ///< bottom of the box
+    double impact_fraction_F0 = 0;           ///< fraction of the box impacting under F_0 within N
+    bool floor_touched = false;              ///< a hovering point in the lowest tenth of the box
+    double area_both_sides = 0;              ///< part whose orbits visit both J_0 and J_0u
+    std::int64_t unresolved = 0;             ///< orbits of F_eps ending otherwise (corner, grazing, limits)
+    bool interrupted = false;                ///< cancelled: the numbers are not a result
+    std::vector<std::int8_t> hovering;       ///< per sample (keep_points): 1 if it hovers
+    std::vector<std::int8_t> both_sides;     ///< per sample (keep_points): 1 if it hovers visiting J_0 and J_0u
 };
 
 /// Outcomes of the n points (phi, K) under F_0 (the same arcs at eps = 0) and the truncated map m.

@@ -33,7 +33,7 @@ enum class FlowStatus : std::int8_t {
 Status orbit_status(FlowStatus s);
 
 /// The names FlowOptions::stepper takes, its default first (bound as hovering.flow.STEPPERS).
-inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd", "rkck",   "rkf45",  "rk4",  "rk2",
+inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd",   "rkck",   "rkf45",  "rk4",  "rk2",
                                                          "msadams", "rk4imp", "rk2imp", "exact"};
 
 /// Integrator settings.
@@ -42,14 +42,14 @@ inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd", "rkck",   "rkf
 /// quadratic coupling: the normal modes of the linear flow); it ignores rtol and atol, and its
 /// "steps" are events passed (uncoupled) or closed-form steps of 1/8 period (linear).
 struct FlowOptions {
-    std::string stepper = "rk8pd";  ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd), msadams, or exact
-    double rtol = 1e-10;            ///< relative tolerance of the step control (not read by "exact")
-    double atol = 1e-12;            ///< absolute tolerance of the step control (not read by "exact")
-    double event_tol = 1e-15;       ///< time accuracy of located events (Newton on exact steps)
+    std::string stepper = "rk8pd";     ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd), msadams, or exact
+    double rtol = 1e-10;               ///< relative tolerance of the step control (not read by "exact")
+    double atol = 1e-12;               ///< absolute tolerance of the step control (not read by "exact")
+    double event_tol = 1e-15;          ///< time accuracy of located events (Newton on exact steps)
     std::int64_t max_steps = 1000000;  ///< per return
-    int max_impacts = 100;          ///< per return; more ends the orbit with ImpactLimit
-    double grazing_tol = 1e-12;     ///< |min distance to a wall| below which an orbit touches it tangentially
-    double corner_tol = 1e-10;      ///< distance to the corner below which an impact is a corner hit
+    int max_impacts = 100;             ///< per return; more ends the orbit with ImpactLimit
+    double grazing_tol = 1e-12;        ///< |min distance to a wall| below which an orbit touches it tangentially
+    double corner_tol = 1e-10;         ///< distance to the corner below which an impact is a corner hit
     /// Validate (throws std::invalid_argument naming the bad value and the allowed range).
     void validate() const;
     /// validate(), and that the stepper applies to s ("exact" needs a closed-form flow; the message
@@ -73,16 +73,16 @@ std::array<double, 2> section_coordinates(const FlowSystem& s, const double* z);
 
 /// Result of one return.
 struct ReturnResult {
-    std::array<double, 4> z{};  ///< state at the return (or where the orbit stopped)
-    double time = 0;            ///< return time, or the time of z where the orbit stopped (every status)
+    std::array<double, 4> z{};           ///< state at the return (or where the orbit stopped)
+    double time = 0;                     ///< return time, or the time of z where the orbit stopped (every status)
     FlowStatus status = FlowStatus::Ok;  ///< how the return ended
     /// Impacts in order ('R' right wall, '1' upper wall: "R", "1", "11", "R1", ...); without
     /// impact "0" if the segment crossed q1 = qw1 above the step, "u" if it never crossed it;
     /// "" for the smooth flow (geometry None), for a return that did not end Ok without impact,
     /// and when labels are off (FlowIterateOptions::labels = false).
     std::string itinerary;
-    double energy_error = 0;    ///< |H(z) - H(z0)|
-    std::int64_t steps = 0;     ///< accepted integrator steps
+    double energy_error = 0;  ///< |H(z) - H(z0)|
+    std::int64_t steps = 0;   ///< accepted integrator steps
 };
 
 /// What the tracer did, counted per worker and summed at the end of a batch (no atomics in the
@@ -116,11 +116,11 @@ enum class TrajectoryPoint : std::int8_t {
 /// plus the exact pre- and post-impact states of every reflection, each return point and where an
 /// orbit stopped. Nothing is computed when points is null.
 struct TrajectoryOutput {
-    double dt = 0;                               ///< sample spacing (> 0 when points is set)
-    std::int64_t max_points_per_orbit = 0;       ///< points kept per orbit (>= 1); beyond, recording stops
-    std::vector<double>* points = nullptr;       ///< (n) per orbit, 5 doubles per point: t, q1, p1, q2, p2
-    std::vector<std::int8_t>* kinds = nullptr;   ///< (n) per orbit, the TrajectoryPoint of each point
-    std::int8_t* truncated = nullptr;            ///< (n) 1 where the orbit reached max_points_per_orbit
+    double dt = 0;                              ///< sample spacing (> 0 when points is set)
+    std::int64_t max_points_per_orbit = 0;      ///< points kept per orbit (>= 1); beyond, recording stops
+    std::vector<double>* points = nullptr;      ///< (n) per orbit, 5 doubles per point: t, q1, p1, q2, p2
+    std::vector<std::int8_t>* kinds = nullptr;  ///< (n) per orbit, the TrajectoryPoint of each point
+    std::int8_t* truncated = nullptr;           ///< (n) 1 where the orbit reached max_points_per_orbit
     /// Whether a trajectory is recorded.
     bool active() const { return points != nullptr; }
     /// Throw std::invalid_argument for a bad dt or limit (when active).
@@ -137,15 +137,15 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
 /// Where a batch of returns writes; null pointers are not written. Arrays have one entry per
 /// orbit (z: 4 per orbit, row-major).
 struct ReturnMapsOutput {
-    double* z = nullptr;             ///< image states (NaN for OffSection)
-    double* time = nullptr;          ///< return times
-    std::int8_t* status = nullptr;   ///< FlowStatus
-    std::int8_t* region = nullptr;   ///< Region of the return (region_of(itinerary))
-    double* energy_error = nullptr;  ///< |H(image) - H(start)|
-    std::int64_t* steps = nullptr;   ///< accepted integrator steps
+    double* z = nullptr;               ///< image states (NaN for OffSection)
+    double* time = nullptr;            ///< return times
+    std::int8_t* status = nullptr;     ///< FlowStatus
+    std::int8_t* region = nullptr;     ///< Region of the return (region_of(itinerary))
+    double* energy_error = nullptr;    ///< |H(image) - H(start)|
+    std::int64_t* steps = nullptr;     ///< accepted integrator steps
     std::string* itinerary = nullptr;  ///< itinerary of each return
-    FlowWork* work = nullptr;        ///< the batch's work counters (summed over workers)
-    TrajectoryOutput trajectory;     ///< dense output of each return (its clock starts at 0)
+    FlowWork* work = nullptr;          ///< the batch's work counters (summed over workers)
+    TrajectoryOutput trajectory;       ///< dense output of each return (its clock starts at 0)
 };
 
 /// Returns of n states z0 (row-major (n, 4)) on the core's thread pool (n_threads, 0 = all

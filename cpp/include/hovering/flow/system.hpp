@@ -32,10 +32,10 @@ struct Coupling {
 /// H = p1^2/2 + V1(q1) + p2^2/2 + V2(q2) + eps Vc(q1, q2), with walls at qw1, qw2.
 struct FlowSystem {
     std::shared_ptr<const Potential> V1, V2;  ///< the oscillators' potentials
-    Coupling coupling;                         ///< the coupling Vc
-    double eps = 0.0;                          ///< coupling strength (0: no coupling term is evaluated)
-    double qw1 = -1.0, qw2 = -0.5;             ///< the walls' positions (step corner at (qw1, qw2))
-    Geometry geometry = Geometry::None;        ///< which walls the flow sees
+    Coupling coupling;                        ///< the coupling Vc
+    double eps = 0.0;                         ///< coupling strength (0: no coupling term is evaluated)
+    double qw1 = -1.0, qw2 = -0.5;            ///< the walls' positions (step corner at (qw1, qw2))
+    Geometry geometry = Geometry::None;       ///< which walls the flow sees
     /// Validate (throws std::invalid_argument naming the bad value).
     void validate() const;
     /// H(z), z = (q1, p1, q2, p2); eps = 0 evaluates no coupling.
@@ -86,7 +86,7 @@ OnsetEstimate onset_estimate_closed_form(double omega1, double alpha1, double om
                                          double qw2, double h, double rtol = 1e-6);
 
 /// The values of onset_estimate_closed_form.
-OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2,
-                                             double qw1, double qw2, double h, double rtol = 1e-6);
+OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2, double qw1,
+                                             double qw2, double h, double rtol = 1e-6);
 
 }  // namespace hovering

@@ -26,13 +26,13 @@ class Tracer;
 
 /// What a flow-map iteration does besides stepping (the flow's counterpart of IterateOptions).
 struct FlowIterateOptions {
-    std::int64_t n_steps = 0;         ///< returns per orbit (>= 0)
-    unsigned exit_mask = 0;           ///< bit r: Region r is in the watched set; 0 disables the watch
-    bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
+    std::int64_t n_steps = 0;   ///< returns per orbit (>= 0)
+    unsigned exit_mask = 0;     ///< bit r: Region r is in the watched set; 0 disables the watch
+    bool stop_on_exit = false;  ///< stop an orbit (Status::Exited) when it first leaves the set
     /// Stop an orbit (Status::Stopped) at the first point x_n (x_0 included) in the set, in map coordinates.
     StopCondition stop;
-    std::int64_t every = 1;           ///< record every k-th point (and the return from it), k >= 1
-    int n_threads = 0;                ///< worker threads; 0 = all hardware threads
+    std::int64_t every = 1;                     ///< record every k-th point (and the return from it), k >= 1
+    int n_threads = 0;                          ///< worker threads; 0 = all hardware threads
     const std::atomic<bool>* cancel = nullptr;  ///< polled between and inside returns
     /// Label returns (itinerary, region; needs the crossings of q1 = qw1 tracked). false: no
     /// label work at all, every region None (then regions, visited, itinerary, rotation and an
@@ -53,28 +53,28 @@ inline constexpr const char* kNoItinerary = "-";
 /// orbit did not reach are NaN (Region::None, -1 integrator steps, kNoItinerary). With stop_on_exit
 /// the return that leaves the watched set is recorded (region, itinerary, time, ...), not taken.
 struct FlowIterateOutput {
-    double* x_final = nullptr;        ///< (n) last point reached: phi or theta
-    double* y_final = nullptr;        ///< (n) K or I
-    double* orbit_x = nullptr;        ///< points: phi (normal) or theta (section)
-    double* orbit_y = nullptr;        ///< K or I
-    double* orbit_theta = nullptr;    ///< section coordinates of the points
-    double* orbit_I = nullptr;        ///< I of the points (section coordinates)
-    double* states = nullptr;         ///< (n, n_steps + 1, 4) points of Sigma_h (q1, p1, q2, p2)
-    std::int8_t* regions = nullptr;   ///< Region of each return
-    double* times = nullptr;          ///< return times
-    double* energy_error = nullptr;   ///< |H(image) - h| before the image is put back on Sigma_h
+    double* x_final = nullptr;                 ///< (n) last point reached: phi or theta
+    double* y_final = nullptr;                 ///< (n) K or I
+    double* orbit_x = nullptr;                 ///< points: phi (normal) or theta (section)
+    double* orbit_y = nullptr;                 ///< K or I
+    double* orbit_theta = nullptr;             ///< section coordinates of the points
+    double* orbit_I = nullptr;                 ///< I of the points (section coordinates)
+    double* states = nullptr;                  ///< (n, n_steps + 1, 4) points of Sigma_h (q1, p1, q2, p2)
+    std::int8_t* regions = nullptr;            ///< Region of each return
+    double* times = nullptr;                   ///< return times
+    double* energy_error = nullptr;            ///< |H(image) - h| before the image is put back on Sigma_h
     std::int64_t* integrator_steps = nullptr;  ///< accepted integrator steps per return
     std::string* itinerary = nullptr;          ///< itinerary of each return
-    double* rotation = nullptr;       ///< (n) mean lifted rotation per return (see FlowMap::rotation_of)
-    std::int8_t* status = nullptr;    ///< (n) Status, always written when non-null
-    std::int64_t* steps_done = nullptr;  ///< (n) returns taken
-    std::int64_t* exit_step = nullptr;   ///< (n) first return outside the watched set, else -1
-    std::int8_t* visited = nullptr;      ///< (n) bit r: a return of Region r was taken (as IterateOutput)
-    double* y_min = nullptr;             ///< (n) min of y (K or I) over the points x_0 .. x_steps_done
-    double* y_max = nullptr;             ///< (n) max of y over the same points
-    std::int64_t* residence = nullptr;   ///< (n, kRegionCount) returns per region (as IterateOutput)
-    std::int64_t* stop_step = nullptr;   ///< (n) first n with x_n in the stop set, else -1
-    FlowWork* work = nullptr;            ///< the iteration's work counters (summed over workers)
+    double* rotation = nullptr;                ///< (n) mean lifted rotation per return (see FlowMap::rotation_of)
+    std::int8_t* status = nullptr;             ///< (n) Status, always written when non-null
+    std::int64_t* steps_done = nullptr;        ///< (n) returns taken
+    std::int64_t* exit_step = nullptr;         ///< (n) first return outside the watched set, else -1
+    std::int8_t* visited = nullptr;            ///< (n) bit r: a return of Region r was taken (as IterateOutput)
+    double* y_min = nullptr;                   ///< (n) min of y (K or I) over the points x_0 .. x_steps_done
+    double* y_max = nullptr;                   ///< (n) max of y over the same points
+    std::int64_t* residence = nullptr;         ///< (n, kRegionCount) returns per region (as IterateOutput)
+    std::int64_t* stop_step = nullptr;         ///< (n) first n with x_n in the stop set, else -1
+    FlowWork* work = nullptr;                  ///< the iteration's work counters (summed over workers)
     /// Dense output of each orbit across its returns (the clock runs on from return to return;
     /// each return's point is the image before the next start is put back on Sigma_h).
     TrajectoryOutput trajectory;
@@ -82,9 +82,9 @@ struct FlowIterateOutput {
 
 /// One return of the map: the image, its region and what the flow reported.
 struct FlowStep {
-    double x = 0, y = 0;  ///< image in map coordinates (NaN unless status is Ok)
+    double x = 0, y = 0;           ///< image in map coordinates (NaN unless status is Ok)
     Region region = Region::None;  ///< region of the return (None unless Ok with labels)
-    ReturnResult ret;     ///< the flow's return (state, time, itinerary, energy error, steps)
+    ReturnResult ret;              ///< the flow's return (state, time, itinerary, energy error, steps)
 };
 
 /// The flow's return map on one section; see the file comment.

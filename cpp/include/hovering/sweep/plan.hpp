@@ -41,7 +41,7 @@ struct SystemSpec {
     PotentialSpec V1, V2;
     std::vector<CouplingTerm> coupling;  ///< distinct (i, j); empty: no coupling
     double eps = 0, qw1 = 0, qw2 = 0;
-    std::string geometry;                ///< "none", "wall" or "step"
+    std::string geometry;  ///< "none", "wall" or "step"
 };
 
 /// The integrator of a flow point (the other FlowOptions keep their defaults).
@@ -61,18 +61,18 @@ struct ModelSpec {
 
 /// One point of a plan.
 struct PlanPoint {
-    std::string label;          ///< what it is, for messages (optional)
-    std::int64_t n_steps = 0;   ///< N, in [4, 2^53]
-    std::int64_t samples = 0;   ///< sample points asked for, in [1, 2^53]
-    std::uint64_t seed = 0;     ///< in [0, 2^63 - 1]
-    double K_low = 0;           ///< bottom of the box, < 0
+    std::string label;                                         ///< what it is, for messages (optional)
+    std::int64_t n_steps = 0;                                  ///< N, in [4, 2^53]
+    std::int64_t samples = 0;                                  ///< sample points asked for, in [1, 2^53]
+    std::uint64_t seed = 0;                                    ///< in [0, 2^63 - 1]
+    double K_low = 0;                                          ///< bottom of the box, < 0
     double theory = std::numeric_limits<double>::quiet_NaN();  ///< carried into the row
     double b1 = std::numeric_limits<double>::quiet_NaN();      ///< carried into the row (flow points)
-    MapParams map;              ///< hovering_area points
-    SystemSpec system;          ///< flow_hovering_area points
-    double h = 0;               ///< flow_hovering_area points
-    IntegratorSpec integrator;  ///< flow_hovering_area points
-    std::vector<ModelSpec> models;  ///< flow_hovering_area points (may be empty)
+    MapParams map;                                             ///< hovering_area points
+    SystemSpec system;                                         ///< flow_hovering_area points
+    double h = 0;                                              ///< flow_hovering_area points
+    IntegratorSpec integrator;                                 ///< flow_hovering_area points
+    std::vector<ModelSpec> models;                             ///< flow_hovering_area points (may be empty)
     /// The point's key in a checkpoint: the canonical JSON (sorted keys, shortest round-trip
     /// numbers, non-finite numbers as the strings "NaN", "Infinity", "-Infinity") of its parameters,
     /// i.e. every field above except label, theory and b1, with the kind.

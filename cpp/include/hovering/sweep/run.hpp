@@ -28,8 +28,8 @@ namespace hovering::sweep {
 
 /// A computed point.
 struct PointRow {
-    std::string row;           ///< the row as canonical JSON text
-    bool interrupted = false;  ///< cancelled before it finished: not a result
+    std::string row;                                      ///< the row as canonical JSON text
+    bool interrupted = false;                             ///< cancelled before it finished: not a result
     double area = 0, error = 0, theory = 0, seconds = 0;  ///< for the run's log
 };
 
@@ -77,11 +77,11 @@ private:
     void write_all(const std::string& text, const char* what);
     std::string path_;
     int fd_ = -1;
-    int read_only_ = 0;            ///< errno of opening for writing when only reading was possible
-    std::uintmax_t offset_ = 0;    ///< bytes of complete lines read so far
-    long lines_ = 0;               ///< complete lines read so far
+    int read_only_ = 0;          ///< errno of opening for writing when only reading was possible
+    std::uintmax_t offset_ = 0;  ///< bytes of complete lines read so far
+    long lines_ = 0;             ///< complete lines read so far
     bool provenance_written_ = false;
-    std::set<std::string> keys_;   ///< canonical keys of the finished points
+    std::set<std::string> keys_;  ///< canonical keys of the finished points
     std::string torn_;
 };
 

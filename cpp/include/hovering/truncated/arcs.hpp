@@ -65,8 +65,8 @@ private:
 /// |J_R| and Omega are smooth in K.
 struct TabulatedArcs {
     /// Build from a K grid (strictly increasing, containing 0 and >= 3 points with K <= 0).
-    TabulatedArcs(const std::vector<double>& K, const std::vector<double>& Omega,
-                  const std::vector<double>& JR, const std::vector<double>& J1);
+    TabulatedArcs(const std::vector<double>& K, const std::vector<double>& Omega, const std::vector<double>& JR,
+                  const std::vector<double>& J1);
     /// Arc lengths at one K (K inside the grid).
     ArcLengths at(double K) const;
     /// Lowest K of the grid range on which all arc lengths stay in (0, 2 pi) up to K = 0.

@@ -27,26 +27,26 @@ namespace hovering {
 /// x_0, x_e, x_2e, ... (n_orbits, n_steps / e + 1) and the regions the returns taken from them,
 /// (n_orbits, ceil(n_steps / e)); entries an orbit did not reach are NaN (Region::None).
 struct IterateOutput {
-    double* phi_final = nullptr;       ///< (n_orbits,) last state reached
-    double* K_final = nullptr;         ///< (n_orbits,)
-    double* orbit_phi = nullptr;       ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
-    double* orbit_K = nullptr;         ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
+    double* phi_final = nullptr;  ///< (n_orbits,) last state reached
+    double* K_final = nullptr;    ///< (n_orbits,)
+    double* orbit_phi = nullptr;  ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
+    double* orbit_K = nullptr;    ///< (n_orbits, n_steps/every + 1), NaN after the orbit stopped
     /// (n_orbits, ceil(n_steps/every)), Region::None after the orbit stopped; with stop_on_exit the
     /// return that leaves the watched set is recorded (its region), though not taken.
     std::int8_t* regions = nullptr;
-    double* rotation = nullptr;        ///< (n_orbits,) mean of omega_a over the steps taken (NaN if none)
-    std::int8_t* status = nullptr;     ///< (n_orbits,) Status, always written when non-null
+    double* rotation = nullptr;          ///< (n_orbits,) mean of omega_a over the steps taken (NaN if none)
+    std::int8_t* status = nullptr;       ///< (n_orbits,) Status, always written when non-null
     std::int64_t* steps_done = nullptr;  ///< (n_orbits,) steps actually taken
     std::int64_t* exit_step = nullptr;   ///< (n_orbits,) first n with region(x_n) outside the set, else -1
     /// (n_orbits,) bit r set: the orbit reached a point of Region r (the points steps were taken
     /// from, and the one where it left the watched set)
     std::int8_t* visited = nullptr;
-    double* K_min = nullptr;             ///< (n_orbits,) min of K over the states x_0 .. x_steps_done
-    double* K_max = nullptr;             ///< (n_orbits,) max of K over the same states
+    double* K_min = nullptr;  ///< (n_orbits,) min of K over the states x_0 .. x_steps_done
+    double* K_max = nullptr;  ///< (n_orbits,) max of K over the same states
     /// (n_orbits, kRegionCount) returns per region code 0..4 (those taken, and with stop_on_exit
     /// the one that leaves the watched set: the returns whose region `visited` sets)
     std::int64_t* residence = nullptr;
-    std::int64_t* stop_step = nullptr;   ///< (n_orbits,) first n with x_n in the stop set, else -1
+    std::int64_t* stop_step = nullptr;  ///< (n_orbits,) first n with x_n in the stop set, else -1
 };
 
 /// What a batch iteration does besides stepping.
@@ -54,13 +54,13 @@ struct IterateOptions {
     std::int64_t n_steps = 0;  ///< steps per orbit (>= 0)
     /// Bit r set: Region r is in the watched set (for exit_step / stop_on_exit); 0 disables the watch.
     unsigned exit_mask = 0;
-    bool stop_on_exit = false;        ///< stop an orbit (Status::Exited) when it first leaves the set
+    bool stop_on_exit = false;  ///< stop an orbit (Status::Exited) when it first leaves the set
     /// Stop an orbit (Status::Stopped) at the first state x_n (x_0 included) in the set; a state
     /// outside the band is Escaped instead.
     StopCondition stop;
-    std::int64_t every = 1;           ///< record every k-th state (and the return from it), k >= 1
-    int n_threads = 0;                ///< worker threads; 0 = all hardware threads
-    Kernel kernel = Kernel::Simd;     ///< which step implementation to use
+    std::int64_t every = 1;        ///< record every k-th state (and the return from it), k >= 1
+    int n_threads = 0;             ///< worker threads; 0 = all hardware threads
+    Kernel kernel = Kernel::Simd;  ///< which step implementation to use
     /// SIMD kernel only: SLEEF's 3.5-ulp sin instead of the 1-ulp one (about 20% faster per step).
     bool fast_sin = false;
     const std::atomic<bool>* cancel = nullptr;  ///< polled every few steps; set it to stop early
@@ -123,8 +123,8 @@ using TruncatedMap = MapCore<AnalyticArcs, SineForcing>;
 using TruncatedFamily = MapCore<TabulatedArcs, FourierForcing>;
 
 /// Build F_eps from the paper's six parameters (validated).
-TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, double tau0, double tau1,
-                                double lam, double K_max = std::numeric_limits<double>::infinity());
+TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, double tau0, double tau1, double lam,
+                                double K_max = std::numeric_limits<double>::infinity());
 
 /// Wrap an angle to [-pi, pi).
 double wrap_angle(double x);

@@ -192,24 +192,21 @@ HoveringAreaResult whole(const HoveringAreaOptions& o, double band_lo, Outcomes&
 }  // namespace
 
 HoveringAreaResult hovering_area(const TruncatedMap& m, const HoveringAreaOptions& o) {
-    return whole(o, m.band().lo, [&](const double* p, const double* k, std::int64_t n) {
-        return hovering_outcomes(m, p, k, n, o);
-    });
+    return whole(o, m.band().lo,
+                 [&](const double* p, const double* k, std::int64_t n) { return hovering_outcomes(m, p, k, n, o); });
 }
 
 HoveringAreaResult hovering_area(const TruncatedFamily& m, const HoveringAreaOptions& o) {
-    return whole(o, m.band().lo, [&](const double* p, const double* k, std::int64_t n) {
-        return hovering_outcomes(m, p, k, n, o);
-    });
+    return whole(o, m.band().lo,
+                 [&](const double* p, const double* k, std::int64_t n) { return hovering_outcomes(m, p, k, n, o); });
 }
 
 HoveringAreaResult hovering_area(const FlowMap& m, const FlowMap& m0, const HoveringAreaOptions& o) {
     if (!m.curve() || !m0.curve()) bad("hovering_area needs flow maps on normal coordinates (phi, K)");
     double lo = detail::kInf;
     for (double I : m.curve()->I()) lo = std::min(lo, I);
-    return whole(o, -lo, [&](const double* p, const double* k, std::int64_t n) {
-        return hovering_outcomes(m, m0, p, k, n, o);
-    });
+    return whole(
+        o, -lo, [&](const double* p, const double* k, std::int64_t n) { return hovering_outcomes(m, m0, p, k, n, o); });
 }
 
 double first_order_shape(const std::vector<double>& b, double Omega0, double psi) {

@@ -44,7 +44,9 @@ inline std::string fmt(double v) {
 }
 
 /// Throw the bad-input exception (pybind11 turns it into ValueError).
-[[noreturn]] inline void bad(const std::string& msg) { throw std::invalid_argument(msg); }
+[[noreturn]] inline void bad(const std::string& msg) {
+    throw std::invalid_argument(msg);
+}
 
 /// Throw unless v is finite, naming it.
 inline void require_finite(double v, const std::string& name) {
@@ -59,8 +61,10 @@ inline constexpr double kMaxAngle = 1e6;
 inline void require_angle(double v, const std::string& name) {
     require_finite(v, name);
     if (!(std::fabs(v) <= kMaxAngle))
-        bad(name + " must be an angle with |" + name + "| <= 1e6 (larger angles cannot be wrapped to [-pi, pi) "
-            "accurately in double precision), got " + fmt(v));
+        bad(name + " must be an angle with |" + name +
+            "| <= 1e6 (larger angles cannot be wrapped to [-pi, pi) "
+            "accurately in double precision), got " +
+            fmt(v));
 }
 
 /// Turn GSL's abort-on-error handler off once: every GSL call here validates its inputs first,
@@ -93,7 +97,9 @@ inline double brent(const std::function<double(double)>& f, double lo, double hi
         gsl_root_fsolver_iterate(s);
         x = gsl_root_fsolver_root(s);
         if (x == ctx.x && std::fabs(ctx.fx) <= ftol) break;
-        if (gsl_root_test_interval(gsl_root_fsolver_x_lower(s), gsl_root_fsolver_x_upper(s), 0.0, rel_tol) == GSL_SUCCESS) break;
+        if (gsl_root_test_interval(gsl_root_fsolver_x_lower(s), gsl_root_fsolver_x_upper(s), 0.0, rel_tol) ==
+            GSL_SUCCESS)
+            break;
     }
     gsl_root_fsolver_free(s);
     return x;
@@ -176,10 +182,12 @@ inline double newton_bracketed(const std::function<void(double, double*, double*
         fdf(r, &f, &df);
         return r;
     }
-    const double r = brent([&](double t) {
-        fdf(t, &f, &df);
-        return f;
-    }, ctx.lo, ctx.hi, 1e-15);
+    const double r = brent(
+        [&](double t) {
+            fdf(t, &f, &df);
+            return f;
+        },
+        ctx.lo, ctx.hi, 1e-15);
     fdf(r, &f, &df);
     return r;
 }
@@ -190,7 +198,8 @@ inline double hermite_root(double f0, double d0, double f1, double d1, double h)
     auto H = [&](double s, double* dh) {  // s in [0, 1]
         const double s2 = s * s, s3 = s2 * s;
         const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
-        *dh = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * h * d0 + (-6 * s2 + 6 * s) * f1 + (3 * s2 - 2 * s) * h * d1;
+        *dh =
+            (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * h * d0 + (-6 * s2 + 6 * s) * f1 + (3 * s2 - 2 * s) * h * d1;
         return h00 * f0 + h10 * h * d0 + h01 * f1 + h11 * h * d1;
     };
     double lo = 0, hi = 1, s = f0 / (f0 - f1);  // secant start

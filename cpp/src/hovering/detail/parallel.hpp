@@ -23,7 +23,8 @@ struct WorkQueue {
     std::atomic<std::int64_t> next{0};
     std::int64_t n = 0;      ///< number of items
     std::int64_t block = 1;  ///< items taken per visit to the shared counter
-    WorkQueue(std::int64_t n_items, std::int64_t block_size) : n(n_items), block(std::max<std::int64_t>(1, block_size)) {}
+    WorkQueue(std::int64_t n_items, std::int64_t block_size)
+        : n(n_items), block(std::max<std::int64_t>(1, block_size)) {}
     /// Hand out nothing more (cancellation, or a worker failed).
     void stop() { next.store(n); }
 };

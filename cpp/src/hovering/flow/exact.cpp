@@ -16,8 +16,12 @@ namespace hovering::detail {
 
 namespace {
 
-bool closed_form(const Potential* V) { return dynamic_cast<const Harmonic*>(V) || dynamic_cast<const Tan*>(V); }
-bool harmonic(const Potential* V) { return dynamic_cast<const Harmonic*>(V) != nullptr; }
+bool closed_form(const Potential* V) {
+    return dynamic_cast<const Harmonic*>(V) || dynamic_cast<const Tan*>(V);
+}
+bool harmonic(const Potential* V) {
+    return dynamic_cast<const Harmonic*>(V) != nullptr;
+}
 
 // Terms that move the flow: nonzero coefficient and a non-constant monomial (eps = 0: none).
 bool coupled(const FlowSystem& s) {
@@ -39,8 +43,8 @@ std::string describe(const FlowSystem& s) {
         if (!c.empty()) c += " + ";
         c += fmt(t[0]) + " q1^" + fmt(t[1]) + " q2^" + fmt(t[2]);
     }
-    return "V1 = " + s.V1->name() + ", V2 = " + s.V2->name() + ", eps = " + fmt(s.eps) + ", Vc = " +
-           (c.empty() ? "0" : c);
+    return "V1 = " + s.V1->name() + ", V2 = " + s.V2->name() + ", eps = " + fmt(s.eps) +
+           ", Vc = " + (c.empty() ? "0" : c);
 }
 
 }  // namespace
@@ -53,8 +57,8 @@ ExactKind exact_kind(const FlowSystem& s, const FlowOptions& o) {
     if (c && harmonic(s.V1.get()) && harmonic(s.V2.get()) && quadratic(s.coupling)) return ExactKind::Linear;
     bad("stepper 'exact' needs a flow in closed form: eps = 0 (or no coupling) with V1 and V2 each Harmonic "
         "or Tan (closed action-angle variables), or V1 and V2 both Harmonic with a quadratic coupling "
-        "(terms q1 q2, q1^2, q2^2: a linear flow); the system has " + describe(s) +
-        " (use a GSL stepper such as 'rk8pd')");
+        "(terms q1 q2, q1^2, q2^2: a linear flow); the system has " +
+        describe(s) + " (use a GSL stepper such as 'rk8pd')");
 }
 
 // ------------------------------------------------------------------------------- linear flow
@@ -82,7 +86,9 @@ LinearFlow::LinearFlow(const FlowSystem& s) {
     }
 }
 
-double LinearFlow::fastest_rate() const { return std::max(rate_[0], rate_[1]); }
+double LinearFlow::fastest_rate() const {
+    return std::max(rate_[0], rate_[1]);
+}
 
 void LinearFlow::propagate(const double* y0, double t, double* y1) const {
     const double q[2] = {y0[0], y0[2]}, p[2] = {y0[1], y0[3]};
@@ -194,7 +200,9 @@ ReturnResult Tracer::trace_angles(const std::array<double, 4>& z0, bool first_cr
         r.time = t;
         r.status = status;
         done = true;
-        if (dense) dense->push(dense->offset + t, y, status == FlowStatus::Ok ? TrajectoryPoint::Return : TrajectoryPoint::End);
+        if (dense)
+            dense->push(dense->offset + t, y,
+                        status == FlowStatus::Ok ? TrajectoryPoint::Return : TrajectoryPoint::End);
     };
     const bool ok = o[0].set(z0[0], z0[1]) && o[1].set(z0[2], z0[3]);
     if (!ok) {
@@ -212,7 +220,7 @@ ReturnResult Tracer::trace_angles(const std::array<double, 4>& z0, bool first_cr
     };
     auto wall_line = [&](const AngleOscillator& a, double qw) {
         WallLine w;
-        if (!(a.h > 0)) return w;  // at rest at q = 0 > qw
+        if (!(a.h > 0)) return w;                              // at rest at q = 0 > qw
         const double d = a.V->turning_points(a.h).first - qw;  // the minimum's distance to the wall
         if (d > opt.grazing_tol) return w;
         if (d >= -opt.grazing_tol) {
@@ -292,8 +300,8 @@ ReturnResult Tracer::trace_angles(const std::array<double, 4>& z0, bool first_cr
         ++work_.wall_searches;
         const bool is_right = ev == Ev::Right || ev == Ev::Min1;
         // The other coordinate decides whether the wall is there (the infinite wall: always).
-        const double other = is_right ? (is_step ? o[1].at(o[1].theta).first - s.qw2 : -1.0)
-                                      : o[0].at(o[0].theta).first - s.qw1;
+        const double other =
+            is_right ? (is_step ? o[1].at(o[1].theta).first - s.qw2 : -1.0) : o[0].at(o[0].theta).first - s.qw1;
         auto stop_here = [&](FlowStatus status) {
             current(y);
             stop(status, y);

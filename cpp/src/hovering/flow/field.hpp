@@ -43,7 +43,7 @@ struct Force {
     Kind kind = Kind::Other;
     double a = 0, b = 0;  // Harmonic: a = omega^2; Tan: a = omega^2 / alpha, b = alpha
     const Potential* p = nullptr;
-    int aux = -1;         // Tan: index of u = tan(alpha q) in the state
+    int aux = -1;  // Tan: index of u = tan(alpha q) in the state
     explicit Force(const Potential* pot);
     /// V'(q) (q is state[QI]); the Tan force reads u from state[AUX].
     template <Kind K, int QI, int AUX>
@@ -132,9 +132,9 @@ struct Field {
                 J[pi * n + qi] = -f.a;
             } else if (f.kind == Kind::Tan) {
                 const double u = z[f.aux];
-                J[pi * n + f.aux] = -f.a * (1 + 3 * u * u);          // d/du of -a u (1 + u^2)
-                J[f.aux * n + f.aux] = 2 * f.b * u * z[pi];          // d/du of b (1 + u^2) p
-                J[f.aux * n + pi] = f.b * (1 + u * u);               // d/dp
+                J[pi * n + f.aux] = -f.a * (1 + 3 * u * u);  // d/du of -a u (1 + u^2)
+                J[f.aux * n + f.aux] = 2 * f.b * u * z[pi];  // d/du of b (1 + u^2) p
+                J[f.aux * n + pi] = f.b * (1 + u * u);       // d/dp
             } else {
                 const double q = z[qi], d = 1e-6 * (1 + std::fabs(q));
                 J[pi * n + qi] = -(f.p->dV(q + d) - f.p->dV(q - d)) / (2 * d);
@@ -179,15 +179,19 @@ inline Force::Force(const Potential* pot) : p(pot) {
 
 template <Kind K1, Kind K2>
 void Field::pick_c() {
-    fn = ckind == CKind::None ? &eval<K1, K2, CKind::None>
-       : ckind == CKind::Bilinear ? &eval<K1, K2, CKind::Bilinear> : &eval<K1, K2, CKind::General>;
+    fn = ckind == CKind::None       ? &eval<K1, K2, CKind::None>
+         : ckind == CKind::Bilinear ? &eval<K1, K2, CKind::Bilinear>
+                                    : &eval<K1, K2, CKind::General>;
 }
 
 template <Kind K1>
 void Field::pick_2() {
-    if (f2.kind == Kind::Harmonic) pick_c<K1, Kind::Harmonic>();
-    else if (f2.kind == Kind::Tan) pick_c<K1, Kind::Tan>();
-    else pick_c<K1, Kind::Other>();
+    if (f2.kind == Kind::Harmonic)
+        pick_c<K1, Kind::Harmonic>();
+    else if (f2.kind == Kind::Tan)
+        pick_c<K1, Kind::Tan>();
+    else
+        pick_c<K1, Kind::Other>();
 }
 
 inline Field::Field(const FlowSystem& s) : f1(s.V1.get()), f2(s.V2.get()), eps(s.eps), coupling(&s.coupling) {
@@ -202,9 +206,12 @@ inline Field::Field(const FlowSystem& s) : f1(s.V1.get()), f2(s.V2.get()), eps(s
     }
     if (f1.kind == Kind::Tan) f1.aux = dim++;
     if (f2.kind == Kind::Tan) f2.aux = dim++;
-    if (f1.kind == Kind::Harmonic) pick_2<Kind::Harmonic>();
-    else if (f1.kind == Kind::Tan) pick_2<Kind::Tan>();
-    else pick_2<Kind::Other>();
+    if (f1.kind == Kind::Harmonic)
+        pick_2<Kind::Harmonic>();
+    else if (f1.kind == Kind::Tan)
+        pick_2<Kind::Tan>();
+    else
+        pick_2<Kind::Other>();
 }
 
 }  // namespace hovering::detail

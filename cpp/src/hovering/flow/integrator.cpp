@@ -24,7 +24,8 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
     if (name == "exact") return nullptr;
     bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods), msadams "
         "(variable-order Adams multistep), rk2imp, rk4imp (implicit Gauss-Legendre, symplectic at a fixed "
-        "step; with the Jacobian) or exact (closed-form flow, where the system has one); got '" + name + "'");
+        "step; with the Jacobian) or exact (closed-form flow, where the system has one); got '" +
+        name + "'");
 }
 
 Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)

@@ -70,19 +70,19 @@ private:
     Field field_;
     gsl_odeiv2_system sys_;
     gsl_odeiv2_step* step_ = nullptr;
-    gsl_odeiv2_control* control_ = nullptr;  // msadams only (the driver's)
-    gsl_odeiv2_driver* driver_ = nullptr;    // msadams only: owns step, control and evolve
-    gsl_odeiv2_step* ext_ = nullptr;       // msadams only: rk8pd for event extensions
+    gsl_odeiv2_control* control_ = nullptr;    // msadams only (the driver's)
+    gsl_odeiv2_driver* driver_ = nullptr;      // msadams only: owns step, control and evolve
+    gsl_odeiv2_step* ext_ = nullptr;           // msadams only: rk8pd for event extensions
     gsl_odeiv2_driver* imp_driver_ = nullptr;  // rk2imp / rk4imp: owns step_ (their Newton reads its control)
-    int ext_sub_ = 1;                      // substeps of the extension
-    double t_ms_ = 0;                      // msadams: running time (its history is in time)
+    int ext_sub_ = 1;                          // substeps of the extension
+    double t_ms_ = 0;                          // msadams: running time (its history is in time)
     double atol_, rtol_;
-    double qlim1_, qlim2_;      // the wells' edges (infinite for unbounded potentials)
+    double qlim1_, qlim2_;  // the wells' edges (infinite for unbounded potentials)
     ExactKind kind_ = ExactKind::None;
-    std::unique_ptr<LinearFlow> linear_;   // stepper "exact", linear flow
-    AngleOscillator osc_[2];               // stepper "exact", uncoupled flow (step loop only)
-    int order_ = 8;             // one-step methods: the stepper's order, for the step-size rule
-    double grow_below_ = 0.43;  // 0.9^order: below this scaled error the step grows
+    std::unique_ptr<LinearFlow> linear_;  // stepper "exact", linear flow
+    AngleOscillator osc_[2];              // stepper "exact", uncoupled flow (step loop only)
+    int order_ = 8;                       // one-step methods: the stepper's order, for the step-size rule
+    double grow_below_ = 0.43;            // 0.9^order: below this scaled error the step grows
 };
 
 }  // namespace hovering::detail

@@ -52,9 +52,11 @@ void check_walls(const Potential& V1, const Potential& V2, double qw1, double qw
     // corner) is no level at all; 1e-300 is where the quadrature path stops too.
     const double h1w = V1.V(qw1), h2w = V2.V(qw2);
     if (!(h1w >= 1e-300))
-        bad("qw1 = " + fmt(qw1) + " is too close to the bottom of V1: V1(qw1) = " + fmt(h1w) + " (allowed: V1(qw1) >= 1e-300)");
+        bad("qw1 = " + fmt(qw1) + " is too close to the bottom of V1: V1(qw1) = " + fmt(h1w) +
+            " (allowed: V1(qw1) >= 1e-300)");
     if (!(h2w >= 1e-300))
-        bad("qw2 = " + fmt(qw2) + " is too close to the bottom of V2: V2(qw2) = " + fmt(h2w) + " (allowed: V2(qw2) >= 1e-300)");
+        bad("qw2 = " + fmt(qw2) + " is too close to the bottom of V2: V2(qw2) = " + fmt(h2w) +
+            " (allowed: V2(qw2) >= 1e-300)");
     const double hw = h1w + h2w;
     if (!std::isfinite(h) || !(h > hw))
         bad("h must exceed the step energy h_0^w = V1(qw1) + V2(qw2) = " + fmt(hw) + ", got " + fmt(h));
@@ -87,7 +89,9 @@ struct Part {
     double scale;  // > 0: a value below its error (and the error below rtol * scale) is reported as 0
 };
 
-bool is_angle(const Part& p) { return std::string(p.name) == "tau1" || std::string(p.name) == "theta_w"; }
+bool is_angle(const Part& p) {
+    return std::string(p.name) == "tau1" || std::string(p.name) == "theta_w";
+}
 
 [[noreturn]] void unresolved(const Part& p, const Inputs& in, double rtol, const std::string& how) {
     const double E = p.input + p.own;
@@ -95,21 +99,24 @@ bool is_angle(const Part& p) { return std::string(p.name) == "tau1" || std::stri
     if (!std::isfinite(p.value) || !std::isfinite(E)) {
         why = "it is not finite (" + fmt(p.value) + " +- " + fmt(E) + ")";
     } else if (p.input >= p.own && is_angle(p) && in.Ed / in.delta >= in.Eh2 / in.h2) {
-        why = "h - h_w = " + fmt(in.delta) + " is below the resolution of the step energy: the rounding of h, V1(qw1) = " +
-              fmt(in.h1w) + " and V2(qw2) = " + fmt(in.h2w) + " leaves h - h_w uncertain by " + fmt(in.Ed) +
-              ", and " + p.name + " has a square-root singularity at h = h_w; allowed: h - h_w well above E / (2 rtol) = " +
+        why = "h - h_w = " + fmt(in.delta) +
+              " is below the resolution of the step energy: the rounding of h, V1(qw1) = " + fmt(in.h1w) +
+              " and V2(qw2) = " + fmt(in.h2w) + " leaves h - h_w uncertain by " + fmt(in.Ed) + ", and " + p.name +
+              " has a square-root singularity at h = h_w; allowed: h - h_w well above E / (2 rtol) = " +
               fmt(in.Ed / (2 * rtol)) + " (or a larger rtol)";
     } else if (p.input >= p.own) {
-        why = "h2 = h - V1(qw1) = " + fmt(in.h2) + ", the energy of oscillator 2 on the tangent torus, is known only to " +
-              fmt(in.Eh2) + " (the rounding of h and V1(qw1) = " + fmt(in.h1w) +
+        why = "h2 = h - V1(qw1) = " + fmt(in.h2) +
+              ", the energy of oscillator 2 on the tangent torus, is known only to " + fmt(in.Eh2) +
+              " (the rounding of h and V1(qw1) = " + fmt(in.h1w) +
               "); allowed: h - V1(qw1) well above that (or a larger rtol)";
     } else {
         why = std::string("the computation of ") + p.name + " itself has error " + fmt(p.own) + " (" + how +
-              "); allowed: a larger rtol" + (how.find("quadrature") != std::string::npos ? " or a closed-form potential" : "");
+              "); allowed: a larger rtol" +
+              (how.find("quadrature") != std::string::npos ? " or a closed-form potential" : "");
     }
-    bad("onset_parameters: " + std::string(p.name) + " = " + fmt(p.value) + " at h = " + fmt(in.h) + " (h - h_w = " +
-        fmt(in.delta) + ") has estimated error " + fmt(E) + ", relative " + fmt(E / std::fabs(p.value)) +
-        " > rtol = " + fmt(rtol) + ": " + why);
+    bad("onset_parameters: " + std::string(p.name) + " = " + fmt(p.value) + " at h = " + fmt(in.h) +
+        " (h - h_w = " + fmt(in.delta) + ") has estimated error " + fmt(E) + ", relative " +
+        fmt(E / std::fabs(p.value)) + " > rtol = " + fmt(rtol) + ": " + why);
 }
 
 // The level through the corner must lie strictly below h2 even after rounding: otherwise theta_w
@@ -117,9 +124,9 @@ bool is_angle(const Part& p) { return std::string(p.name) == "tau1" || std::stri
 void require_resolved(const Inputs& in, double rtol) {
     if (!(in.delta > 2 * in.Ed))
         bad("onset_parameters: theta_w and tau1 at h = " + fmt(in.h) + ": h - h_w = " + fmt(in.delta) +
-            " is below the resolution of the step energy: the rounding of h, V1(qw1) = " + fmt(in.h1w) + " and V2(qw2) = " +
-            fmt(in.h2w) + " leaves h - h_w uncertain by " + fmt(in.Ed) + "; allowed: h - h_w well above E / (2 rtol) = " +
-            fmt(in.Ed / (2 * rtol)));
+            " is below the resolution of the step energy: the rounding of h, V1(qw1) = " + fmt(in.h1w) +
+            " and V2(qw2) = " + fmt(in.h2w) + " leaves h - h_w uncertain by " + fmt(in.Ed) +
+            "; allowed: h - h_w well above E / (2 rtol) = " + fmt(in.Ed / (2 * rtol)));
 }
 
 // Check each parameter against rtol and assemble the estimate.
@@ -144,8 +151,7 @@ OnsetEstimate finish(Part (&parts)[6], const Inputs& in, double rtol, const std:
 
 }  // namespace
 
-OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw1, double qw2, double h,
-                             double rtol) {
+OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw1, double qw2, double h, double rtol) {
     require_rtol(rtol);
     check_walls(V1, V2, qw1, qw2, h);
     const Inputs in = inputs(V1, V2, qw1, qw2, h);
@@ -179,10 +185,9 @@ OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw
     Part parts[6] = {
         {"Omega0", Omega0, std::fabs(dw2) * in.Eh2 * T1 + w2 * std::fabs(dT1.value) * in.E1,
          (a1 + a2 + 2 * kEps) * Omega0, 0},
-        {"tau0", tau0,
-         (std::fabs(A) + std::fabs(B)) * 3 * (in.Eh2 / in.h2 + in.E1 / in.h1w),
-         std::fabs(A) * (Ew2 / w2 + ET1 / T1) + std::fabs(w2 * T1) * Edw2 + 2 * std::fabs(B) * Ew2 / w2 + w2 * w2 * EdT1 +
-             4 * kEps * (std::fabs(A) + std::fabs(B)),
+        {"tau0", tau0, (std::fabs(A) + std::fabs(B)) * 3 * (in.Eh2 / in.h2 + in.E1 / in.h1w),
+         std::fabs(A) * (Ew2 / w2 + ET1 / T1) + std::fabs(w2 * T1) * Edw2 + 2 * std::fabs(B) * Ew2 / w2 +
+             w2 * w2 * EdT1 + 4 * kEps * (std::fabs(A) + std::fabs(B)),
          Omega0 / I_tan},
         // d theta / dh ~ (h2 - V2(qw2))^(-1/2): relative sensitivity 1 / (2 delta) to the level.
         {"tau1", tau1, std::fabs(tau1) * in.Ed * (1 / (2 * in.delta) + 3 / in.h2),
@@ -198,9 +203,11 @@ OnsetEstimate onset_estimate(const Potential& V1, const Potential& V2, double qw
         // bounds the periods and angles: 100x (a closed form keeps its 10 x 8 eps).
         {"I_tan", I_tan, in.Eh2 / w2, ((a2 > 1e-14 ? 100 : 10) * a2 + 2 * kEps) * I_tan, 0},
     };
-    const std::string how = "the potentials' " + std::string(a1 > 1e-14 || a2 > 1e-14 ? "quadratures (relative accuracy " +
-                                                                                            fmt(std::max(a1, a2)) + ") and their difference quotients"
-                                                                                      : "closed forms' rounding");
+    const std::string how =
+        "the potentials' " +
+        std::string(a1 > 1e-14 || a2 > 1e-14
+                        ? "quadratures (relative accuracy " + fmt(std::max(a1, a2)) + ") and their difference quotients"
+                        : "closed forms' rounding");
     return finish(parts, in, rtol, how);
 }
 
@@ -264,8 +271,8 @@ OnsetEstimate onset_estimate_closed_form(double omega1, double alpha1, double om
     return finish(parts, in, rtol, "the closed forms' rounding");
 }
 
-OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2,
-                                             double qw1, double qw2, double h, double rtol) {
+OnsetParameters onset_parameters_closed_form(double omega1, double alpha1, double omega2, double alpha2, double qw1,
+                                             double qw2, double h, double rtol) {
     return onset_estimate_closed_form(omega1, alpha1, omega2, alpha2, qw1, qw2, h, rtol).value;
 }
 

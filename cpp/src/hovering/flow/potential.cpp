@@ -28,7 +28,9 @@ using detail::gsl_quiet;
 using detail::kInf;
 using detail::kPi;
 
-double call(double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); }
+double call(double x, void* p) {
+    return (*static_cast<const std::function<double(double)>*>(p))(x);
+}
 
 // pi - kPi: the angle theta (a double) lies (kPi - theta) + kPiLow before pi, which matters
 // relatively for p near theta = +-pi (the closed forms' sin(theta) sees it too).
@@ -51,9 +53,12 @@ struct Level {
         for (const double e : {a, b}) {
             const double v = p.V(e);
             if (!(v >= 0.5 * h) && !std::isfinite(p.V(std::nextafter(e, e > 0 ? kInf : -kInf))))
-                bad(p.name() + "." + who + ": the level h = " + fmt(h) + " lies above the largest value V reaches inside the wall q_limit = " +
-                    fmt(p.q_limit()) + " (V(" + fmt(e) + ") = " + fmt(v) + " at the turning point): it has no turning point the "
-                    "quadrature can resolve; allowed: h <= " + fmt(2 * v) + ", or a closed-form potential");
+                bad(p.name() + "." + who + ": the level h = " + fmt(h) +
+                    " lies above the largest value V reaches inside the wall q_limit = " + fmt(p.q_limit()) + " (V(" +
+                    fmt(e) + ") = " + fmt(v) +
+                    " at the turning point): it has no turning point the "
+                    "quadrature can resolve; allowed: h <= " +
+                    fmt(2 * v) + ", or a closed-form potential");
         }
     }
 
@@ -75,8 +80,8 @@ struct Level {
         }
         static constexpr double x[5] = {0.0, 0.5384693101056831, -0.5384693101056831, 0.9061798459386640,
                                         -0.9061798459386640};
-        static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
-                                        0.2369268850561891, 0.2369268850561891};
+        static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891,
+                                        0.2369268850561891};
         double s = 0;
         for (int i = 0; i < 5; ++i) s += w[i] * pot.dV(e - side * (0.5 * d * (1 + x[i])));
         return 0.5 * side * s;
@@ -127,7 +132,8 @@ double Level::qaws(const std::function<double(double)>& f, double lo, double hi,
     if (st != GSL_SUCCESS && st != GSL_EROUND && !(err <= 1e-10 * std::fabs(r)))
         bad(pot.name() + "." + who + ": the quadrature over the level h = " + fmt(h) + " did not converge (" +
             gsl_strerror(st) + "); the turning points [" + fmt(a) + ", " + fmt(b) +
-            "] are too close to resolve, or V is flat there; allowed: a level the quadrature resolves (a larger h) or a "
+            "] are too close to resolve, or V is flat there; allowed: a level the quadrature resolves (a larger h) or "
+            "a "
             "closed-form potential");
     return r;
 }
@@ -183,7 +189,9 @@ Estimate ridders(const std::function<double(double)>& f, double x, double d0, do
 
 // ------------------------------------------------------------------------------- generic paths
 
-double Potential::q_limit() const { return kInf; }
+double Potential::q_limit() const {
+    return kInf;
+}
 
 void Potential::check_energy(double h, const char* who) const {
     if (!std::isfinite(h) || !(h > 0))
@@ -257,18 +265,25 @@ double Potential::period(double h) const {
     const double a = L.a, b = L.b, mid = 0.5 * (a + b);
     // 2 int dq / sqrt(2(h - V)) = 2 int w(q) r(q) dq, w = ((q-a)(b-q))^-1/2, r = sqrt((q-a)(b-q) / (2(h-V))),
     // h - V written as slope x distance to the nearer turning point (no cancellation there).
-    return 2 * L.qaws([&](double q) {
-        return q >= mid ? std::sqrt((q - a) / (2 * L.slope(b - q, 1))) : std::sqrt((b - q) / (2 * L.slope(q - a, -1)));
-    }, a, b, -0.5, -0.5, "period");
+    return 2 * L.qaws(
+                   [&](double q) {
+                       return q >= mid ? std::sqrt((q - a) / (2 * L.slope(b - q, 1)))
+                                       : std::sqrt((b - q) / (2 * L.slope(q - a, -1)));
+                   },
+                   a, b, -0.5, -0.5, "period");
 }
 
 double Potential::action(double h) const {
     const Level L(*this, h, "action");
     const double a = L.a, b = L.b, mid = 0.5 * (a + b);
     const auto whole = [&] {
-        return L.qaws([&](double q) {
-            return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) / (q - a)) : std::sqrt(2 * L.slope(q - a, -1) / (b - q));
-        }, a, b, 0.5, 0.5, "action") / kPi;
+        return L.qaws(
+                   [&](double q) {
+                       return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) / (q - a))
+                                       : std::sqrt(2 * L.slope(q - a, -1) / (b - q));
+                   },
+                   a, b, 0.5, 0.5, "action") /
+               kPi;
     };
     // Near a steep wall p = sqrt(2 (h - V)) climbs from 0 to ~sqrt(2 h) within l = h / |V'| of the
     // turning point; on a high level of a Tan well l is 1e-10 of the width, and one QAWS over the
@@ -284,11 +299,16 @@ double Potential::action(double h) const {
         return whole();
     try {
         // In the layers' local distance d from their turning point (exact near it): p = sqrt(2 d slope(d)).
-        const double left = L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, -1)); }, 0.0, la, 0.5, 0.0, "action");
-        const double right = L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, 1)); }, 0.0, lb, 0.5, 0.0, "action");
-        const double inner = L.qaws([&](double q) {
-            return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) * (b - q)) : std::sqrt(2 * L.slope(q - a, -1) * (q - a));
-        }, a + la, b - lb, 0.0, 0.0, "action");
+        const double left =
+            L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, -1)); }, 0.0, la, 0.5, 0.0, "action");
+        const double right =
+            L.qaws([&](double d) { return std::sqrt(2 * L.slope(d, 1)); }, 0.0, lb, 0.5, 0.0, "action");
+        const double inner = L.qaws(
+            [&](double q) {
+                return q >= mid ? std::sqrt(2 * L.slope(b - q, 1) * (b - q))
+                                : std::sqrt(2 * L.slope(q - a, -1) * (q - a));
+            },
+            a + la, b - lb, 0.0, 0.0, "action");
         return (left + inner + right) / kPi;
     } catch (const std::invalid_argument&) {
         return whole();
@@ -312,7 +332,9 @@ double Potential::energy(double I) const {
     return brent([&](double h) { return action(h) - I; }, lo, hi);
 }
 
-double Potential::frequency(double h) const { return 2 * kPi / period(h); }
+double Potential::frequency(double h) const {
+    return 2 * kPi / period(h);
+}
 
 double Potential::angle_of(double q, double h) const {
     const Level L(*this, h, "angle_of");
@@ -321,7 +343,8 @@ double Potential::angle_of(double q, double h) const {
     // turning point, rounding elsewhere) is on the level, at its end.
     const double tol = 8 * std::numeric_limits<double>::epsilon() * std::max(-a, b);
     if (!(q >= a - tol && q <= b + tol))
-        bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h) + ", [" + fmt(a) + ", " + fmt(b) + "]");
+        bad(name() + ".angle_of: q = " + fmt(q) + " is outside the level h = " + fmt(h) + ", [" + fmt(a) + ", " +
+            fmt(b) + "]");
     q = std::min(std::max(q, a), b);
     const double w = frequency(h);
     // From the nearer turning point (exact distance: Sterbenz), where the time has its 1/sqrt.
@@ -330,7 +353,8 @@ double Potential::angle_of(double q, double h) const {
 }
 
 std::pair<double, double> Potential::point_at(double theta, double h) const {
-    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi)
+        bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
     const Level L(*this, h, "point_at");
     const double th = std::fabs(theta), w = frequency(h), sg = theta > 0 ? -1.0 : 1.0;
     // The right half of the level (q >= its midpoint, distance dm from b) has the angles up to
@@ -397,7 +421,9 @@ double Potential::angle_on_level(double q, double p, double h) const {
 
 // 1e-12: the tolerance every generic quadrature asks of QAWS (measured: ~3e-15 on Harmonic and
 // Tan levels 1e-10 .. 1e20; the tolerance is what is promised for any V).
-double Potential::relative_accuracy() const { return 1e-12; }
+double Potential::relative_accuracy() const {
+    return 1e-12;
+}
 
 Estimate Potential::period_slope(double h) const {
     check_energy(h, "period_slope");
@@ -424,10 +450,18 @@ Estimate Potential::angle_slope(double q, double h) const {
 
 // ------------------------------------------------------------------------------- closed forms
 
-Harmonic::Harmonic(double omega) : omega_(omega) { require_scale(omega, "Harmonic: omega"); }
-double Harmonic::V(double q) const { return 0.5 * omega_ * omega_ * q * q; }
-double Harmonic::dV(double q) const { return omega_ * omega_ * q; }
-std::string Harmonic::name() const { return "Harmonic(omega=" + fmt(omega_) + ")"; }
+Harmonic::Harmonic(double omega) : omega_(omega) {
+    require_scale(omega, "Harmonic: omega");
+}
+double Harmonic::V(double q) const {
+    return 0.5 * omega_ * omega_ * q * q;
+}
+double Harmonic::dV(double q) const {
+    return omega_ * omega_ * q;
+}
+std::string Harmonic::name() const {
+    return "Harmonic(omega=" + fmt(omega_) + ")";
+}
 std::pair<double, double> Harmonic::turning_points(double h) const {
     check_energy(h, "turning_points");
     const double A = std::sqrt(2 * h) / omega_;
@@ -452,7 +486,8 @@ double Harmonic::angle_of(double q, double h) const {
 }
 
 std::pair<double, double> Harmonic::point_at(double theta, double h) const {
-    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi)
+        bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
     const double A = turning_points(h).second;
     return {A * std::cos(theta), -A * omega_ * std::sin(theta)};
 }
@@ -461,7 +496,9 @@ double Harmonic::angle_on_level(double q, double p, double) const {
     return std::atan2(-p / omega_, q);  // (q, p) = A (cos theta, -omega sin theta): no arccos near +-1
 }
 
-double Harmonic::relative_accuracy() const { return 4 * kEps; }
+double Harmonic::relative_accuracy() const {
+    return 4 * kEps;
+}
 
 Estimate Harmonic::period_slope(double h) const {
     check_energy(h, "period_slope");
@@ -472,7 +509,8 @@ Estimate Harmonic::angle_slope(double q, double h) const {
     check_energy(h, "angle_slope");
     const double v = V(q), D = h - v;
     if (!std::isfinite(q) || !(D > 0))
-        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) + " (V(q) < h)");
+        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) +
+            " (V(q) < h)");
     // theta = acos(q / A), A = sqrt(2 h) / omega, sin(theta) = sqrt(D / h). The deficit D = h - V
     // carries the rounding of V (4 ulps) relative to D: the slope's sqrt halves it.
     const double s = q * omega_ / (2 * std::sqrt(2.0) * h * std::sqrt(D));
@@ -496,8 +534,12 @@ double Tan::dV(double q) const {
     const double t = std::tan(alpha_ * q);
     return omega_ * omega_ / alpha_ * t * (1 + t * t);
 }
-std::string Tan::name() const { return "Tan(omega=" + fmt(omega_) + ", alpha=" + fmt(alpha_) + ")"; }
-double Tan::q_limit() const { return 0.5 * kPi / alpha_; }
+std::string Tan::name() const {
+    return "Tan(omega=" + fmt(omega_) + ", alpha=" + fmt(alpha_) + ")";
+}
+double Tan::q_limit() const {
+    return 0.5 * kPi / alpha_;
+}
 std::pair<double, double> Tan::turning_points(double h) const {
     check_energy(h, "turning_points");
     const double b = std::atan(alpha_ * std::sqrt(2 * h) / omega_) / alpha_;
@@ -524,7 +566,8 @@ double Tan::angle_of(double q, double h) const {
 }
 
 std::pair<double, double> Tan::point_at(double theta, double h) const {
-    if (!std::isfinite(theta) || std::fabs(theta) > kPi) bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
+    if (!std::isfinite(theta) || std::fabs(theta) > kPi)
+        bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
     check_energy(h, "point_at");
     // q = asin(k cos theta) / alpha and p = omega(h) dq/dtheta: no sqrt(h - V) near the turning
     // points, where it would turn a rounding of V into an O(1e-8) momentum.
@@ -542,7 +585,9 @@ double Tan::angle_on_level(double q, double p, double h) const {
     return std::atan2(-p * alpha_ * std::cos(alpha_ * q) / w, std::sin(alpha_ * q));
 }
 
-double Tan::relative_accuracy() const { return 8 * kEps; }
+double Tan::relative_accuracy() const {
+    return 8 * kEps;
+}
 
 Estimate Tan::period_slope(double h) const {
     check_energy(h, "period_slope");
@@ -555,7 +600,8 @@ Estimate Tan::angle_slope(double q, double h) const {
     check_energy(h, "angle_slope");
     const double v = V(q), D = h - v;
     if (!std::isfinite(q) || !(D > 0))
-        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) + " (V(q) < h)");
+        bad(name() + ".angle_slope: q = " + fmt(q) + " must lie strictly inside the level h = " + fmt(h) +
+            " (V(q) < h)");
     // cos(theta) = k sin(alpha q) / alpha, k = W / sqrt(2 h): d theta / dh = -(d cos / dh) / sin(theta)
     // with sin(theta) = cos(alpha q) sqrt(D / h) (no cancellation: 1 - k^2 s^2 written out).
     const double x = alpha_ * q, c = std::cos(x);

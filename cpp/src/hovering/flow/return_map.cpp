@@ -17,15 +17,24 @@ using detail::kNaN;
 
 Status orbit_status(FlowStatus s) {
     switch (s) {
-        case FlowStatus::Ok: return Status::Ok;
-        case FlowStatus::Corner: return Status::Corner;
-        case FlowStatus::Grazing: return Status::Grazing;
-        case FlowStatus::StepLimit: return Status::StepLimit;
-        case FlowStatus::NonFinite: return Status::NonFinite;
-        case FlowStatus::ImpactLimit: return Status::ImpactLimit;
-        case FlowStatus::OffSection: return Status::OffSection;
-        case FlowStatus::Interrupted: return Status::Interrupted;
-        case FlowStatus::OutsideWell: return Status::OutsideWell;
+        case FlowStatus::Ok:
+            return Status::Ok;
+        case FlowStatus::Corner:
+            return Status::Corner;
+        case FlowStatus::Grazing:
+            return Status::Grazing;
+        case FlowStatus::StepLimit:
+            return Status::StepLimit;
+        case FlowStatus::NonFinite:
+            return Status::NonFinite;
+        case FlowStatus::ImpactLimit:
+            return Status::ImpactLimit;
+        case FlowStatus::OffSection:
+            return Status::OffSection;
+        case FlowStatus::Interrupted:
+            return Status::Interrupted;
+        case FlowStatus::OutsideWell:
+            return Status::OutsideWell;
     }
     return Status::NonFinite;
 }
@@ -82,7 +91,9 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
             if (out.z) out.z[4 * i + k] = r.status == FlowStatus::OffSection ? kNaN : r.z[std::size_t(k)];
         if (out.time) out.time[i] = r.time;
         if (out.status) out.status[i] = static_cast<std::int8_t>(r.status);
-        if (out.region) out.region[i] = static_cast<std::int8_t>(r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None);
+        if (out.region)
+            out.region[i] =
+                static_cast<std::int8_t>(r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None);
         if (out.energy_error) out.energy_error[i] = r.energy_error;
         if (out.steps) out.steps[i] = r.steps;
         if (out.itinerary) out.itinerary[i] = r.itinerary;

@@ -22,9 +22,12 @@ void FlowOptions::validate() const {
     if (!(atol > 0 && std::isfinite(atol))) bad("atol must be finite and > 0, got " + fmt(atol));
     if (!(event_tol > 0 && std::isfinite(event_tol))) bad("event_tol must be finite and > 0, got " + fmt(event_tol));
     if (max_steps < 1) bad("max_steps must be >= 1, got " + std::to_string(max_steps));
-    if (max_impacts < 1 || max_impacts > 1000000) bad("max_impacts must be in [1, 1000000], got " + std::to_string(max_impacts));
-    if (!(grazing_tol >= 0 && std::isfinite(grazing_tol))) bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
-    if (!(corner_tol >= 0 && std::isfinite(corner_tol))) bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
+    if (max_impacts < 1 || max_impacts > 1000000)
+        bad("max_impacts must be in [1, 1000000], got " + std::to_string(max_impacts));
+    if (!(grazing_tol >= 0 && std::isfinite(grazing_tol)))
+        bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
+    if (!(corner_tol >= 0 && std::isfinite(corner_tol)))
+        bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
 }
 
 void FlowOptions::validate(const FlowSystem& s) const {
@@ -86,8 +89,8 @@ bool try_section_point(const FlowSystem& s, double h, double theta, double I, st
     double dz[4];
     s.rhs(p.data(), dz);
     if (!(dz[1] < 0))
-        return fail("the point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + ") has dp1/dt = " +
-                    fmt(dz[1]) + " >= 0 (Sigma_h needs dp1/dt < 0)");
+        return fail("the point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) +
+                    ") has dp1/dt = " + fmt(dz[1]) + " >= 0 (Sigma_h needs dp1/dt < 0)");
     z = p;
     return true;
 }

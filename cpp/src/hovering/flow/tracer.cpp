@@ -33,8 +33,8 @@ double lower_bound(double q0, double v0, double a0, double q1, double v1, double
         const double quintic = q0 * (1 - 10 * s3 + 15 * s4 - 6 * s5) + d0 * (s - 6 * s3 + 8 * s4 - 3 * s5) +
                                c0 * (0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5) + c1 * (0.5 * s3 - s4 + 0.5 * s5) +
                                d1 * (-4 * s3 + 7 * s4 - 3 * s5) + q1 * (10 * s3 - 15 * s4 + 6 * s5);
-        const double cubic = q0 * (2 * s3 - 3 * s2 + 1) + d0 * (s3 - 2 * s2 + s) + q1 * (-2 * s3 + 3 * s2) +
-                             d1 * (s3 - s2);
+        const double cubic =
+            q0 * (2 * s3 - 3 * s2 + 1) + d0 * (s3 - 2 * s2 + s) + q1 * (-2 * s3 + 3 * s2) + d1 * (s3 - s2);
         lo = std::min(lo, quintic);
         dev = std::max(dev, std::fabs(quintic - cubic));
     }
@@ -83,7 +83,9 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
 
 }  // namespace
 
-Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) { cands_.reserve(8); }
+Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) {
+    cands_.reserve(8);
+}
 
 FlowWork Tracer::work() const {
     FlowWork w = work_;

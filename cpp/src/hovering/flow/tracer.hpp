@@ -16,11 +16,11 @@ namespace hovering::detail {
 /// One orbit's trajectory while it is recorded: where the points go, the orbit's clock and the
 /// room left. The tracer samples t = k dt of the clock offset + (time within the return).
 struct DenseRecorder {
-    double dt = 0;                        ///< sample spacing
-    double offset = 0;                    ///< the orbit's clock at the start of the current return
-    std::int64_t next = 0;                ///< index k of the next uniform sample
-    std::int64_t room = 0;                ///< points that may still be recorded
-    bool truncated = false;               ///< a point was dropped for want of room
+    double dt = 0;                              ///< sample spacing
+    double offset = 0;                          ///< the orbit's clock at the start of the current return
+    std::int64_t next = 0;                      ///< index k of the next uniform sample
+    std::int64_t room = 0;                      ///< points that may still be recorded
+    bool truncated = false;                     ///< a point was dropped for want of room
     std::vector<double>* points = nullptr;      ///< 5 doubles per point: t, q1, p1, q2, p2
     std::vector<std::int8_t>* kinds = nullptr;  ///< TrajectoryPoint of each point
 

@@ -29,7 +29,8 @@ FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const 
     if (!std::isfinite(h_)) bad("h must be finite, got " + fmt(h_));
     if (curve_) {
         if (!curve_->is_graph()) bad(curve_->not_graph_reason());
-        if (curve_->h() != h_) bad("the tangential curve was measured at h = " + fmt(curve_->h()) + ", not at h = " + fmt(h_));
+        if (curve_->h() != h_)
+            bad("the tangential curve was measured at h = " + fmt(curve_->h()) + ", not at h = " + fmt(h_));
     }
     if (lift_) lift_->validate();
     const double E1 = h_ - s_.V1->V(s_.qw1);
@@ -170,8 +171,10 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         }
         if (out.states) {
             std::array<double, 4> zz{kNaN, kNaN, kNaN, kNaN};
-            if (z) zz = *z;
-            else state(x, y, zz);
+            if (z)
+                zz = *z;
+            else
+                state(x, y, zz);
             for (int c = 0; c < 4; ++c) out.states[4 * at + c] = zz[std::size_t(c)];
         }
     };

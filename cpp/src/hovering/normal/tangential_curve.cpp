@@ -21,7 +21,8 @@ using detail::wrap;
 
 TrigInterpolant::TrigInterpolant(const std::vector<double>& v) {
     const std::size_t n = v.size();
-    if (n < 4 || n % 2) bad("a trigonometric interpolant needs an even number >= 4 of samples, got " + std::to_string(n));
+    if (n < 4 || n % 2)
+        bad("a trigonometric interpolant needs an even number >= 4 of samples, got " + std::to_string(n));
     const std::size_t m = n / 2;
     a_.assign(m + 1, 0.0);
     b_.assign(m + 1, 0.0);
@@ -62,7 +63,9 @@ std::pair<double, double> TrigInterpolant::with_derivative(double s) const {
     return {f, df};
 }
 
-double TrigInterpolant::operator()(double s) const { return with_derivative(s).first; }
+double TrigInterpolant::operator()(double s) const {
+    return with_derivative(s).first;
+}
 
 // ------------------------------------------------------------------ the curve
 
@@ -97,12 +100,15 @@ std::array<double, 4> wall_point(const FlowSystem& sys, double h, double s, doub
         I_prev = I;
     }
     if (changes == 0)
-        bad("the wall tangency curve has no point at wall angle " + fmt(s) + ": no action in (0, 4 I_tan] puts "
-            "oscillator 2 on H2 + eps Vc(qw1, q2) = h - V1(qw1) (eps = " + fmt(sys.eps) + " too large?)");
+        bad("the wall tangency curve has no point at wall angle " + fmt(s) +
+            ": no action in (0, 4 I_tan] puts "
+            "oscillator 2 on H2 + eps Vc(qw1, q2) = h - V1(qw1) (eps = " +
+            fmt(sys.eps) + " too large?)");
     if (changes > 1)
-        bad("the wall tangency curve is not a graph over the wall angle: at angle " + fmt(s) + " the level "
-            "H2 + eps Vc(qw1, q2) = h - V1(qw1) is met at " + std::to_string(changes) + " actions (eps = " +
-            fmt(sys.eps) + "); normal coordinates do not exist");
+        bad("the wall tangency curve is not a graph over the wall angle: at angle " + fmt(s) +
+            " the level "
+            "H2 + eps Vc(qw1, q2) = h - V1(qw1) is met at " +
+            std::to_string(changes) + " actions (eps = " + fmt(sys.eps) + "); normal coordinates do not exist");
     const double I = detail::brent(G, lo, hi, 1e-15);
     const auto [q2, p2] = sys.V2->point_at(s, sys.V2->energy(I));
     std::array<double, 4> z{sys.qw1, 0.0, q2, p2};
@@ -138,7 +144,9 @@ TangentialCurve TangentialCurve::measure(const FlowSystem& s, double h, int n, c
     if (n_check < 0 || n_check > n) bad("n_check must be in [0, n], got " + std::to_string(n_check));
     if (!std::isfinite(h)) bad("h must be finite, got " + fmt(h));
     const double E1 = h - s.V1->V(s.qw1);
-    if (!(E1 > 0)) bad("h = " + fmt(h) + " does not reach the line q1 = qw1 (h must exceed V1(qw1) = " + fmt(s.V1->V(s.qw1)) + ")");
+    if (!(E1 > 0))
+        bad("h = " + fmt(h) + " does not reach the line q1 = qw1 (h must exceed V1(qw1) = " + fmt(s.V1->V(s.qw1)) +
+            ")");
     FlowSystem smooth = s;  // the segment from Sigma_h to its touching point meets no wall
     smooth.geometry = Geometry::None;
     detail::Tracer tr(smooth, opt);
@@ -177,12 +185,14 @@ void TangentialCurve::interpolate() {
     double wind = 0;
     for (int k = 1; k <= n; ++k) {
         const double d = wrap(u[std::size_t(k % n)] - u[std::size_t(k - 1)]);
-        if (k < n) u[std::size_t(k)] = u[std::size_t(k - 1)] + d;
-        else wind = u[std::size_t(n - 1)] + d - u[0];
+        if (k < n)
+            u[std::size_t(k)] = u[std::size_t(k - 1)] + d;
+        else
+            wind = u[std::size_t(n - 1)] + d - u[0];
     }
     if (std::fabs(wind) > 1e-6)
-        bad("the tangential curve winds " + fmt(wind / kTwoPi) + " extra times around the cylinder (eps = " + fmt(eps_) +
-            "): it is not a graph over theta and normal coordinates do not exist");
+        bad("the tangential curve winds " + fmt(wind / kTwoPi) + " extra times around the cylinder (eps = " +
+            fmt(eps_) + "): it is not a graph over theta and normal coordinates do not exist");
     u_ = TrigInterpolant(u);
     Ifun_ = TrigInterpolant(I_);
     min_slope_ = 1e300;
@@ -239,8 +249,9 @@ std::pair<double, double> TangentialCurve::at(double s) const {
 
 std::string TangentialCurve::not_graph_reason() const {
     if (is_graph()) return "";
-    return "the tangential curve is not a graph over theta at eps = " + fmt(eps_) + ": theta(s) turns back (dtheta/ds = " +
-           fmt(min_slope_) + " at wall angle " + fmt(min_slope_s_) + "), so one theta has several tangency actions and "
+    return "the tangential curve is not a graph over theta at eps = " + fmt(eps_) +
+           ": theta(s) turns back (dtheta/ds = " + fmt(min_slope_) + " at wall angle " + fmt(min_slope_s_) +
+           "), so one theta has several tangency actions and "
            "normal coordinates (phi, K) do not exist; use section coordinates (theta, I)";
 }
 
@@ -304,7 +315,8 @@ std::vector<double> sine_coefficients(const std::vector<double>& f, int n_modes)
     const std::vector<double> ph = forcing_angles(n_phi);
     std::vector<double> b(std::size_t(n_modes), 0.0);
     for (int j = 0; j < n_phi; ++j)
-        for (int k = 0; k < n_modes; ++k) b[std::size_t(k)] += f[std::size_t(j)] * std::sin(double(k + 1) * ph[std::size_t(j)]);
+        for (int k = 0; k < n_modes; ++k)
+            b[std::size_t(k)] += f[std::size_t(j)] * std::sin(double(k + 1) * ph[std::size_t(j)]);
     for (auto& x : b) x *= 2.0 / n_phi;
     return b;
 }

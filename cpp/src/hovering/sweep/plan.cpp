@@ -12,8 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <nlohmann/json.hpp>
 #include <toml++/toml.h>
+#include <nlohmann/json.hpp>
 
 #include "hovering/flow/potential.hpp"
 #include "hovering/flow/return_map.hpp"
@@ -83,8 +83,8 @@ public:
             v = double(i->get());
         else
             bad(key, *n, allowed);
-        const bool ok = !std::isnan(v) && (!finite || std::isfinite(v)) && v >= lo && v <= hi && !(lo_open && v == lo) &&
-                        !(hi_open && v == hi);
+        const bool ok = !std::isnan(v) && (!finite || std::isfinite(v)) && v >= lo && v <= hi &&
+                        !(lo_open && v == lo) && !(hi_open && v == hi);
         if (!ok) bad(key, *n, allowed);
         return v;
     }
@@ -142,7 +142,8 @@ public:
                 v = double(n->get());
             else
                 fail(key + "[" + std::to_string(i) + "]", " = " + show(a[i]) + ": allowed: a finite number");
-            if (!std::isfinite(v)) fail(key + "[" + std::to_string(i) + "]", " = " + num(v) + ": allowed: a finite number");
+            if (!std::isfinite(v))
+                fail(key + "[" + std::to_string(i) + "]", " = " + num(v) + ": allowed: a finite number");
             out.push_back(v);
         }
         return out;
@@ -209,7 +210,8 @@ SystemSpec read_system(Table& t) {
     std::set<std::pair<int, int>> seen;
     for (std::size_t k = 0; k < c.size(); ++k) {
         const std::string at = "coupling[" + std::to_string(k) + "]";
-        const std::string allowed = "a term [c, i, j]: c a finite number, i and j integers in [0, 20], each (i, j) once";
+        const std::string allowed =
+            "a term [c, i, j]: c a finite number, i and j integers in [0, 20], each (i, j) once";
         auto a = c[k].as_array();
         if (!a || a->size() != 3) t.bad(at, c[k], allowed);
         const auto* cf = (*a)[0].as_floating_point();
@@ -230,7 +232,9 @@ SystemSpec read_system(Table& t) {
     return s;
 }
 
-std::vector<std::string> steppers() { return std::vector<std::string>(kSteppers.begin(), kSteppers.end()); }
+std::vector<std::string> steppers() {
+    return std::vector<std::string>(kSteppers.begin(), kSteppers.end());
+}
 
 IntegratorSpec read_integrator(Table& t) {
     IntegratorSpec it;
@@ -279,11 +283,8 @@ json potential_key(const PotentialSpec& p) {
 }
 
 std::string point_key(const std::string& kind, const PlanPoint& p) {
-    json k = {{"kind", kind},
-              {"n_steps", p.n_steps},
-              {"samples", p.samples},
-              {"seed", p.seed},
-              {"K_low", jnum(p.K_low)}};
+    json k = {
+        {"kind", kind}, {"n_steps", p.n_steps}, {"samples", p.samples}, {"seed", p.seed}, {"K_low", jnum(p.K_low)}};
     if (kind == "hovering_area") {
         const MapParams& m = p.map;
         k["map"] = {{"eps", jnum(m.eps)},   {"Omega0", jnum(m.Omega0)}, {"theta_w", jnum(m.theta_w)},
@@ -296,13 +297,19 @@ std::string point_key(const std::string& kind, const PlanPoint& p) {
                        {"eps", jnum(s.eps)},        {"qw1", jnum(s.qw1)},        {"qw2", jnum(s.qw2)},
                        {"geometry", s.geometry}};
         k["h"] = jnum(p.h);
-        k["integrator"] = {{"stepper", p.integrator.stepper}, {"rtol", jnum(p.integrator.rtol)},
-                           {"atol", jnum(p.integrator.atol)}};
+        k["integrator"] = {
+            {"stepper", p.integrator.stepper}, {"rtol", jnum(p.integrator.rtol)}, {"atol", jnum(p.integrator.atol)}};
         json models = json::array();
         for (const auto& m : p.models)
-            models.push_back({{"name", m.name}, {"K_low", jnum(m.K_low)}, {"eps", jnum(m.eps)}, {"K", jreals(m.K)},
-                              {"Omega", jreals(m.Omega)}, {"JR", jreals(m.JR)}, {"J1", jreals(m.J1)},
-                              {"forcing", jreals(m.forcing)}, {"K_max", jnum(m.K_max)}});
+            models.push_back({{"name", m.name},
+                              {"K_low", jnum(m.K_low)},
+                              {"eps", jnum(m.eps)},
+                              {"K", jreals(m.K)},
+                              {"Omega", jreals(m.Omega)},
+                              {"JR", jreals(m.JR)},
+                              {"J1", jreals(m.J1)},
+                              {"forcing", jreals(m.forcing)},
+                              {"K_max", jnum(m.K_max)}});
         k["models"] = models;
     }
     return k.dump();
@@ -334,7 +341,8 @@ PlanPoint read_point(Table& t, const std::string& kind) {
                 Table m(*(*models)[i].as_table(), t.where() + at + ".");
                 p.models.push_back(read_model(m));
                 if (!names.insert(p.models.back().name).second)
-                    t.fail(at + ".name", " = '" + p.models.back().name + "': allowed: a name no other model of the point has");
+                    t.fail(at + ".name",
+                           " = '" + p.models.back().name + "': allowed: a name no other model of the point has");
             }
         }
     }
@@ -351,8 +359,8 @@ Plan parse_plan(const std::string& text, const std::string& where) {
         root = toml::parse(text, where);
     } catch (const toml::parse_error& e) {
         const auto& b = e.source().begin;
-        throw std::invalid_argument(where + " line " + std::to_string(b.line) + ": not a TOML file: " +
-                                    std::string(e.description()));
+        throw std::invalid_argument(where + " line " + std::to_string(b.line) +
+                                    ": not a TOML file: " + std::string(e.description()));
     }
     Plan plan;
     Table t(root, where + ": ");
@@ -360,7 +368,8 @@ Plan parse_plan(const std::string& text, const std::string& where) {
     (void)format;
     const toml::node* v = t.get("version", true, "an integer");
     if (!v->as_integer() || v->as_integer()->get() != kPlanVersion)
-        t.fail("version", " = " + show(*v) + ": this hovering_sweep reads plan version " + std::to_string(kPlanVersion) +
+        t.fail("version", " = " + show(*v) + ": this hovering_sweep reads plan version " +
+                              std::to_string(kPlanVersion) +
                               " (write the plan again with this version's python -m hovering plan)");
     plan.kind = t.string("kind", {"hovering_area", "flow_hovering_area"});
     plan.name = t.string("name", {}, false);
@@ -378,7 +387,8 @@ Plan parse_plan(const std::string& text, const std::string& where) {
             throw std::invalid_argument(where + ": " + at + ": " + e.what());
         }
         if (!keys.insert(plan.points.back().key).second)
-            throw std::invalid_argument(where + ": " + at + " has the parameters of an earlier point (each point once)");
+            throw std::invalid_argument(where + ": " + at +
+                                        " has the parameters of an earlier point (each point once)");
     }
     t.done();
     return plan;

@@ -32,7 +32,8 @@ FlowSystem build_system(const SystemSpec& sp, double eps) {
     s.qw2 = sp.qw2;
     s.geometry = sp.geometry == "step" ? Geometry::Step : sp.geometry == "wall" ? Geometry::Wall : Geometry::None;
     if (eps != 0 && s.coupling.terms.empty())
-        throw std::invalid_argument("system.eps = " + std::to_string(eps) + " needs a coupling (system.coupling is empty)");
+        throw std::invalid_argument("system.eps = " + std::to_string(eps) +
+                                    " needs a coupling (system.coupling is empty)");
     s.validate();
     return s;
 }
@@ -67,8 +68,8 @@ void check_point(const std::string& kind, const PlanPoint& p) {
     if (kind == "hovering_area") {
         const TruncatedMap m = build_map(p.map);
         if (!(m.band().lo < p.K_low))
-            throw std::invalid_argument("K_low = " + std::to_string(p.K_low) + " lies below the map's band (lower end " +
-                                        std::to_string(m.band().lo) + ")");
+            throw std::invalid_argument("K_low = " + std::to_string(p.K_low) +
+                                        " lies below the map's band (lower end " + std::to_string(m.band().lo) + ")");
         return;
     }
     const FlowSystem s = build_system(p.system, p.system.eps);

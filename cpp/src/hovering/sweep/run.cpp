@@ -102,8 +102,8 @@ PointRow run_point(const Plan& plan, std::size_t i, int n_threads, const std::at
                 for (std::size_t k = 0; k < mh.hovering.size(); ++k) same += mh.hovering[k] == h.hovering[k];
                 agree = double(same) / double(mh.hovering.size());
             }
-            models[ms.name] = {{"area", jnum(mh.area)}, {"error", jnum(mh.error)}, {"agree", jnum(agree)},
-                               {"K_low", jnum(ms.K_low)}};
+            models[ms.name] = {
+                {"area", jnum(mh.area)}, {"error", jnum(mh.error)}, {"agree", jnum(agree)}, {"K_low", jnum(ms.K_low)}};
         }
         row["models"] = models;
     }
@@ -128,13 +128,16 @@ constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 30;
 /// Longest line read (a key holds a model's tables of at most 100000 heights: ~10 MB).
 constexpr std::size_t kMaxLine = std::size_t(16) << 20;
 
-std::string sys_error(const std::string& what, int err) { return what + ": " + std::strerror(err); }
+std::string sys_error(const std::string& what, int err) {
+    return what + ": " + std::strerror(err);
+}
 
 /// Why a complete line is not a record of a checkpoint ("" if it is one); `header`: the first line.
 std::string check_line(const std::string& line, bool header, std::string& key) {
     const json j = json::parse(line, nullptr, false);
-    const std::string not_header = "the first line is not the header {\"format\": \"hovering-checkpoint\", \"version\": " +
-                                   std::to_string(kCheckpointVersion) + "}: ";
+    const std::string not_header =
+        "the first line is not the header {\"format\": \"hovering-checkpoint\", \"version\": " +
+        std::to_string(kCheckpointVersion) + "}: ";
     if (header && (j.is_discarded() || !j.is_object())) return not_header + "another program's file";
     if (j.is_discarded()) return "not a line of JSON";
     if (!j.is_object()) return "not a JSON object";
@@ -200,7 +203,9 @@ Checkpoint::Checkpoint(const std::string& path) : path_(path) {
     }
 }
 
-Checkpoint::~Checkpoint() { ::close(fd_); }
+Checkpoint::~Checkpoint() {
+    ::close(fd_);
+}
 
 void Checkpoint::scan(bool may_cut) {
     struct stat st;
@@ -223,7 +228,8 @@ void Checkpoint::scan(bool may_cut) {
             if (c != '\n') {
                 if (line.size() == kMaxLine)
                     throw std::invalid_argument(path_ + " line " + std::to_string(lines_ + 1) + " is longer than " +
-                                                std::to_string(kMaxLine) + " bytes: not a checkpoint line (use another --out)");
+                                                std::to_string(kMaxLine) +
+                                                " bytes: not a checkpoint line (use another --out)");
                 line.push_back(c);
                 continue;
             }
@@ -288,8 +294,7 @@ bool Checkpoint::append(const std::string& key, const std::string& row, const st
     scan(true);  // what other runs appended meanwhile (a torn tail of a crashed one is cut off)
     if (keys_.count(key)) return false;
     std::string text;
-    if (lines_ == 0)
-        text += json({{"format", "hovering-checkpoint"}, {"version", kCheckpointVersion}}).dump() + "\n";
+    if (lines_ == 0) text += json({{"format", "hovering-checkpoint"}, {"version", kCheckpointVersion}}).dump() + "\n";
     if (!provenance_written_) text += "{\"provenance\":" + provenance + "}\n";
     text += "{\"key\":" + key + ",\"row\":" + row + "}\n";
     write_all(text, "a point");

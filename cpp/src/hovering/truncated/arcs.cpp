@@ -11,9 +11,9 @@
 #include <string>
 
 #include "hovering/detail/common.hpp"
+#include "hovering/truncated/classify.hpp"
 #include "hovering/truncated/forcing.hpp"
 #include "hovering/truncated/map.hpp"
-#include "hovering/truncated/classify.hpp"
 
 namespace hovering {
 
@@ -25,8 +25,9 @@ using detail::kPi;
 using detail::kTwoPi;
 using detail::require_finite;
 
-double wrap_angle(double x) { return detail::wrap(x); }
-
+double wrap_angle(double x) {
+    return detail::wrap(x);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Analytic arcs
@@ -36,7 +37,8 @@ void AnalyticArcs::validate() const {
     // The rotation of a step must be wrappable: Omega0 = -2.4e39 iterated to phi = 3e23 "OK".
     if (!(std::fabs(Omega0) <= detail::kMaxAngle))
         bad("Omega0 must lie in [-1e6, 1e6] (a larger rotation per step cannot be wrapped to [-pi, pi) "
-            "accurately), got " + fmt(Omega0));
+            "accurately), got " +
+            fmt(Omega0));
     require_finite(theta_w, "theta_w");
     require_finite(tau0, "tau0");
     require_finite(tau1, "tau1");
@@ -81,8 +83,8 @@ Spline::Spline(std::vector<double> x, std::vector<double> y, const char* name)
         require_finite(x_[i], n + " grid[" + std::to_string(i) + "]");
         require_finite(y_[i], n + " value[" + std::to_string(i) + "]");
         if (i > 0 && !(x_[i] > x_[i - 1]))
-            bad(n + ": grid must be strictly increasing, but grid[" + std::to_string(i) + "] = " +
-                fmt(x_[i]) + " <= grid[" + std::to_string(i - 1) + "] = " + fmt(x_[i - 1]));
+            bad(n + ": grid must be strictly increasing, but grid[" + std::to_string(i) + "] = " + fmt(x_[i]) +
+                " <= grid[" + std::to_string(i - 1) + "] = " + fmt(x_[i - 1]));
     }
     gsl_spline* s = gsl_spline_alloc(gsl_interp_cspline, x_.size());
     if (!s) throw std::bad_alloc();
@@ -107,8 +109,7 @@ double Spline::operator()(double x) const {
 
 namespace {
 
-std::vector<double> nonpositive_part(const std::vector<double>& K, const std::vector<double>& v,
-                                     bool in_s) {
+std::vector<double> nonpositive_part(const std::vector<double>& K, const std::vector<double>& v, bool in_s) {
     // Points with K <= 0; in s = sqrt(-K) they must be reversed to stay increasing.
     std::vector<double> out;
     for (std::size_t i = 0; i < K.size(); ++i)
@@ -117,8 +118,7 @@ std::vector<double> nonpositive_part(const std::vector<double>& K, const std::ve
     return out;
 }
 
-std::vector<double> nonpositive_values_reversed(const std::vector<double>& K,
-                                                const std::vector<double>& v) {
+std::vector<double> nonpositive_values_reversed(const std::vector<double>& K, const std::vector<double>& v) {
     std::vector<double> out;
     for (std::size_t i = 0; i < K.size(); ++i)
         if (K[i] <= 0.0) out.push_back(v[i]);
@@ -126,12 +126,11 @@ std::vector<double> nonpositive_values_reversed(const std::vector<double>& K,
     return out;
 }
 
-void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
-                 const std::vector<double>& JR, const std::vector<double>& J1) {
+void check_table(const std::vector<double>& K, const std::vector<double>& Omega, const std::vector<double>& JR,
+                 const std::vector<double>& J1) {
     if (Omega.size() != K.size() || JR.size() != K.size() || J1.size() != K.size())
         bad("K, Omega, JR and J1 must have the same length, got " + std::to_string(K.size()) + ", " +
-            std::to_string(Omega.size()) + ", " + std::to_string(JR.size()) + ", " +
-            std::to_string(J1.size()));
+            std::to_string(Omega.size()) + ", " + std::to_string(JR.size()) + ", " + std::to_string(J1.size()));
     bool has_zero = false;
     std::size_t n_nonpos = 0;
     // Checked here with the caller's indices: the splines see reordered copies.
@@ -141,12 +140,14 @@ void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
         require_finite(JR[i], "JR[" + std::to_string(i) + "]");
         require_finite(J1[i], "J1[" + std::to_string(i) + "]");
         if (!(std::fabs(Omega[i]) <= detail::kMaxAngle))
-            bad("Omega[" + std::to_string(i) + "] must lie in [-1e6, 1e6] (a larger rotation per step cannot be "
-                "wrapped accurately), got " + fmt(Omega[i]));
+            bad("Omega[" + std::to_string(i) +
+                "] must lie in [-1e6, 1e6] (a larger rotation per step cannot be "
+                "wrapped accurately), got " +
+                fmt(Omega[i]));
         // Before the K = 0 and band checks, whose messages would mislead for a reversed grid.
         if (i > 0 && !(K[i] > K[i - 1]))
-            bad("the K grid must be strictly increasing, but K[" + std::to_string(i) + "] = " + fmt(K[i]) +
-                " <= K[" + std::to_string(i - 1) + "] = " + fmt(K[i - 1]));
+            bad("the K grid must be strictly increasing, but K[" + std::to_string(i) + "] = " + fmt(K[i]) + " <= K[" +
+                std::to_string(i - 1) + "] = " + fmt(K[i - 1]));
     }
     for (std::size_t i = 0; i < K.size(); ++i) {
         if (K[i] == 0.0) {
@@ -171,10 +172,10 @@ void check_table(const std::vector<double>& K, const std::vector<double>& Omega,
         if (!(K[i] - K[i - 1] >= 1e-9 * range))
             bad("the K grid's points must be at least 1e-9 of its range (" + fmt(range) + ") apart, but K[" +
                 std::to_string(i - 1) + "] = " + fmt(K[i - 1]) + " and K[" + std::to_string(i) + "] = " + fmt(K[i]) +
-                " are " + fmt(K[i] - K[i - 1]) + " apart (a cubic spline through nearly coincident points amplifies "
+                " are " + fmt(K[i] - K[i - 1]) +
+                " apart (a cubic spline through nearly coincident points amplifies "
                 "their rounding by range / spacing)");
-    if (n_nonpos < 3)
-        bad("the K grid needs at least 3 points with K <= 0, got " + std::to_string(n_nonpos));
+    if (n_nonpos < 3) bad("the K grid needs at least 3 points with K <= 0, got " + std::to_string(n_nonpos));
     if (!(K.back() > 0.0)) bad("the K grid must extend above K = 0, got max K = " + fmt(K.back()));
 }
 
@@ -207,8 +208,8 @@ double TabulatedArcs::band_lo() const {
         }
         if (good == 0.0)
             bad("the tabulated arcs give no valid band below K = 0: at K = " + fmt(-s * s) +
-                " the arc lengths (|J_R|, |J_1|) = (" + fmt(at(-s * s).JR) + ", " +
-                fmt(at(-s * s).J1) + ") are not all in (0, 2 pi)");
+                " the arc lengths (|J_R|, |J_1|) = (" + fmt(at(-s * s).JR) + ", " + fmt(at(-s * s).J1) +
+                ") are not all in (0, 2 pi)");
         double badv = s;  // bisect the first failure between the last good and first bad sample
         for (int it = 0; it < 200 && badv - good > 1e-15 * badv; ++it) {
             const double mid = 0.5 * (good + badv);
@@ -249,7 +250,9 @@ double TabulatedArcs::omega_limit(double direction) const {
 // ---------------------------------------------------------------------------------------------
 // Forcings
 
-double SineForcing::at(double phi) const { return std::sin(phi); }
+double SineForcing::at(double phi) const {
+    return std::sin(phi);
+}
 
 double FourierForcing::at(double phi) const {
     double f = 0.0;

@@ -28,7 +28,9 @@ struct Classified {
 };
 
 /// Wrap u in [-pi, 3 pi) to [-pi, pi), exactly (u - 2 pi is exact for u in [pi, 4 pi]).
-inline double wrap_once(double u) { return u >= kPi ? u - kTwoPi : u; }
+inline double wrap_once(double u) {
+    return u >= kPi ? u - kTwoPi : u;
+}
 
 /// Left ends of J_1, J_R, J_0 (eq:phi1rsymmetric) in [-pi, pi), for K < 0.
 struct ArcStarts {
@@ -46,7 +48,9 @@ inline ArcStarts arc_starts(const ArcLengths& a) {
 }
 
 /// Whether q lies in the half-open arc [a, b) of the circle (empty if a == b); all in [-pi, pi).
-inline bool in_arc(double q, double a, double b) { return a <= b ? (a <= q && q < b) : (a <= q || q < b); }
+inline bool in_arc(double q, double a, double b) {
+    return a <= b ? (a <= q && q < b) : (a <= q || q < b);
+}
 
 /// Rotation omega_a of the arc r at these arc lengths (for r = Beside: Omega).
 inline double arc_rotation(Region r, const ArcLengths& a) {
@@ -67,6 +71,8 @@ inline Classified classify(double phi, double K, const ArcLengths& a) {
 
 /// Image of (phi, K) under the rotation part of a step: wrap(phi + omega_a), the one expression
 /// the forward step, both kernels and the inverse's image starts use.
-inline double rotate(double phi, double omega) { return wrap(phi + omega); }
+inline double rotate(double phi, double omega) {
+    return wrap(phi + omega);
+}
 
 }  // namespace hovering::detail

@@ -22,16 +22,16 @@ namespace hovering {
 namespace {
 
 using detail::bad;
-using detail::classify;
 using detail::Classified;
+using detail::classify;
 using detail::kInvTwoPi;
 using detail::kNaN;
 using detail::kPi;
 using detail::kTwoPi;
+using detail::kW;
 using detail::Packet;
 using detail::psin;
 using detail::WorkCursor;
-using detail::kW;
 namespace ei = Eigen::internal;
 
 // Arc lengths of a packet of heights: packet arithmetic for the analytic model, in the same
@@ -60,14 +60,17 @@ inline void arcs_packet(const TabulatedArcs& a, const Packet& k, Packet& Om, Pac
 }
 
 template <bool Fast>
-inline Packet force_packet(const SineForcing&, const Packet& p) { return psin<Fast>(p); }
+inline Packet force_packet(const SineForcing&, const Packet& p) {
+    return psin<Fast>(p);
+}
 
 template <bool Fast>
 inline Packet force_packet(const FourierForcing& f, const Packet& p) {
     Packet acc = ei::pset1<Packet>(0.0);
     for (std::size_t k = 0; k < f.b.size(); ++k)
         if (f.b[k] != 0.0)
-            acc = ei::padd(acc, ei::pmul(ei::pset1<Packet>(f.b[k]), psin<Fast>(ei::pmul(ei::pset1<Packet>(double(k + 1)), p))));
+            acc = ei::padd(
+                acc, ei::pmul(ei::pset1<Packet>(f.b[k]), psin<Fast>(ei::pmul(ei::pset1<Packet>(double(k + 1)), p))));
     return acc;
 }
 
@@ -88,10 +91,14 @@ struct Tally {
 struct Finisher {
     const IterateOptions& opt;
     const IterateOutput& out;
-    detail::ProgressShare& progress;  // credits the steps an orbit that stops early will not take
+    detail::ProgressShare& progress;          // credits the steps an orbit that stops early will not take
     std::int64_t every, n_states, n_returns;  // recorded per orbit: every e-th state and return
     Finisher(const IterateOptions& o, const IterateOutput& w, detail::ProgressShare& p)
-        : opt(o), out(w), progress(p), every(o.every), n_states(recorded_states(o.n_steps, o.every)),
+        : opt(o),
+          out(w),
+          progress(p),
+          every(o.every),
+          n_states(recorded_states(o.n_steps, o.every)),
           n_returns(recorded_returns(o.n_steps, o.every)) {}
     void start(std::int64_t i, double phi, double K) const {
         if (out.orbit_phi) out.orbit_phi[i * n_states] = phi;
@@ -156,8 +163,8 @@ constexpr double kNearArcEnd = 0x1p-24;
 constexpr int kLanes = kP * kW;
 
 template <bool Fast, class A, class F>
-void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
-              const IterateOptions& opt, const IterateOutput& out, detail::ProgressShare& progress) {
+void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src, const IterateOptions& opt,
+              const IterateOutput& out, detail::ProgressShare& progress) {
     // Lane kernel on Eigen packets: kLanes orbits are stepped together; an orbit that stops frees
     // its lane, which is refilled from the source at once, so the vectors stay full even when
     // orbits stop at very different times (early exit). Per-lane bookkeeping happens on a rare
@@ -177,13 +184,15 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                  three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
                  twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
                  half = ei::pset1<Packet>(0.5), eps = ei::pset1<Packet>(m.eps()), plo = ei::pset1<Packet>(lo),
-                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero),
-                 margin = ei::pset1<Packet>(kNearArcEnd), pi_less_margin = ei::pset1<Packet>(kPi - kNearArcEnd);
+                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero), margin = ei::pset1<Packet>(kNearArcEnd),
+                 pi_less_margin = ei::pset1<Packet>(kPi - kNearArcEnd);
     // The stop curve: its scale and cell count, and the bound beyond which no state can be in the set.
     const Packet cscale = ei::pset1<Packet>(stopping ? curve->scale() : 0.0),
                  ncells = ei::pset1<Packet>(stopping ? double(curve->size()) : 0.0),
                  cflat = ei::pset1<Packet>(stopping ? curve->samples()[0] : 0.0),
-                 cbound = ei::pset1<Packet>(!stopping ? 0.0 : above ? curve->lower() : curve->upper());
+                 cbound = ei::pset1<Packet>(!stopping ? 0.0
+                                            : above   ? curve->lower()
+                                                      : curve->upper());
     // detail::wrap and detail::wrap_once on packets (same operations, same order).
     auto pwrap = [&](const Packet& x) {
         Packet y = ei::psub(x, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(x, pi), inv2pi))));
@@ -260,7 +269,12 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             }
         }
     };
-    const double on = [] { double x; const std::uint64_t b = ~std::uint64_t(0); std::memcpy(&x, &b, 8); return x; }();
+    const double on = [] {
+        double x;
+        const std::uint64_t b = ~std::uint64_t(0);
+        std::memcpy(&x, &b, 8);
+        return x;
+    }();
     auto is_live = [&](int j) { return std::memcmp(&llive[j], &on, 8) == 0; };
     // Lane j's tally from the lane arrays (after unpack()); `exiting`: the exiting return is counted.
     auto tally = [&](int j, bool exiting = false) {
@@ -375,9 +389,9 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                     const Packet T = ei::padd(J1, JR);
                     in1 = ei::pcmp_lt(d, J1);
                     inR = ei::pcmp_lt(d, T);
-                    const Packet close = ei::por(
-                        ei::pcmp_lt(ei::pmin(ei::pabs(ei::psub(d, J1)), ei::pabs(ei::psub(d, T))), margin),
-                        ei::pcmp_lt(pi_less_margin, ei::pabs(ei::psub(d, pi))));
+                    const Packet close =
+                        ei::por(ei::pcmp_lt(ei::pmin(ei::pabs(ei::psub(d, J1)), ei::pabs(ei::psub(d, T))), margin),
+                                ei::pcmp_lt(pi_less_margin, ei::pabs(ei::psub(d, pi))));
                     near = ei::por(near, ei::pand(close, neg));
                 } else {
                     const Packet s1 = pwrap(p01);
@@ -407,11 +421,13 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         if (need_reg)
             for (int q = 0; q < kP; ++q) {
                 if (out.visited)
-                    for (int r = 0; r < 4; ++r) seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
+                    for (int r = 0; r < 4; ++r)
+                        seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
                 if (watch) {
-                    const Packet ok = ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
-                                      ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
-                                      ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
+                    const Packet ok =
+                        ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
+                                    ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
+                                                ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
                     leaving = ei::por(leaving, ei::pandnot(ei::pand(live[q], fresh[q]), ok));
                 }
             }
@@ -482,7 +498,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         if (stopping) {
             Packet maybe = zero;
             for (int q = 0; q < kP; ++q)
-                maybe = ei::por(maybe, ei::pand(live[q], above ? ei::pcmp_le(cbound, K[q]) : ei::pcmp_le(K[q], cbound)));
+                maybe =
+                    ei::por(maybe, ei::pand(live[q], above ? ei::pcmp_le(cbound, K[q]) : ei::pcmp_le(K[q], cbound)));
             if (ei::predux_any(maybe))
                 for (int q = 0; q < kP; ++q) hit = ei::por(hit, ei::pand(live[q], in_set(phi[q], K[q])));
         }
@@ -598,18 +615,19 @@ bool simd_is_avx2() {
 #endif
 }
 
-int simd_width() { return detail::kW; }
+int simd_width() {
+    return detail::kW;
+}
 
 template <class A, class F>
-void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n,
-                            const IterateOptions& opt, const IterateOutput& out) const {
+void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n, const IterateOptions& opt,
+                            const IterateOutput& out) const {
     if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
     if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
     if (opt.exit_mask >= (1u << kRegionCount))
         bad("exit_mask must be a set of region codes 0.." + std::to_string(kRegionCount - 1) + " (a bit mask < " +
             std::to_string(1u << kRegionCount) + "), got " + std::to_string(opt.exit_mask));
-    if (opt.stop_on_exit && opt.exit_mask == 0u)
-        bad("stop_on_exit needs a non-empty set of regions to stay in");
+    if (opt.stop_on_exit && opt.exit_mask == 0u) bad("stop_on_exit needs a non-empty set of regions to stay in");
     if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
             std::to_string(opt.n_threads));

@@ -14,8 +14,8 @@
 namespace hovering {
 
 using detail::bad;
-using detail::classify;
 using detail::Classified;
+using detail::classify;
 using detail::fmt;
 using detail::kInf;
 using detail::kPi;
@@ -44,15 +44,20 @@ double arcs_kmin(const AnalyticArcs& a) {
     if (a.tau0 < 0) return -(detail::kMaxAngle - a.Omega0) / -a.tau0;
     return -kInf;
 }
-double arcs_kmin(const TabulatedArcs& a) { return a.omega_limit(-1.0); }
-double arcs_kmax(const TabulatedArcs& a) { return std::min(a.kmax(), a.omega_limit(1.0)); }
-void validate_arcs(const AnalyticArcs& a) { a.validate(); }
+double arcs_kmin(const TabulatedArcs& a) {
+    return a.omega_limit(-1.0);
+}
+double arcs_kmax(const TabulatedArcs& a) {
+    return std::min(a.kmax(), a.omega_limit(1.0));
+}
+void validate_arcs(const AnalyticArcs& a) {
+    a.validate();
+}
 void validate_arcs(const TabulatedArcs&) {}
 void validate_forcing(const SineForcing&) {}
 void validate_forcing(const FourierForcing& f) {
     if (f.b.empty()) bad("forcing needs at least one sine coefficient, got none");
-    for (std::size_t k = 0; k < f.b.size(); ++k)
-        require_finite(f.b[k], "forcing[" + std::to_string(k) + "]");
+    for (std::size_t k = 0; k < f.b.size(); ++k) require_finite(f.b[k], "forcing[" + std::to_string(k) + "]");
 }
 }  // namespace
 
@@ -71,8 +76,8 @@ void MapCore<A, F>::check_point(double phi, double K, const char* who) const {
     require_angle(phi, std::string(who) + ": phi");
     require_finite(K, std::string(who) + ": K");
     if (!(K > band_.lo && K < band_.hi))
-        bad(std::string(who) + ": K = " + fmt(K) + " is outside the band (" + fmt(band_.lo) + ", " +
-            fmt(band_.hi) + ") where the map is defined");
+        bad(std::string(who) + ": K = " + fmt(K) + " is outside the band (" + fmt(band_.lo) + ", " + fmt(band_.hi) +
+            ") where the map is defined");
 }
 
 template <class A, class F>
@@ -211,8 +216,8 @@ double MapCore<A, F>::preimage_height(double K1, double kick) const {
     const double first = std::nextafter(band_.lo, kInf), last = std::nextafter(band_.hi, -kInf);
     if (K0 <= band_.lo && first < band_.hi && first + kick <= K1) return first;
     if (K0 >= band_.hi && last > band_.lo && last + kick >= K1) return last;
-    bad("step_inverse (preimage): K = " + fmt(K0) + " is outside the band (" + fmt(band_.lo) + ", " +
-        fmt(band_.hi) + ") where the map is defined");
+    bad("step_inverse (preimage): K = " + fmt(K0) + " is outside the band (" + fmt(band_.lo) + ", " + fmt(band_.hi) +
+        ") where the map is defined");
 }
 
 template <class A, class F>
@@ -315,8 +320,8 @@ std::vector<double> MapCore<A, F>::arc_starts(double K) const {
 template class MapCore<AnalyticArcs, SineForcing>;
 template class MapCore<TabulatedArcs, FourierForcing>;
 
-TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, double tau0, double tau1,
-                                double lam, double K_max) {
+TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, double tau0, double tau1, double lam,
+                                double K_max) {
     return TruncatedMap(eps, AnalyticArcs{Omega0, theta_w, tau0, tau1, lam}, SineForcing{}, K_max);
 }
 
