@@ -20,7 +20,8 @@ def _python_blocks():
     return re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
 
 
-def test_readme_examples_run_and_agree_with_the_text():
+def test_readme_examples_run_and_agree_with_the_text(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
     blocks = _python_blocks()
     assert len(blocks) >= 2, "README lost its Python examples"
     ns: dict = {}
@@ -53,7 +54,8 @@ def test_readme_examples_run_and_agree_with_the_text():
     assert flo < 0 < fhi == 1.0
 
 
-def test_readme_fullmap_block():
+def test_readme_fullmap_block(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
     # The hovering.fullmap block: measured-arc truncation at eps = 0.05 on the circle K = -0.015.
     # All three regions are hit and agree with the flow; G_K = O(eps K) with the constant 0.4-0.7
     # measured in tests/normal/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
@@ -67,7 +69,8 @@ def test_readme_fullmap_block():
     np.testing.assert_allclose(ns["curves"].JR + ns["curves"].J0 + ns["curves"].J1, 2 * np.pi, atol=1e-9)
 
 
-def test_readme_flowmap_block():
+def test_readme_flowmap_block(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
     # The FlowMap block's claims: the region of (0.3, -0.02), the theory's sign and area, b1.
     ns: dict = {}
     for code in _python_blocks():
