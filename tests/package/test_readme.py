@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pathlib
 import re
+import shutil
 
 import numpy as np
 import pytest
@@ -20,8 +21,15 @@ def _python_blocks():
     return re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
 
 
+def _in_a_copy(tmp_path, monkeypatch):
+    """Run in a folder with a copy of examples/ (the README's paths are relative to the checkout's
+    root): what the README writes (fp.npz, ...) lands there, not in the checkout."""
+    shutil.copytree(README.parent / "examples", tmp_path / "examples")
+    monkeypatch.chdir(tmp_path)
+
+
 def test_readme_examples_run_and_agree_with_the_text(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
+    _in_a_copy(tmp_path, monkeypatch)
     blocks = _python_blocks()
     assert len(blocks) >= 2, "README lost its Python examples"
     ns: dict = {}
@@ -55,7 +63,7 @@ def test_readme_examples_run_and_agree_with_the_text(tmp_path, monkeypatch):
 
 
 def test_readme_fullmap_block(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
+    _in_a_copy(tmp_path, monkeypatch)
     # The hovering.fullmap block: measured-arc truncation at eps = 0.05 on the circle K = -0.015.
     # All three regions are hit and agree with the flow; G_K = O(eps K) with the constant 0.4-0.7
     # measured in tests/normal/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
@@ -70,7 +78,7 @@ def test_readme_fullmap_block(tmp_path, monkeypatch):
 
 
 def test_readme_flowmap_block(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # what the README writes (fp.npz, ...) lands here, as in a user's folder
+    _in_a_copy(tmp_path, monkeypatch)
     # The FlowMap block's claims: the region of (0.3, -0.02), the theory's sign and area, b1.
     ns: dict = {}
     for code in _python_blocks():
