@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import operator
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -295,6 +295,40 @@ class IterateResult(Saveable):
     K_max: np.ndarray | None = None
     residence: np.ndarray | None = None
     every: int = 1
+
+    @classmethod
+    def from_core(cls, d: dict, m, n_steps: int, every: int, names: dict | None = None) -> IterateResult:
+        """The result of a core iterate's output dict: one reader for every map.
+
+        Parameters
+        ----------
+        d : dict
+            What the compiled iterate returned (records absent from it stay None).
+        m : object
+            The map that iterated.
+        n_steps, every : int
+            The call's arguments.
+        names : dict, optional
+            ``{field: key}`` where the core names a field otherwise (the flow's ``x``, ``y``).
+
+        Returns
+        -------
+        IterateResult
+
+        Raises
+        ------
+        KeyboardInterrupt
+            If the core was interrupted; the result so far is its ``partial`` attribute.
+        """
+        names = names or {}
+        given: dict = {"n_steps": n_steps, "map": m, "every": every}
+        values: dict = {f.name: d.get(names.get(f.name, f.name)) for f in fields(cls) if f.name not in given}
+        res = cls(**values, **given)
+        if d["interrupted"]:
+            exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
+            exc.partial = res  # type: ignore[attr-defined]
+            raise exc
+        return res
 
     def trajectory_of(self, i: int) -> np.ndarray:
         """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).

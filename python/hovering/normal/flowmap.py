@@ -89,6 +89,11 @@ class FlowSteps(Saveable):
     z: np.ndarray
 
 
+#: Where the flow's core names a field of IterateResult otherwise (its states are (x, y) = (phi, K)
+#: or (theta, I)).
+_CORE_NAMES = {"phi": "x", "K": "y", "phi_final": "x_final", "K_final": "y_final", "K_min": "y_min", "K_max": "y_max"}
+
+
 class FlowMap(MapAnalyses):
     """The impact flow's return map to Sigma_h on normal coordinates (phi, K) (or (theta, I)).
 
@@ -535,42 +540,7 @@ class FlowMap(MapAnalyses):
                 stop_side,
                 stop_curve,
             )
-        res = IterateResult(
-            phi=d.get("x"),
-            K=d.get("y"),
-            region=d.get("region"),
-            rotation=d.get("rotation"),
-            phi_final=d["x_final"],
-            K_final=d["y_final"],
-            status=d["status"],
-            steps_done=d["steps_done"],
-            exit_step=d.get("exit_step"),
-            n_steps=n_steps,
-            map=self,
-            theta=d.get("theta"),
-            I=d.get("I"),
-            z=d.get("z"),
-            time=d.get("time"),
-            energy_error=d.get("energy_error"),
-            integrator_steps=d.get("integrator_steps"),
-            itinerary=d.get("itinerary"),
-            visited=d.get("visited"),
-            trajectory=d.get("trajectory"),
-            trajectory_index=d.get("trajectory_index"),
-            trajectory_kind=d.get("trajectory_kind"),
-            trajectory_truncated=d.get("trajectory_truncated"),
-            work=d["work"],
-            stop_step=d.get("stop_step"),
-            K_min=d.get("y_min"),
-            K_max=d.get("y_max"),
-            residence=d.get("residence"),
-            every=every,
-        )
-        if d["interrupted"]:
-            exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
-            exc.partial = res
-            raise exc
-        return res
+        return IterateResult.from_core(d, self, n_steps, every, names=_CORE_NAMES)
 
     def with_eps(self, eps: float) -> FlowMap:
         """The same system, section and integrator at another eps (its own tangential curve).

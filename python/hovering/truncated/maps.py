@@ -333,30 +333,7 @@ class _MapAPI(MapAnalyses):
                 "extrema" in record,
                 "residence" in record,
             )
-        res = IterateResult(
-            phi=d.get("phi"),
-            K=d.get("K"),
-            region=d.get("region"),
-            rotation=d.get("rotation"),
-            phi_final=d["phi_final"],
-            K_final=d["K_final"],
-            status=d["status"],
-            steps_done=d["steps_done"],
-            exit_step=d.get("exit_step"),
-            n_steps=n_steps,
-            map=self,
-            visited=d.get("visited"),
-            stop_step=d.get("stop_step"),
-            K_min=d.get("K_min"),
-            K_max=d.get("K_max"),
-            residence=d.get("residence"),
-            every=every,
-        )
-        if d["interrupted"]:
-            exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
-            exc.partial = res
-            raise exc
-        return res
+        return IterateResult.from_core(d, self, n_steps, every)
 
 
 class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
