@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core
 from ._checks import MAX_ANGLE, _short, real_array
 from ._core import FlowStatus, Geometry, Kernel, Region, Status, TrajectoryPoint
+from ._core import wrap as _core_wrap
 
 __all__ = [
     "Region",
@@ -129,7 +129,7 @@ def wrap(x):
                 f"angles to wrap must satisfy |x| <= 1e6 (beyond, 2 pi floor(x / 2 pi) loses accuracy), "
                 f"got {np.ravel(bad)[0]}"
             )
-    y = _core.wrap(x)  # the core's one definition: every entry point wraps alike
+    y = _core_wrap(x)  # the core's one definition: every entry point wraps alike
     return y if np.ndim(y) else float(y)
 
 

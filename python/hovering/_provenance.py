@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from . import _core
+from ._core import build_info as _core_build_info
 from ._version import __version__
 
 __all__ = ["provenance", "show_versions"]
@@ -39,7 +39,7 @@ def _dist_version(name: str) -> str | None:
 
 @functools.cache
 def _static() -> tuple:
-    core = dict(_core.build_info())
+    core = dict(_core_build_info())
     rec = {
         "hovering": __version__,
         "git": core["git"],

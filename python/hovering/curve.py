@@ -25,8 +25,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _core
 from ._checks import _short, real_array, require_finite
+from ._core import Curve as _core_Curve
 from ._enums import wrap
 
 __all__ = ["Curve", "Above", "Below", "StopCondition", "MAX_SAMPLES"]
@@ -108,7 +108,7 @@ class Curve:
                 raise ValueError(f"error must be >= 0, got {e[np.argmax(e < 0)]} at sample {int(np.argmax(e < 0))}")
             error = np.array(e, dtype=float)
             error.setflags(write=False)
-        self._c = _core.Curve(np.ascontiguousarray(k, dtype=float))
+        self._c = _core_Curve(np.ascontiguousarray(k, dtype=float))
         self._error = error
 
     # ------------------------------------------------------------------ construction

@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core
 from .._checks import check_memory, flag, integer, real_number, thread_count
+from .._core import analysis as _core_analysis
+from .._core import truncated as _core_truncated
 from .._progress import check_progress, progress_bar
 from .._serial import Saveable
 from ..interface import require_map
@@ -94,7 +95,7 @@ def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | No
     The grid has at most ``samples + n_phi`` cells whatever the box's aspect ratio (a thin box
     gets one row, not millions of columns).
     """
-    return _core.analysis.stratified_samples(int(samples), float(K_low), int(seed), int(lo), hi)
+    return _core_analysis.stratified_samples(int(samples), float(K_low), int(seed), int(lo), hi)
 
 
 def default_depth(m) -> float:
@@ -106,19 +107,19 @@ def default_depth(m) -> float:
     (``hovering._core.analysis.default_depth``), which the sweep plans use too.
     """
     th = m.theory()
-    return float(_core.analysis.default_depth(float(m.eps), float(th.Omega0), [float(b) for b in th.forcing]))
+    return float(_core_analysis.default_depth(float(m.eps), float(th.Omega0), [float(b) for b in th.forcing]))
 
 
 def _outcomes(m, phi, K, n_steps: int, n_threads: int, progress=False) -> tuple:
     """Per-sample outcomes (status under F_0, status, steps done, regions visited) of F_0 then F_eps
     with early exit from {J_0u, J_0}, by the core; KeyboardInterrupt on Ctrl-C."""
-    if hasattr(m, "_core") and not isinstance(m, (_core.truncated.TruncatedMap, _core.truncated.TruncatedFamily)):
+    if hasattr(m, "_core") and not isinstance(m, (_core_truncated.TruncatedMap, _core_truncated.TruncatedFamily)):
         m0 = m.with_eps(0.0)  # the flow's F_0: the eps = 0 flow on its own normal coordinates
-        d = _core.analysis.hovering_outcomes(
+        d = _core_analysis.hovering_outcomes(
             m._core, m0._core, phi, K, int(n_steps), _flow_threads(m, n_threads), progress or None
         )
     else:
-        d = _core.analysis.hovering_outcomes(m, phi, K, int(n_steps), int(n_threads), progress or None)
+        d = _core_analysis.hovering_outcomes(m, phi, K, int(n_steps), int(n_threads), progress or None)
     if d["interrupted"]:
         raise KeyboardInterrupt("hovering_area interrupted")
     return d["status_F0"], d["status"], d["steps_done"], d["visited"]
@@ -310,7 +311,7 @@ def hovering_area(
             s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec)
         else:
             s0, s1, steps_done, visited = _outcomes(m, phi, K, n_steps, n_threads, bar.part(0))
-    e = _core.analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), keep_points)
+    e = _core_analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), keep_points)
     return HoveringArea(
         area=e["area"],
         error=e["error"],

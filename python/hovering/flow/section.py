@@ -6,8 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core
 from .._checks import integer, is_choice, real_array, real_number, thread_count
+from .._core import flow as _core_flow
 from .._enums import FlowStatus, status_code
 from .._pickle import reduce_record
 from .._progress import check_progress, progress_bar
@@ -20,7 +20,7 @@ __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS
 #: Steppers the flow offers, its default first: GSL's explicit Runge-Kutta methods, Adams multistep
 #: method and implicit Gauss-Legendre methods, and ``"exact"``, the flow in closed form where the
 #: system has one (see :meth:`Section.return_map`). The core's list (``hovering._core.flow.STEPPERS``).
-STEPPERS = tuple(_core.flow.STEPPERS)
+STEPPERS = tuple(_core_flow.STEPPERS)
 
 
 def flow_options(
@@ -32,7 +32,7 @@ def flow_options(
     max_impacts: int | None = None,
     grazing_tol: float | None = None,
     corner_tol: float | None = None,
-) -> _core.flow.FlowOptions:
+) -> _core_flow.FlowOptions:
     """Integrator settings of the flow, validated with errors that name the value and its range.
 
     Parameters
@@ -74,7 +74,7 @@ def flow_options(
         corner_tol=corner_tol,
     )
     kw.update({k: checks[k](v) for k, v in given.items() if v is not None})
-    return _core.flow.FlowOptions(**kw)
+    return _core_flow.FlowOptions(**kw)
 
 
 def _threads(n_threads, python_defined: bool) -> int:
@@ -229,7 +229,7 @@ class Section:
             raise ValueError(
                 f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}"
             ) from None
-        return _core.flow.section_points(
+        return _core_flow.section_points(
             self.sys.core, self.h, np.ascontiguousarray(t.ravel()), np.ascontiguousarray(i.ravel())
         )
 
@@ -250,7 +250,7 @@ class Section:
         z = np.atleast_2d(real_array("z", z))
         if z.ndim != 2 or z.shape[1] != 4:
             raise ValueError(f"z must be states (q1, p1, q2, p2) of shape (n, 4), got shape {np.shape(z)}")
-        return _core.flow.section_coordinates(self.sys.core, np.ascontiguousarray(z))
+        return _core_flow.section_coordinates(self.sys.core, np.ascontiguousarray(z))
 
     def return_map(
         self,
@@ -346,7 +346,7 @@ class Section:
             else trajectory_arguments(trajectory_dt, max_trajectory_points, z0.shape[0])
         )
         with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
-            d = _core.flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
+            d = _core_flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
         # The image's coordinates where there is an image: a stopped orbit's z is its last state,
         # which need not have coordinates (a runaway's H2 overflows), and its records are NaN.
         c = np.full((z0.shape[0], 2), np.nan)

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
 from .._checks import is_choice, real_number
+from .._core import flow as _core_flow
 from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
 from .._enums import Geometry
 from .._pickle import reduce_record
@@ -255,11 +255,11 @@ class StepSystem:
         object.__setattr__(
             self,
             "_core",
-            _core.flow.FlowSystem(self.V1, self.V2, _terms(self.coupling), self.eps, self.qw1, self.qw2, geometry),
+            _core_flow.FlowSystem(self.V1, self.V2, _terms(self.coupling), self.eps, self.qw1, self.qw2, geometry),
         )
 
     @property
-    def core(self) -> _core.flow.FlowSystem:
+    def core(self) -> _core_flow.FlowSystem:
         """The core's FlowSystem of this system (what the compiled flow integrates)."""
         return self._core
 
@@ -272,7 +272,7 @@ class StepSystem:
     def python_defined(self) -> bool:
         """Whether V1 or V2 calls back into Python (CustomPotential or a Python subclass)."""
         return any(
-            isinstance(p, _core.flow._CallablePotential) or not type(p).__module__.startswith("hovering._core")
+            isinstance(p, _core_flow._CallablePotential) or not type(p).__module__.startswith("hovering._core")
             for p in (self.V1, self.V2)
         )
 
@@ -372,9 +372,9 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rto
     if not isinstance(errors, bool):
         raise ValueError(f"errors must be True or False, got {errors!r}")
     if method == "definitions":
-        r = _core.flow._onset_estimate(sys.V1, sys.V2, sys.qw1, sys.qw2, h, rtol)
+        r = _core_flow._onset_estimate(sys.V1, sys.V2, sys.qw1, sys.qw2, h, rtol)
     elif method == "quadrature":
-        r = _core.flow._onset_estimate(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, h, rtol)
+        r = _core_flow._onset_estimate(Numerical(sys.V1), Numerical(sys.V2), sys.qw1, sys.qw2, h, rtol)
     elif method == "closed_form":
 
         def wa(p):
@@ -385,7 +385,7 @@ def onset_parameters(sys: StepSystem, h: float, method: str = "definitions", rto
             raise ValueError(f"closed_form needs Harmonic or Tan potentials, got {p!r}")
 
         (w1, a1), (w2, a2) = wa(sys.V1), wa(sys.V2)
-        r = _core.flow._onset_estimate_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, h, rtol)
+        r = _core_flow._onset_estimate_closed_form(w1, a1, w2, a2, sys.qw1, sys.qw2, h, rtol)
     else:
         raise ValueError(f"method must be 'definitions', 'quadrature' or 'closed_form', got {method!r}")
     return r if errors else r[0]

@@ -16,8 +16,8 @@ import operator
 
 import numpy as np
 
-from .. import _core
 from .._checks import MAX_MODES, integer, real_array, require_angles, require_finite, require_type
+from .._core import normal as _core_normal
 from .._enums import wrap
 from .._pickle import reduce_record
 from .._serial import Saveable
@@ -95,9 +95,9 @@ class TangentialCurve(Saveable):
             raise ValueError(f"n_check must be in [0, n], got {n_check!r}")
         opts = flow_options(rtol=rtol, atol=rtol * 1e-2)
         if auto:  # the core's rule (64 wall points, doubled up to 1024 for an error below 1e-12)
-            c = _core.normal.TangentialCurve.measure_refined(sec.sys.core, sec.h, opts, n_check)
+            c = _core_normal.TangentialCurve.measure_refined(sec.sys.core, sec.h, opts, n_check)
         else:
-            c = _core.normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
+            c = _core_normal.TangentialCurve(sec.sys.core, sec.h, n, opts, n_check)
         self._adopt(sec, c, checked=bool(n_check))
 
     def _adopt(self, sec: Section, c, checked: bool) -> None:
@@ -129,7 +129,7 @@ class TangentialCurve(Saveable):
             raise ValueError(
                 f"the tangential curve's samples were measured at h = {state[0]}, not at the section's h = {sec.h}"
             )
-        c = _core.normal.TangentialCurve.__new__(_core.normal.TangentialCurve)
+        c = _core_normal.TangentialCurve.__new__(_core_normal.TangentialCurve)
         c.__setstate__(state)
         obj = cls.__new__(cls)
         obj._adopt(sec, c, checked=bool(samples.get("checked", True)))
@@ -263,9 +263,9 @@ class TangentialCurve(Saveable):
 def _mode_counts(n_modes, n_phi) -> tuple:
     """(n_modes, n_phi) of a sine fit: 1 <= n_modes <= MAX_MODES, 2 n_modes < n_phi <= 65536 (beyond,
     each sample is a flow trace and the fit gains nothing); None: the core's defaults."""
-    n_modes = integer("n_modes", _core.normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
+    n_modes = integer("n_modes", _core_normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
     if n_phi is None:
-        n_phi = _core.normal.FORCING_SAMPLES
+        n_phi = _core_normal.FORCING_SAMPLES
     return n_modes, integer("n_phi (> 2 n_modes, so the fit is determined)", n_phi, 2 * n_modes + 1, 65536)
 
 
@@ -441,8 +441,8 @@ def forcing_coefficients(sec: Section, n_modes: int | None = None, n_phi: int | 
     """
     _section("sec", sec)
     n_modes, n_phi = _mode_counts(n_modes, n_phi)
-    f = forcing_function(sec, _core.normal.forcing_angles(n_phi), **kwargs)
-    return _core.normal.sine_coefficients(np.ascontiguousarray(f, dtype=float), n_modes)
+    f = forcing_function(sec, _core_normal.forcing_angles(n_phi), **kwargs)
+    return _core_normal.sine_coefficients(np.ascontiguousarray(f, dtype=float), n_modes)
 
 
 def to_normal(sec: Section, theta, I, **kwargs):

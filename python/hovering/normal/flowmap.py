@@ -14,8 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
 from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, point_pair
+from .._core import flow as _core_flow
+from .._core import normal as _core_normal
 from .._enums import Region, wrap
 from .._pickle import reduce_record
 from .._progress import check_progress, progress_bar
@@ -189,7 +190,7 @@ class FlowMap(MapAnalyses):
             self.accuracy_choice = hook("choose_setting")(self.section, accuracy, accuracy_returns)
             stepper, rtol = self.accuracy_choice["method"], self.accuracy_choice["tolerance"]
             atol = rtol
-        default = _core.flow.FlowOptions()  # the core's defaults, for what is not given
+        default = _core_flow.FlowOptions()  # the core's defaults, for what is not given
         stepper = default.stepper if stepper is None else stepper
         rtol = default.rtol if rtol is None else rtol
         atol = rtol if atol is None else atol
@@ -212,7 +213,7 @@ class FlowMap(MapAnalyses):
                 raise ValueError(self.curve.not_graph_reason)
         p = self.onset
         lift = None if p is None else (p.Omega0, p.theta_w, p.tau0, p.tau1, p.lam)
-        self._core = _core.normal.FlowMap(sys.core, self.h, self._options, self.curve._c if self.curve else None, lift)
+        self._core = _core_normal.FlowMap(sys.core, self.h, self._options, self.curve._c if self.curve else None, lift)
         self._forcing = None
 
     def __repr__(self) -> str:
@@ -584,7 +585,7 @@ class FlowMap(MapAnalyses):
         ``FORCING_MODES``). At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit
         is used there, measured on the system at eps = 1e-6 (zeros without a coupling).
         """
-        n_modes = integer("n_modes", _core.normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
+        n_modes = integer("n_modes", _core_normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
         if self._forcing is None or self._forcing.size != n_modes:
             if self.curve is None:
                 raise ValueError("the forcing needs normal coordinates (coordinates='normal')")

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .._output import write_text
+from .._version import __version__
 from ..analysis.hovering import default_depth
 from ..flow import Harmonic, Tan
 from ..flow.system import Polynomial, StepSystem
@@ -313,8 +314,6 @@ def plan_text(scene: SceneSpec, quick: bool = False, points: list | None = None,
     -------
     str
     """
-    from .. import __version__  # the package's own version (its __init__ is loaded by then)
-
     pts = plan_points(scene, quick) if points is None else points
     lines = [
         f"# The resolved sweep plan of {scene.name}{' (--quick)' if quick else ''}: every number explicit "

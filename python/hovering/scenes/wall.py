@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .. import _core
+from .._core import flow as _core_flow
 from .._enums import FlowStatus, Region
 from ..flow.section import flow_options
 from ..flow.system import StepSystem
@@ -274,7 +274,7 @@ class WallFlow:
         dt, per_orbit = (
             (0.0, 0) if trajectory_dt is None else trajectory_arguments(trajectory_dt, 2_000_000, max(z.shape[0], 1))
         )
-        d = _core.flow.return_maps(sys.core, z, self.options, 0, dt, per_orbit)
+        d = _core_flow.return_maps(sys.core, z, self.options, 0, dt, per_orbit)
         w = self.work[stage]
         for k, v in d["work"].items():
             w[k] = w.get(k, 0) + int(v)

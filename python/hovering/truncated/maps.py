@@ -13,7 +13,6 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from .. import _core
 from .._checks import (
     check_memory,
     forcing_array,
@@ -25,6 +24,7 @@ from .._checks import (
     require_finite,
     thread_count,
 )
+from .._core import truncated as _core_truncated
 from .._enums import Region, wrap
 from .._pickle import reduce_record
 from .._progress import check_progress, progress_bar
@@ -336,7 +336,7 @@ class _MapAPI(MapAnalyses):
         return IterateResult.from_core(d, self, n_steps, every)
 
 
-class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
+class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     """The paper's truncated map F_eps (eq:truncatedmap), corrected as in shared/PAPER-NOTES.md.
 
     ``Kbar = K + eps sin(phibar)``, ``phibar = phi + omega_a(K)`` for ``phi`` in the arc ``J_a(K)``;
@@ -377,7 +377,7 @@ class TruncatedMap(_MapAPI, _core.truncated.TruncatedMap):
             K_max = float(K_max)
         except (TypeError, ValueError):
             raise ValueError(f"K_max must be a real number > 0, got {K_max!r}") from None
-        _core.truncated.TruncatedMap.__init__(self, **vals, K_max=K_max)
+        _core_truncated.TruncatedMap.__init__(self, **vals, K_max=K_max)
 
     def __repr__(self) -> str:
         return (
@@ -487,7 +487,7 @@ def _as_table(name: str, values, K: np.ndarray) -> np.ndarray:
     return a
 
 
-class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
+class TruncatedFamily(_MapAPI, _core_truncated.TruncatedFamily):
     """The general truncated family F_{eps1,eps2} (eq:trunceps1eps2) with tabulated arcs.
 
     ``Kbar = K + eps f(phibar)`` with ``f(phi) = sum_k b_k sin(k phi)``, and an interval exchange
@@ -523,7 +523,7 @@ class TruncatedFamily(_MapAPI, _core.truncated.TruncatedFamily):
             raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")
         tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]
         b = forcing_array(forcing)
-        _core.truncated.TruncatedFamily.__init__(self, eps, list(Kg), *(list(t) for t in tabs), list(b), float(K_max))
+        _core_truncated.TruncatedFamily.__init__(self, eps, list(Kg), *(list(t) for t in tabs), list(b), float(K_max))
         self._tables = (Kg.copy(), *(t.copy() for t in tabs))
         self._K_max = float(K_max)
 

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
 from .._checks import forcing_array, integer, real_array, real_number, require_angles, require_finite
+from .._core import analysis as _core_analysis
 from .._enums import wrap
 from .._serial import Saveable
 
@@ -415,7 +415,7 @@ class Theory(Saveable):
     def G(self, psi):
         """The first-order shape ``G(psi)``, ``psi = phi + Omega0/2``, of the curves through L1."""
         psi = np.asarray(psi, dtype=float)
-        g = _core.analysis.first_order_shape(list(self.forcing), self.Omega0, np.ascontiguousarray(psi.ravel()))
+        g = _core_analysis.first_order_shape(list(self.forcing), self.Omega0, np.ascontiguousarray(psi.ravel()))
         return g.reshape(psi.shape) if psi.ndim else float(g[0])
 
     def curve(self, phi):
