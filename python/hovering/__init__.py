@@ -29,6 +29,7 @@ from .analysis import (
     ConeCrossing,
     CriticalCurve,
     HoveringArea,
+    ImpactZone,
     OrbitClasses,
     birkhoff_average,
     classify_orbits,
@@ -36,6 +37,7 @@ from .analysis import (
     converse_kam,
     critical_curve,
     hovering_area,
+    impact_zone,
     regularity,
     rotation_number,
 )
@@ -179,6 +181,8 @@ __all__ = [
     "ConeCrossing",
     "cone_crossing",
     "converse_kam",
+    "ImpactZone",
+    "impact_zone",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):

@@ -1,5 +1,6 @@
 """Analyses written once for every map (TruncatedMap, TruncatedFamily, FlowMap): rotation numbers
-and regularity, the hovering set HOV(eps), and the critical invariant curve."""
+and regularity, the hovering set HOV(eps), the critical invariant curve, orbit classes and the
+impact zone."""
 
 from ..interface import register
 from .critical import CriticalCurve, critical_curve, max_angular_gap
@@ -14,6 +15,7 @@ from .orbits import (
     rank_rotation,
 )
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
+from .zone import ImpactZone, impact_zone
 
 __all__ = [
     "birkhoff_weights",
@@ -32,6 +34,8 @@ __all__ = [
     "ConeCrossing",
     "cone_crossing",
     "converse_kam",
+    "ImpactZone",
+    "impact_zone",
 ]
 
 # The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the

@@ -15,6 +15,7 @@ from .._checks import is_choice, real_array
 from .._enums import REGION_LABELS, Region, Status, region_mask
 from .._progress import check_progress, progress_bar
 from .._serial import Saveable
+from ..curve import Curve
 from ..interface import require_map
 from .rotation import regularity, rotation_number
 
@@ -87,6 +88,18 @@ class CriticalCurve(Saveable):
     line: str = "L1"
     hovers: bool = True
     note: str = ""
+
+    @property
+    def curve(self) -> Curve:
+        """The critical orbit as a closed curve K(phi) (:meth:`hovering.Curve.from_orbit`; its
+        ``error`` is the orbit's scatter about the curve, per bin).
+
+        Raises
+        ------
+        ValueError
+            If the orbit does not fill the circle at the default resolution (too few points).
+        """
+        return Curve.from_orbit(self.phi, self.K)
 
 
 def critical_curve(

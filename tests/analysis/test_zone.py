@@ -1,0 +1,81 @@
+"""The impact zone as two curves and its coordinate s: s and K_at are each other's inverse, the
+boundaries sit at s = 0 and 1, and the orbits the boundaries were measured from lie on them within
+the curves' own error estimates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hovering
+from hovering import paper
+
+PHI = np.linspace(-np.pi, np.pi, 257)
+
+
+def test_constant_curves_give_the_affine_coordinate_exactly():
+    z = hovering.ImpactZone(ceiling=hovering.Curve.constant(0.25), floor=hovering.Curve.constant(-0.75))
+    K = np.linspace(-1, 1, 9)
+    # (K + 0.75) / 1.0 in binary: exact for these K (multiples of 1/4)
+    assert np.array_equal(z.s(0.3, K), K + 0.75)
+    assert np.array_equal(z.K_at(0.3, K + 0.75), K)
+    assert z.s(2.0, 0.25) == 1.0 and z.s(-2.0, -0.75) == 0.0 and z.height(0.1) == 1.0
+
+
+def test_s_and_K_at_are_inverse_and_the_boundaries_are_0_and_1_on_spline_curves():
+    c = hovering.Curve.from_function(lambda p: 0.1 + 0.05 * np.cos(p) + 0.02 * np.sin(3 * p), n=64)
+    f = hovering.Curve.from_function(lambda p: -0.3 + 0.04 * np.sin(p), n=32)
+    z = hovering.ImpactZone(ceiling=c, floor=f)
+    assert np.array_equal(z.s(PHI, c(PHI)), np.ones_like(PHI))  # the same evaluation, divided by itself
+    assert np.array_equal(z.s(PHI, f(PHI)), np.zeros_like(PHI))
+    s = np.linspace(-0.5, 1.5, 41)[:, None]
+    K = z.K_at(PHI[None, :], s)
+    # Rounding only: a few ulps of the values involved (|K| <= 0.5, height ~0.4).
+    assert np.max(np.abs(z.s(PHI[None, :], K) - s)) <= 1e-14
+    assert np.isnan(z.s(0.0, np.nan))  # the padding of a stopped orbit stays missing
+
+
+def test_a_ceiling_below_the_floor_is_refused_naming_where():
+    c = hovering.Curve.from_function(lambda p: 0.1 * np.cos(p), n=32)
+    with pytest.raises(ValueError, match=r"ceiling must lie above the floor .* at phi = "):
+        hovering.ImpactZone(ceiling=c, floor=hovering.Curve.constant(0.05))
+    with pytest.raises(ValueError, match="ceiling must be a hovering.Curve, got float"):
+        hovering.ImpactZone(ceiling=0.1, floor=hovering.Curve.constant(0.0))
+    with pytest.raises(ValueError, match="ceiling must lie above the floor"):
+        hovering.impact_zone(paper.truncated_map(0.3), ceiling=-1.0, floor=-0.5)
+
+
+def test_truncated_zone_ceiling_is_the_critical_curve_and_the_floor_the_band_edge():
+    m = paper.truncated_map(0.3)
+    z = hovering.impact_zone(m, n_steps=5000)
+    assert z.floor_kind == "band" and z.floor.n == 1 and z.floor(0.0) == m.valid_band()[0]
+    cc = m.critical_curve(5000)  # the same search, run again: an orbit the curve was built from
+    ok = np.isfinite(cc.K)
+    s = z.s(cc.phi[ok], cc.K[ok])
+    # The orbit lies on the ceiling within the curve's own scatter estimate (max_error, in K)
+    # divided by the zone's least height.
+    tol = z.ceiling.max_error / np.min(z.height(PHI))
+    assert np.max(np.abs(s - 1)) <= tol and tol < 1e-6
+    # The curve passes through the critical orbit's start on L1 (its height K0 there).
+    assert z.ceiling(m.L1(cc.K0)) == pytest.approx(cc.K0, abs=2 * z.ceiling.max_error + 1e-9)
+
+
+def test_flow_zone_floor_is_the_flows_own_and_its_orbit_lies_at_s_0():
+    fm = paper.flow_map(0.05)
+    z = hovering.impact_zone(fm, n_steps=1000)
+    assert z.floor_kind == "flow"
+    fl = fm.impact_zone_floor(n_steps=1000)
+    ok = np.isfinite(fl.K)
+    tol = z.floor.max_error / np.min(z.height(PHI))
+    assert np.max(np.abs(z.s(fl.phi[ok], fl.K[ok]))) <= tol and tol < 1e-5
+    # The floor lies below the flow's upper-tangent torus height +- the search window, and the
+    # ceiling above it: the zone is the band the paper's Discussion asks about.
+    assert np.all(z.floor(PHI) < 0) and np.all(z.height(PHI) > 0)
+
+
+def test_a_zone_saves_and_loads(tmp_path):
+    c = hovering.Curve.from_function(lambda p: 0.1 + 0.05 * np.cos(p), n=16)
+    z = hovering.ImpactZone(ceiling=c, floor=hovering.Curve.constant(-0.2), floor_kind="band")
+    hovering.save(z, tmp_path / "z.npz")
+    back = hovering.load(tmp_path / "z.npz")
+    assert back.floor_kind == "band" and np.array_equal(back.s(PHI, 0.0), z.s(PHI, 0.0))
