@@ -40,6 +40,7 @@ from .analysis import (
     impact_zone,
     regularity,
     rotation_number,
+    transit,
 )
 from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
@@ -183,6 +184,7 @@ __all__ = [
     "converse_kam",
     "ImpactZone",
     "impact_zone",
+    "transit",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):

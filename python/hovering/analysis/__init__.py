@@ -15,6 +15,7 @@ from .orbits import (
     rank_rotation,
 )
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
+from .transit import TransitResult, transit
 from .zone import ImpactZone, impact_zone
 
 __all__ = [
@@ -36,6 +37,8 @@ __all__ = [
     "converse_kam",
     "ImpactZone",
     "impact_zone",
+    "TransitResult",
+    "transit",
 ]
 
 # The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the

@@ -1,0 +1,263 @@
+"""Transport across the impact zone: do orbits started near one boundary reach the other?
+
+:func:`transit` launches orbits on a level ``s = start_s`` of the zone coordinate
+(:class:`hovering.ImpactZone`) and stops each the first time it reaches ``s = target_s`` (a stop
+condition of ``iterate``, evaluated per step inside the kernels). It reports first-passage steps,
+the fraction that crossed with its binomial error, the extremes of K and s each orbit reached,
+the returns spent in each region, and, when crossings exist, the escape rate of the censored
+exponential fit (maximum likelihood: crossings divided by the steps observed) with its error.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import integer, is_choice, real_number
+from .._serial import Saveable
+from ..curve import Above, Below, Curve
+from ..interface import require_map
+from ..parallel.executor import as_executor, run_pieces
+from ..parallel.executor import executor as open_executor
+from .zone import ImpactZone
+
+__all__ = ["TransitResult", "transit"]
+
+
+@dataclass(frozen=True)
+class TransitResult(Saveable):
+    """What :func:`transit` measured (one entry per orbit where an array).
+
+    Attributes
+    ----------
+    direction : str
+        ``"up"`` (towards the ceiling) or ``"down"``.
+    start_s, target_s : float
+        The zone levels the orbits start on and must reach.
+    n_steps : int
+        Steps (returns) each orbit was given.
+    phi0, K0 : ndarray
+        The starts (on ``s = start_s``).
+    first_passage : ndarray of int64
+        The first step at which the orbit reached the target (-1 if it never did within ``n_steps``
+        or stopped otherwise, see ``status``).
+    status : ndarray of int8
+        :class:`hovering.Status` per orbit: STOPPED (crossed), OK (did not), ESCAPED / EXITED /
+        a flow outcome (stopped for another reason: neither crossed nor censored at ``n_steps``).
+    steps_done : ndarray of int64
+        Steps taken by each orbit.
+    K_min, K_max : ndarray
+        The extremes of K over every state the orbit visited (start and final state included).
+    s_min, s_max : ndarray
+        The extremes of s over the recorded states ``x_0, x_k, x_2k, ...`` (``every = k``; exact
+        for ``every=1``), and the final state.
+    residence : ndarray of int64
+        Returns from each region, shape ``(n_orbits, 5)`` (Region order).
+    every : int
+        The stride of the states s was measured on.
+    target : Curve or None
+        The target level ``s = target_s`` as the curve the stop condition used.
+    """
+
+    direction: str
+    start_s: float
+    target_s: float
+    n_steps: int
+    phi0: np.ndarray
+    K0: np.ndarray
+    first_passage: np.ndarray
+    status: np.ndarray
+    steps_done: np.ndarray
+    K_min: np.ndarray
+    K_max: np.ndarray
+    s_min: np.ndarray
+    s_max: np.ndarray
+    residence: np.ndarray
+    every: int = 1
+    target: Curve | None = None
+
+    @property
+    def crossed(self) -> np.ndarray:
+        """Per orbit: it reached the target."""
+        return self.first_passage >= 0
+
+    @property
+    def fraction(self) -> float:
+        """Fraction of the orbits that crossed."""
+        return float(np.mean(self.crossed)) if self.crossed.size else float("nan")
+
+    @property
+    def fraction_error(self) -> float:
+        """Binomial standard error of :attr:`fraction` (for none or all crossed: the one-sided
+        ``1 / n`` resolution instead of 0)."""
+        n = self.crossed.size
+        p = self.fraction
+        return math.sqrt(p * (1 - p) / n) if 0 < p < 1 else 1.0 / max(n, 1)
+
+    @property
+    def escape_rate(self) -> tuple[float, float] | None:
+        """``(gamma, error)`` of the exponential fit ``P(T > n) = exp(-gamma n)`` to the first
+        passages, censored at each orbit's last step: the maximum-likelihood rate is the number of
+        crossings over the steps observed, with standard error ``gamma / sqrt(crossings)``. None
+        without crossings (the data then bound gamma below ~1 / (steps observed) only)."""
+        k = int(np.count_nonzero(self.crossed))
+        if k == 0:
+            return None
+        exposure = float(np.sum(np.where(self.crossed, self.first_passage, self.steps_done)))
+        gamma = k / max(exposure, 1.0)
+        return gamma, gamma / math.sqrt(k)
+
+    def _validate_loaded(self) -> None:
+        n = self.phi0.shape[0] if isinstance(self.phi0, np.ndarray) and self.phi0.ndim == 1 else -1
+        for name in ("K0", "first_passage", "status", "steps_done", "K_min", "K_max", "s_min", "s_max"):
+            a = getattr(self, name)
+            if not isinstance(a, np.ndarray) or a.shape != (n,):
+                raise ValueError(f"{name} must have the shape of phi0 ({n},)")
+
+
+def _target(zone: ImpactZone, s: float) -> Curve:
+    """The level curve ``s`` of the zone as a Curve: on the finer of the two boundaries' grids
+    (times 4), the spline through the level's values there."""
+    n = max(zone.ceiling.n, zone.floor.n, 16) * 4
+    return Curve.from_function(lambda p: zone.K_at(p, s), n=n)
+
+
+def _piece(m, phi, K, n_steps, stop, every, kwargs):
+    """One piece of orbits (runs in any process)."""
+    try:
+        res = m.iterate(phi, K, n_steps, record=("orbit", "extrema", "residence"), every=every, stop=stop, **kwargs)
+    except KeyboardInterrupt as e:
+        res = getattr(e, "partial", None)
+        if res is None:
+            raise
+        return res, True
+    return res, False
+
+
+def transit(
+    m,
+    zone: ImpactZone,
+    direction: str = "up",
+    n_orbits: int = 1000,
+    n_steps: int = 10_000,
+    start_s: float | None = None,
+    target_s: float | None = None,
+    seed: int = 0,
+    every: int | None = None,
+    executor=None,
+    **iterate_kwargs,
+) -> TransitResult:
+    """Launch orbits on one level of the impact zone and measure whether they reach another.
+
+    Parameters
+    ----------
+    m : TruncatedMap, TruncatedFamily or FlowMap
+        The map.
+    zone : ImpactZone
+        The zone (:func:`hovering.impact_zone`).
+    direction : {"up", "down"}, optional
+        Towards the ceiling (stop on ``K >= target``) or the floor (``K <= target``).
+    n_orbits : int, optional
+        Orbits, started at stratified angles (one per cell of ``[-pi, pi)``, jittered by ``seed``).
+    n_steps : int, optional
+        Steps (returns) per orbit.
+    start_s, target_s : float, optional
+        Zone levels; defaults: up from 0.05 to 1 (the ceiling), down from 0.95 to 0 (the floor).
+        They must lie on the direction's side of each other.
+    seed : int, optional
+        Seed of the angle jitter.
+    every : int, optional
+        Stride of the states s is measured on (default ``max(1, n_steps // 1000)``: at most 1001
+        states per orbit kept); first passages and K extremes are exact at any stride.
+    executor : optional
+        Where it runs (see :func:`hovering.parallel.executor.as_executor`): the orbits are cut into
+        pieces; the result is the one-process result.
+    **iterate_kwargs
+        Passed to ``m.iterate`` (``n_threads``, ``kernel``, ``progress``, ...).
+
+    Returns
+    -------
+    TransitResult
+
+    Raises
+    ------
+    ValueError
+        For a map or zone of the wrong type, a direction other than up/down, levels on the wrong
+        side of each other or not finite, counts out of range; before any iteration.
+    KeyboardInterrupt
+        On Ctrl-C, with the result so far (orbits cut short keep their steps) as ``.partial`` (in
+        this process; on an executor the finished pieces are cancelled with the rest).
+    """
+    require_map("m", m)
+    if not isinstance(zone, ImpactZone):
+        raise ValueError(f"zone must be a hovering.ImpactZone (hovering.impact_zone(m)), got {type(zone).__name__}")
+    if not is_choice(direction, ("up", "down")):
+        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}")
+    n_orbits = integer("n_orbits", n_orbits, 1, 2**31 - 1)
+    n_steps = integer("n_steps", n_steps, 1, 2**53)
+    seed = integer("seed", seed, 0, 2**63 - 1)
+    up = direction == "up"
+    start_s = real_number("start_s", 0.05 if up and start_s is None else 0.95 if start_s is None else start_s)
+    target_s = real_number("target_s", 1.0 if up and target_s is None else 0.0 if target_s is None else target_s)
+    if not (start_s < target_s if up else start_s > target_s):
+        raise ValueError(
+            f"for direction={direction!r} start_s must lie {'below' if up else 'above'} target_s, got start_s = "
+            f"{start_s} and target_s = {target_s}"
+        )
+    every = integer("every", every if every is not None else max(1, n_steps // 1000), 1, 2**53)
+    spec = as_executor(executor)
+
+    rng = np.random.default_rng(seed)
+    phi0 = -np.pi + 2 * np.pi * (np.arange(n_orbits) + rng.random(n_orbits)) / n_orbits
+    K0 = np.asarray(zone.K_at(phi0, start_s), dtype=float)
+    target = _target(zone, target_s)
+    stop = Above(target) if up else Below(target)
+
+    if spec is None:
+        parts = [_piece(m, phi0, K0, n_steps, stop, every, iterate_kwargs)]
+    else:
+        with open_executor(**spec.where()) as ex:
+            k = min(n_orbits, spec.pieces if spec.pieces is not None else 4 * ex.workers)
+            cuts = [(n_orbits * i // k, n_orbits * (i + 1) // k) for i in range(k)]
+            kw = dict(iterate_kwargs)
+            kw.setdefault("n_threads", ex.threads_per_piece)
+            out = [None] * k
+            for i, part in run_pieces(ex, _piece, [(m, phi0[a:b], K0[a:b], n_steps, stop, every, kw) for a, b in cuts]):
+                out[i] = part
+            parts = out
+    interrupted = any(p[1] for p in parts)
+    res = [p[0] for p in parts]
+
+    def cat(name):
+        return np.concatenate([getattr(r, name) for r in res])
+
+    s_states = np.concatenate([zone.s(r.phi, r.K) for r in res])  # recorded states (NaN after a stop)
+    s_final = zone.s(cat("phi_final"), cat("K_final"))
+    with np.errstate(all="ignore"):
+        s_min = np.fmin(np.nanmin(np.where(np.isfinite(s_states), s_states, np.inf), axis=1), s_final)
+        s_max = np.fmax(np.nanmax(np.where(np.isfinite(s_states), s_states, -np.inf), axis=1), s_final)
+    result = TransitResult(
+        direction=direction,
+        start_s=start_s,
+        target_s=target_s,
+        n_steps=n_steps,
+        phi0=phi0,
+        K0=K0,
+        first_passage=cat("stop_step").astype(np.int64),
+        status=cat("status"),
+        steps_done=cat("steps_done").astype(np.int64),
+        K_min=cat("K_min"),
+        K_max=cat("K_max"),
+        s_min=s_min,
+        s_max=s_max,
+        residence=cat("residence").astype(np.int64),
+        every=every,
+        target=target,
+    )
+    if interrupted:
+        exc = KeyboardInterrupt("transit interrupted; the orbits so far are in .partial")
+        exc.partial = result  # type: ignore[attr-defined]
+        raise exc
+    return result
