@@ -298,3 +298,18 @@ def test_section_return_map_interrupt_keeps_finished_returns():
     i = int(np.flatnonzero(done)[0])
     again = sec.return_map(th[i : i + 1], I[i : i + 1])
     assert again.theta[0] == out.theta[i] and again.I[0] == out.I[i]
+
+
+def test_repr_says_the_effective_eps_and_the_band_and_still_evaluates():
+    # The truncated model of the flow sees eps b1, not eps (b1 = 0.56 here); the repr says so, with
+    # the band, in a comment, so eval(repr) is still the map.
+    from hovering import Bilinear, FlowMap, Harmonic, StepSystem, Tan  # noqa: F401  (names eval needs)
+
+    fm = paper.flow_map(0.05)
+    text = repr(fm)
+    b1 = float(fm.forcing_coefficients()[0])
+    lo, hi = fm.valid_band()
+    assert f"effective eps = eps b1 = {0.05 * b1:.4g} (b1 = {b1:.4g})" in text
+    assert f"band K in [{lo:.4g}, {hi:.4g}]" in text
+    again = eval(text)
+    assert again.sys == fm.sys and again.h == fm.h and again.step(0.3, -0.02) == fm.step(0.3, -0.02)

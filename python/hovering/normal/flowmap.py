@@ -217,7 +217,18 @@ class FlowMap(MapAnalyses):
         self._forcing = None
 
     def __repr__(self) -> str:
-        return f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
+        base = f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
+        # What a user needs before reading any result: the perturbation the truncated model sees is
+        # eps b1 (the measured forcing's first mode), not eps; and where points of Sigma_h exist. A
+        # comment, so the text still evaluates to the map.
+        lo, hi = self.valid_band()
+        if self.coordinates != "normal" or self.eps == 0:
+            return f"{base}  # band {'K' if self.coordinates == 'normal' else 'I'} in [{lo:.4g}, {hi:.4g}]"
+        try:
+            b1 = float(self.forcing_coefficients()[0])
+        except ValueError:  # a tangential curve that is not a graph has no forcing: say so
+            return f"{base}  # eps b1 undefined (the tangential curve is not a graph), band K in [{lo:.4g}, {hi:.4g}]"
+        return f"{base}  # effective eps = eps b1 = {self.eps * b1:.4g} (b1 = {b1:.4g}), band K in [{lo:.4g}, {hi:.4g}]"
 
     # ---------------------------------------------------------------- pickling and saving
     # A FlowMap is rebuilt from its constructor arguments, with its tangential curve passed in: the
