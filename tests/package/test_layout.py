@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -15,7 +16,8 @@ PACKAGE = ROOT / "python" / "hovering"
 
 
 def _lint_imports(cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
+    """lint-imports in ``cwd``, its report as plain text (some releases colour it even into a pipe)."""
+    r = subprocess.run(
         [
             sys.executable,
             "-c",
@@ -27,6 +29,8 @@ def _lint_imports(cwd: Path, env: dict | None = None) -> subprocess.CompletedPro
         timeout=300,
         env=env,
     )
+    r.stdout = re.sub(r"\x1b\[[0-9;]*m", "", r.stdout)
+    return r
 
 
 def test_the_contracts_see_a_cycle_made_inside_a_function(tmp_path):
