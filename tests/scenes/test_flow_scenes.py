@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import hovering
+from helpers.figures import artists
 from hovering import Region, pipeline, scenes
 from hovering.pipeline import run_scene
 from hovering.plot.style import REGION_COLORS
@@ -58,22 +59,6 @@ def runs(tmp_path_factory):
         plt.close(s["figure"])
 
 
-def _artists(fig):
-    """Every drawn data array of a figure, keyed by axes index, artist kind and order."""
-    data = {}
-    for i, ax in enumerate(fig.axes):
-        for j, ln in enumerate(ax.lines):
-            x, y = ln.get_data()
-            data[(i, "line", j, ln.get_gid(), ln.get_label())] = (np.asarray(x, float), np.asarray(y, float))
-        for j, c in enumerate(ax.collections):
-            data[(i, "coll", j, c.get_gid(), c.get_label())] = (
-                np.asarray(c.get_offsets(), float),
-                np.asarray(c.get_facecolor(), float),
-            )
-        data[(i, "axes")] = (ax.get_xlabel(), ax.get_ylabel(), ax.get_title(), ax.get_xlim(), ax.get_ylim())
-    return data
-
-
 def test_every_flow_scene_file_loads_and_names_its_effects():
     for name in FLOW_FILES:
         s = scenes.load_scene(SCENE_DIR / f"{name}.toml")
@@ -98,7 +83,7 @@ def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, mo
     png, result, fig = pipeline.redraw(s["npz"], out=tmp_path / "again.png", keep_figure=True)
     try:
         assert png.stat().st_size > 10_000
-        a, b = _artists(s["figure"]), _artists(fig)
+        a, b = artists(s["figure"]), artists(fig)
         assert a.keys() == b.keys()
         for k in a:
             if k[1] == "axes":

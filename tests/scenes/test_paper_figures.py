@@ -31,6 +31,7 @@ import pytest
 from matplotlib.colors import to_rgb
 
 import hovering
+from helpers.figures import artists
 from hovering import Region, pipeline
 from hovering._enums import FlowStatus, wrap
 from hovering.flow.system import StepSystem
@@ -650,21 +651,6 @@ def runs(tmp_path_factory):
         plt.close(s["figure"])
 
 
-def _artists(fig) -> dict:
-    data = {}
-    for i, ax in enumerate(fig.axes):
-        for j, ln in enumerate(ax.lines):
-            x, y = ln.get_data()
-            data[(i, "line", j, ln.get_gid(), ln.get_label())] = (np.asarray(x, float), np.asarray(y, float))
-        for j, c in enumerate(ax.collections):
-            data[(i, "coll", j, c.get_gid(), c.get_label())] = (
-                np.asarray(c.get_offsets(), float),
-                np.asarray(c.get_facecolor(), float),
-            )
-        data[(i, "axes")] = (ax.get_xlabel(), ax.get_ylabel(), ax.get_title(), ax.get_xlim(), ax.get_ylim())
-    return data
-
-
 @pytest.mark.e2e
 @pytest.mark.parametrize("name", FILES)
 def test_a_quick_run_writes_png_npz_json(runs, name):
@@ -735,7 +721,7 @@ def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, mo
     png, result, fig = pipeline.redraw(s["npz"], out=tmp_path / "again.png", keep_figure=True)
     try:
         assert png.stat().st_size > 20_000
-        a, b = _artists(s["figure"]), _artists(fig)
+        a, b = artists(s["figure"]), artists(fig)
         assert a.keys() == b.keys()
         for k in a:
             if k[1] == "axes":
