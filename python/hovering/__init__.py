@@ -26,11 +26,13 @@ from ._provenance import show_versions
 from ._serial import load, save
 from ._version import __version__
 from .analysis import (
+    BarrierScan,
     ConeCrossing,
     CriticalCurve,
     HoveringArea,
     ImpactZone,
     OrbitClasses,
+    barrier_scan,
     birkhoff_average,
     classify_orbits,
     cone_crossing,
@@ -185,6 +187,8 @@ __all__ = [
     "ImpactZone",
     "impact_zone",
     "transit",
+    "BarrierScan",
+    "barrier_scan",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):

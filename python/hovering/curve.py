@@ -180,7 +180,8 @@ class Curve:
             orbit that stopped, are dropped). ``|phi| <= 1e6``.
         n : int, optional
             Number of samples, 3 .. 2**24; default ``N // 8`` (about 8 points per bin) within
-            [3, 4096].
+            [3, 4096], lowered where needed so that every bin holds a point (a bin at least as
+            wide as the orbit's widest gap in phi; an orbit near a resonance clusters its points).
 
         Returns
         -------
@@ -208,11 +209,15 @@ class Curve:
         N = p.size
         if N < 3:
             raise ValueError(f"an orbit needs at least 3 points (not NaN) to make a curve, got {N}")
-        n = min(4096, max(3, N // 8)) if n is None else _sample_count("n", n)
-        if n == 1:
-            raise ValueError("n must be in [3, 2**24] for a curve from an orbit, got 1")
         order = np.argsort(p, kind="stable")
         p, k = p[order], k[order]
+        if n is None:
+            widest = float(np.max(np.diff(np.concatenate([p, [p[0] + 2 * math.pi]]))))
+            n = max(3, min(4096, N // 8, int(0.999 * 2 * math.pi / widest)))
+        else:
+            n = _sample_count("n", n)
+        if n == 1:
+            raise ValueError("n must be in [3, 2**24] for a curve from an orbit, got 1")
         h = 2 * math.pi / n
         grid = _grid(n)
         bins = np.floor((p + math.pi) / h + 0.5).astype(np.int64) % n

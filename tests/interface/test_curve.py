@@ -167,6 +167,20 @@ def test_from_orbit_default_size_and_dropped_padding():
     assert c == Curve.from_orbit(r.phi[0], r.K[0])
 
 
+def test_from_orbit_default_size_lowers_itself_until_every_bin_holds_a_point():
+    # points clustered in 400 groups (an orbit near the rotation 1/400): N // 8 = 1000 bins would
+    # leave most empty; the default takes the most bins whose width exceeds the widest gap.
+    phi = (-np.pi + 2 * np.pi * np.arange(400) / 400)[:, None] + 1e-4 * np.arange(20)[None, :]
+    K = 0.1 * np.sin(phi)
+    c = Curve.from_orbit(phi, K)
+    widest = 2 * np.pi / 400 - 19e-4
+    assert c.n == int(0.999 * 2 * np.pi / widest) <= 8000 // 8
+    # samples interpolate linearly across gaps: error <= max|K''| gap**2 / 8 (the spline adds ~1e-11)
+    assert np.max(np.abs(c(FINE) - 0.1 * np.sin(FINE))) < 1.01 * 0.1 * widest**2 / 8
+    with pytest.raises(ValueError, match="bins empty"):
+        Curve.from_orbit(phi, K, n=1000)  # an explicit n is kept, and refused
+
+
 # ------------------------------------------------------------------------------------------------
 # pickling and saving
 

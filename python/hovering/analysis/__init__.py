@@ -1,8 +1,9 @@
 """Analyses written once for every map (TruncatedMap, TruncatedFamily, FlowMap): rotation numbers
-and regularity, the hovering set HOV(eps), the critical invariant curve, orbit classes and the
-impact zone."""
+and regularity, the hovering set HOV(eps), the critical invariant curve, orbit classes, the
+impact zone, transport across it and its barriers."""
 
 from ..interface import register
+from .barriers import BarrierScan, Layer, barrier_scan
 from .critical import CriticalCurve, critical_curve, max_angular_gap
 from .hovering import HoveringArea, hovering_area
 from .orbits import (
@@ -39,6 +40,9 @@ __all__ = [
     "impact_zone",
     "TransitResult",
     "transit",
+    "BarrierScan",
+    "Layer",
+    "barrier_scan",
 ]
 
 # The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the

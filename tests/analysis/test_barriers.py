@@ -1,0 +1,183 @@
+"""Barriers and layers across the impact zone (hovering.barrier_scan), against known answers:
+the eps = 0 truncated map (every level is invariant: every cut a barrier, margins the start
+spacing), the standard map (the truncated map's J_0u region: barriers between its KAM circles at
+k = 0.5, a barrier near the golden circle at k = 0.9, none at k = 1.2 > 63/64 where no rotational
+circle exists), a brute-force per-cut loop for the separation margins, the executor against one
+process, Ctrl-C, bad input and saving."""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import math
+import time
+
+import numpy as np
+import pytest
+
+import hovering
+from conftest import PROMPT, CtrlCOnceStarted
+from hovering import Curve, ImpactZone, paper
+from hovering.analysis.barriers import _envelopes, launch_points
+
+TWO_PI = 2.0 * math.pi
+
+
+def standard_map(k):
+    """The truncated map with Omega0 = 0, tau0 = 1 is Chirikov's standard map on K >= 0 (J_0u:
+    phibar = phi + K, Kbar = K + k sin phibar); (phi, K) = (x, p) on the line phi = 0."""
+    return hovering.TruncatedMap(eps=k, Omega0=0.0, theta_w=3 * math.pi / 4)
+
+
+def band(lo, hi):
+    return ImpactZone(ceiling=Curve.constant(hi), floor=Curve.constant(lo))
+
+
+# ------------------------------------------------------------------------------------------------
+# Known answers
+
+
+def test_eps0_every_level_is_a_barrier_with_the_start_spacing_as_margin():
+    """At eps = 0 the truncated map keeps K: every orbit stays on its level, so every cut is a
+    barrier and its margin is exactly the spacing of the starts in s (to rounding of s)."""
+    m = paper.truncated_map(0.0)
+    r = hovering.barrier_scan(m, band(-0.3, 0.2), n_starts=12, n_steps=2000, line="L1")
+    assert r.barrier.all() and len(r.layers) == 12
+    np.testing.assert_allclose(r.margin, 1.0 / 12, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(r.s_min, r.s0, atol=1e-12)
+    np.testing.assert_allclose(r.s_max, r.s0, atol=1e-12)
+    assert set(r.kind) == {"circle"}
+    # the levels below K = 0 impact (J_1, J_R), those above never do
+    assert np.array_equal(r.impact_fraction > 0, r.K0 < 0)
+    assert r.spanning(0.1, 0.9).size == 0
+
+
+def test_standard_map_k05_circles_are_barriers():
+    """k = 0.5: most starts on phi = 0 lie on KAM circles, and a cut between two circles is a
+    barrier (an invariant circle separates the cylinder); no orbit spans the band."""
+    r = hovering.barrier_scan(standard_map(0.5), band(TWO_PI, 2 * TWO_PI), n_starts=24, n_steps=4000, line=0.0)
+    circ = r.kind == "circle"
+    assert circ.sum() >= 14
+    both = circ[:-1] & circ[1:]
+    assert both.sum() >= 8 and np.all(r.barrier[both])
+    assert r.spanning(0.2, 0.8).size == 0
+    # converse KAM applies (J_0u of a TruncatedMap) and never fires on a circle
+    assert set(r.cone[circ]) == {"none"}
+
+
+def test_standard_map_k09_keeps_a_barrier_and_k12_has_none():
+    """k = 0.9 < k_c = 0.9716: the golden circle survives and divides the band [1.4 pi, 2.6 pi]
+    (it crosses phi = 0 near p = 4.18 at k = 0.9716): at least one barrier, and one orbit on each
+    side of it. k = 1.2: no rotational circle exists (MacKay-Percival 63/64), and in 2e4 steps
+    the orbits of the band mix across it: no barrier, one chaotic layer; the cone crossing
+    certifies it for most starts."""
+    zone = band(1.4 * math.pi, 2.6 * math.pi)
+    r09 = hovering.barrier_scan(standard_map(0.9), zone, n_starts=24, n_steps=20_000, line=0.0)
+    assert r09.barrier.any()
+    golden = [b for b in r09.barriers if 0.1 < b < 0.9]  # the golden level is inside the band
+    assert golden, r09.summary()
+    r12 = hovering.barrier_scan(standard_map(1.2), zone, n_starts=24, n_steps=20_000, line=0.0)
+    assert not r12.barrier.any(), r12.summary()
+    (layer,) = r12.layers
+    assert layer.kind == "chaotic" and layer.counts["circle"] == 0
+    assert np.mean(r12.cone == "crossing") > 0.5
+    assert r12.spanning(0.1, 0.9).size > 0
+
+
+def test_margins_are_the_brute_force_per_cut_loop():
+    """The vectorised margins against a plain loop over cuts and bins on the points themselves
+    (the same definition, computed independently from the recorded orbits)."""
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    r = hovering.barrier_scan(m, zone, n_starts=10, n_steps=1024, n_bins=16, s_range=(0.5, 1.0))
+    res = m.iterate(r.phi0, r.K0, 1024, record=("orbit",))
+    s = zone.s(res.phi, res.K)
+    hi, lo = _envelopes(res.phi, s, 16)
+    for c in range(9):
+        worst = math.inf
+        for b in range(16):
+            below = max(hi[j, b] for j in range(c + 1))
+            above = [min(lo[j, bb % 16] for j in range(c + 1, 10)) for bb in (b - 1, b, b + 1)]
+            above = [a if math.isfinite(a) else above[1] for a in above]
+            gap = max(above) - below
+            if not math.isnan(gap):
+                worst = min(worst, gap)
+        assert r.margin[c] == pytest.approx(worst, abs=0, rel=0) or (math.isinf(worst) and np.isnan(r.margin[c]))
+        assert r.barrier[c] == (worst >= 0)
+    # the extremes of s are those of the recorded orbits
+    np.testing.assert_array_equal(r.s_min, np.nanmin(s, axis=1))
+    np.testing.assert_array_equal(r.s_max, np.nanmax(s, axis=1))
+
+
+def test_launch_points_lie_on_the_line_at_their_level():
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    s = np.linspace(0.05, 0.95, 7)
+    for line in ("L1", "L2", 1.0):
+        phi, K = launch_points(m, zone, s, line)
+        want = m.L1(K) if line == "L1" else m.L2(K) if line == "L2" else np.full_like(K, 1.0)
+        np.testing.assert_allclose(phi, want, atol=1e-12)
+        np.testing.assert_allclose(zone.s(phi, K), s, atol=1e-9)
+
+
+# ------------------------------------------------------------------------------------------------
+# Execution: executor, Ctrl-C, saving, bad input
+
+
+def test_an_executor_gives_the_one_process_answer():
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    kw = dict(n_starts=12, n_steps=2000, s_range=(0.6, 1.0))
+    one = hovering.barrier_scan(m, zone, **kw)
+    with cf.ThreadPoolExecutor(2) as pool:
+        many = hovering.barrier_scan(m, zone, executor=hovering.parallel.Executor(pool=pool, pieces=3), **kw)
+    for f in ("kind", "period", "s_min", "s_max", "margin", "barrier", "impact_fraction", "cone", "status"):
+        assert np.array_equal(getattr(one, f), getattr(many, f), equal_nan=f in ("margin",)), f
+
+
+def test_ctrl_c_keeps_the_orbits_so_far():
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    press = CtrlCOnceStarted()
+    with pytest.raises(KeyboardInterrupt) as info:
+        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, progress=press)
+    assert time.perf_counter() - press.fired_at < PROMPT
+    part = info.value.partial
+    assert not part.complete and len(part) == 4
+    cut_short = part.status == hovering.Status.INTERRUPTED
+    assert cut_short.any() and not part.barrier.any()
+    # an orbit that ended on its own (here: left the band) keeps its verdict; the others have none
+    assert np.all((part.decided_by == "interrupted") == cut_short)
+    assert np.all(part.kind[cut_short] == "undecided")
+
+
+def test_results_save_and_load(tmp_path):
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    r = hovering.barrier_scan(m, zone, n_starts=6, n_steps=600)
+    back = hovering.load(hovering.save(r, tmp_path / "scan.npz"))
+    assert back.summary() == r.summary()
+    assert np.array_equal(back.margin, r.margin, equal_nan=True)
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        (dict(n_starts=1), r"n_starts must be an integer in \[2, 100000\], got 1"),
+        (dict(n_steps=10), r"n_steps must be an integer in \[256, "),
+        (dict(s_range=(0.8, 0.2)), r"s_range must rise: got \(0.8, 0.2\)"),
+        (dict(s_range="ab"), "s_range must be two zone levels"),
+        (dict(line="L3"), "line must be 'L1', 'L2' or an angle, got 'L3'"),
+        (dict(line=4.0), r"line must lie in \[-3.14159.*got 4"),
+        (dict(s_range=(-50.0, 1.0)), r"lies outside the map's band"),
+        (dict(n_bins=2), r"n_bins must be an integer in \[4, "),
+    ],
+)
+def test_bad_input_is_named_before_any_work(kw, match):
+    m = paper.truncated_map(0.3)
+    zone = ImpactZone(ceiling=Curve.constant(0.3), floor=Curve.constant(-0.3))
+    t = time.process_time()
+    with pytest.raises(ValueError, match=match):
+        hovering.barrier_scan(m, zone, **{"n_steps": 10**9, **kw})
+    assert time.process_time() - t < 5  # refused, not computed
+    with pytest.raises(ValueError, match="zone must be a hovering.ImpactZone"):
+        hovering.barrier_scan(m, (0, 1))
