@@ -62,6 +62,9 @@ CORNER_STYLES = {"01": ":", "1R": "--", "R0": "-."}
 #: Grey of K = 0, L1, L2 and the step's walls.
 GEOMETRY_COLOR = "0.55"
 
+#: Orbit classes (hovering.classify_orbits) in the impact-zone figure.
+CLASS_COLORS = {"circle": "#1f77b4", "islands": "#2ca02c", "chaotic": "#d62728", "undecided": "#9a9a9a"}
+
 #: Title suffix of a quick run.
 QUICK_MARK = " [quick]"
 

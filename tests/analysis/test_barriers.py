@@ -153,7 +153,11 @@ def test_ctrl_c_keeps_the_orbits_so_far():
 def test_results_save_and_load(tmp_path):
     m = paper.truncated_map(0.3)
     zone = hovering.impact_zone(m, n_steps=5000)
-    r = hovering.barrier_scan(m, zone, n_starts=6, n_steps=600)
+    r = hovering.barrier_scan(m, zone, n_starts=6, n_steps=600, keep=7)
+    full = m.iterate(r.phi0, r.K0, 600, record=("orbit",))
+    take = [0, 100, 200, 300, 400, 500, 600]  # keep=7 over 600 returns: evenly strided, ends included
+    assert np.array_equal(r.phi, full.phi[:, take], equal_nan=True)
+    assert np.array_equal(r.K, full.K[:, take], equal_nan=True)
     back = hovering.load(hovering.save(r, tmp_path / "scan.npz"))
     assert back.summary() == r.summary()
     assert np.array_equal(back.margin, r.margin, equal_nan=True)
@@ -170,6 +174,7 @@ def test_results_save_and_load(tmp_path):
         (dict(line=4.0), r"line must lie in \[-3.14159.*got 4"),
         (dict(s_range=(-50.0, 1.0)), r"lies outside the map's band"),
         (dict(n_bins=2), r"n_bins must be an integer in \[4, "),
+        (dict(keep=-1), r"keep must be an integer in \[0, "),
     ],
 )
 def test_bad_input_is_named_before_any_work(kw, match):

@@ -28,6 +28,7 @@ SCENE_DIR = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "fig_hov_vs_eps"}
 FLOW = {"flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma"}  # tests/scenes/test_flow_scenes.py
 PAPER_FIGURES = {"fig_corner_directions", "fig_sigma0_wall", "fig_wallsection"}  # tests/scenes/test_paper_figures.py
+ZONE = {"impact_zone", "impact_zone_neg", "impact_zone_second"}  # tests/scenes/test_impact_zone_scene.py
 SCENE_FILES = [SCENE_DIR / f"{n}.toml" for n in sorted(EXPECTED)]
 
 
@@ -41,7 +42,7 @@ def _raw(name):
 
 
 def test_one_scene_file_per_figure():
-    assert {p.stem for p in SCENE_DIR.glob("*.toml")} == EXPECTED | FLOW | PAPER_FIGURES
+    assert {p.stem for p in SCENE_DIR.glob("*.toml")} == EXPECTED | FLOW | PAPER_FIGURES | ZONE
 
 
 @pytest.mark.parametrize("path", SCENE_FILES, ids=[p.stem for p in SCENE_FILES])

@@ -115,6 +115,9 @@ class BarrierScan(Saveable):
     complete : bool
         False for the partial result of an interrupted scan (orbits not computed are
         ``"undecided"`` with ``decided_by == "interrupted"``; no barrier is claimed next to them).
+    phi, K : ndarray or None
+        With ``keep=k``: k points of each orbit, evenly strided over its returns (NaN after an
+        orbit ended), shape ``(n, k)``, for drawing.
     """
 
     line: str
@@ -136,6 +139,8 @@ class BarrierScan(Saveable):
     cone: np.ndarray
     n_bins: int
     complete: bool = True
+    phi: np.ndarray | None = None
+    K: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.s0.size)
@@ -294,7 +299,7 @@ def _envelopes(phi, s, n_bins):
     return hi.reshape(n, n_bins), lo.reshape(n, n_bins)
 
 
-def _scan_piece(m, zone, phi0, K0, n_steps, n_bins, classify, kwargs):
+def _scan_piece(m, zone, phi0, K0, n_steps, n_bins, classify, kwargs, keep=0):
     """Iterate, classify and reduce one piece of starts (runs in any process); returns small arrays."""
     interrupted = False
     try:
@@ -329,6 +334,9 @@ def _scan_piece(m, zone, phi0, K0, n_steps, n_bins, classify, kwargs):
         # an orbit is done when it ran its steps or ended for a reason of its own (not Ctrl-C)
         "computed": np.asarray(res.status) != int(Status.INTERRUPTED),
     }
+    if keep:
+        take = np.linspace(0, n_steps, keep).round().astype(np.int64)
+        out["phi"], out["K"] = res.phi[:, take], res.K[:, take]
     return out, interrupted
 
 
@@ -365,6 +373,7 @@ def barrier_scan(
     cone_steps: int = 2000,
     executor=None,
     classify: dict | None = None,
+    keep: int = 0,
     **iterate_kwargs,
 ) -> BarrierScan:
     """Scan the impact zone along a symmetry line for layers and two-sided barriers.
@@ -399,6 +408,8 @@ def barrier_scan(
         the one-process result.
     classify : dict, optional
         Options of :func:`hovering.analysis.orbits.classify_orbits`.
+    keep : int, optional
+        Points of each orbit kept in the result (``phi``, ``K``; 0: none), 0 .. n_steps + 1.
     **iterate_kwargs
         Passed to ``m.iterate`` (``n_threads``, ``kernel``, ``progress``, ...).
 
@@ -428,6 +439,7 @@ def barrier_scan(
         raise ValueError(f"s_range must rise: got ({a}, {b})")
     n_bins = integer("n_bins", n_bins if n_bins is not None else min(1024, max(16, n_steps // 64)), 4, 1 << 16)
     classify = dict(classify or {})
+    keep = integer("keep", keep, 0, n_steps + 1)
     spec = as_executor(executor)
 
     s0 = a + (np.arange(n_starts) + 0.5) * (b - a) / n_starts
@@ -448,7 +460,9 @@ def barrier_scan(
     try:
         if spec is None:
             for j, (i0, i1) in enumerate(cuts):
-                parts[j], stop = _scan_piece(m, zone, phi0[i0:i1], K0[i0:i1], n_steps, n_bins, classify, iterate_kwargs)
+                parts[j], stop = _scan_piece(
+                    m, zone, phi0[i0:i1], K0[i0:i1], n_steps, n_bins, classify, iterate_kwargs, keep
+                )
                 if stop:
                     interrupted = True
                     break
@@ -456,13 +470,13 @@ def barrier_scan(
             with open_executor(**spec.where()) as ex:
                 kw = dict(iterate_kwargs)
                 kw.setdefault("n_threads", ex.threads_per_piece)
-                args = [(m, zone, phi0[i0:i1], K0[i0:i1], n_steps, n_bins, classify, kw) for i0, i1 in cuts]
+                args = [(m, zone, phi0[i0:i1], K0[i0:i1], n_steps, n_bins, classify, kw, keep) for i0, i1 in cuts]
                 for j, part in run_pieces(ex, _scan_piece, args):
                     parts[j], stop = part
                     interrupted |= stop
     except KeyboardInterrupt:
         interrupted = True
-    result = _assemble(m, line_name, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, not interrupted)
+    result = _assemble(m, line_name, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, not interrupted, keep)
     if interrupted:
         exc = KeyboardInterrupt("barrier_scan interrupted; the orbits so far are in .partial")
         exc.partial = result  # type: ignore[attr-defined]
@@ -470,8 +484,9 @@ def barrier_scan(
     return result
 
 
-def _assemble(m, line, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, complete) -> BarrierScan:
+def _assemble(m, line, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, complete, keep=0) -> BarrierScan:
     n = s0.size
+    kept = (np.full((n, keep), np.nan), np.full((n, keep), np.nan)) if keep else (None, None)
     cols = {
         "kind": np.full(n, "undecided", dtype=object),
         "period": np.zeros(n, dtype=np.int64),
@@ -493,6 +508,8 @@ def _assemble(m, line, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, c
             cols[k][i0:i1] = part[k]
         hi[i0:i1], lo[i0:i1] = part["hi"], part["lo"]
         computed[i0:i1] = part["computed"]
+        if keep:
+            kept[0][i0:i1], kept[1][i0:i1] = part["phi"], part["K"]
         cols["decided_by"][i0:i1] = np.where(part["computed"], part["decided_by"], "interrupted")
         cols["kind"][i0:i1] = np.where(part["computed"], part["kind"], "undecided")
     margin, barrier = _margins(hi, lo, computed)
@@ -521,4 +538,6 @@ def _assemble(m, line, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, c
         cone=cone.astype(str),
         n_bins=n_bins,
         complete=complete,
+        phi=kept[0],
+        K=kept[1],
     )

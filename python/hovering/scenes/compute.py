@@ -22,6 +22,9 @@ from .._progress import check_progress, progress_bar
 from .._style import SPECIAL_COLORS, orbit_color
 from .._version import __version__
 from ..analysis import rotation_number
+from ..analysis.barriers import barrier_scan
+from ..analysis.transit import transit
+from ..analysis.zone import impact_zone
 from ..diagnostics.work_precision import _reverse
 from ..flow.section import Section
 from ..normal.coordinates import TangentialCurve
@@ -40,6 +43,7 @@ from .results import (
     FlowPortraitResult,
     Geometry,
     HoveringAreaResult,
+    ImpactZoneResult,
     OrbitPanelResult,
     OrbitSceneResult,
     OrbitSet,
@@ -52,6 +56,7 @@ from .results import (
     WallSectionResult,
     WallSegment,
     WallTangencyResult,
+    ZoneStudy,
     ZoomPanelResult,
 )
 from .spec import (
@@ -60,6 +65,7 @@ from .spec import (
     FlowHoveringScene,
     FlowPortraitScene,
     HoveringAreaScene,
+    ImpactZoneScene,
     OrbitScene,
     PanelSpec,
     SceneSpec,
@@ -1159,6 +1165,59 @@ def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) ->
     )
 
 
+def _zone_study(name, m, zone, scene: ImpactZoneScene, n_scan: int, n_transit: int, progress) -> ZoneStudy:
+    """The scan and both transits of one map in its zone."""
+    sec = {}
+    t = time.perf_counter()
+    scan = barrier_scan(
+        m,
+        zone,
+        n_starts=scene.n_starts,
+        n_steps=n_scan,
+        line=scene.line,
+        keep=min(scene.keep, n_scan + 1),
+        **_progress_kw(progress),
+    )
+    sec["scan"] = time.perf_counter() - t
+    t = time.perf_counter()
+    kw = dict(n_orbits=scene.transit_orbits, n_steps=n_transit, **_progress_kw(progress))
+    up = transit(m, zone, "up", start_s=0.05, target_s=1.0, **kw)
+    down = transit(m, zone, "down", start_s=0.95, target_s=0.0, **kw)
+    sec["transit"] = time.perf_counter() - t
+    return ZoneStudy(name=name, zone=zone, scan=scan, up=up, down=down, seconds=sec)
+
+
+def _impact_zone(scene: ImpactZoneScene, quick: bool, progress, meta: dict) -> ImpactZoneResult:
+    n_scan, n_transit = scaled(scene.n_steps, quick, floor=1000), scaled(scene.transit_steps, quick, floor=200)
+    n_crit = scaled(scene.critical_steps, quick, floor=2000)
+    f = scene.model_factor
+    meta.update(n_steps=n_scan, transit_steps=n_transit, critical_steps=n_crit)
+    t = time.perf_counter()
+    fm = _flowmap(scene)
+    tm = fm.truncated(forcing=scene.model)
+    fzone = impact_zone(fm, n_steps=n_crit)
+    # The model has no floor of its own: it is measured in the flow's zone coordinate, between its
+    # own critical curve and the flow's floor (the torus tangent to the upper wall).
+    mzone = impact_zone(tm, n_steps=n_crit, floor=fzone.floor)
+    meta["timings"]["zones"] = time.perf_counter() - t
+    t = time.perf_counter()
+    flow = _zone_study("flow", fm, fzone, scene, n_scan, n_transit, progress)
+    meta["timings"]["flow"] = time.perf_counter() - t
+    t = time.perf_counter()
+    model = _zone_study(scene.model, tm, mzone, scene, n_scan * f, n_transit * f, progress)
+    meta["timings"]["model"] = time.perf_counter() - t
+    p = fm.onset
+    return ImpactZoneResult(
+        scene=scene,
+        meta=meta,
+        flow=flow,
+        model=model,
+        model_name=scene.model,
+        onset=dict(Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam),
+        b1=float(fm.forcing_coefficients()[0]),
+    )
+
+
 def scene_map(scene: SceneSpec):
     """The map a scene is about: an orbit scene's first panel's, a hovering-area scene's first
     series at its first eps, a flow scene's :class:`~hovering.FlowMap` (its system, section and
@@ -1268,6 +1327,8 @@ def compute(
         out = _wall_tangency(scene, quick, progress, meta)
     elif isinstance(scene, WallSectionScene):
         out = _wall_section(scene, quick, progress, meta)
+    elif isinstance(scene, ImpactZoneScene):
+        out = _impact_zone(scene, quick, progress, meta)
     else:
         raise ValueError(f"no computation for scene kind {scene.kind!r}")
     meta["timings"]["total"] = time.perf_counter() - t0

@@ -96,7 +96,7 @@ def format_summary(summary: dict) -> str:
                 f"    eps = {f(r['eps'], '+.3f')}: |HOV| = {f(r['area'], '.4f')} +- {f(r['error'], '.4f')}, "
                 f"theory {f(r['theory'], '.4f')}{flag}"
             )
-    if "flow" in summary and "model" in summary:
+    if "flow" in summary and "model" in summary and summary.get("kind") == "flow_portrait":
         o = summary["onset"]
         lines.append(
             f"  onset: Omega0 = {f(o['Omega0'], '.5f')}, theta_w = {f(o['theta_w'], '.5f')}, "
@@ -160,6 +160,23 @@ def format_summary(summary: dict) -> str:
                 f"p2 = {f(p['p2'], '+.4f')}: step system {p['status']} {p['itinerary']!r}"
             )
         lines.append(f"  interior regions {summary['regions']}")
+    if kind == "impact_zone":
+        lines.append(f"  the model ({summary['model_name']} forcing) acts with eps b1, b1 = {f(summary['b1'], '.4f')}")
+        for name in ("flow", "model"):
+            d = summary[name]
+            lines.append(
+                f"  {name:>5}: {d['starts']} starts x {d['n_steps']} returns: classes {d['classes']}, "
+                f"{len(d['barriers'])} barrier(s) at s = {', '.join(f(b, '.3f') for b in d['barriers']) or '-'}; "
+                f"{d['spanning']} orbit(s) span s 0.1..0.9"
+            )
+            for direction in ("up", "down"):
+                t = d[direction]
+                rate = t["escape_rate"]
+                lines.append(
+                    f"         {direction}: {t['crossed']}/{t['orbits']} crossed s {f(t['start_s'], 'g')} -> "
+                    f"{f(t['target_s'], 'g')} in {t['n_steps']} returns, s reached {f(t['s_reached'], '.3f')}"
+                    + (f", rate {f(rate[0], '.2g')} +- {f(rate[1], '.1g')}" if rate else "")
+                )
     if kind == "wall_section":
         b, a = summary["boundaries"], summary["arcs"]
         lines.append(

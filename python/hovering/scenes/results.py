@@ -17,6 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import _serial
+from ..analysis.barriers import BarrierScan
+from ..analysis.transit import TransitResult
+from ..analysis.zone import ImpactZone
 from .._enums import Region, Status
 from .._output import write_text
 from .._provenance import provenance
@@ -46,6 +49,8 @@ __all__ = [
     "WallTangencyResult",
     "WallSegment",
     "WallSectionResult",
+    "ZoneStudy",
+    "ImpactZoneResult",
     "load_result",
     "jsonable",
 ]
@@ -973,6 +978,113 @@ def _region_counts(region) -> dict:
     return {Region(r).label: int(np.count_nonzero(region == int(r))) for r in Region if r != Region.NONE}
 
 
+@dataclass
+class ZoneStudy:
+    """One map's answer to "does anything cross the impact zone?" (an ``impact_zone`` scene).
+
+    Attributes
+    ----------
+    name : str
+        ``"flow"`` or the model's name.
+    zone : ImpactZone
+        Its floor and ceiling.
+    scan : BarrierScan
+        Layers and barriers along the scene's line (with ``keep`` points of each orbit).
+    up, down : TransitResult
+        Orbits from s = 0.05 towards the ceiling and from s = 0.95 towards the floor.
+    seconds : dict
+        Seconds per stage (``zone``, ``scan``, ``transit``).
+    """
+
+    name: str = ""
+    zone: ImpactZone = None
+    scan: BarrierScan = None
+    up: TransitResult = None
+    down: TransitResult = None
+    seconds: dict = field(default_factory=dict)
+
+    def _validate_loaded(self) -> None:
+        for k in ("zone", "scan", "up", "down"):
+            want = ImpactZone if k == "zone" else BarrierScan if k == "scan" else TransitResult
+            if not isinstance(getattr(self, k), want):
+                raise ValueError(f"{k} must be a {want.__name__}, got {type(getattr(self, k)).__name__}")
+        if len(self.name) > MAX_TEXT:
+            raise ValueError(f"name: a string of {len(self.name)} characters; allowed: at most {MAX_TEXT}")
+
+    def summary(self) -> dict:
+        """The numbers of the study, JSON-able: layers, barriers, transit fractions and extremes.
+
+        Returns
+        -------
+        dict
+        """
+        sc = self.scan
+        out = dict(
+            name=self.name,
+            floor=self.zone.floor_kind,
+            starts=len(sc),
+            n_steps=sc.n_steps,
+            classes={k: int(np.count_nonzero(sc.kind == k)) for k in ("circle", "islands", "chaotic", "undecided")},
+            barriers=[float(b) for b in sc.barriers],
+            layers=[
+                dict(
+                    s_start=list(ly.s_start),
+                    s=[ly.s_min, ly.s_max],
+                    kind=ly.kind,
+                    periods=list(ly.periods),
+                    impacting=ly.impacting,
+                )
+                for ly in sc.layers
+            ],
+            spanning=int(sc.spanning(0.1, 0.9).size),
+            seconds=self.seconds,
+        )
+        for d in ("up", "down"):
+            t = getattr(self, d)
+            rate = t.escape_rate
+            out[d] = dict(
+                orbits=int(t.crossed.size),
+                n_steps=t.n_steps,
+                start_s=t.start_s,
+                target_s=t.target_s,
+                crossed=int(np.count_nonzero(t.crossed)),
+                fraction=t.fraction,
+                fraction_error=t.fraction_error,
+                s_reached=float(np.nanmax(t.s_max) if d == "up" else np.nanmin(t.s_min)),
+                escape_rate=list(rate) if rate is not None else None,
+            )
+        return out
+
+
+@dataclass
+class ImpactZoneResult(SceneResult):
+    """Result of an ``impact_zone`` scene: the flow's and its model's :class:`ZoneStudy`.
+
+    Attributes
+    ----------
+    flow, model : ZoneStudy
+        The two studies.
+    model_name : str
+        ``"measured"`` or ``"first_mode"``.
+    onset : dict
+        The onset parameters (Omega0, theta_w, tau0, tau1, lam).
+    b1 : float
+        First mode of the measured forcing: the model acts with eps b1.
+    """
+
+    flow: ZoneStudy = None
+    model: ZoneStudy = None
+    model_name: str = "measured"
+    onset: dict = field(default_factory=dict)
+    b1: float = float("nan")
+
+    def _validate_loaded(self) -> None:
+        super()._validate_loaded()
+        for k in ("flow", "model"):
+            if not isinstance(getattr(self, k), ZoneStudy):
+                raise ValueError(f"{k} must be a ZoneStudy, got {type(getattr(self, k)).__name__}")
+
+
 def summarize(result) -> dict:
     """The numbers a scene result shows, as a JSON-able dict.
 
@@ -1117,6 +1229,9 @@ def summarize(result) -> dict:
             for p in result.points
         ]
         s["regions"] = _region_counts(result.grid["region"])
+    elif isinstance(result, ImpactZoneResult):
+        s.update(onset=result.onset, b1=result.b1, model_name=result.model_name)
+        s["flow"], s["model"] = result.flow.summary(), result.model.summary()
     elif isinstance(result, WallSectionResult):
         b = result.boundaries
         two_pi = 2 * math.pi

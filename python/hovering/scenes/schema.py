@@ -31,6 +31,7 @@ from .spec import (
     FlowHoveringScene,
     FlowPortraitScene,
     HoveringAreaScene,
+    ImpactZoneScene,
     IntegratorSpec,
     MapSpec,
     OrbitScene,
@@ -360,6 +361,17 @@ _CRITICAL_KEYS = ("n_steps", "K_range", "line", "color")
 _HOV_KEYS = _COMMON_KEYS + ("map", "n_steps", "samples", "seed", "eps", "series")
 _SERIES_KEYS = ("label", "golden_c", "color", "K_low") + _MAP_KEYS
 
+_ZONE_KEYS = (
+    "n_starts",
+    "n_steps",
+    "transit_orbits",
+    "transit_steps",
+    "model_factor",
+    "model",
+    "line",
+    "critical_steps",
+    "keep",
+)
 # The physical flow: the tables that name a scene's effects.
 _FLOW_COMMON = _COMMON_KEYS + ("system", "section", "integrator", "outputs")
 _FLOW_KEYS = {
@@ -370,6 +382,7 @@ _FLOW_KEYS = {
     "corner_directions": _FLOW_COMMON + ("p1w_fractions", "n_curve"),
     "wall_tangency": _FLOW_COMMON + ("grid", "n_points", "marker_size"),
     "wall_section": _FLOW_COMMON + ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments"),
+    "impact_zone": _FLOW_COMMON + _ZONE_KEYS,
 }
 _FLOW_REQUIRED = {
     "flow_portrait": ("n_steps",),
@@ -379,6 +392,7 @@ _FLOW_REQUIRED = {
     "corner_directions": (),
     "wall_tangency": (),
     "wall_section": (),
+    "impact_zone": (),
 }
 #: The scene's own keys of each kind, as ``scene_table`` writes them back (after the common ones).
 _KIND_KEYS = {
@@ -389,6 +403,7 @@ _KIND_KEYS = {
     "corner_directions": ("p1w_fractions", "n_curve"),
     "wall_tangency": ("grid", "n_points", "marker_size"),
     "wall_section": ("rho_w_fraction", "n_theta", "n_circles", "bisections", "segments"),
+    "impact_zone": _ZONE_KEYS,
 }
 # (allowed, required) records per kind: a figure's own needs are required, the rest optional.
 _FLOW_RECORDS = {
@@ -399,6 +414,7 @@ _FLOW_RECORDS = {
     "corner_directions": (("trajectory",), ("trajectory",)),
     "wall_tangency": (("regions", "trajectory"), ("regions", "trajectory")),
     "wall_section": (("regions", "trajectory"), ("regions", "trajectory")),
+    "impact_zone": ((), ()),
 }
 _SYSTEM_KEYS = ("V1", "V2", "coupling", "eps", "qw1", "qw2", "geometry")
 _POTENTIAL_KEYS = ("kind", "omega", "alpha")
@@ -918,6 +934,7 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
             "corner_directions",
             "wall_tangency",
             "wall_section",
+            "impact_zone",
         )
         and system.geometry != "step"
     ):
@@ -970,6 +987,8 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
         )
     if kind in ("corner_directions", "wall_tangency", "wall_section"):
         return _parse_wall_scene(where, kind, data, common)
+    if kind == "impact_zone":
+        return _parse_zone_scene(where, data, common)
     grid = (240, 60)
     if "grid" in data:
         gv = data["grid"]
@@ -985,6 +1004,31 @@ def _parse_flow_scene(where: str, kind: str, data: dict, common: dict) -> SceneS
             if "marker_size" in data
             else 1.0
         ),
+        **common,
+    )
+
+
+def _parse_zone_scene(where: str, data: dict, common: dict) -> SceneSpec:
+    """The ``impact_zone`` kind: counts bounded so that a scene from elsewhere cannot ask for days."""
+    if common["system"].eps == 0:
+        raise ValueError(
+            f"{where}.system.eps = 0: at eps = 0 every level K is invariant and the zone has no critical "
+            "curve; allowed: eps != 0"
+        )
+
+    def num(key, lo, hi, default):
+        return _int(f"{where}.{key}", data[key], lo, hi) if key in data else default
+
+    return ImpactZoneScene(
+        n_starts=num("n_starts", 2, 2000, 40),
+        n_steps=num("n_steps", 256, 10_000_000, 20_000),
+        transit_orbits=num("transit_orbits", 1, 100_000, 40),
+        transit_steps=num("transit_steps", 1, 100_000_000, 100_000),
+        model_factor=num("model_factor", 1, 1000, 20),
+        model=_str(f"{where}.model", data["model"], ("measured", "first_mode")) if "model" in data else "measured",
+        line=_str(f"{where}.line", data["line"], ("L1", "L2")) if "line" in data else "L1",
+        critical_steps=num("critical_steps", 500, 10_000_000, 20_000),
+        keep=num("keep", 0, 100_000, 2000),
         **common,
     )
 

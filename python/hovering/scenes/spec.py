@@ -41,6 +41,7 @@ __all__ = [
     "CornerDirectionsScene",
     "WallTangencyScene",
     "WallSectionScene",
+    "ImpactZoneScene",
     "Scene",
     "figure_inches",
 ]
@@ -56,6 +57,7 @@ FLOW_KINDS = (
     "corner_directions",
     "wall_tangency",
     "wall_section",
+    "impact_zone",
 )
 #: Every kind of scene.
 KINDS = TRUNCATED_KINDS + FLOW_KINDS
@@ -709,6 +711,48 @@ class WallSectionScene(FlowScene):
     segments: int = 2
 
 
+@dataclass(frozen=True, kw_only=True)
+class ImpactZoneScene(FlowScene):
+    """``impact_zone``: does anything cross the impact zone? The flow and its model side by side.
+
+    For each map (the flow's return map and its truncated model): the zone between the critical
+    curve and the floor (:func:`hovering.impact_zone`), a :func:`hovering.barrier_scan` along a
+    symmetry line (layers by class, two-sided barriers) and :func:`hovering.transit` up from near
+    the floor and down from near the ceiling.
+
+    Attributes
+    ----------
+    n_starts : int
+        Starts of the barrier scan.
+    n_steps : int
+        Returns per orbit of the scan (steps of the model).
+    transit_orbits : int
+        Orbits per transit direction.
+    transit_steps : int
+        Returns per transit orbit (the model gets ``model_factor`` times more steps).
+    model_factor : int
+        How many more steps the model's orbits get than the flow's (it is ~1000x cheaper per step).
+    model : {"measured", "first_mode"}
+        The truncated model.
+    line : {"L1", "L2"}
+        Where the scan's starts lie.
+    critical_steps : int
+        Iterates per tested orbit of the critical-curve search (the zone's ceiling).
+    keep : int
+        Points of each scan orbit drawn.
+    """
+
+    n_starts: int = 40
+    n_steps: int = 20_000
+    transit_orbits: int = 40
+    transit_steps: int = 100_000
+    model_factor: int = 20
+    model: str = "measured"
+    line: str = "L1"
+    critical_steps: int = 20_000
+    keep: int = 2000
+
+
 #: Old name of the truncated orbit scenes' spec (kept for one release).
 Scene = SceneSpec
 
@@ -723,6 +767,7 @@ _FIGSIZE = {
     "corner_directions": (12.0, 10.0),
     "wall_tangency": (18.0, 6.2),
     "wall_section": (12.0, 10.0),
+    "impact_zone": (14.0, 10.0),
 }
 
 
