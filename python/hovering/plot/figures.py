@@ -1014,10 +1014,10 @@ def impact_zone_figure(result: ImpactZoneResult):
         bottom.set_ylim(-0.1, 1.1)
         bottom.set_xlabel(f"start level $s_0$ on {sc.line}")
         bottom.set_ylabel("levels visited by the orbit")
-        bottom.set_title(f"({'cd'[col]}) layers; no orbit spans s 0.1..0.9: {sc.spanning(0.1, 0.9).size == 0}", fontsize=8)
-        bottom.text(
-            0.02, 0.98, _transit_text(study), transform=bottom.transAxes, fontsize=7, va="top", gid="transit"
+        bottom.set_title(
+            f"({'cd'[col]}) layers; no orbit spans s 0.1..0.9: {sc.spanning(0.1, 0.9).size == 0}", fontsize=8
         )
+        bottom.text(0.02, 0.98, _transit_text(study), transform=bottom.transAxes, fontsize=7, va="top", gid="transit")
     fig.suptitle(
         scene.title + "\n" + _system_text(scene) + f"; the model acts with eps b1 = {scene.system.eps * result.b1:.4g}",
         fontsize=9,

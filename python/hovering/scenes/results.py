@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import _serial
-from ..analysis.barriers import BarrierScan
-from ..analysis.transit import TransitResult
-from ..analysis.zone import ImpactZone
 from .._enums import Region, Status
 from .._output import write_text
 from .._provenance import provenance
+from ..analysis.barriers import BarrierScan
+from ..analysis.transit import TransitResult
+from ..analysis.zone import ImpactZone
 from .schema import MAX_TEXT, _color, _str
 from .spec import SceneSpec
 
