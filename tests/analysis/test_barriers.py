@@ -83,6 +83,23 @@ def test_standard_map_k09_keeps_a_barrier_and_k12_has_none():
     assert r12.spanning(0.1, 0.9).size > 0
 
 
+def test_the_critical_curve_is_a_barrier_between_impacting_layers_and_circles():
+    """The ceiling s = 1 is the critical invariant curve (the lowest circle that never impacts):
+    the cut across it is a barrier, every start above it lies on a non-impacting circle where the
+    converse-KAM test finds no crossing, and every start below it impacts (eps = 0.3, measured:
+    margin 0.0047 at the cut, starts spaced 0.01)."""
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=20_000)
+    r = hovering.barrier_scan(m, zone, n_starts=20, n_steps=20_000, s_range=(0.9, 1.1))
+    above = r.s0 > 1.0
+    cut = int(np.argmax(above)) - 1
+    assert r.barrier[cut] and r.s0[cut] < 1.0 < r.s0[cut + 1]
+    assert np.all(r.kind[above] == "circle") and np.all(r.impact_fraction[above] == 0)
+    assert np.all(r.cone[above] == "none")
+    assert np.all(r.impact_fraction[~above] > 0) and np.all(r.cone[~above] == "left_domain")
+    assert np.all(r.s_max[~above] <= 1.0 + 1e-6)  # nothing below rose through the critical curve
+
+
 def test_margins_are_the_brute_force_per_cut_loop():
     """The vectorised margins against a plain loop over cuts and bins on the points themselves
     (the same definition, computed independently from the recorded orbits)."""

@@ -79,3 +79,20 @@ def test_a_zone_saves_and_loads(tmp_path):
     hovering.save(z, tmp_path / "z.npz")
     back = hovering.load(tmp_path / "z.npz")
     assert back.floor_kind == "band" and np.array_equal(back.s(PHI, 0.0), z.s(PHI, 0.0))
+
+
+def test_a_floor_below_the_band_is_raised_just_inside_it():
+    """A floor that dips below the map's band (the second system of docs/impact-zone.md: the flow's
+    floor torus at K = -0.541, its band from -0.531) is raised to 1% of the band's height above the
+    band's edge where it dips, and kept where it does not (to the spline's accuracy on a smooth
+    stretch, 1e-6 of the floor's size here)."""
+    m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, K_max=1.0)
+    lo, hi = m.valid_band()
+    floor = hovering.Curve.from_function(lambda p: lo + 0.05 * np.cos(p), n=64)
+    zone = hovering.impact_zone(m, ceiling=0.5, floor=floor)
+    assert zone.raised and not hovering.impact_zone(m, ceiling=0.5, floor=lo + 0.1).raised
+    p = np.linspace(-np.pi, np.pi, 2001)
+    edge = lo + 0.01 * (hi - lo)
+    assert np.all(zone.floor(p) > lo)
+    away = np.abs(floor(p) - edge) > 0.01  # off the kinks, where the spline is smooth
+    np.testing.assert_allclose(zone.floor(p)[away], np.maximum(floor(p), edge)[away], atol=1e-6)

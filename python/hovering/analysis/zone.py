@@ -38,6 +38,9 @@ class ImpactZone(Saveable):
     floor_kind : str, optional
         Where the floor comes from: ``"flow"`` (the flow's own floor), ``"band"`` (the lower edge of
         the map's band) or ``"given"``.
+    raised : bool, optional
+        Whether :func:`impact_zone` raised the floor to just inside the map's band where it dipped
+        below it (orbits cannot start outside the band).
 
     Raises
     ------
@@ -49,6 +52,7 @@ class ImpactZone(Saveable):
     ceiling: Curve
     floor: Curve
     floor_kind: str = "given"
+    raised: bool = False
 
     def __post_init__(self):
         for name in ("ceiling", "floor"):
@@ -132,7 +136,9 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
     floor : Curve or float, optional
         The lower boundary; default: for a :class:`hovering.FlowMap` its own floor
         (``m.impact_zone_floor().curve``); for the truncated maps, which have none, the lower edge
-        of the band (``m.valid_band()[0]``).
+        of the band (``m.valid_band()[0]``). A flow's or given floor that dips within 1% of the
+        band's height of the band's lower edge (or below it) is raised to that level there
+        (``zone.raised``): no orbit can start outside the band.
     n_steps : int, optional
         Iterates per tested orbit of the curve searches.
     **kwargs
@@ -161,4 +167,27 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
             floor, kind = Curve.constant(m.valid_band()[0]), "band"
     elif not isinstance(floor, Curve):
         floor = Curve.constant(floor)
-    return ImpactZone(ceiling=ceiling, floor=floor, floor_kind=kind)
+    floor, raised = (floor, False) if kind == "band" else _inside_band(m, floor)
+    return ImpactZone(ceiling=ceiling, floor=floor, floor_kind=kind, raised=raised)
+
+
+def _inside_band(m, floor: Curve) -> tuple[Curve, bool]:
+    """The floor, raised where it dips below 1% of the band's height above its lower edge.
+
+    A flow's torus tangent to the upper wall can lie below the band where its normal coordinates
+    hold (Tan(1, 0.5) x Harmonic(0.7): floor -0.541, band from -0.531), and no orbit can start
+    there; the zone then starts just inside the band.
+    """
+    lo, hi = (float(v) for v in m.valid_band())
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return floor, False
+    edge = lo + 0.01 * (hi - lo)
+    phi = -np.pi + 2 * np.pi * np.arange(_CHECK_POINTS) / _CHECK_POINTS
+    if float(np.min(floor(phi))) > edge:
+        return floor, False
+    # The spline through the kinks where the floor meets the edge overshoots by O(slope jump x
+    # sample spacing); 1024 samples keep that far inside the 1% margin.
+    raised = Curve.from_function(lambda p: np.maximum(floor(p), edge), n=max(floor.n, 1024))
+    if not float(np.min(raised(phi))) > lo:
+        raise ValueError(f"the floor dips below the map's band ({lo}, {hi}) and could not be raised inside it")
+    return raised, True
