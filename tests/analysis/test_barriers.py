@@ -140,15 +140,17 @@ def test_launch_points_lie_on_the_line_at_their_level():
 # Execution: executor, Ctrl-C, saving, bad input
 
 
-def test_an_executor_gives_the_one_process_answer():
+def test_an_executor_and_any_thread_count_give_the_one_process_answer():
     m = paper.truncated_map(0.3)
     zone = hovering.impact_zone(m, n_steps=5000)
     kw = dict(n_starts=12, n_steps=2000, s_range=(0.6, 1.0))
     one = hovering.barrier_scan(m, zone, **kw)
     with cf.ThreadPoolExecutor(2) as pool:
         many = hovering.barrier_scan(m, zone, executor=hovering.parallel.Executor(pool=pool, pieces=3), **kw)
+    threads = hovering.barrier_scan(m, zone, n_threads=1, **kw)
     for f in ("kind", "period", "s_min", "s_max", "margin", "barrier", "impact_fraction", "cone", "status"):
         assert np.array_equal(getattr(one, f), getattr(many, f), equal_nan=f in ("margin",)), f
+        assert np.array_equal(getattr(one, f), getattr(threads, f), equal_nan=f in ("margin",)), f
 
 
 def test_ctrl_c_keeps_the_orbits_so_far():

@@ -12,18 +12,20 @@ def test_cli_demo_writes_png(tmp_path, capsys):
     from hovering.__main__ import main
 
     out = tmp_path / "demo.png"
-    rc = main(["demo", "--out", str(out), "--steps", "200", "--orbits", "5", "--dpi", "40"])
+    rc = main(["demo", "--out", str(out), "--steps", "100", "--orbits", "3", "--dpi", "40"])
     assert rc == 0
     data = out.read_bytes()
     assert len(data) > 1000 and data[:8] == b"\x89PNG\r\n\x1a\n"
     text = capsys.readouterr().out
-    assert "eps = 0.3" in text and "eps = -0.3" in text and "wrote" in text and "scene demo (portrait)" in text
+    assert "scene demo (flow_portrait)" in text and "flow: 3 orbits" in text and "model: 3 orbits" in text
+    assert "wrote" in text
     # demo is the packaged scene: its result is saved like any scene's and redraws without computing
     from hovering import scenes
 
     res = scenes.load_result(out.with_suffix(".npz"))
-    assert res.scene.kind == "portrait" and res.scene.color_by == "region" and res.meta["n_steps"] == 200
-    assert [p.orbits.n_orbits for p in res.panels] == [5, 5]
+    # the physical flow beside its model (issue 21: the demo shows the package's subject)
+    assert res.scene.kind == "flow_portrait" and res.scene.system.eps == -0.05 and res.meta["n_steps"] == 100
+    assert res.flow.n_orbits == res.model.n_orbits == 3 and "regions" in res.scene.outputs.record
     plt.close("all")
 
 

@@ -352,9 +352,10 @@ def test_checkpoint_cuts_a_torn_last_line_and_appends_cleanly(tmp_path):
 @pytest.mark.parametrize(
     "argv,text",
     [
-        (["--eps", "nan"], "argument --eps: nan is out of range; allowed: [0.0, 10.0]"),
-        (["--orbits", "-3"], "argument --orbits: -3 is out of range; allowed: [1, 10000]"),
-        (["--steps", "-1"], "argument --steps: -1 is out of range; allowed: [1, 10000000]"),
+        (["--eps", "nan"], "argument --eps: nan is out of range; allowed: [-0.2, 0.2]"),
+        (["--eps", "0.5"], "argument --eps: 0.5 is out of range; allowed: [-0.2, 0.2]"),
+        (["--orbits", "-3"], "argument --orbits: -3 is out of range; allowed: [1, 1000]"),
+        (["--steps", "-1"], "argument --steps: -1 is out of range; allowed: [1, 1000000]"),
         (["--dpi", "0"], "argument --dpi: 0 is out of range; allowed: [30, 1200]"),
         (["--orbits", "2.5"], "argument --orbits: '2.5' is not an integer"),
         (["--out", "fig.xyz"], "--out = 'fig.xyz': matplotlib cannot write '.xyz' files"),

@@ -1,4 +1,4 @@
-"""The README's section "Iterating for transport" runs as written and its comments are true."""
+"""The user guide's page "Iterating for transport" runs as written and its comments are true."""
 
 from __future__ import annotations
 
@@ -9,17 +9,14 @@ import numpy as np
 
 import hovering
 
-README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
+PAGE = pathlib.Path(__file__).resolve().parents[2] / "docs" / "guide" / "transport.md"
 
 
 def test_transport_section_runs_and_agrees_with_its_comments():
-    text = README.read_text()
-    section = text[text.index("## Iterating for transport") :]
-    section = section[: section.index("\n## ", 1)]
-    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
-    assert len(blocks) == 1, "the transport section lost its example"
+    blocks = re.findall(r"```python\n(.*?)```", PAGE.read_text(), flags=re.S)
+    assert len(blocks) == 1, "the transport page lost its example"
     ns: dict = {}
-    exec(compile(blocks[0], str(README), "exec"), ns)
+    exec(compile(blocks[0], str(PAGE), "exec"), ns)
     barrier, tr, up, K0 = ns["barrier"], ns["tr"], ns["up"], ns["K0"]
     # "(~3e-8)": the orbit lies on the curve to the spline's error, i.e. it is a circle
     assert 1e-9 < barrier.max_error < 1e-7

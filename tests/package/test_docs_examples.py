@@ -1,15 +1,18 @@
-"""The README's Python examples run as written (so the documentation cannot drift from the API)."""
+"""The documentation's Python examples run as written and the numbers in their comments hold (so
+the documentation cannot drift from the API): README.md's example, and the user guide's pages
+(docs/guide), run in reading order in one namespace as a reader would."""
 
 from __future__ import annotations
 
 import pathlib
-import re
+
 import shutil
 
 import numpy as np
 import pytest
 
 import hovering
+from helpers.docs_pages import GUIDE, PAGES, guide_blocks, python_blocks
 
 # The README's code run as a user would: end to end.
 pytestmark = pytest.mark.e2e
@@ -18,7 +21,7 @@ README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 
 
 def _python_blocks():
-    return re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+    return [code for _, code in guide_blocks()]
 
 
 def _in_a_copy(tmp_path, monkeypatch):
@@ -28,13 +31,33 @@ def _in_a_copy(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
 
 
+def test_the_guide_lists_every_page_in_reading_order():
+    index = (GUIDE / "index.md").read_text()
+    toc = index[index.index("```{toctree}") :]
+    listed = [ln.strip() for ln in toc.splitlines()[1:] if ln.strip() and not ln.startswith((":", "```"))]
+    assert listed == list(PAGES)
+    assert {p.stem for p in GUIDE.glob("*.md")} - {"index"} == set(PAGES)
+
+
+def test_the_readme_example_runs_and_its_comments_hold():
+    (code,) = python_blocks(README)
+    ns: dict = {}
+    exec(compile(code, str(README), "exec"), ns)
+    fm, flow, mod = ns["fm"], ns["flow"], ns["mod"]
+    assert "effective eps = eps b1 = -0.0282 (b1 = 0.5639), band K in [-0.2966, 0.2638]" in repr(fm)
+    assert np.all(flow.status == hovering.Status.OK) and flow.phi.shape == (4, 501)
+    # "0.006: each orbit's lowest K agrees to O(|eps b1|) = 0.03"
+    d = np.abs(flow.K.min(1) - mod.K.min(1)).max()
+    assert d < 0.03 and abs(d - 0.006) < 0.001
+
+
 def test_readme_examples_run_and_agree_with_the_text(tmp_path, monkeypatch):
     _in_a_copy(tmp_path, monkeypatch)
     blocks = _python_blocks()
     assert len(blocks) >= 2, "README lost its Python examples"
     ns: dict = {}
     for code in blocks:
-        exec(compile(code, str(README), "exec"), ns)
+        exec(compile(code, "docs/guide", "exec"), ns)
     m, res = ns["m"], ns["res"]
     # Claims made in the README's comments:
     lo, hi = m.valid_band()
@@ -69,7 +92,7 @@ def test_readme_fullmap_block(tmp_path, monkeypatch):
     # measured in tests/normal/test_fullmap.py (bound 2 eps |K|); dphi = O(eps) (measured 0.4 eps; bound 2 eps).
     ns: dict = {}
     for code in _python_blocks():
-        exec(compile(code, str(README), "exec"), ns)
+        exec(compile(code, "docs/guide", "exec"), ns)
     c = ns["cmp"]
     assert c.agree.mean() > 0.95 and {"0", "R", "1"} <= set(c.region_full)
     assert np.nanmax(np.abs(c.GK)) < 2 * 0.05 * 0.015
@@ -82,7 +105,7 @@ def test_readme_flowmap_block(tmp_path, monkeypatch):
     # The FlowMap block's claims: the region of (0.3, -0.02), the theory's sign and area, b1.
     ns: dict = {}
     for code in _python_blocks():
-        exec(compile(code, str(README), "exec"), ns)
+        exec(compile(code, "docs/guide", "exec"), ns)
     fm, th, tm = ns["fm"], ns["th"], ns["tm"]
     assert fm.region(0.3, -0.02) is hovering.Region.ABOVE
     assert th.hovers and abs(th.area - 0.0745) < 1e-4

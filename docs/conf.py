@@ -1,0 +1,66 @@
+"""Sphinx configuration of the hovering documentation (built by ``bash scripts/docs.sh``).
+
+The API pages are generated from ``hovering.__all__`` and the subpackages' ``__all__`` (so every
+public name has a page, tests/package/test_docs.py checks it); the gallery is generated from the
+scene files in examples/scenes (one page per scene, run in quick mode at build time) and the
+scripts in examples/gallery.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import hovering
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from _generate import write_api_pages, write_scene_gallery  # noqa: E402
+
+project = "hovering"
+author = "the hovering developers"
+copyright = "2026, the hovering developers"
+release = version = hovering.__version__
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "numpydoc",
+    "sphinx_gallery.gen_gallery",
+]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+exclude_patterns = ["_build", "internals", "**/*.png", "README.md"]
+myst_enable_extensions = ["dollarmath", "colon_fence"]
+myst_heading_anchors = 3
+
+html_theme = "furo"
+html_title = f"hovering {release}"
+html_static_path: list = []
+
+autosummary_generate = True
+autodoc_default_options = {"members": True, "inherited-members": False, "show-inheritance": True}
+autodoc_typehints = "none"  # the numpydoc sections say the types
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+numpydoc_xref_param_type = False
+
+write_api_pages(HERE / "api")
+write_scene_gallery(ROOT / "examples" / "scenes", HERE / "_scene_gallery")
+
+sphinx_gallery_conf = {
+    "examples_dirs": [str(HERE / "_scene_gallery"), str(ROOT / "examples" / "gallery")],
+    "gallery_dirs": ["gallery/scenes", "gallery/examples"],
+    "filename_pattern": r"/(plot_|scene_)",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+    "matplotlib_animations": False,
+    "image_scrapers": ("matplotlib",),
+    "abort_on_example_error": True,
+}
+os.environ.setdefault("MPLBACKEND", "Agg")
