@@ -4,7 +4,8 @@ impact zone."""
 
 from ..interface import register
 from .critical import CriticalCurve, critical_curve, max_angular_gap
-from .hovering import HoveringArea, hovering_area
+from .hovering import HoveringArea, HoveringComponents, hovering_area
+from .hovering_compare import HoveringComparison, ModelVerdicts, compare_hovering
 from .orbits import (
     ConeCrossing,
     OrbitClasses,
@@ -24,7 +25,11 @@ __all__ = [
     "rotation_number",
     "regularity",
     "HoveringArea",
+    "HoveringComponents",
     "hovering_area",
+    "HoveringComparison",
+    "ModelVerdicts",
+    "compare_hovering",
     "CriticalCurve",
     "critical_curve",
     "max_angular_gap",

@@ -374,7 +374,7 @@ def _chain_periods(m, phi, K, one, n_K: int, n_threads: int) -> tuple:
     return period, int(flat.size)
 
 
-def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_threads: int) -> tuple:
+def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_steps: int, n_threads: int) -> tuple:
     """The components of the hovering samples: (HoveringComponents, per-sample code, per-sample
     period). Only hovering samples that stay on one side cost anything: one floor search (a
     FlowMap's) and a few classified orbits per cluster."""
@@ -387,7 +387,8 @@ def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_thread
         floor = "unneeded"
         if one.any():
             try:
-                curve = m.impact_zone_floor(n_threads=n_threads).curve
+                # Orbits of the search no longer than the measurement's own "never" (as impact_zone).
+                curve = m.impact_zone_floor(n_steps=min(n_steps, 2000), n_threads=n_threads).curve
             except ValueError as e:  # no curve found: say why, keep the points in `islands`
                 floor = f"not found: {e}"
             else:
@@ -553,10 +554,12 @@ def hovering_area(
     deepened, band_edge = 0, False
     while True:
         phi, K, e = _measure(m, n_steps, samples, K_low, seed, n_threads, progress, spec)
-        if not (default_box and e["floor_touched"]) or deepened == deepen:
+        if not (default_box and e["floor_touched"]):
             break
         if K_low <= bottom:  # the band ends first: nothing deeper to sample
             band_edge = True
+            break
+        if deepened == deepen:
             break
         # A fresh box: a deeper box's stratified grid shares no point with this one, and its
         # estimate is the core's count over one box (no stitching of two densities).
@@ -564,7 +567,7 @@ def hovering_area(
     hovering, both = e["hovering"], e["both_sides"]
     comp = code = period = None
     if components:
-        comp, code, period = _split(m, phi, K, hovering, both, samples, K_low, n_threads)
+        comp, code, period = _split(m, phi, K, hovering, both, samples, K_low, n_steps, n_threads)
     return HoveringArea(
         area=e["area"],
         error=e["error"],
