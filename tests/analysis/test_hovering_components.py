@@ -204,6 +204,16 @@ def test_flow_under_the_floor():
         assert hovers and seen == {int(Region.ABOVE)}
 
 
+def test_a_floor_that_is_not_found_loses_nothing():
+    # 50 returns per tested orbit find no floor on this flow (the search raises): the area stands,
+    # the one-sided points stay in `islands`, and `floor` says why.
+    fm = hovering.FlowMap(paper.system(0.1), 1.0)
+    hv = hovering.hovering_area(fm, n_steps=50, samples=60, K_low=-0.2)
+    c = hv.components
+    assert c.floor.startswith("not found: no invariant curve") and c.under_floor == 0.0
+    assert hv.area > 0 and c.band + c.islands == pytest.approx(hv.area, rel=1e-12)
+
+
 def test_save_and_load_keep_the_components(tmp_path, negative_eps):
     _, hv = negative_eps
     hovering.save(hv, tmp_path / "hv")

@@ -389,7 +389,7 @@ def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_steps:
             try:
                 # Orbits of the search no longer than the measurement's own "never" (as impact_zone).
                 curve = m.impact_zone_floor(n_steps=min(n_steps, 2000), n_threads=n_threads).curve
-            except ValueError as e:  # no curve found: say why, keep the points in `islands`
+            except (ValueError, RuntimeError) as e:  # no curve found: say why, keep the points in `islands`
                 floor = f"not found: {e}"
             else:
                 floor = "flow"
