@@ -168,6 +168,21 @@ TEST_CASE("hovering_area of F_eps agrees with eq:hovsetsize and ignores the thre
     CHECK(h.area <= h.error);
 }
 
+TEST_CASE("part_area: parts of the box add up to the estimate, with their binomial sigma") {
+    // A box of bottom -0.5 (area pi) and 1000 samples: 250 of them cover a quarter of it, sigma
+    // = pi sqrt(0.25 0.75 / 1000); an empty part keeps the 1/n floor of the variance.
+    const PartArea a = part_area(250, 1000, -0.5);
+    CHECK(a.area == Approx(kPi / 4).epsilon(1e-15));
+    CHECK(a.sampling_error == Approx(kPi * std::sqrt(0.25 * 0.75 / 1000)).epsilon(1e-14));
+    const PartArea z = part_area(0, 1000, -0.5);
+    CHECK(z.area == 0.0);
+    CHECK(z.sampling_error == Approx(kPi * std::sqrt(1e-3 / 1000)).epsilon(1e-14));
+    CHECK_THROWS_AS(part_area(1001, 1000, -0.5), std::invalid_argument);
+    CHECK_THROWS_AS(part_area(-1, 1000, -0.5), std::invalid_argument);
+    CHECK_THROWS_AS(part_area(1, 0, -0.5), std::invalid_argument);
+    CHECK_THROWS_AS(part_area(1, 10, 0.5), std::invalid_argument);
+}
+
 TEST_CASE("hovering_area: bad boxes are refused, a cancelled run says so") {
     const TruncatedMap m = make_truncated_map(0.1, kOmegaG, 3 * kPi / 4, 1.0, 0.5, 0.5);
     HoveringAreaOptions o;

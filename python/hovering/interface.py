@@ -139,7 +139,7 @@ class MapAnalyses:
             Sample points (stratified over the box below K = 0).
         **kwargs
             ``K_low``, ``seed``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
-            stderr; a callable ``progress(done, total)``).
+            stderr; a callable ``progress(done, total)``), ``components``, ``deepen``, ``executor``.
 
         Returns
         -------

@@ -145,6 +145,14 @@ void register_analysis(py::module_& m) {
         py::arg("n_steps"), py::arg("K_low"), py::arg("keep_points") = false,
         "The estimates at N/4, N/2, N, the error bar and the counts from the samples' outcomes (pieces "
         "concatenated in index order give the single-process answer).");
+    m.def(
+        "part_area",
+        [](std::int64_t count, std::int64_t n, double K_low) {
+            const PartArea a = part_area(count, n, K_low);
+            return py::make_tuple(a.area, a.sampling_error);
+        },
+        py::arg("count"), py::arg("n"), py::arg("K_low"),
+        "(area, sampling_error) of the part of hovering_area's box holding count of its n samples.");
     m.def("default_depth", &default_depth, py::arg("eps"), py::arg("Omega0"), py::arg("forcing"),
           "Depth of hovering_area's default box below K = 0 (inf when not finite and positive).");
     m.def(

@@ -77,32 +77,36 @@ def _points(path) -> list:
     return [json.loads(x) for x in path.read_text().splitlines() if x.startswith('{"key":')]
 
 
-def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(single, tmp_path):
+def test_checkpoint_keeps_finished_pieces_and_keys_every_parameter(tmp_path):
     ck = tmp_path / "hov.jsonl"
     seen = []
-    first = hovering_area(M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck))
+    # One box (deepen=0; the default box of this map would deepen once, a second box of pieces):
+    # four pieces per box measured.
+    kw = dict(KW, deepen=0)
+    single = hovering_area(M, **kw)
+    first = hovering_area(M, **kw, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     same(single, first)
     assert len(_points(ck)) == 4
     # The key is the canonical record: the map's parameters, the counts, the box, the seed, the range.
     key = _points(ck)[0]["key"]["hovering_area_piece"]
-    assert key["map"]["data"]["__dict__"]["eps"] == M.eps and key["n_steps"] == KW["n_steps"]
+    assert key["map"]["data"]["__dict__"]["eps"] == M.eps and key["n_steps"] == kw["n_steps"]
     assert sorted(p["key"]["hovering_area_piece"]["lo"] for p in _points(ck))[0] == 0
     # a rerun reads all four pieces back: the progress callback sees every unit done, no new line
     again = hovering_area(
-        M, **KW, executor=Executor(workers=2, pieces=4, checkpoint=ck), progress=lambda d, t: seen.append((d, t))
+        M, **kw, executor=Executor(workers=2, pieces=4, checkpoint=ck), progress=lambda d, t: seen.append((d, t))
     )
     same(single, again)
     assert len(_points(ck)) == 4 and seen[-1][0] == seen[-1][1]
     # another parameter (n_steps) is another key: four new pieces
-    hovering_area(M, **{**KW, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
+    hovering_area(M, **{**kw, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     assert len(_points(ck)) == 8
     # a torn last line (a killed run) is dropped and that piece alone recomputed
     text = ck.read_text()
     lines = text.splitlines()
     ck.write_text("\n".join(lines[:-1]) + "\n" + lines[-1][: len(lines[-1]) // 2])
-    redo = hovering_area(M, **{**KW, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
+    redo = hovering_area(M, **{**kw, "n_steps": 400}, executor=Executor(workers=2, pieces=4, checkpoint=ck))
     assert len(_points(ck)) == 8
-    assert redo.area == hovering_area(M, **{**KW, "n_steps": 400}).area
+    assert redo.area == hovering_area(M, **{**kw, "n_steps": 400}).area
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,8 @@ impact zone, transport across it and its barriers."""
 from ..interface import register
 from .barriers import BarrierScan, Layer, barrier_scan
 from .critical import CriticalCurve, critical_curve, max_angular_gap
-from .hovering import HoveringArea, hovering_area
+from .hovering import HoveringArea, HoveringComponents, hovering_area
+from .hovering_compare import HoveringComparison, ModelVerdicts, compare_hovering
 from .orbits import (
     ConeCrossing,
     OrbitClasses,
@@ -25,7 +26,11 @@ __all__ = [
     "rotation_number",
     "regularity",
     "HoveringArea",
+    "HoveringComponents",
     "hovering_area",
+    "HoveringComparison",
+    "ModelVerdicts",
+    "compare_hovering",
     "CriticalCurve",
     "critical_curve",
     "max_angular_gap",

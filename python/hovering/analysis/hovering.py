@@ -23,8 +23,98 @@ from ..interface import require_map
 from ..parallel.checkpoint import Checkpoint
 from ..parallel.executor import Executor, from_old_arguments, run_pieces
 from ..parallel.executor import executor as open_executor
+from .orbits import classify_orbits
 
-__all__ = ["HoveringArea", "hovering_area"]
+__all__ = ["HoveringArea", "HoveringComponents", "hovering_area"]
+
+#: Names of the per-sample codes of :attr:`HoveringArea.component` (code = index).
+COMPONENTS = ("none", "band", "islands", "under_floor")
+
+#: Points of the recorded orbit that classifies an island chain: classify_orbits needs 32 points
+#: per island, so chains up to period 64 are found.
+ORBIT_STEPS = 2048
+
+#: Orbits classified per connected cluster of one-sided hovering points (spread over the cluster).
+REPRESENTATIVES = 3
+
+
+@dataclass(frozen=True)
+class HoveringComponents:
+    """The hovering set split by what its orbits do (:attr:`HoveringArea.components`).
+
+    Every hovering sample lies in exactly one part, so ``band + islands + under_floor`` is
+    :attr:`HoveringArea.area` (to rounding): the counts add up to the hovering samples.
+
+    Attributes
+    ----------
+    band, band_error : float
+        The non-resonant hovering band (eq:hovsetsize): hovering points whose orbit visits both
+        J_0 and J_0u, "sometimes above the step and sometimes to its side". The error is two
+        binomial sigmas of the part (the iteration error stays with the whole area).
+    islands, islands_error : float
+        Hovering points whose orbit stays on one side (J_0 only, never beside the step) above the
+        zone's floor: island chains, which the definition counts and eq:hovsetsize does not.
+    under_floor, under_floor_error : float
+        Hovering points below the zone's floor (for a FlowMap its own floor curve,
+        :meth:`hovering.FlowMap.impact_zone_floor`: orbits that pass above the step every return
+        there). The truncated maps have no floor (their zone reaches down to the band's edge, see
+        :func:`hovering.impact_zone`): 0 there.
+    periods : dict
+        ``{period: area}`` of the ``islands`` part by chain period, from
+        :func:`hovering.classify_orbits` of a recorded orbit; period 0 collects the points whose
+        orbits were no island chain there (chaotic, sticky or undecided, e.g. period > 64).
+    counts : dict
+        Samples in each part: ``{"band": n, "islands": n, "under_floor": n}``.
+    floor : str
+        Where the floor came from: ``"flow"`` (the FlowMap's floor curve), ``"none"`` (a truncated
+        map: no floor), ``"unneeded"`` (no one-sided hovering point, no search) or
+        ``"not found: <why>"`` (the search failed; the one-sided points are then all in ``islands``).
+    orbits_classified : int
+        Orbits recorded and classified for the periods: up to 3 per connected cluster of
+        one-sided points on the sample grid (one island of a chain is one cluster), not one per
+        point (docs/orbit-classes.md measures the saving).
+    orbit_steps : int
+        Points of each classified orbit.
+    """
+
+    band: float
+    band_error: float
+    islands: float
+    islands_error: float
+    under_floor: float
+    under_floor_error: float
+    periods: dict
+    counts: dict
+    floor: str
+    orbits_classified: int
+    orbit_steps: int
+
+    @property
+    def total(self) -> float:
+        """``band + islands + under_floor``: the hovering area."""
+        return self.band + self.islands + self.under_floor
+
+    def __repr__(self) -> str:
+        chains = ", ".join(f"{q}: {a:.4g}" if q else f"none: {a:.4g}" for q, a in sorted(self.periods.items()))
+        return (
+            f"HoveringComponents(band={self.band:.4g} +- {self.band_error:.2g}, islands={self.islands:.4g} "
+            f"+- {self.islands_error:.2g} (by period {{{chains}}}), under_floor={self.under_floor:.4g} +- "
+            f"{self.under_floor_error:.2g}, floor={self.floor!r})"
+        )
+
+    def _validate_loaded(self) -> None:
+        """A file's components (untrusted): finite non-negative areas, integer counts and periods."""
+        for name in ("band", "band_error", "islands", "islands_error", "under_floor", "under_floor_error"):
+            real_number(name, getattr(self, name), lo=0.0, lo_open=False)
+        for q, a in self.periods.items():
+            integer("a period of periods", q, 0, 10**9)
+            real_number(f"periods[{q}]", a, lo=0.0, lo_open=False)
+        if set(self.counts) != {"band", "islands", "under_floor"}:
+            raise ValueError(f"counts must have the keys band, islands, under_floor, got {sorted(self.counts)}")
+        for k, v in self.counts.items():
+            integer(f"counts[{k!r}]", v, 0, 2**62)
+        integer("orbits_classified", self.orbits_classified, 0, 2**62)
+        integer("orbit_steps", self.orbit_steps, 0, 2**62)
 
 
 @dataclass(frozen=True)
@@ -54,7 +144,8 @@ class HoveringArea(Saveable):
     impact_fraction_F0 : float
         Fraction of the box that impacts under F_0 within N steps (part of the definition).
     floor_touched : bool
-        Whether a hovering point lies in the lowest tenth of the box (then enlarge it: K_low).
+        Whether a hovering point lies in the lowest tenth of the box (the default box deepens
+        itself then: see ``deepened``; with a given K_low, enlarge it).
     area_both_sides : float
         The part of ``area`` whose orbits visit both J_0 and J_0u: the paper's hovering orbits,
         "sometimes above the step and sometimes to its side". The rest, ``area - area_both_sides``,
@@ -64,9 +155,22 @@ class HoveringArea(Saveable):
     unresolved : int
         Sample points whose orbit ended otherwise (the flow's corner hits, grazing, step limits:
         counted as not hovering).
+    components : HoveringComponents or None
+        ``area`` split into the non-resonant band, island chains (by period) and the region under
+        the zone's floor; None with ``components=False`` (and in files written before 0.3.0).
+    deepened : int
+        Times the default box was doubled in depth because ``floor_touched`` (0 with a given K_low):
+        ``box`` is the box finally used.
+    band_edge : bool
+        The default box reached the lower edge of the map's band while the floor was still touched:
+        it could not deepen further (the band ends first).
     phi, K, hovering, both_sides : ndarray or None
         Sample points, their membership, and whether their orbit visits both J_0 and J_0u, when
         ``keep_points`` was set.
+    component, period : ndarray or None
+        Per sample (``keep_points`` and ``components``): the part it lies in, as an index into
+        ``("none", "band", "islands", "under_floor")`` (:data:`COMPONENTS`), and its chain period
+        (0 outside ``islands`` or where no chain was found).
     """
 
     area: float
@@ -85,6 +189,11 @@ class HoveringArea(Saveable):
     K: np.ndarray | None = field(default=None, repr=False)
     hovering: np.ndarray | None = field(default=None, repr=False)
     both_sides: np.ndarray | None = field(default=None, repr=False)
+    components: HoveringComponents | None = None
+    deepened: int = 0
+    band_edge: bool = False
+    component: np.ndarray | None = field(default=None, repr=False)
+    period: np.ndarray | None = field(default=None, repr=False)
 
 
 def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | None = None) -> tuple:
@@ -209,6 +318,126 @@ def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Exec
     return tuple(np.concatenate([o[j] for o in out]) for j in range(4))
 
 
+def _clusters(one: np.ndarray, n_K: int) -> list:
+    """Connected clusters of the samples ``one`` (bool per sample) on the sample grid: sample i sits
+    in column ``i // n_K``, row ``i % n_K``; 8 neighbours, periodic in phi (the columns wrap). A
+    list of index arrays (each sorted), by union-find over the marked samples only."""
+    n_phi = one.size // n_K
+    idx = np.flatnonzero(one)
+    parent = {int(i): int(i) for i in idx}
+
+    def find(a: int) -> int:
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]  # path halving
+            a = parent[a]
+        return a
+
+    for i in parent:
+        c, r = divmod(i, n_K)
+        # The four neighbours before i in scan order: each pair of neighbours is joined once.
+        for dc, dr in ((0, -1), (-1, -1), (-1, 0), (-1, 1)):
+            if 0 <= r + dr < n_K:
+                j = ((c + dc) % n_phi) * n_K + r + dr
+                if j in parent:
+                    a, b = find(i), find(j)
+                    if a != b:
+                        parent[max(a, b)] = min(a, b)
+    if idx.size == 0:
+        return []
+    roots = np.fromiter((find(int(i)) for i in idx), dtype=np.int64, count=idx.size)
+    _, label = np.unique(roots, return_inverse=True)
+    order = np.argsort(label, kind="stable")
+    return np.split(idx[order], np.flatnonzero(np.diff(label[order])) + 1)
+
+
+def _chain_periods(m, phi, K, one, n_K: int, n_threads: int) -> tuple:
+    """The chain period of each sample of ``one`` (0 where none was found) and the number of
+    orbits classified: per connected cluster, up to :data:`REPRESENTATIVES` samples spread over it
+    are iterated for :data:`ORBIT_STEPS` points and classified (:func:`hovering.classify_orbits`);
+    the cluster takes the commonest island period among them (the smallest on a tie)."""
+    period = np.zeros(one.size, dtype=np.int64)
+    groups = _clusters(one, n_K)
+    if not groups:
+        return period, 0
+    reps = [np.unique(g[[g.size // 4, g.size // 2, (3 * g.size) // 4]]) for g in groups]
+    flat = np.concatenate(reps)
+    res = m.iterate(phi[flat], K[flat], ORBIT_STEPS - 1, record=("orbit",), n_threads=n_threads)
+    classes = classify_orbits(res)
+    start = 0
+    for g, r in zip(groups, reps):
+        kind, q = classes.kind[start : start + r.size], classes.period[start : start + r.size]
+        start += r.size
+        qs = q[kind == "islands"]
+        if qs.size:
+            values, counts = np.unique(qs, return_counts=True)
+            period[g] = values[np.argmax(counts)]
+    return period, int(flat.size)
+
+
+def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_steps: int, n_threads: int) -> tuple:
+    """The components of the hovering samples: (HoveringComponents, per-sample code, per-sample
+    period). Only hovering samples that stay on one side cost anything: one floor search (a
+    FlowMap's) and a few classified orbits per cluster."""
+    n = phi.size
+    code = np.zeros(n, dtype=np.int8)
+    code[hovering & both_sides] = COMPONENTS.index("band")
+    one = hovering & ~both_sides
+    floor = "none"
+    if hasattr(m, "impact_zone_floor"):  # a FlowMap: the zone has a floor of its own
+        floor = "unneeded"
+        if one.any():
+            try:
+                # Orbits of the search no longer than the measurement's own "never" (as impact_zone).
+                curve = m.impact_zone_floor(n_steps=min(n_steps, 2000), n_threads=n_threads).curve
+            except (ValueError, RuntimeError) as e:  # no curve found: say why, keep the points in `islands`
+                floor = f"not found: {e}"
+            else:
+                floor = "flow"
+                under = np.zeros(n, dtype=bool)
+                under[one] = K[one] < curve(phi[one])
+                code[under] = COMPONENTS.index("under_floor")
+                one &= ~under
+    code[one] = COMPONENTS.index("islands")
+    period, classified = _chain_periods(m, phi, K, one, _core_analysis.sample_grid(samples, K_low)[1], n_threads)
+
+    def part(mask):
+        area, sigma = _core_analysis.part_area(int(np.count_nonzero(mask)), n, float(K_low))
+        return area, 2 * sigma
+
+    band, band_err = part(code == COMPONENTS.index("band"))
+    isl, isl_err = part(one)
+    under, under_err = part(code == COMPONENTS.index("under_floor"))
+    periods = {int(q): part(one & (period == q))[0] for q in np.unique(period[one])}
+    comp = HoveringComponents(
+        band=band,
+        band_error=band_err,
+        islands=isl,
+        islands_error=isl_err,
+        under_floor=under,
+        under_floor_error=under_err,
+        periods=periods,
+        counts={name: int(np.count_nonzero(code == COMPONENTS.index(name))) for name in COMPONENTS[1:]},
+        floor=floor,
+        orbits_classified=classified,
+        orbit_steps=ORBIT_STEPS if classified else 0,
+    )
+    return comp, code, period
+
+
+def _measure(m, n_steps, samples, K_low, seed, n_threads, progress, spec) -> tuple:
+    """Samples, outcomes and the core's estimate (with the per-sample membership) of one box."""
+    phi, K = _stratified(samples, K_low, seed)
+    n = phi.size
+    unit = getattr(m, "_progress_unit", "step")
+    with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
+        if spec is not None:
+            s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec)
+        else:
+            s0, s1, steps_done, visited = _outcomes(m, phi, K, n_steps, n_threads, bar.part(0))
+    e = _core_analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), True)
+    return phi, K, e
+
+
 def hovering_area(
     m,
     n_steps: int = 10_000,
@@ -219,6 +448,8 @@ def hovering_area(
     keep_points: bool = False,
     progress=False,
     *,
+    components: bool = True,
+    deepen: int = 3,
     executor=None,
     workers: int | None = None,
     client=None,
@@ -247,7 +478,8 @@ def hovering_area(
         Number of sample points (rounded up to fill the grid).
     K_low : float, optional
         Bottom of the box. Default: twice the deepest leading-order critical curve (see
-        :func:`default_depth`; ``-2 |eps| / |sin(Omega0/2)|`` for f = sin), clipped to the band.
+        :func:`default_depth`; ``-2 |eps| / |sin(Omega0/2)|`` for f = sin), clipped to the band;
+        that box deepens itself (see ``deepen``). A given K_low is used as it is.
     seed : int, optional
         Seed of the jitter.
     n_threads : int, optional
@@ -255,9 +487,19 @@ def hovering_area(
     keep_points : bool, optional
         Keep the sample points and their membership in the result (for plotting).
     progress : bool or callable, optional
-        One report for the whole call (both iterations, ``2 * n_samples * n_steps`` steps or
+        One report per box measured (both iterations, ``2 * n_samples * n_steps`` steps or
         returns): ``True`` a tqdm bar on stderr, a callable ``progress(done, total)``, ``False``
         (default) none. See :mod:`hovering._progress`.
+    components : bool, optional
+        Split the area into its parts (:class:`HoveringComponents`: the non-resonant band, island
+        chains by period, the region under the zone's floor). Only hovering samples whose orbit
+        stays on one side cost extra: a FlowMap's floor search (:meth:`FlowMap.impact_zone_floor`)
+        and a recorded orbit of 2048 points for up to 3 samples per connected cluster of them.
+        ``False``: ``components`` is None.
+    deepen : int, optional
+        With the default box only: how many times it may double its depth (a fresh measurement of
+        the deeper box each time, with the same ``samples``) while ``floor_touched``; it stops at
+        the lower edge of the map's band (``band_edge``). 0 keeps the first box. >= 0.
     executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
         Where it runs (:func:`hovering.parallel.executor.as_executor`): ``None`` in this process on
         ``n_threads`` core threads; otherwise the samples are cut into pieces run on that many local
@@ -278,11 +520,15 @@ def hovering_area(
     ------
     ValueError
         For counts that are not integers in range, or a K_low outside the band below 0.
+    KeyboardInterrupt
+        On Ctrl-C, within ~0.1 s.
     """
     require_map("m", m)
     n_steps = integer("n_steps", n_steps, 4, 2**53)
     samples = integer("samples", samples, 1, 2**53)
     keep_points = flag("keep_points", keep_points)
+    components = flag("components", components)
+    deepen = integer("deepen", deepen, 0, 64)
     seed = integer("seed", seed, 0, 2**63 - 1)
     n_threads = thread_count(n_threads)
     progress = check_progress(progress)
@@ -292,26 +538,36 @@ def hovering_area(
         raise ValueError(
             f"this map's band has no part below K = 0 (lower end {lo}): no point impacts under F_0, nothing can hover"
         )
-    if K_low is None:
+    bottom = lo * (1 - 1e-9)  # the deepest box inside the band
+    default_box = K_low is None
+    if default_box:
         depth = default_depth(m) if m.eps != 0 else 0.1
-        K_low = max(-depth, lo * (1 - 1e-9))
+        K_low = max(-depth, bottom)
     K_low = real_number("K_low", K_low)
     if not (lo < K_low < 0):
         raise ValueError(f"K_low must lie in the band below 0, ({lo}, 0), got {K_low}")
-    phi, K = _stratified(samples, K_low, seed)
-    n = phi.size
-    unit = getattr(m, "_progress_unit", "step")
     spec = from_old_arguments(
         "hovering_area",
         executor,
         dict(workers=workers, client=client, scheduler=scheduler, dask=dask, pieces=pieces, checkpoint=checkpoint),
     )
-    with progress_bar(progress, 2 * n * n_steps, desc="hovering_area", unit=unit) as bar:
-        if spec is not None:
-            s0, s1, steps_done, visited = _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec)
-        else:
-            s0, s1, steps_done, visited = _outcomes(m, phi, K, n_steps, n_threads, bar.part(0))
-    e = _core_analysis.hovering_estimate(s0, s1, steps_done, visited, K, int(n_steps), float(K_low), keep_points)
+    deepened, band_edge = 0, False
+    while True:
+        phi, K, e = _measure(m, n_steps, samples, K_low, seed, n_threads, progress, spec)
+        if not (default_box and e["floor_touched"]):
+            break
+        if K_low <= bottom:  # the band ends first: nothing deeper to sample
+            band_edge = True
+            break
+        if deepened == deepen:
+            break
+        # A fresh box: a deeper box's stratified grid shares no point with this one, and its
+        # estimate is the core's count over one box (no stitching of two densities).
+        K_low, deepened = max(2.0 * K_low, bottom), deepened + 1
+    hovering, both = e["hovering"], e["both_sides"]
+    comp = code = period = None
+    if components:
+        comp, code, period = _split(m, phi, K, hovering, both, samples, K_low, n_steps, n_threads)
     return HoveringArea(
         area=e["area"],
         error=e["error"],
@@ -327,6 +583,11 @@ def hovering_area(
         unresolved=int(e["unresolved"]),
         phi=phi if keep_points else None,
         K=K if keep_points else None,
-        hovering=e["hovering"] if keep_points else None,
-        both_sides=e["both_sides"] if keep_points else None,
+        hovering=hovering if keep_points else None,
+        both_sides=both if keep_points else None,
+        components=comp,
+        deepened=deepened,
+        band_edge=band_edge,
+        component=code if keep_points else None,
+        period=period if keep_points else None,
     )

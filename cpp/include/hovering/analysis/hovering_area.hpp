@@ -96,6 +96,16 @@ HoveringOutcomes hovering_outcomes(const FlowMap& m, const FlowMap& m0, const do
 HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K, std::int64_t n, std::int64_t n_steps,
                                      double K_low, bool keep_points);
 
+/// Area of a part of the box holding `count` of its n samples, and the part's one binomial sigma.
+struct PartArea {
+    double area = 0;            ///< box area * count / n
+    double sampling_error = 0;  ///< box area * sqrt(max(p (1 - p), 1 / n) / n), p = count / n
+};
+
+/// The area and sampling error of a part (0 <= count <= n, n >= 1) of the box of bottom K_low
+/// (finite, < 0): the one formula of the estimate, the whole set's and each of its components'.
+PartArea part_area(std::int64_t count, std::int64_t n, double K_low);
+
 /// HOV of the truncated map m: checks, samples, outcomes and estimate in one call.
 HoveringAreaResult hovering_area(const TruncatedMap& m, const HoveringAreaOptions& opt);
 /// HOV of the truncated family m.

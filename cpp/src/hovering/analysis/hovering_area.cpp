@@ -124,6 +124,18 @@ HoveringOutcomes hovering_outcomes(const FlowMap& m, const FlowMap& m0, const do
     return run_both<FlowIterateOptions, FlowIterateOutput>(m, m0, phi, K, n, o);
 }
 
+PartArea part_area(std::int64_t count, std::int64_t n, double K_low) {
+    if (n < 1) bad("part_area needs at least one sample, got n = " + std::to_string(n));
+    if (count < 0 || count > n)
+        bad("part_area: count must lie in [0, n = " + std::to_string(n) + "], got " + std::to_string(count));
+    if (!(K_low < 0) || !std::isfinite(K_low)) bad("K_low must be a finite number < 0, got " + fmt(K_low));
+    const double box_area = 2 * kPi * (-K_low), dn = double(n), p = double(count) / dn;
+    PartArea a;
+    a.area = box_area * double(count) / dn;
+    a.sampling_error = box_area * std::sqrt(std::max(p * (1 - p), 1.0 / dn) / dn);
+    return a;
+}
+
 HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K, std::int64_t n, std::int64_t n_steps,
                                      double K_low, bool keep_points) {
     if (n < 1) bad("hovering_estimate needs at least one sample, got " + std::to_string(n));
@@ -135,7 +147,6 @@ HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K,
     h.K_low = K_low;
     h.interrupted = r.interrupted;
     const auto is = [](std::int8_t s, Status t) { return s == std::int8_t(t); };
-    const double box_area = 2 * kPi * (-K_low);
     const std::int64_t Ns[3] = {n_steps / 4, n_steps / 2, n_steps};
     std::int64_t count[3] = {0, 0, 0}, hov = 0, hov_both = 0, impacts = 0, unresolved = 0;
     bool floor = false;
@@ -162,10 +173,9 @@ HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K,
         }
     }
     const double dn = double(n);
-    const double areas[3] = {box_area * double(count[0]) / dn, box_area * double(count[1]) / dn,
-                             box_area * double(count[2]) / dn};
-    const double p = double(hov) / dn;
-    h.sampling_error = box_area * std::sqrt(std::max(p * (1 - p), 1.0 / dn) / dn);
+    const double areas[3] = {part_area(count[0], n, K_low).area, part_area(count[1], n, K_low).area,
+                             part_area(count[2], n, K_low).area};
+    h.sampling_error = part_area(hov, n, K_low).sampling_error;
     h.iteration_error = areas[1] - areas[2];
     h.area = areas[2];
     h.area_half = areas[1];
@@ -173,7 +183,7 @@ HoveringAreaResult hovering_estimate(const HoveringOutcomes& r, const double* K,
     h.error = 2 * h.sampling_error + h.iteration_error;
     h.impact_fraction_F0 = double(impacts) / dn;
     h.floor_touched = floor;
-    h.area_both_sides = box_area * double(hov_both) / dn;
+    h.area_both_sides = part_area(hov_both, n, K_low).area;
     h.unresolved = unresolved;
     return h;
 }
