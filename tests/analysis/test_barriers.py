@@ -158,15 +158,27 @@ def test_ctrl_c_keeps_the_orbits_so_far():
     zone = hovering.impact_zone(m, n_steps=5000)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt) as info:
-        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, progress=press)
+        # starts that stay in the band, so that the press lands inside a long orbit (an orbit that
+        # leaves the band early still returns its 1e7-wide padded record, which takes seconds)
+        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, s_range=(0.5, 1.0), progress=press)
     assert time.perf_counter() - press.fired_at < PROMPT
     part = info.value.partial
     assert not part.complete and len(part) == 4
     cut_short = part.status == hovering.Status.INTERRUPTED
-    assert cut_short.any() and not part.barrier.any()
-    # an orbit that ended on its own (here: left the band) keeps its verdict; the others have none
-    assert np.all((part.decided_by == "interrupted") == cut_short)
-    assert np.all(part.kind[cut_short] == "undecided")
+    assert cut_short.all() and not part.barrier.any()
+    assert np.all(part.decided_by == "interrupted") and np.all(part.kind == "undecided")
+
+
+def test_an_orbit_that_ends_on_its_own_keeps_its_verdict_when_the_rest_is_interrupted():
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    with pytest.raises(KeyboardInterrupt) as info:
+        # the lowest start leaves the band after 1160 steps; the second one is cut short
+        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**6, progress=CtrlCOnceStarted(after=1))
+    part = info.value.partial
+    cut_short = part.status == hovering.Status.INTERRUPTED
+    assert part.status[0] == hovering.Status.ESCAPED and part.decided_by[0] != "interrupted"
+    assert cut_short[1:].all() and np.all((part.decided_by == "interrupted") == cut_short)
 
 
 def test_results_save_and_load(tmp_path):

@@ -309,9 +309,12 @@ def _scan_piece(m, zone, phi0, K0, n_steps, n_bins, classify, kwargs, keep=0):
         if res is None:
             raise
         interrupted = True  # its orbits cut short carry Status.INTERRUPTED
-    c = classify_orbits(res.phi, res.K, **classify)
-    s = np.asarray(zone.s(res.phi, res.K), dtype=float)
-    hi, lo = _envelopes(res.phi, s, n_bins)
+    # Columns past the longest orbit are padding (an interrupted run stops far short of n_steps).
+    width = int(np.max(res.steps_done, initial=0)) + 1
+    phi, K = res.phi[:, :width], res.K[:, :width]
+    c = classify_orbits(phi, K, **classify)
+    s = np.asarray(zone.s(phi, K), dtype=float)
+    hi, lo = _envelopes(phi, s, n_bins)
     with np.errstate(all="ignore"):
         s_min = np.nanmin(np.where(np.isfinite(s), s, np.nan), axis=1)
         s_max = np.nanmax(np.where(np.isfinite(s), s, np.nan), axis=1)
@@ -335,7 +338,7 @@ def _scan_piece(m, zone, phi0, K0, n_steps, n_bins, classify, kwargs, keep=0):
         "computed": np.asarray(res.status) != int(Status.INTERRUPTED),
     }
     if keep:
-        take = np.linspace(0, n_steps, keep).round().astype(np.int64)
+        take = np.linspace(0, n_steps, keep).round().astype(np.int64)  # on the full width: NaN after the end
         out["phi"], out["K"] = res.phi[:, take], res.K[:, take]
     return out, interrupted
 
