@@ -76,7 +76,7 @@ def write_api_pages(where: Path) -> None:
     _write(where / "index.rst", "\n".join(parts))
 
 
-_SCENE_SCRIPT = '''"""
+_SCENE_SCRIPT = '''r"""
 {title}
 {underline}
 
@@ -107,6 +107,12 @@ print(format_summary(summary))
 '''
 
 
+def _rst_text(text: str) -> str:
+    """Plain text for a reStructuredText paragraph: markup characters of the scene files' comments
+    (|HOV|, *, `) read literally."""
+    return text.replace("\\", "\\\\").replace("*", r"\*").replace("`", "'").replace("|", r"\|").replace("_", r"\_")
+
+
 def write_scene_gallery(scenes: Path, where: Path) -> None:
     """One ``scene_<name>.py`` per scene file, its text taken from the file's comments and title."""
     _write(where / "README.rst", "Scenes\n======\n\nEvery example scene (examples/scenes), the paper's figures among them, run in quick mode.\n")
@@ -114,8 +120,8 @@ def write_scene_gallery(scenes: Path, where: Path) -> None:
         text = path.read_text()
         data = tomllib.loads(text)
         comments = [ln[1:].strip() for ln in text.splitlines() if ln.startswith("#")]
-        description = " ".join(c for c in comments if not c.startswith("Run:")).replace("*", r"\*").replace("`", "'")
-        title = str(data.get("title", path.stem)).replace("*", r"\*")
+        description = _rst_text(" ".join(c for c in comments if not c.startswith("Run:")))
+        title = _rst_text(str(data.get("title", path.stem)))
         body = "\n".join("   " + ln if ln else "" for ln in text.splitlines() if not ln.startswith("#"))
         _write(
             where / f"scene_{path.stem}.py",

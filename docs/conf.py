@@ -34,7 +34,8 @@ extensions = [
     "sphinx_gallery.gen_gallery",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
-exclude_patterns = ["_build", "internals", "**/*.png", "README.md"]
+exclude_patterns = ["_build", "internals", "**/*.png", "README.md", "_scene_gallery", "_templates"]
+templates_path = ["_templates"]
 myst_enable_extensions = ["dollarmath", "colon_fence"]
 myst_heading_anchors = 3
 
@@ -48,6 +49,18 @@ autodoc_typehints = "none"  # the numpydoc sections say the types
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
+
+def _literal_pipes(app, what, name, obj, options, lines):
+    """Docstrings write |HOV|, |J_R| and |x| as mathematics: escape the bars outside inline
+    literals, or reStructuredText reads them as substitution references."""
+    for i, line in enumerate(lines):
+        parts = line.split("``")
+        lines[i] = "``".join(p.replace("|", r"\|") if k % 2 == 0 else p for k, p in enumerate(parts))
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _literal_pipes, priority=400)
+
 
 write_api_pages(HERE / "api")
 write_scene_gallery(ROOT / "examples" / "scenes", HERE / "_scene_gallery")
