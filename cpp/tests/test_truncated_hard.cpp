@@ -99,8 +99,7 @@ TEST_CASE("the SIMD kernel computes phi and regions as step() does, bit for bit"
         int differ = 0;
         for (std::size_t i = 0; i < n; ++i) {
             if (!(K[i] > m.band().lo && K[i] < m.band().hi)) continue;
-            differ +=
-                pf[i] != m.step(phi[i], K[i]).first || reg[i] != static_cast<std::int8_t>(m.region(phi[i], K[i]));
+            differ += pf[i] != m.step(phi[i], K[i]).first || reg[i] != static_cast<std::int8_t>(m.region(phi[i], K[i]));
         }
         CHECKF(differ == 0, "%s: SIMD phi or region differs from step()/region() at %d of %zu points", level.c_str(),
                differ, n);

@@ -118,11 +118,14 @@ struct LaneBuild {
 };
 
 const std::vector<LaneBuild>& lane_builds() {
+#if defined(HOVERING_LANES_DISPATCH)
+    __builtin_cpu_init();  // idempotent; needed if the first call runs before libgcc's constructor
+#endif
     static const std::vector<LaneBuild> builds = {
         {&hovering_lanes_base, [] { return true; }, "the baseline of this build"},
 #if defined(HOVERING_LANES_DISPATCH)
-        {&hovering_lanes_avx2,
-         [] { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }, "AVX2 and FMA"},
+        {&hovering_lanes_avx2, [] { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); },
+         "AVX2 and FMA"},
         {&hovering_lanes_avx512,
          [] {
              return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
@@ -157,8 +160,8 @@ const LaneKernels* find_lanes(const std::string& level, const char* what) {
             throw std::invalid_argument(std::string(what) + "='" + level + "' is not available: this CPU lacks " +
                                         b.needs + " (allowed here: auto, " + level_names(true) + ")");
     throw std::invalid_argument(std::string(what) + " must be one of auto, " + level_names(true) + " (the " +
-                                "SIMD levels of this build that this CPU runs; this build has " +
-                                level_names(false) + "), got '" + level + "'");
+                                "SIMD levels of this build that this CPU runs; this build has " + level_names(false) +
+                                "), got '" + level + "'");
 }
 
 // The selected build: set_simd_level's, else HOVERING_SIMD's (read at first use; a bad value is an

@@ -96,10 +96,10 @@ using LaneKernel = void (*)(const MapCore<A, F>&, const double* phi0, const doub
 
 /// One build of the lane kernel: its instruction set, its packet width and its entry points.
 struct LaneKernels {
-    const char* level;                                      ///< "sse2", "avx2", "avx512", ... as compiled
-    int width;                                              ///< doubles per packet
-    int lanes;                                              ///< orbits stepped together by one worker
-    LaneKernel<AnalyticArcs, SineForcing> analytic[2];      ///< [fast_sin]
+    const char* level;                                       ///< "sse2", "avx2", "avx512", ... as compiled
+    int width;                                               ///< doubles per packet
+    int lanes;                                               ///< orbits stepped together by one worker
+    LaneKernel<AnalyticArcs, SineForcing> analytic[2];       ///< [fast_sin]
     LaneKernel<TabulatedArcs, FourierForcing> tabulated[2];  ///< [fast_sin]
 };
 
