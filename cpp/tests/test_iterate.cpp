@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "hovering/truncated/map.hpp"
@@ -208,4 +209,50 @@ TEST_CASE("batch iteration: the progress counter ends at n * n_steps, early exit
             CHECK(st[5] == static_cast<std::int8_t>(Status::Escaped));
         }
     }
+}
+
+TEST_CASE("every SIMD level this CPU runs, forced: its width, the scalar kernel's regions, states to 1e-12",
+          "[truncated][iterate][simd]") {
+    TruncatedMap m = make_truncated_map(0.3, kPi * (std::sqrt(5.0) - 1.0), 3 * kPi / 4, 1.0, 0.5, 0.5);
+    std::mt19937_64 rng(4);
+    std::uniform_real_distribution<double> uphi(-kPi, kPi), uK(-0.3, 0.3);
+    const std::size_t n = 1003;
+    std::vector<double> p0(n), k0(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        p0[i] = uphi(rng);
+        k0[i] = uK(rng);
+    }
+    const std::string chosen = simd_level();
+    const std::vector<std::string> levels = simd_levels();
+    // x86-64 always runs the SSE2 build (a non-x86 or native build has one level of its own).
+    CHECKF(!levels.empty(), "no SIMD level");
+    set_simd_level("auto");
+    CHECKF(simd_level() == levels.back(), "auto selected %s, the widest is %s", simd_level().c_str(),
+           levels.back().c_str());
+    const Run s = run(m, p0, k0, 5, Kernel::Scalar, 1);
+    for (const std::string& level : levels) {
+        set_simd_level(level);
+        const int want = level == "avx512" ? 8 : level == "avx2" ? 4 : level == "sse2" ? 2 : simd_width();
+        CHECKF(simd_level() == level && simd_width() == want, "forced %s: level %s, width %d (want %d)", level.c_str(),
+               simd_level().c_str(), simd_width(), want);
+        // As in the kernels test above: SLEEF's sin is within 1 ulp of libm's, so 5 steps agree to
+        // 1e-12; regions agree exactly; threads change nothing.
+        const Run v = run(m, p0, k0, 5, Kernel::Simd, 1), w = run(m, p0, k0, 5, Kernel::Simd, 2);
+        CHECKF(v.pf == w.pf && v.kf == w.kf && v.reg == w.reg, "%s: thread count changed results", level.c_str());
+        double worst = 0;
+        int reg_diff = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            worst = std::max({worst, std::fabs(wrap_angle(s.pf[i] - v.pf[i])), std::fabs(s.kf[i] - v.kf[i])});
+            for (int j = 0; j < 5; ++j) reg_diff += s.reg[i * 5 + j] != v.reg[i * 5 + j];
+        }
+        CHECKF(worst < 1e-12 && reg_diff == 0, "%s vs scalar after 5 steps: %.3g, %d regions differ", level.c_str(),
+               worst, reg_diff);
+    }
+    // A level this build has not (or this CPU does not run): an error naming it and the choices;
+    // the selection stays.
+    set_simd_level(levels.front());
+    CHECK_INVALID(set_simd_level("avx1024"), "got 'avx1024'");
+    CHECK_INVALID(set_simd_level("avx1024"), "must be one of auto, " + levels.front());
+    CHECKF(simd_level() == levels.front(), "a failed set_simd_level changed the level to %s", simd_level().c_str());
+    set_simd_level(chosen);
 }

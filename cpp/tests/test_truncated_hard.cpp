@@ -2,6 +2,7 @@
 // region, step, step_inverse and both kernels; images at the band floor; the rotation bound.
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "hovering/truncated/map.hpp"
@@ -89,13 +90,21 @@ TEST_CASE("the SIMD kernel computes phi and regions as step() does, bit for bit"
     out.K_final = kf.data();
     out.regions = reg.data();
     out.status = st.data();
-    m.iterate(phi.data(), K.data(), std::int64_t(n), o, out);
-    int differ = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!(K[i] > m.band().lo && K[i] < m.band().hi)) continue;
-        differ += pf[i] != m.step(phi[i], K[i]).first || reg[i] != static_cast<std::int8_t>(m.region(phi[i], K[i]));
+    // Every build of the lane kernel this CPU runs (the run-time choice and each forced level).
+    const std::string chosen = simd_level();
+    for (const std::string& level : simd_levels()) {
+        set_simd_level(level);
+        CHECKF(simd_level() == level, "forced %s, selected %s", level.c_str(), simd_level().c_str());
+        m.iterate(phi.data(), K.data(), std::int64_t(n), o, out);
+        int differ = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!(K[i] > m.band().lo && K[i] < m.band().hi)) continue;
+            differ += pf[i] != m.step(phi[i], K[i]).first || reg[i] != static_cast<std::int8_t>(m.region(phi[i], K[i]));
+        }
+        CHECKF(differ == 0, "%s: SIMD phi or region differs from step()/region() at %d of %zu points", level.c_str(),
+               differ, n);
     }
-    CHECKF(differ == 0, "SIMD phi or region differs from step()/region() at %d of %zu points", differ, n);
+    set_simd_level(chosen);
 }
 
 TEST_CASE("one rotation bound, |Omega| <= 1e6, for parameters and points", "[truncated][hard]") {

@@ -103,7 +103,23 @@ from .truncated import (
 from .truncated.theory import theory
 
 simd_is_avx2 = _core.truncated.simd_is_avx2
-simd_width = _core.truncated.simd_width
+
+
+def simd_width() -> int:
+    """Doubles per SIMD packet of the truncated map's lane kernel selected for this CPU.
+
+    A portable build (the default, and every wheel) holds the kernel for SSE2, AVX2 and AVX-512 and
+    selects at run time the widest this CPU runs; ``HOVERING_SIMD=sse2|avx2|avx512|auto`` set
+    before the import forces one (a level this CPU does not run is a ValueError at import). A
+    build with ``HOVERING_NATIVE=ON`` has the one kernel of the machine it was built on.
+
+    Returns
+    -------
+    int
+        8 (AVX-512), 4 (AVX2) or 2 (SSE2); another platform's vector width, or 1 without SIMD.
+    """
+    return _core.truncated.simd_width()
+
 
 __all__ = [
     "__version__",

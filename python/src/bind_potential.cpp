@@ -15,7 +15,6 @@
 #include <string>
 
 #include "gil.hpp"
-#include "hovering/detail/common.hpp"
 #include "hovering/flow/system.hpp"
 #include "pybind.hpp"
 
@@ -23,9 +22,13 @@ using namespace hovering;
 
 namespace {
 
-using hovering::detail::kInf;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
-using hovering::detail::fmt;  // all 17 digits: a message names the value the core really saw
+/// A double as Python prints it (shortest round trip): a message names the value the core really
+/// saw, in the user's language. Called with the GIL held (every caller is talking to Python).
+std::string fmt(double v) {
+    return py::repr(py::float_(v)).cast<std::string>();
+}
 
 /// A Python exception of a Python-defined potential on its way through the core (GSL's frames, the
 /// worker threads) to the caller, where the module's translator raises it again unchanged. Its

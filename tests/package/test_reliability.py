@@ -20,8 +20,9 @@ SIGINT_IN_ITERATE = textwrap.dedent(
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
     said = []
     def ready(done, total):  # "ready" once the C++ loop has done work, whatever the machine's load
-        if done > 0 and not said:
-            said.append(print("ready", flush=True))
+        if done > 0 and not said:  # marked before printing: the SIGINT the print triggers may land
+            said.append(True)       # before the next statement, and the final report calls this again
+            print("ready", flush=True)
     t0 = time.perf_counter()
     try:
         m.iterate(np.zeros(20000), np.full(20000, 0.1), 10**7, record=(), progress=ready)  # ~minutes

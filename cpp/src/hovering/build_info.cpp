@@ -12,11 +12,8 @@
 #include <thread>
 
 #include "hovering/truncated/map.hpp"
+#include "hovering/version.hpp"
 #include "hovering_git.h"
-
-#ifndef HOVERING_VERSION
-#error "HOVERING_VERSION is defined by CMake (the project's version)"
-#endif
 
 namespace hovering {
 
@@ -60,7 +57,7 @@ std::string json_string(const std::string& s) {
 std::vector<BuildFact> build_info() {
     auto n = [](long v) { return std::to_string(v); };
     return {
-        {"hovering", HOVERING_VERSION},
+        {"hovering", kVersion},
         {"git", HOVERING_GIT_COMMIT},
         {"compiler", compiler()},
         {"gsl", GSL_VERSION},

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -129,9 +130,16 @@ TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, doubl
 /// Wrap an angle to [-pi, pi).
 double wrap_angle(double x);
 
-/// Whether this build's SIMD kernel uses 4-wide AVX2 (true) or 2-wide SSE2 (false) vectors.
+/// Whether the selected SIMD lane kernel uses 4-wide (AVX2) or wider vectors.
 bool simd_is_avx2();
-/// Doubles per SIMD packet of the kernel in this build (8 AVX-512, 4 AVX2, 2 SSE2, 1 none).
+/// Doubles per SIMD packet of the selected lane kernel (8 AVX-512, 4 AVX2, 2 SSE2, 1 none).
 int simd_width();
+/// Instruction set of the selected lane kernel: "sse2", "avx2", "avx512" (a native build: its own).
+std::string simd_level();
+/// The lane kernels of this build that this CPU runs, narrowest first (names as simd_level()).
+std::vector<std::string> simd_levels();
+/// Select the lane kernel by name ("" or "auto": the widest this CPU runs); throws
+/// std::invalid_argument naming the allowed levels. Without a call: HOVERING_SIMD, else auto.
+void set_simd_level(const std::string& level);
 
 }  // namespace hovering

@@ -1,20 +1,18 @@
-// Batch iteration of the truncated family: the SIMD lane kernel (Eigen packets + SLEEF sin), the
-// scalar reference kernel, and MapCore::iterate on the core's thread pool. Compiled with
-// -fno-trapping-math -fno-math-errno (see CMakeLists.txt): without them GCC will not if-convert
-// Eigen's select() chains or inline sqrt, and the lane kernel falls back to scalar code. Neither
-// flag changes IEEE results.
+// Batch iteration of the truncated family: the scalar reference kernel, the choice of the SIMD
+// lane kernel's build (lanes.cpp) for this CPU, and MapCore::iterate on the core's thread pool.
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <cstring>
-#include <limits>
+#include <cstdlib>
+#include <stdexcept>
 #include <string>
-#include <type_traits>
+#include <vector>
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
-#include "hovering/detail/simd.hpp"
 #include "hovering/truncated/classify.hpp"
+#include "hovering/truncated/lanes.hpp"
 #include "hovering/truncated/map.hpp"
 
 namespace hovering {
@@ -22,511 +20,17 @@ namespace hovering {
 namespace {
 
 using detail::bad;
+using detail::cancelled;
 using detail::Classified;
 using detail::classify;
-using detail::kInvTwoPi;
-using detail::kNaN;
-using detail::kPi;
-using detail::kTwoPi;
-using detail::kW;
-using detail::Packet;
-using detail::psin;
+using detail::Finisher;
+using detail::LaneKernels;
+using detail::Tally;
 using detail::WorkCursor;
-namespace ei = Eigen::internal;
 
-// Arc lengths of a packet of heights: packet arithmetic for the analytic model, in the same
-// operation order as AnalyticArcs::at so that both kernels round alike ...
-inline void arcs_packet(const AnalyticArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
-    const Packet zero = ei::pset1<Packet>(0.0);
-    Om = ei::padd(ei::pset1<Packet>(a.Omega0), ei::pmul(ei::pset1<Packet>(a.tau0), k));
-    J1 = ei::pmul(ei::pset1<Packet>(2.0 * a.lam), detail::psqrt_rn(ei::pmax(ei::pnegate(k), zero)));
-    JR = ei::pand(ei::pcmp_lt(k, zero),
-                  ei::padd(ei::pset1<Packet>(2.0 * (kPi - a.theta_w)), ei::pmul(ei::pset1<Packet>(a.tau1), k)));
-}
-
-// ... and lane by lane for tables (spline lookups are gathers; this model is not the hot path).
-inline void arcs_packet(const TabulatedArcs& a, const Packet& k, Packet& Om, Packet& JR, Packet& J1) {
-    alignas(64) double kk[kW], o[kW], r[kW], l[kW];
-    ei::pstore(kk, k);
-    for (int w = 0; w < kW; ++w) {
-        const ArcLengths x = a.at(kk[w]);
-        o[w] = x.Omega;
-        r[w] = x.JR;
-        l[w] = x.J1;
-    }
-    Om = ei::pload<Packet>(o);
-    JR = ei::pload<Packet>(r);
-    J1 = ei::pload<Packet>(l);
-}
-
-template <bool Fast>
-inline Packet force_packet(const SineForcing&, const Packet& p) {
-    return psin<Fast>(p);
-}
-
-template <bool Fast>
-inline Packet force_packet(const FourierForcing& f, const Packet& p) {
-    Packet acc = ei::pset1<Packet>(0.0);
-    for (std::size_t k = 0; k < f.b.size(); ++k)
-        if (f.b[k] != 0.0)
-            acc = ei::padd(
-                acc, ei::pmul(ei::pset1<Packet>(f.b[k]), psin<Fast>(ei::pmul(ei::pset1<Packet>(double(k + 1)), p))));
-    return acc;
-}
-
-// ------------------------------------------------------------------ batch iteration
-
-// What an orbit gathers besides its state, for the records that stream (nothing per step is stored).
-struct Tally {
-    double rot = 0.0;                   // sum of omega_a over the steps taken
-    int visited = 0;                    // bit r: a return from Region r was taken (or was the exiting one)
-    double K_min = kNaN, K_max = kNaN;  // over the states x_0 .. x_steps
-    // Returns counted for the residence: from J_1, from J_R, from any point with K < 0 (all three
-    // arcs), and in all (those taken, plus the exiting one with stop_on_exit); J_0 and J_0u follow.
-    double upper = 0, right = 0, below = 0;
-    std::int64_t counted = 0;
-};
-
-// Writes an orbit's outputs once it stops, and the NaN / None tail of its recorded arrays.
-struct Finisher {
-    const IterateOptions& opt;
-    const IterateOutput& out;
-    detail::ProgressShare& progress;          // credits the steps an orbit that stops early will not take
-    std::int64_t every, n_states, n_returns;  // recorded per orbit: every e-th state and return
-    Finisher(const IterateOptions& o, const IterateOutput& w, detail::ProgressShare& p)
-        : opt(o),
-          out(w),
-          progress(p),
-          every(o.every),
-          n_states(recorded_states(o.n_steps, o.every)),
-          n_returns(recorded_returns(o.n_steps, o.every)) {}
-    void start(std::int64_t i, double phi, double K) const {
-        if (out.orbit_phi) out.orbit_phi[i * n_states] = phi;
-        if (out.orbit_K) out.orbit_K[i * n_states] = K;
-        if (out.exit_step) out.exit_step[i] = -1;
-        if (out.stop_step) out.stop_step[i] = -1;
-    }
-    // State x_n of orbit i (n a multiple of every).
-    void state(std::int64_t i, std::int64_t n, double phi, double K) const {
-        if (out.orbit_phi) out.orbit_phi[i * n_states + n / every] = phi;
-        if (out.orbit_K) out.orbit_K[i * n_states + n / every] = K;
-    }
-    // Region of the return from x_n of orbit i (n a multiple of every, n < n_steps).
-    void region(std::int64_t i, std::int64_t n, int r) const {
-        if (out.regions) out.regions[i * n_returns + n / every] = static_cast<std::int8_t>(r);
-    }
-    void operator()(std::int64_t i, double phi, double K, std::int64_t steps, Status st, const Tally& t) const {
-        if (out.visited) out.visited[i] = static_cast<std::int8_t>(t.visited);
-        if (out.phi_final) out.phi_final[i] = phi;
-        if (out.K_final) out.K_final[i] = K;
-        if (out.rotation) out.rotation[i] = steps > 0 ? t.rot / double(steps) : kNaN;
-        if (out.status) out.status[i] = static_cast<std::int8_t>(st);
-        if (out.steps_done) out.steps_done[i] = steps;
-        if (out.stop_step && st == Status::Stopped) out.stop_step[i] = steps;
-        if (out.K_min) out.K_min[i] = t.K_min;
-        if (out.K_max) out.K_max[i] = t.K_max;
-        if (out.residence) {
-            std::int64_t* r = out.residence + i * kRegionCount;
-            r[int(Region::Beside)] = t.counted - std::int64_t(t.below);
-            r[int(Region::Above)] = std::int64_t(t.below - t.upper - t.right);
-            r[int(Region::Upper)] = std::int64_t(t.upper);
-            r[int(Region::Right)] = std::int64_t(t.right);
-            r[int(Region::Multi)] = 0;
-        }
-        if (st != Status::Interrupted) progress.add(opt.n_steps - steps);
-        if (steps % every == 0) state(i, steps, phi, K);
-        const std::int64_t s_end = steps / every + 1;  // first state index not reached
-        if (out.orbit_phi) std::fill(out.orbit_phi + i * n_states + s_end, out.orbit_phi + (i + 1) * n_states, kNaN);
-        if (out.orbit_K) std::fill(out.orbit_K + i * n_states + s_end, out.orbit_K + (i + 1) * n_states, kNaN);
-        // Returns recorded: those from x_n, n < steps, and the exiting one (n = steps) if it was.
-        const std::int64_t exiting = st == Status::Exited ? 1 : 0;
-        const std::int64_t r_end = (steps + exiting + every - 1) / every;
-        if (out.regions)
-            std::fill(out.regions + i * n_returns + r_end, out.regions + (i + 1) * n_returns,
-                      static_cast<std::int8_t>(Region::None));
-    }
-};
-
-bool cancelled(const IterateOptions& opt) {
-    return opt.cancel && opt.cancel->load(std::memory_order_relaxed);
-}
-
-// Packets in flight per worker: several independent dependency chains hide the latency of one
-// step (sqrt, floor, sin) while the whole state stays in registers / L1.
-constexpr int kP = 8;
-
-// How close to an arc end the offset of phi from phi_01 must come for a packet to be classified
-// by comparing with the arc starts. The offset's rounding (phi - phi_01, its reduction mod 2 pi and
-// the starts' own) is a few ulps of |phi_01| + 2 pi < 2^20, as |Omega| <= 1e6 on the band, so
-// below 1e-9; 2^-24 = 6e-8 keeps that by a factor of 60, and only ~1 lane-step in 1e7 is that close.
-constexpr double kNearArcEnd = 0x1p-24;
-constexpr int kLanes = kP * kW;
-
-template <bool Fast, class A, class F>
-void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src, const IterateOptions& opt,
-              const IterateOutput& out, detail::ProgressShare& progress) {
-    // Lane kernel on Eigen packets: kLanes orbits are stepped together; an orbit that stops frees
-    // its lane, which is refilled from the source at once, so the vectors stay full even when
-    // orbits stop at very different times (early exit). Per-lane bookkeeping happens on a rare
-    // path that unpacks the packets into lane arrays and packs them back.
-    const Finisher finish(opt, out, progress);
-    const std::int64_t ns = opt.n_steps, every = opt.every;
-    const double lo = m.band().lo, hi = m.band().hi;
-    const bool watch = opt.exit_mask != 0;
-    const bool need_reg = watch || out.regions || out.visited;  // region codes are only built when read
-    const bool extrema = out.K_min || out.K_max, residence = out.residence != nullptr;
-    const bool rec_states = out.orbit_phi || out.orbit_K, rec = rec_states || out.regions;
-    const StopCondition& stop = opt.stop;
-    const bool stopping = stop.active(), above = stop.side == StopSide::Above;
-    const Curve* curve = stopping ? stop.curve.get() : nullptr;
-    const bool flat = stopping && curve->is_constant();
-    const Packet zero = ei::pset1<Packet>(0.0), one = ei::pset1<Packet>(1.0), two = ei::pset1<Packet>(2.0),
-                 three = ei::pset1<Packet>(3.0), pi = ei::pset1<Packet>(kPi), mpi = ei::pset1<Packet>(-kPi),
-                 twopi = ei::pset1<Packet>(kTwoPi), inv2pi = ei::pset1<Packet>(kInvTwoPi),
-                 half = ei::pset1<Packet>(0.5), eps = ei::pset1<Packet>(m.eps()), plo = ei::pset1<Packet>(lo),
-                 phi_ = ei::pset1<Packet>(hi), all = ei::pcmp_eq(zero, zero), margin = ei::pset1<Packet>(kNearArcEnd),
-                 pi_less_margin = ei::pset1<Packet>(kPi - kNearArcEnd);
-    // The stop curve: its scale and cell count, and the bound beyond which no state can be in the set.
-    const Packet cscale = ei::pset1<Packet>(stopping ? curve->scale() : 0.0),
-                 ncells = ei::pset1<Packet>(stopping ? double(curve->size()) : 0.0),
-                 cflat = ei::pset1<Packet>(stopping ? curve->samples()[0] : 0.0),
-                 cbound = ei::pset1<Packet>(!stopping ? 0.0
-                                            : above   ? curve->lower()
-                                                      : curve->upper());
-    // detail::wrap and detail::wrap_once on packets (same operations, same order).
-    auto pwrap = [&](const Packet& x) {
-        Packet y = ei::psub(x, ei::pmul(twopi, ei::pfloor(ei::pmul(ei::padd(x, pi), inv2pi))));
-        y = ei::pselect(ei::pcmp_le(pi, y), ei::psub(y, twopi), y);
-        return ei::pselect(ei::pcmp_lt(y, mpi), ei::padd(y, twopi), y);
-    };
-    auto wrap_once = [&](const Packet& u) { return ei::pselect(ei::pcmp_le(pi, u), ei::psub(u, twopi), u); };
-    // Curve::value on packets (same operations, same order).
-    auto curve_at = [&](const Packet& p) {
-        if (flat) return cflat;
-        const Packet t = ei::pmul(ei::padd(p, pi), cscale);
-        Packet f = ei::pfloor(t);
-        const Packet s = ei::psub(t, f);
-        f = ei::pselect(ei::pcmp_le(ncells, f), ei::psub(f, ncells), f);
-        Packet c[4];
-        detail::pgather_cells(curve->cells(), f, c);
-        return ei::padd(c[0], ei::pmul(s, ei::padd(c[1], ei::pmul(s, ei::padd(c[2], ei::pmul(s, c[3]))))));
-    };
-    auto in_set = [&](const Packet& p, const Packet& k) {
-        const Packet c = curve_at(p);
-        return above ? ei::pcmp_le(c, k) : ei::pcmp_le(k, c);
-    };
-    Packet allow[4];
-    for (int r = 0; r < 4; ++r) allow[r] = (opt.exit_mask >> r) & 1u ? all : zero;
-
-    Packet phi[kP], K[kP], rot[kP], live[kP], fresh[kP], reg[kP], omega[kP];
-    Packet kmin[kP], kmax[kP], nup[kP], nright[kP], nbelow[kP], mup[kP], mright[kP], mbelow[kP];
-    alignas(64) double lphi[kLanes], lK[kLanes], lrot[kLanes], llive[kLanes], lfresh[kLanes], lreg[kLanes];
-    alignas(64) double lkmin[kLanes], lkmax[kLanes], lup[kLanes], lright[kLanes], lbelow[kLanes];
-    // Regions visited (record "visited" only): one all-ones mask per region code 0..3 and lane.
-    Packet seen[4][kP];
-    alignas(64) double lseen[4][kLanes];
-    const Packet code[4] = {zero, one, two, three};
-    std::int64_t idx[kLanes], start[kLanes], due[kLanes];  // due: the next n whose state / return is recorded
-    std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
-
-    auto unpack = [&] {
-        for (int q = 0; q < kP; ++q) {
-            ei::pstore(lphi + q * kW, phi[q]);
-            ei::pstore(lK + q * kW, K[q]);
-            ei::pstore(lrot + q * kW, rot[q]);
-            ei::pstore(llive + q * kW, live[q]);
-            ei::pstore(lfresh + q * kW, fresh[q]);
-            if (out.visited)
-                for (int r = 0; r < 4; ++r) ei::pstore(lseen[r] + q * kW, seen[r][q]);
-            if (extrema) {
-                ei::pstore(lkmin + q * kW, kmin[q]);
-                ei::pstore(lkmax + q * kW, kmax[q]);
-            }
-            if (residence) {
-                ei::pstore(lup + q * kW, nup[q]);
-                ei::pstore(lright + q * kW, nright[q]);
-                ei::pstore(lbelow + q * kW, nbelow[q]);
-            }
-        }
-    };
-    auto pack = [&] {
-        for (int q = 0; q < kP; ++q) {
-            phi[q] = ei::pload<Packet>(lphi + q * kW);
-            K[q] = ei::pload<Packet>(lK + q * kW);
-            rot[q] = ei::pload<Packet>(lrot + q * kW);
-            live[q] = ei::pload<Packet>(llive + q * kW);
-            fresh[q] = ei::pload<Packet>(lfresh + q * kW);
-            if (out.visited)
-                for (int r = 0; r < 4; ++r) seen[r][q] = ei::pload<Packet>(lseen[r] + q * kW);
-            if (extrema) {
-                kmin[q] = ei::pload<Packet>(lkmin + q * kW);
-                kmax[q] = ei::pload<Packet>(lkmax + q * kW);
-            }
-            if (residence) {
-                nup[q] = ei::pload<Packet>(lup + q * kW);
-                nright[q] = ei::pload<Packet>(lright + q * kW);
-                nbelow[q] = ei::pload<Packet>(lbelow + q * kW);
-            }
-        }
-    };
-    const double on = [] {
-        double x;
-        const std::uint64_t b = ~std::uint64_t(0);
-        std::memcpy(&x, &b, 8);
-        return x;
-    }();
-    auto is_live = [&](int j) { return std::memcmp(&llive[j], &on, 8) == 0; };
-    // Lane j's tally from the lane arrays (after unpack()); `exiting`: the exiting return is counted.
-    auto tally = [&](int j, bool exiting = false) {
-        Tally t;
-        t.rot = lrot[j];
-        if (out.visited)
-            for (int r = 0; r < 4; ++r) t.visited |= std::memcmp(&lseen[r][j], &on, 8) == 0 ? 1 << r : 0;
-        t.K_min = lkmin[j];
-        t.K_max = lkmax[j];
-        t.upper = lup[j];
-        t.right = lright[j];
-        t.below = lbelow[j];
-        t.counted = it - start[j] + (exiting ? 1 : 0);
-        return t;
-    };
-    auto clear = [&](int j) {
-        lrot[j] = 0.0;
-        for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
-        lup[j] = lright[j] = lbelow[j] = 0.0;
-    };
-    // Put the next orbit that starts inside the band and outside the stop set into lane j (the
-    // others finish at once); with no work left the lane computes a harmless point that is ignored.
-    auto fill = [&](int j) {
-        for (std::int64_t i; src.pop(i);) {
-            const double w = detail::wrap(phi0[i]);  // the kernel compares angles in [-pi, pi)
-            finish.start(i, w, K0[i]);
-            Tally t0;
-            t0.K_min = t0.K_max = K0[i];
-            if (!(K0[i] > lo && K0[i] < hi)) {
-                finish(i, w, K0[i], 0, Status::Escaped, t0);
-                continue;
-            }
-            if (stopping && stop.reached(w, K0[i])) {
-                finish(i, w, K0[i], 0, Status::Stopped, t0);
-                continue;
-            }
-            if (ns == 0) {
-                finish(i, w, K0[i], 0, Status::Ok, t0);
-                continue;
-            }
-            lphi[j] = w;
-            lK[j] = K0[i];
-            llive[j] = on;
-            lfresh[j] = on;  // not yet reported as leaving the watched regions
-            lkmin[j] = lkmax[j] = K0[i];
-            clear(j);
-            idx[j] = i;
-            start[j] = it;
-            due[j] = 0;
-            return true;
-        }
-        lphi[j] = 0.0;
-        lK[j] = 0.0;
-        llive[j] = 0.0;
-        lfresh[j] = 0.0;
-        lkmin[j] = lkmax[j] = 0.0;
-        clear(j);
-        due[j] = 0;
-        return false;
-    };
-    int nlive = 0;
-    for (int j = 0; j < kLanes; ++j) nlive += fill(j);
-    pack();
-    auto next_completion = [&] {
-        std::int64_t c = ns;
-        for (int j = 0; j < kLanes; ++j)
-            if (is_live(j)) c = std::min(c, ns - (it - start[j]));
-        return c;
-    };
-    // The first iteration at which some live lane records its state / return.
-    auto next_record = [&] {
-        std::int64_t r = std::numeric_limits<std::int64_t>::max();
-        if (rec)
-            for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) r = std::min(r, start[j] + due[j]);
-        return r;
-    };
-    std::int64_t countdown = next_completion(), record_at = next_record();
-
-    while (nlive > 0) {
-        if ((it & 63) == 0 && cancelled(opt)) {
-            unpack();
-            for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) finish(idx[j], lphi[j], lK[j], it - start[j], Status::Interrupted, tally(j));
-            for (std::int64_t i; src.pop(i);) {  // not started: keep their initial state
-                const double w = detail::wrap(phi0[i]);
-                finish.start(i, w, K0[i]);
-                const bool inside = K0[i] > lo && K0[i] < hi;
-                Tally t0;
-                t0.K_min = t0.K_max = K0[i];
-                finish(i, w, K0[i], 0, inside ? Status::Interrupted : Status::Escaped, t0);
-            }
-            return;
-        }
-        // Classify every lane: region code and rotation omega_a, exactly as detail::classify, which
-        // compares phi with the arc starts (the boundary convention). That costs ~25 vector
-        // operations per packet, so a first pass uses the offset d of phi from phi_01 reduced mod
-        // 2 pi, which gives the same regions wherever it is farther than kNearArcEnd from an arc
-        // end (d = 0, |J_1|, |J_1| + |J_R|, 2 pi); only if some lane is that close (~1 lane-step in
-        // 1e7) are all packets classified again by comparison with the starts.
-        auto classify_packets = [&](auto exact) {  // std::bool_constant: two instantiations
-            Packet near = zero;
-            for (int q = 0; q < kP; ++q) {
-                Packet Om, JR, J1;
-                arcs_packet(m.arcs(), K[q], Om, JR, J1);
-                const Packet p01 = ei::psub(pi, ei::pmul(half, ei::padd(ei::padd(Om, JR), J1)));
-                const Packet neg = ei::pcmp_lt(K[q], zero);
-                Packet in1, inR;  // phi in J_1; phi in J_R (fast pass: in J_1 or J_R)
-                if constexpr (!decltype(exact)::value) {
-                    Packet d = ei::psub(phi[q], p01);
-                    d = ei::psub(d, ei::pmul(twopi, ei::pfloor(ei::pmul(d, inv2pi))));
-                    const Packet T = ei::padd(J1, JR);
-                    in1 = ei::pcmp_lt(d, J1);
-                    inR = ei::pcmp_lt(d, T);
-                    const Packet close =
-                        ei::por(ei::pcmp_lt(ei::pmin(ei::pabs(ei::psub(d, J1)), ei::pabs(ei::psub(d, T))), margin),
-                                ei::pcmp_lt(pi_less_margin, ei::pabs(ei::psub(d, pi))));
-                    near = ei::por(near, ei::pand(close, neg));
-                } else {
-                    const Packet s1 = pwrap(p01);
-                    const Packet uR = ei::padd(s1, J1);
-                    const Packet sR = wrap_once(uR), s0 = wrap_once(ei::padd(uR, JR));
-                    // detail::in_arc(x, a, b) as masks: (a <= x) ^ (x < b) ^ (a <= b). For a <= b
-                    // the first two are never both false (x < a <= b), so the xor is their and;
-                    // for a > b never both true, so it is their or. Both arcs compare with s_R.
-                    const Packet below_R = ei::pcmp_lt(phi[q], sR);
-                    in1 = ei::pxor(ei::pxor(ei::pcmp_le(s1, phi[q]), below_R), ei::pcmp_le(s1, sR));
-                    inR = ei::pxor(ei::pandnot(all, below_R), ei::pxor(ei::pcmp_lt(phi[q], s0), ei::pcmp_le(sR, s0)));
-                }
-                const Packet up = ei::pand(neg, in1);
-                const Packet rt = ei::pandnot(ei::pand(neg, inR), up);
-                omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
-                if (need_reg) reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
-                if (residence) {
-                    mup[q] = up;
-                    mright[q] = rt;
-                    mbelow[q] = neg;
-                }
-            }
-            return ei::predux_any(near);
-        };
-        if (classify_packets(std::false_type{})) classify_packets(std::true_type{});
-        Packet leaving = zero;
-        if (need_reg)
-            for (int q = 0; q < kP; ++q) {
-                if (out.visited)
-                    for (int r = 0; r < 4; ++r)
-                        seen[r][q] = ei::por(seen[r][q], ei::pand(live[q], ei::pcmp_eq(reg[q], code[r])));
-                if (watch) {
-                    const Packet ok =
-                        ei::pselect(ei::pcmp_eq(reg[q], zero), allow[0],
-                                    ei::pselect(ei::pcmp_eq(reg[q], one), allow[1],
-                                                ei::pselect(ei::pcmp_eq(reg[q], two), allow[2], allow[3])));
-                    leaving = ei::por(leaving, ei::pandnot(ei::pand(live[q], fresh[q]), ok));
-                }
-            }
-        if (watch && ei::predux_any(leaving)) {
-            unpack();
-            for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
-            bool refilled = false;
-            for (int j = 0; j < kLanes; ++j) {
-                if (!is_live(j) || std::memcmp(&lfresh[j], &on, 8) != 0) continue;
-                const int r = int(lreg[j]);
-                if ((opt.exit_mask >> r) & 1u) continue;
-                const std::int64_t n = it - start[j];
-                if (out.exit_step) out.exit_step[idx[j]] = n;
-                lfresh[j] = 0.0;
-                if (opt.stop_on_exit) {
-                    // The exiting return is recorded (its region, its residence count), not taken.
-                    if (n % every == 0) finish.region(idx[j], n, r);
-                    lbelow[j] += r != int(Region::Beside);
-                    lup[j] += r == int(Region::Upper);
-                    lright[j] += r == int(Region::Right);
-                    finish(idx[j], lphi[j], lK[j], n, Status::Exited, tally(j, true));
-                    nlive -= !fill(j);
-                    refilled = true;
-                }
-            }
-            pack();
-            if (refilled) {  // refilled lanes need their own classification
-                countdown = next_completion();
-                record_at = next_record();
-                continue;
-            }
-        }
-        if (it == record_at) {  // some lane records its state x_n and the region of its return
-            unpack();
-            if (out.regions)  // reg is only built when something reads it
-                for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
-            for (int j = 0; j < kLanes; ++j) {
-                if (!is_live(j) || it - start[j] != due[j]) continue;
-                if (rec_states) finish.state(idx[j], due[j], lphi[j], lK[j]);
-                if (out.regions) finish.region(idx[j], due[j], int(lreg[j]));
-                due[j] += every;
-            }
-            record_at = next_record();
-        }
-        if (residence)
-            for (int q = 0; q < kP; ++q) {
-                nup[q] = ei::padd(nup[q], ei::pand(mup[q], one));
-                nright[q] = ei::padd(nright[q], ei::pand(mright[q], one));
-                nbelow[q] = ei::padd(nbelow[q], ei::pand(mbelow[q], one));
-            }
-        // Step: rotate, wrap to [-pi, pi), kick.
-        Packet outside = zero;
-        for (int q = 0; q < kP; ++q) {
-            rot[q] = ei::padd(rot[q], omega[q]);
-            const Packet p = pwrap(ei::padd(phi[q], omega[q]));
-            phi[q] = p;
-            K[q] = ei::padd(K[q], ei::pmul(eps, force_packet<Fast>(m.forcing(), p)));
-            const Packet inside = ei::pand(ei::pcmp_lt(plo, K[q]), ei::pcmp_lt(K[q], phi_));
-            outside = ei::por(outside, ei::pandnot(live[q], inside));
-            if (extrema) {
-                kmin[q] = ei::pmin(kmin[q], K[q]);
-                kmax[q] = ei::pmax(kmax[q], K[q]);
-            }
-        }
-        // Stop condition: only packets with a lane beyond the curve's bound can hold a state in the
-        // set; which lanes are is decided on the rare path by Curve::value itself (the same bits).
-        Packet hit = zero;
-        if (stopping) {
-            Packet maybe = zero;
-            for (int q = 0; q < kP; ++q)
-                maybe =
-                    ei::por(maybe, ei::pand(live[q], above ? ei::pcmp_le(cbound, K[q]) : ei::pcmp_le(K[q], cbound)));
-            if (ei::predux_any(maybe))
-                for (int q = 0; q < kP; ++q) hit = ei::por(hit, ei::pand(live[q], in_set(phi[q], K[q])));
-        }
-        ++it;
-        --countdown;
-        progress.add(nlive);  // every live lane took one step
-        if (countdown == 0 || ei::predux_any(outside) || ei::predux_any(hit)) {
-            unpack();
-            for (int j = 0; j < kLanes; ++j) {
-                if (!is_live(j)) continue;
-                const std::int64_t n = it - start[j];
-                if (!(lK[j] > lo && lK[j] < hi))
-                    finish(idx[j], lphi[j], lK[j], n, Status::Escaped, tally(j));
-                else if (stopping && stop.reached(lphi[j], lK[j]))
-                    finish(idx[j], lphi[j], lK[j], n, Status::Stopped, tally(j));
-                else if (n == ns)
-                    finish(idx[j], lphi[j], lK[j], ns, Status::Ok, tally(j));
-                else
-                    continue;
-                nlive -= !fill(j);
-            }
-            pack();
-            countdown = next_completion();
-            record_at = next_record();
-        }
-    }
-}
+// Orbits per worker at least, for the scalar kernel: the lane block of the AVX2 build, which the
+// scalar kernel has always been given.
+constexpr std::int64_t kScalarBlock = 32;
 
 template <class A, class F>
 void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, WorkCursor& src,
@@ -605,18 +109,110 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
     }
 }
 
+// The builds of the lane kernel this binary has, narrowest first, each with the test of whether
+// this CPU (and its OS, which must save the wider registers) runs it.
+struct LaneBuild {
+    const LaneKernels* kernels;
+    bool (*runs)();
+    const char* needs;  // the CPU features it needs, for messages
+};
+
+const std::vector<LaneBuild>& lane_builds() {
+#if defined(HOVERING_LANES_DISPATCH)
+    __builtin_cpu_init();  // idempotent; needed if the first call runs before libgcc's constructor
+#endif
+    static const std::vector<LaneBuild> builds = {
+        {&hovering_lanes_base, [] { return true; }, "the baseline of this build"},
+#if defined(HOVERING_LANES_DISPATCH)
+        {&hovering_lanes_avx2, [] { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); },
+         "AVX2 and FMA"},
+        {&hovering_lanes_avx512,
+         [] {
+             return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                    __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512bw") &&
+                    __builtin_cpu_supports("avx512vl");
+         },
+         "AVX-512 F, CD, BW, DQ and VL"},
+#endif
+    };
+    return builds;
+}
+
+std::string level_names(bool runnable_only) {
+    std::string s;
+    for (const LaneBuild& b : lane_builds())
+        if (!runnable_only || b.runs()) s += std::string(s.empty() ? "" : ", ") + b.kernels->level;
+    return s;
+}
+
+// The build named `level` ("" or "auto": the widest this CPU runs); `what` names the setting in
+// messages (the environment variable or the function).
+const LaneKernels* find_lanes(const std::string& level, const char* what) {
+    const LaneKernels* widest = nullptr;
+    for (const LaneBuild& b : lane_builds()) {
+        if (!b.runs()) continue;
+        widest = b.kernels;
+        if (level == b.kernels->level) return b.kernels;
+    }
+    if (level.empty() || level == "auto") return widest;
+    for (const LaneBuild& b : lane_builds())
+        if (level == b.kernels->level)
+            throw std::invalid_argument(std::string(what) + "='" + level + "' is not available: this CPU lacks " +
+                                        b.needs + " (allowed here: auto, " + level_names(true) + ")");
+    throw std::invalid_argument(std::string(what) + " must be one of auto, " + level_names(true) + " (the " +
+                                "SIMD levels of this build that this CPU runs; this build has " + level_names(false) +
+                                "), got '" + level + "'");
+}
+
+// The selected build: set_simd_level's, else HOVERING_SIMD's (read at first use; a bad value is an
+// error at every use until it is fixed), else the widest this CPU runs.
+std::atomic<const LaneKernels*> g_lanes{nullptr};
+
+const LaneKernels& lanes() {
+    const LaneKernels* k = g_lanes.load(std::memory_order_acquire);
+    if (!k) {
+        const char* env = std::getenv("HOVERING_SIMD");
+        k = find_lanes(env ? env : "", "HOVERING_SIMD");
+        const LaneKernels* expected = nullptr;  // a concurrent set_simd_level wins
+        if (!g_lanes.compare_exchange_strong(expected, k, std::memory_order_acq_rel)) k = expected;
+    }
+    return *k;
+}
+
+template <class A, class F>
+detail::LaneKernel<A, F> lane_kernel(bool fast);
+template <>
+detail::LaneKernel<AnalyticArcs, SineForcing> lane_kernel<AnalyticArcs, SineForcing>(bool fast) {
+    return lanes().analytic[fast];
+}
+template <>
+detail::LaneKernel<TabulatedArcs, FourierForcing> lane_kernel<TabulatedArcs, FourierForcing>(bool fast) {
+    return lanes().tabulated[fast];
+}
+
 }  // namespace
 
 bool simd_is_avx2() {
-#if defined(__AVX2__)
-    return true;
-#else
-    return false;
-#endif
+    return lanes().width >= 4;
 }
 
 int simd_width() {
-    return detail::kW;
+    return lanes().width;
+}
+
+std::string simd_level() {
+    return lanes().level;
+}
+
+std::vector<std::string> simd_levels() {
+    std::vector<std::string> v;
+    for (const LaneBuild& b : lane_builds())
+        if (b.runs()) v.emplace_back(b.kernels->level);
+    return v;
+}
+
+void set_simd_level(const std::string& level) {
+    g_lanes.store(find_lanes(level, "SIMD level"), std::memory_order_release);
 }
 
 template <class A, class F>
@@ -638,17 +234,18 @@ void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n
         detail::require_finite(K0[i], "K0[" + std::to_string(i) + "]");
     }
     if (n == 0) return;
-    // A worker needs at least a lane-block's worth of orbits to fill its vectors; small blocks
-    // keep workers balanced when orbits stop at different times.
-    const int threads = detail::worker_count(opt.n_threads, (n + kLanes - 1) / kLanes);
+    // A SIMD worker needs at least a lane-block's worth of orbits to fill its vectors; small blocks
+    // keep workers balanced when orbits stop at different times. (The scalar kernel takes the
+    // SIMD path's thread count too, without asking for a lane build it does not use.)
+    const std::int64_t block = opt.kernel == Kernel::Simd ? lanes().lanes : kScalarBlock;
+    const detail::LaneKernel<A, F> simd = opt.kernel == Kernel::Simd ? lane_kernel<A, F>(opt.fast_sin) : nullptr;
+    const int threads = detail::worker_count(opt.n_threads, (n + block - 1) / block);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 256));
     detail::run_workers(threads, queue, [&](WorkCursor& src) {
         // Steps are ~1 ns: a worker hands its count over every 2^14 of them (~20 us).
         detail::ProgressShare progress(opt.progress, std::int64_t(1) << 14);
-        if (opt.kernel == Kernel::Simd && opt.fast_sin)
-            run_simd<true>(*this, phi0, K0, src, opt, out, progress);
-        else if (opt.kernel == Kernel::Simd)
-            run_simd<false>(*this, phi0, K0, src, opt, out, progress);
+        if (simd)
+            simd(*this, phi0, K0, src, opt, out, progress);
         else
             run_scalar(*this, phi0, K0, src, opt, out, progress);
     });
