@@ -17,7 +17,7 @@ import numpy as np
 from .._checks import check_memory, flag, integer, real_number, thread_count
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
-from .._progress import check_progress, progress_bar
+from .._progress import check_progress, progress_bar, stop_hook
 from .._serial import Saveable
 from ..interface import require_map
 from ..parallel.checkpoint import Checkpoint
@@ -133,7 +133,7 @@ def _flow_threads(m, n_threads: int) -> int:
 def _piece(m, samples, K_low, seed, lo, hi, n_steps: int, n_threads: int):
     """The outcomes of samples lo..hi-1 (a piece of a distributed run: it draws its own samples)."""
     phi, K = _stratified(samples, K_low, seed, lo, hi)
-    return _outcomes(m, phi, K, n_steps, n_threads)
+    return _outcomes(m, phi, K, n_steps, n_threads, stop_hook() or False)
 
 
 def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> dict:
@@ -261,7 +261,7 @@ def hovering_area(
     executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
         Where it runs (:func:`hovering.parallel.executor.as_executor`): ``None`` in this process on
         ``n_threads`` core threads; otherwise the samples are cut into pieces run on that many local
-        worker processes (``int``), a Dask scheduler (address), a Dask client, or as an
+        worker threads (``int``), a Dask scheduler (address), a Dask client, or as an
         :class:`~hovering.parallel.Executor` says (a Dask LocalCluster, the number of pieces, a
         checkpoint file that keeps finished pieces, keyed by every parameter that changes them). The
         result is identical to the single-process one for the same seed: each piece draws its own
