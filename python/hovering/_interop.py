@@ -106,9 +106,9 @@ def _flags(attrs: dict, enum) -> dict:
     }
 
 
-def _common(kind: str, **params) -> dict:
+def _common(result_type: str, **params) -> dict:
     """The dataset's attrs: the result type, its parameters (JSON-able scalars) and provenance."""
-    out = {"source": f"hovering {kind}", "provenance": json.dumps(provenance(), default=str)}
+    out = {"source": f"hovering {result_type}", "provenance": json.dumps(provenance(), default=str)}
     for k, v in params.items():
         if v is None:
             continue
@@ -121,7 +121,7 @@ def iterate_dataset(res):
     xr = _xr("IterateResult.to_xarray()")
     n_states = res.n_steps // res.every + 1
     n_returns = -(-res.n_steps // res.every)
-    per_state, per_return, per_orbit = ("orbit", "state"), ("orbit", "return"), ("orbit",)
+    per_state, per_return, per_orbit = ("orbit", "step"), ("orbit", "return_step"), ("orbit",)
     data = {}
 
     def put(name, dims, values, attrs=None):
@@ -147,9 +147,9 @@ def iterate_dataset(res):
     put("status", per_orbit, res.status, _flags(_attrs("status"), Status))
     coords = {"orbit": np.arange(res.n_orbits)}
     if any(d[0] == per_state for d in data.values()):
-        coords["step"] = ("state", np.arange(n_states) * res.every, _attrs("step"))
+        coords["step"] = ("step", np.arange(n_states) * res.every, _attrs("step"))
     if any(d[0] == per_return for d in data.values()):
-        coords["return_step"] = ("return", np.arange(n_returns) * res.every, _attrs("return_step"))
+        coords["return_step"] = ("return_step", np.arange(n_returns) * res.every, _attrs("return_step"))
     if res.residence is not None:
         put("residence", ("orbit", "region_name"), res.residence)
         coords["region_name"] = [r.name for r in Region if r.value >= 0][: res.residence.shape[1]]
@@ -226,9 +226,7 @@ def transit_frame(t):
     pd = _pd("TransitResult.to_pandas()")
     cols = {name: getattr(t, name) for name in ("phi0", "K0", "first_passage", "steps_done", "K_min", "K_max", "s_min", "s_max")}
     cols["crossed"] = t.crossed
-    cols["status"] = pd.Categorical.from_codes(
-        [list(Status).index(Status(int(s))) for s in t.status], categories=[s.name for s in Status]
-    )
+    cols["status"] = pd.Categorical([Status(int(s)).name for s in t.status], categories=[s.name for s in Status])
     for j, r in enumerate(r for r in Region if r.value >= 0):
         if j < t.residence.shape[1]:
             cols[f"residence_{r.name}"] = t.residence[:, j]

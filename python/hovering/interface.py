@@ -391,9 +391,9 @@ class IterateResult(Summarized, Saveable):
     def to_xarray(self):
         """The result as an :class:`xarray.Dataset` (needs ``hovering[xarray]``).
 
-        Dimensions ``orbit`` and ``state`` (the kept states ``x_0, x_every, ...``; coordinate
-        ``step``, the step index of each) and ``return`` (the returns taken from them; coordinate
-        ``return_step``); ``region`` for the residence counts (coordinate: the region names).
+        Dimensions ``orbit``, ``step`` (the kept states ``x_0, x_every, ...``, labelled by their
+        step index) and ``return_step`` (the returns taken from them, labelled by the step they
+        start from); ``region_name`` for the residence counts.
         Every per-orbit and per-state record present becomes a variable with its units and meaning
         in attrs; the dataset's attrs hold ``n_steps``, ``every``, the map's ``repr`` and the
         provenance of this installation (versions, build, machine). The flow's ``z`` and

@@ -17,6 +17,7 @@ import numpy as np
 from .._checks import check_memory, flag, integer, real_number, thread_count
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
+from .._display import Summarized
 from .._progress import check_progress, progress_bar, stop_hook
 from .._serial import Saveable
 from ..interface import require_map
@@ -27,8 +28,8 @@ from ..parallel.executor import executor as open_executor
 __all__ = ["HoveringArea", "hovering_area"]
 
 
-@dataclass(frozen=True)
-class HoveringArea(Saveable):
+@dataclass(frozen=True, repr=False)
+class HoveringArea(Summarized, Saveable):
     """Measured area of the hovering set HOV(eps) (see :func:`hovering_area`).
 
     Attributes
@@ -85,6 +86,36 @@ class HoveringArea(Saveable):
     K: np.ndarray | None = field(default=None, repr=False)
     hovering: np.ndarray | None = field(default=None, repr=False)
     both_sides: np.ndarray | None = field(default=None, repr=False)
+
+    def _summary(self) -> list:
+        return [
+            ("area", f"{self.area:.6g} +- {self.error:.2g}"),
+            ("theory", self.theory),
+            ("area_both_sides", self.area_both_sides),
+            ("n_samples", self.n_samples),
+            ("N", max(self.areas) if self.areas else None),
+            ("K_low", self.box[2]),
+            ("floor_touched", self.floor_touched),
+            ("unresolved", self.unresolved),
+        ]
+
+    def to_xarray(self):
+        """The estimate as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): the numbers as
+        scalar variables, ``area_at_N`` over dimension ``n_steps`` (N/4, N/2, N), the sample points
+        over ``sample`` when kept; units, ``box`` and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import hovering_area_dataset
+
+        return hovering_area_dataset(self)
 
 
 def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | None = None) -> tuple:
