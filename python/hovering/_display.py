@@ -95,4 +95,6 @@ class Summarized:
             f"<td style='text-align:left'>{html.escape(short(v))}</td></tr>"
             for k, v in self._summary()
         )
-        return f"<table><caption style='text-align:left'><b>{html.escape(type(self).__name__)}</b></caption>{rows}</table>"
+        return (
+            f"<table><caption style='text-align:left'><b>{html.escape(type(self).__name__)}</b></caption>{rows}</table>"
+        )

@@ -19,7 +19,14 @@ from types import ModuleType
 __all__ = ["EXTRAS", "require"]
 
 #: The extra of pyproject.toml that installs each optional top-level module.
-EXTRAS = {"distributed": "distributed", "dask": "distributed", "xarray": "xarray", "pandas": "pandas", "tqdm": "progress", "scipy": "scipy"}
+EXTRAS = {
+    "distributed": "distributed",
+    "dask": "distributed",
+    "xarray": "xarray",
+    "pandas": "pandas",
+    "tqdm": "progress",
+    "scipy": "scipy",
+}
 
 
 def require(module: str, feature: str) -> ModuleType:

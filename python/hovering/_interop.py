@@ -138,9 +138,23 @@ def iterate_dataset(res):
     if res.region is not None:
         put("region", per_return, res.region, _flags(_attrs("region"), Region))
     if res.itinerary is not None and len({len(row) for row in res.itinerary}) <= 1:
-        put("itinerary", per_return, np.array(res.itinerary, dtype=str).reshape(len(res.itinerary), -1), {
-            "long_name": "impacts of each return ('-': not taken)"})
-    for name in ("rotation", "phi_final", "K_final", "steps_done", "exit_step", "stop_step", "K_min", "K_max", "visited"):
+        put(
+            "itinerary",
+            per_return,
+            np.array(res.itinerary, dtype=str).reshape(len(res.itinerary), -1),
+            {"long_name": "impacts of each return ('-': not taken)"},
+        )
+    for name in (
+        "rotation",
+        "phi_final",
+        "K_final",
+        "steps_done",
+        "exit_step",
+        "stop_step",
+        "K_min",
+        "K_max",
+        "visited",
+    ):
         a = getattr(res, name)
         if a is not None:
             put(name, per_orbit, a)
@@ -183,7 +197,13 @@ def hovering_area_dataset(h):
     data = {
         name: ((), getattr(h, name), _attrs(name))
         for name in (
-            "area", "error", "sampling_error", "iteration_error", "theory", "area_both_sides", "impact_fraction_F0"
+            "area",
+            "error",
+            "sampling_error",
+            "iteration_error",
+            "theory",
+            "area_both_sides",
+            "impact_fraction_F0",
         )
     }
     steps = sorted(h.areas)
@@ -224,14 +244,19 @@ def _pd(feature: str):
 def transit_frame(t):
     """:meth:`hovering.TransitResult.to_pandas`."""
     pd = _pd("TransitResult.to_pandas()")
-    cols = {name: getattr(t, name) for name in ("phi0", "K0", "first_passage", "steps_done", "K_min", "K_max", "s_min", "s_max")}
+    cols = {
+        name: getattr(t, name)
+        for name in ("phi0", "K0", "first_passage", "steps_done", "K_min", "K_max", "s_min", "s_max")
+    }
     cols["crossed"] = t.crossed
     cols["status"] = pd.Categorical([Status(int(s)).name for s in t.status], categories=[s.name for s in Status])
     for j, r in enumerate(r for r in Region if r.value >= 0):
         if j < t.residence.shape[1]:
             cols[f"residence_{r.name}"] = t.residence[:, j]
     df = pd.DataFrame(cols, index=pd.RangeIndex(len(t.phi0), name="orbit"))
-    df.attrs.update(direction=t.direction, start_s=t.start_s, target_s=t.target_s, n_steps=int(t.n_steps), every=int(t.every))
+    df.attrs.update(
+        direction=t.direction, start_s=t.start_s, target_s=t.target_s, n_steps=int(t.n_steps), every=int(t.every)
+    )
     return df
 
 

@@ -334,7 +334,11 @@ def main(argv=None) -> int:
         default=None,
         help="sweep scenes: run N points at a time on threads of this process (1..4096)",
     )
-    sc.add_argument("--dask", action="store_true", help="with --workers: a Dask LocalCluster of N worker processes instead of threads")
+    sc.add_argument(
+        "--dask",
+        action="store_true",
+        help="with --workers: a Dask LocalCluster of N worker processes instead of threads",
+    )
     sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
     force_flag(sc)

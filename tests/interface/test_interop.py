@@ -35,7 +35,11 @@ def res(m):
     # every=3: the coordinates must be the step indices 0, 3, 6, ..., not positions
     phi0, K0 = np.linspace(-2, 2, 40), np.full(40, -0.15)
     return m.iterate(
-        phi0, K0, 300, record=("orbit", "regions", "rotation", "extrema", "residence", "visited"), every=3,
+        phi0,
+        K0,
+        300,
+        record=("orbit", "regions", "rotation", "extrema", "residence", "visited"),
+        every=3,
         exit_regions=("0", "0u"),
     )
 
@@ -120,8 +124,18 @@ def _series(label, eps, offset):
     eps = np.asarray(eps, dtype=float)
     z = np.zeros_like(eps)
     return SeriesResult(
-        label=label, color="C0", eps=eps, area=eps + offset, error=0.01 + z, theory=eps * 2, floor_touched=z > 1,
-        K_low=-1 + z, Omega0=3.0 + z, theta_w=2.0 + z, theory_eps=eps, theory_curve=eps * 2,
+        label=label,
+        color="C0",
+        eps=eps,
+        area=eps + offset,
+        error=0.01 + z,
+        theory=eps * 2,
+        floor_touched=z > 1,
+        K_low=-1 + z,
+        Omega0=3.0 + z,
+        theta_w=2.0 + z,
+        theory_eps=eps,
+        theory_curve=eps * 2,
     )
 
 
@@ -150,8 +164,18 @@ def test_flow_sweep_to_pandas_and_to_xarray():
         "first_mode": {"area": eps + 2, "error": eps * 0 + 0.2, "agree": eps * 0 + 0.8},
     }
     r = FlowHoveringResult(
-        scene=scene, meta={}, eps=eps, flow_area=eps * 3, flow_error=eps * 0 + 0.05, flow_both_sides=eps, models=models,
-        theory=eps * 4, K_low=eps - 1, b1=eps * 0 + 0.5, seconds=eps * 0 + 1, unresolved=np.zeros(3, dtype=int),
+        scene=scene,
+        meta={},
+        eps=eps,
+        flow_area=eps * 3,
+        flow_error=eps * 0 + 0.05,
+        flow_both_sides=eps,
+        models=models,
+        theory=eps * 4,
+        K_low=eps - 1,
+        b1=eps * 0 + 0.5,
+        seconds=eps * 0 + 1,
+        unresolved=np.zeros(3, dtype=int),
     )
     df = r.to_pandas()
     assert df.index.name == "eps" and list(df.index) == list(eps)

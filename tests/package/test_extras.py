@@ -67,7 +67,11 @@ def test_a_dask_run_without_dask_fails_before_any_work(monkeypatch):
     calls = []
     with pytest.raises(ImportError, match=r"hovering\[distributed\]"):
         hovering.hovering_area(
-            paper.truncated_map(0.3), n_steps=8, samples=4, executor="tcp://127.0.0.1:1", progress=lambda d, t: calls.append(d)
+            paper.truncated_map(0.3),
+            n_steps=8,
+            samples=4,
+            executor="tcp://127.0.0.1:1",
+            progress=lambda d, t: calls.append(d),
         )
     assert calls == []
 
@@ -75,9 +79,10 @@ def test_a_dask_run_without_dask_fails_before_any_work(monkeypatch):
 def test_local_workers_need_no_extra(monkeypatch):
     _missing(monkeypatch, "distributed", "dask")
     m = paper.truncated_map(0.3)
-    assert hovering.hovering_area(m, n_steps=40, samples=200, executor=2).area == hovering.hovering_area(
-        m, n_steps=40, samples=200
-    ).area
+    assert (
+        hovering.hovering_area(m, n_steps=40, samples=200, executor=2).area
+        == hovering.hovering_area(m, n_steps=40, samples=200).area
+    )
 
 
 def test_to_xarray_and_to_pandas_without_them_name_their_extras(monkeypatch):

@@ -380,7 +380,13 @@ def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Callable | 
     for i, args in enumerate(pieces):
         futures[ex.submit(fn, *args)] = i
     n = len(futures)
-    _log.info("%d pieces of %s on %s (%d workers)", n, getattr(fn, "__qualname__", fn), getattr(ex, "name", type(ex).__name__), ex.workers)
+    _log.info(
+        "%d pieces of %s on %s (%d workers)",
+        n,
+        getattr(fn, "__qualname__", fn),
+        getattr(ex, "name", type(ex).__name__),
+        ex.workers,
+    )
     try:
         for f in ex.as_completed(list(futures)):
             i = futures.pop(f)
