@@ -371,7 +371,7 @@ class IterateResult(Summarized, Saveable):
         return int(np.count_nonzero(self.status == status_code(Status, status)))
 
     def _summary(self) -> list:
-        out = [("n_orbits", self.n_orbits), ("n_steps", self.n_steps)]
+        out: list[tuple[str, object]] = [("n_orbits", self.n_orbits), ("n_steps", self.n_steps)]
         if self.every != 1:
             out.append(("every", self.every))
         out.append(("status", status_counts(self.status, Status)))
