@@ -7,7 +7,7 @@ debug records) on stderr, ``-q`` only errors, and none of the lines below but th
     The packaged demo scene (phase portraits of F_eps for +-eps, coloured by region).
 ``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress] [--workers N [--dask] | --scheduler ADDRESS]``
     One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
-    and the PNG, prints the numbers shown. Sweep scenes run their points on N local processes, a
+    and the PNG, prints the numbers shown. Sweep scenes run their points on N local threads, a
     Dask LocalCluster or a running Dask scheduler, each point checkpointed as it arrives.
 ``plan SCENE.toml [-o PLAN.toml] [--quick] [--force]``
     The resolved sweep plan of a sweep scene (docs/sweep-plan.md): every point's numbers

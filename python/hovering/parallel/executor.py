@@ -1,5 +1,5 @@
 """Where work runs: :class:`Executor` (the one ``executor=`` argument of the functions that can
-split their work) and the machinery behind it: a local process pool, a Dask ``LocalCluster``, or an
+split their work) and the machinery behind it: local threads, a Dask ``LocalCluster``, or an
 existing Dask cluster, behind one small interface.
 
 ``executor=`` takes what scipy's ``workers=`` would, and a little more: ``None`` (this process,
@@ -57,7 +57,7 @@ class Executor:
         single-threaded worker processes. Default 2 when neither ``client`` nor ``scheduler`` is
         given.
     dask : bool, optional
-        With ``workers``: a Dask LocalCluster instead of a process pool.
+        With ``workers``: a Dask LocalCluster (worker processes) instead of local threads.
     client : distributed.Client, optional
         An existing Dask client: its cluster runs the pieces (the client is not closed).
     scheduler : str, optional
@@ -312,7 +312,7 @@ def executor(workers: int | None = None, client=None, scheduler: str | None = No
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``).
     dask : bool, optional
-        With ``workers``: a Dask LocalCluster instead of a process pool.
+        With ``workers``: a Dask LocalCluster instead of local threads.
     pool : concurrent.futures.Executor, optional
         The caller's pool (used, not shut down).
 
