@@ -1,9 +1,9 @@
-"""Sweep throughput on 1 vs 2 workers (local process pool and Dask LocalCluster) and the Dask
+"""Sweep throughput on 1 vs 2 workers (local threads, as executor=N runs them, and a Dask LocalCluster) and the Dask
 overhead per task, measured in one run.
 
 * hovering_area of the truncated map (paper parameters, eps = 0.3), 200,000 samples x 20,000 steps,
-  in 16 pieces: one process (the core's own 2 threads), then 1 and 2 worker processes (each piece
-  on 1 core thread), pool and LocalCluster;
+  in 16 pieces: one process (the core's own 2 threads), then 1 and 2 local workers (threads of this
+  process) and LocalCluster worker processes (each piece on 1 core thread);
 * the flow's |HOV| at one eps (V1 = Harmonic(1), V2 = Tan(1.4, 0.7), eps = -0.1, h = 1), 400
   samples x 400 returns, in 8 pieces, same settings;
 * Dask's overhead per task: 200 empty tasks on the 2-worker LocalCluster.
@@ -38,9 +38,9 @@ def main():
         ("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, samples=200_000), 16, "step"),
         ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, samples=1600), 8, "return"),
     ]
-    with executor(workers=2) as ex:  # what a pool's start costs (spawn + import hovering), for reference
+    with executor(workers=2) as ex:  # what starting the local workers costs, for reference
         t_pool, _ = timed(lambda: list(run_pieces(ex, _noop, [(0,), (1,)])))
-    print(f"process pool start (2 workers, first tasks): {t_pool:.2f} s, included in the pool times below")
+    print(f"local workers start (2 threads, first tasks): {t_pool:.2f} s, included in the times below")
     import distributed
 
     for name, m, kw, pieces, unit in cases:
@@ -53,7 +53,7 @@ def main():
             t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, executor=Executor(workers=w, pieces=pieces)))
             assert r.area == ref.area
             base = base or t
-            print(f"process pool, {w} worker(s):      {t:8.2f} s  speed-up vs 1 worker {base / t:.2f}x")
+            print(f"local threads, {w} worker(s):     {t:8.2f} s  speed-up vs 1 worker {base / t:.2f}x")
         for w in (1, 2):
             ts = time.perf_counter()
             cluster = distributed.LocalCluster(n_workers=w, threads_per_worker=1, dashboard_address=":0")
@@ -62,7 +62,7 @@ def main():
             t, r = timed(lambda: hovering_area(m, **kw, n_threads=1, executor=Executor(client=client, pieces=pieces)))
             assert r.area == ref.area
             print(
-                f"Dask LocalCluster, {w} worker(s): {t:8.2f} s  speed-up vs pool 1 worker {base / t:.2f}x "
+                f"Dask LocalCluster, {w} worker(s): {t:8.2f} s  speed-up vs 1 local worker {base / t:.2f}x "
                 f"(cluster start {start:.1f} s, not included)"
             )
             client.close()

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Print pip constraints that pin every dependency pyproject.toml declares (build, run and the
-extras asked for) to its declared minimum: ``numpy>=1.23.2`` becomes ``numpy==1.23.2``.
+extras asked for, and the extras those name, as ``hovering[pandas]``) to its declared minimum:
+``numpy>=1.23.2`` becomes ``numpy==1.23.2``.
 
 ``scripts/test.sh --oldest`` installs with these constraints (``PIP_CONSTRAINT``, which pip also
 applies inside the isolated build environment), so the suite runs against the floors the package
@@ -27,10 +28,25 @@ def floors(extras: list[str]) -> list[str]:
     meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
     reqs = list(meta["build-system"]["requires"]) + list(meta["project"]["dependencies"])
     optional = meta["project"].get("optional-dependencies", {})
-    for extra in extras:
+    name = meta["project"]["name"]
+    done: set[str] = set()
+
+    def add(extra):
+        if extra in done:
+            return
+        done.add(extra)
         if extra not in optional:
             raise SystemExit(f"floors.py: no extra {extra!r} in pyproject.toml (have: {', '.join(optional)})")
-        reqs += optional[extra]
+        for r in optional[extra]:
+            own = re.match(rf"^\s*{re.escape(name)}\[([^\]]*)\]\s*$", r)
+            if own:  # an extra made of others ("hovering[pandas]"): their requirements
+                for e in own.group(1).split(","):
+                    add(e.strip())
+            else:
+                reqs.append(r)
+
+    for extra in extras:
+        add(extra)
     out, seen = [], set()
     for r in reqs:
         m = REQ.match(r)

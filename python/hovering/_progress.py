@@ -4,7 +4,9 @@ Every long computation (``iterate`` of both models, :meth:`hovering.Section.retu
 :func:`hovering.hovering_area`, :func:`hovering.critical_curve`) takes ``progress``:
 
 * ``False`` (default): no reporting, and no cost;
-* ``True``: a `tqdm <https://tqdm.github.io>`_ bar on stderr;
+* ``True``: a `tqdm <https://tqdm.github.io>`_ bar (``tqdm.auto``: a widget in Jupyter, text on
+  stderr elsewhere) when tqdm is installed (``hovering[progress]``), else a plain-text line on
+  stderr every few seconds;
 * a callable ``progress(done, total)``: called with the work done so far (non-decreasing) and
   the total it ends at, every ~0.1 s and once at the end (``done == total`` unless interrupted).
 
@@ -20,17 +22,24 @@ analyses, sweeps, scenes) opens a :func:`progress_bar` for the whole and hands e
 A :class:`Progress` is also callable with an absolute value (``bar(done)``) and has
 :meth:`Progress.advance` for increments, :meth:`Progress.set_total` for a total learnt on the
 way. The bar is closed when the ``with`` block ends, also by an exception (KeyboardInterrupt).
+
+Ctrl-C reaches only Python's main thread. A piece of a parallel run that runs on another thread
+(:mod:`hovering.parallel.executor`) is stopped through the same callback instead: inside
+:func:`stoppable`, every core call's reporter (also a disabled one) raises KeyboardInterrupt once
+the run's stop event is set, and the core ends its orbits as it does on Ctrl-C.
 """
 
 from __future__ import annotations
 
 import contextlib
 import sys
+import threading
+import time
 from collections.abc import Callable, Iterator
 
 import numpy as np
 
-__all__ = ["Progress", "progress_bar", "check_progress", "ProgressArg"]
+__all__ = ["Progress", "progress_bar", "check_progress", "ProgressArg", "stoppable", "stop_hook", "TextBar"]
 
 #: What a ``progress`` argument may be.
 ProgressArg = bool | Callable[[int, int], object]
@@ -63,8 +72,93 @@ def check_progress(value, name: str = "progress"):
     r = repr(value)
     r = r if len(r) <= 60 else r[:57] + "..."
     raise ValueError(
-        f"{name} must be True (a tqdm bar on stderr), False (none) or a callable progress(done, total), got {r}"
+        f"{name} must be True (a progress bar on stderr), False (none) or a callable progress(done, total), got {r}"
     )
+
+
+_piece = threading.local()  # .stop: the stop event of the piece this thread runs, if any
+
+
+@contextlib.contextmanager
+def stoppable(stop: threading.Event) -> Iterator[None]:
+    """Make the core calls of this thread stop (KeyboardInterrupt) once ``stop`` is set.
+
+    Parameters
+    ----------
+    stop : threading.Event
+        Set by whoever runs the pieces (on Ctrl-C in the main thread, or a failed piece).
+    """
+    before = getattr(_piece, "stop", None)
+    _piece.stop = stop
+    try:
+        yield
+    finally:
+        _piece.stop = before
+
+
+def stop_hook():
+    """The ``progress`` callback a core call needs to be stoppable from another thread.
+
+    Returns
+    -------
+    callable or None
+        Inside :func:`stoppable`: ``f(done, total)`` that raises KeyboardInterrupt once the stop
+        event is set (the core polls it every ~0.1 s). Elsewhere None: the main thread's core calls
+        see Ctrl-C themselves.
+    """
+    stop = getattr(_piece, "stop", None)
+    if stop is None:
+        return None
+
+    def check(done, total=None):
+        if stop.is_set():
+            raise KeyboardInterrupt("stopped: another piece of this run failed or was interrupted")
+
+    return check
+
+
+class TextBar:
+    """The bar of ``progress=True`` without tqdm: one line on stderr at most every ``every`` seconds
+    and one at the end (``desc: 42% (4200/10000 steps)``), readable in a log file too.
+
+    Parameters
+    ----------
+    total : int
+        Units of work at 100 %.
+    desc : str, optional
+        The label.
+    unit : str, optional
+        The unit's name (singular).
+    every : float, optional
+        Seconds between lines.
+    """
+
+    def __init__(self, total: int, desc: str | None = None, unit: str = "step", every: float = 2.0):
+        self.total, self.n, self.desc, self.unit, self.every = int(total), 0, desc or "progress", unit, every
+        self._last = time.monotonic()
+
+    def _line(self) -> None:
+        pct = 100.0 * self.n / self.total if self.total > 0 else 100.0
+        sys.stderr.write(f"{self.desc}: {pct:.0f}% ({self.n}/{self.total} {self.unit}s)\n")
+        sys.stderr.flush()
+
+    def update(self, k: int) -> None:
+        """Count ``k`` more units; a line if ``every`` seconds have passed since the last one.
+
+        Parameters
+        ----------
+        k : int
+            Units done since the last update.
+        """
+        self.n += int(k)
+        now = time.monotonic()
+        if now - self._last >= self.every:
+            self._last = now
+            self._line()
+
+    def close(self) -> None:
+        """The last line (where the work ended)."""
+        self._line()
 
 
 class Progress:
@@ -145,12 +239,20 @@ class Progress:
         -------
         callable or False
             ``f(done, total)`` reporting ``offset + done`` (the sub-call's own total is ignored),
-            or False when this reporter is disabled (so the sub-call does no reporting at all).
+            or False when this reporter is disabled (so the sub-call does no reporting at all; inside
+            :func:`stoppable`, the stop check of :func:`stop_hook` instead).
         """
         if self._sink is None:
-            return False
+            return stop_hook() or False
         offset = int(offset)
-        return lambda done, total=None: self(offset + int(done))
+        hook = stop_hook()
+
+        def report(done, total=None):
+            if hook is not None:
+                hook(done)
+            self(offset + int(done))
+
+        return report
 
 
 @contextlib.contextmanager
@@ -160,7 +262,7 @@ def progress_bar(progress, total: int, desc: str | None = None, unit: str = "ste
     Parameters
     ----------
     progress : bool or callable
-        ``False``: a disabled reporter. ``True``: a tqdm bar on stderr (closed when the block
+        ``False``: a disabled reporter. ``True``: a bar (tqdm.auto, or :class:`TextBar`) (closed when the block
         ends, also on KeyboardInterrupt). A callable: ``progress(done, total)`` is called.
     total : int
         Units of work the call ends at.
@@ -183,9 +285,12 @@ def progress_bar(progress, total: int, desc: str | None = None, unit: str = "ste
         yield Progress(None, total)
         return
     if progress is True:
-        from tqdm import tqdm
-
-        bar = tqdm(total=int(total), desc=desc, unit=unit, file=sys.stderr, unit_scale=True, dynamic_ncols=True)
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:  # tqdm is an extra (hovering[progress]): the plain-text bar then
+            bar = TextBar(total=int(total), desc=desc, unit=unit)
+        else:
+            bar = tqdm(total=int(total), desc=desc, unit=unit, file=sys.stderr, unit_scale=True, dynamic_ncols=True)
 
         def sink(done, tot):
             if bar.total != tot:

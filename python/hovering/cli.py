@@ -1,10 +1,13 @@
-"""Command line of ``python -m hovering``.
+"""Command line of ``hovering`` (the same as ``python -m hovering``).
+
+``hovering --version`` prints the version; ``-v`` shows what the package logs (``-vv`` also its
+debug records) on stderr, ``-q`` only errors, and none of the lines below but the numbers.
 
 ``demo [--out PNG]``
     The packaged demo scene: the physical flow's return map beside its truncated model.
 ``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress] [--workers N [--dask] | --scheduler ADDRESS]``
     One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
-    and the PNG, prints the numbers shown. Sweep scenes run their points on N local processes, a
+    and the PNG, prints the numbers shown. Sweep scenes run their points on N local threads, a
     Dask LocalCluster or a running Dask scheduler, each point checkpointed as it arrives.
 ``plan SCENE.toml [-o PLAN.toml] [--quick] [--force]``
     The resolved sweep plan of a sweep scene (docs/sweep-plan.md): every point's numbers
@@ -32,6 +35,7 @@ previous files intact.
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 import time
 
@@ -56,6 +60,28 @@ def _error(e) -> int:
     return 2
 
 
+_quiet = False  # -q: the lines that only report (files written, times) are left out
+
+
+def _say(text: str) -> None:
+    if not _quiet:
+        print(text)
+
+
+def _logging(verbose: int, quiet: bool) -> None:
+    """The package's log records (``logging.getLogger("hovering")``) on stderr at the level the
+    flags ask: warnings by default, -v info, -vv debug, -q errors only."""
+    level = logging.ERROR if quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(verbose, 2)]
+    log = logging.getLogger("hovering")
+    log.setLevel(level)
+    for h in [h for h in log.handlers if getattr(h, "_hovering_cli", False)]:
+        log.removeHandler(h)  # one handler however often main() runs, on today's sys.stderr
+    h = logging.StreamHandler(sys.stderr)
+    h.setFormatter(logging.Formatter("%(name)s: %(levelname)s: %(message)s"))
+    h._hovering_cli = True  # type: ignore[attr-defined]
+    log.addHandler(h)
+
+
 def _progress(args) -> bool:
     # Bars only for a person watching: on by default when stderr is a terminal, never in logs.
     return sys.stderr.isatty() if args.progress is None else args.progress
@@ -67,9 +93,9 @@ def _run(scene, out, quick: bool, progress: bool, where=None, force: bool = Fals
 
     try:
         summary = run_scene(scene, out=out, quick=quick, progress=progress, force=force, executor=where)
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, ImportError) as e:
         # a value only the computation can check (e.g. a K beyond the band's top), a file in the
-        # way, or a write that failed (a full disk): one line, the previous files intact
+        # way, a write that failed (a full disk), or a missing extra: one line, the previous files intact
         return _error(e)
     print(format_summary(summary))
     return 0
@@ -94,7 +120,7 @@ def _scene(args) -> int:
 
         try:
             where = Executor(workers=args.workers, scheduler=args.scheduler, dask=args.dask)
-        except ValueError as e:
+        except (ValueError, ImportError) as e:
             return _error(e)
     elif args.dask:
         return _error("--dask needs --workers N (a LocalCluster of N workers)")
@@ -122,7 +148,7 @@ def _demo(args) -> int:
     t0 = time.perf_counter()
     rc = _run(scene, out, False, _progress(args), force=args.force)
     if rc == 0:
-        print(f"demo done in {time.perf_counter() - t0:.2f} s")
+        _say(f"demo done in {time.perf_counter() - t0:.2f} s")
     return rc
 
 
@@ -146,7 +172,7 @@ def _plan(args) -> int:
         path = write_plan(scene, out, quick=args.quick)
     except (OSError, ValueError) as e:
         return _error(e)
-    print(
+    _say(
         f"wrote {path} ({scene.kind}, {len(scene.eps) * len(getattr(scene, 'series', [None]))} points) in "
         f"{time.perf_counter() - t0:.2f} s; run it with: hovering_sweep --plan {path}"
     )
@@ -165,7 +191,7 @@ def _redraw(args) -> int:
         png, result, _ = redraw(args.path, out=out, force=args.force)
     except (OSError, ValueError) as e:
         return _error(e)
-    print(
+    _say(
         f"redrew {result.scene.kind} scene {result.scene.name!r} (computed by hovering "
         f"{result.meta.get('version')}) without computing: wrote {png}"
     )
@@ -215,7 +241,7 @@ def _accuracy(args) -> int:
     except (OSError, ValueError) as e:
         return _error(e)
     print(wp.format())
-    print(f"wrote {out} and {side} in {time.perf_counter() - t0:.1f} s")
+    _say(f"wrote {out} and {side} in {time.perf_counter() - t0:.1f} s")
     return 0
 
 
@@ -229,7 +255,7 @@ def _explore(args) -> int:
 
 
 def main(argv=None) -> int:
-    """Entry point of ``python -m hovering``.
+    """Entry point of ``hovering`` and ``python -m hovering``.
 
     Parameters
     ----------
@@ -241,7 +267,15 @@ def main(argv=None) -> int:
     int
         Exit status (0 success, 2 bad input).
     """
-    p = argparse.ArgumentParser(prog="python -m hovering", description=__doc__.split("\n\n")[0])
+    from ._version import __version__
+
+    p = argparse.ArgumentParser(prog="hovering", description=__doc__.split("\n\n")[0])
+    p.add_argument("--version", action="version", version=f"hovering {__version__}")
+    loud = p.add_mutually_exclusive_group()
+    loud.add_argument(
+        "-v", "--verbose", action="count", default=0, help="show the package's log on stderr (-vv: also debug records)"
+    )
+    loud.add_argument("-q", "--quiet", action="store_true", help="print only the numbers and errors")
     sub = p.add_subparsers(dest="cmd", required=True)
 
     def progress_flags(sp):
@@ -299,9 +333,13 @@ def main(argv=None) -> int:
         "--workers",
         type=_checked(int, 1, 4096),
         default=None,
-        help="sweep scenes: run the points on N local worker processes (1..4096)",
+        help="sweep scenes: run N points at a time on threads of this process (1..4096)",
     )
-    sc.add_argument("--dask", action="store_true", help="with --workers: a Dask LocalCluster instead of a process pool")
+    sc.add_argument(
+        "--dask",
+        action="store_true",
+        help="with --workers: a Dask LocalCluster of N worker processes instead of threads",
+    )
     sc.add_argument("--scheduler", default=None, help="sweep scenes: run the points on the Dask scheduler at ADDRESS")
     progress_flags(sc)
     force_flag(sc)
@@ -325,6 +363,9 @@ def main(argv=None) -> int:
     ex.add_argument("path", help="scene file (TOML)")
     ex.add_argument("--n-steps", type=_checked(int, 1, 10_000_000), default=None, help="iterates per launched orbit")
     args = p.parse_args(argv)
+    global _quiet
+    _quiet = args.quiet
+    _logging(args.verbose, args.quiet)
     return {
         "demo": _demo,
         "scene": _scene,

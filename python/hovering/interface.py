@@ -14,6 +14,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from ._checks import _short, check_memory, integer, is_choice, real_number
+from ._display import Summarized, status_counts
 from ._enums import Status, region_mask, status_code
 from ._serial import Saveable
 from .curve import StopCondition
@@ -171,8 +172,8 @@ class MapAnalyses:
         return bool(self.theory().hovers)  # type: ignore[attr-defined]  # every ReturnMap has theory()
 
 
-@dataclass(frozen=True)
-class IterateResult(Saveable):
+@dataclass(frozen=True, repr=False)
+class IterateResult(Summarized, Saveable):
     """Outcome of :meth:`TruncatedMap.iterate` for ``n_orbits`` orbits of ``n_steps`` steps.
 
     Every per-state and per-return record keeps every ``every``-th entry (``iterate(...,
@@ -368,6 +369,48 @@ class IterateResult(Saveable):
         int
         """
         return int(np.count_nonzero(self.status == status_code(Status, status)))
+
+    def _summary(self) -> list:
+        out: list[tuple[str, object]] = [("n_orbits", self.n_orbits), ("n_steps", self.n_steps)]
+        if self.every != 1:
+            out.append(("every", self.every))
+        out.append(("status", status_counts(self.status, Status)))
+        out.append(("steps_done", f"{int(self.steps_done.min(initial=0))}..{int(self.steps_done.max(initial=0))}"))
+        recorded = [
+            f.name
+            for f in fields(self)
+            if isinstance(getattr(self, f.name), (np.ndarray, list))
+            and f.name not in ("phi_final", "K_final", "status", "steps_done")
+            and not f.name.startswith("trajectory_")
+        ]
+        out.append(("records", ", ".join(recorded) or "none"))
+        if self.map is not None:
+            out.append(("map", type(self.map).__name__))
+        return out
+
+    def to_xarray(self):
+        """The result as an :class:`xarray.Dataset` (needs ``hovering[xarray]``).
+
+        Dimensions ``orbit``, ``step`` (the kept states ``x_0, x_every, ...``, labelled by their
+        step index) and ``return_step`` (the returns taken from them, labelled by the step they
+        start from); ``region_name`` for the residence counts.
+        Every per-orbit and per-state record present becomes a variable with its units and meaning
+        in attrs; the dataset's attrs hold ``n_steps``, ``every``, the map's ``repr`` and the
+        provenance of this installation (versions, build, machine). The flow's ``z`` and
+        ``trajectory`` are left out (use the arrays).
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from ._interop import iterate_dataset
+
+        return iterate_dataset(self)
 
 
 def require_map(name: str, m):

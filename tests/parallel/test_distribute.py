@@ -1,4 +1,4 @@
-"""Distributed hovering-area runs (issue: sweeps past one machine): a local process pool, a Dask
+"""Distributed hovering-area runs (issue: sweeps past one machine): local workers (threads), a Dask
 LocalCluster and an existing client give the single-process answer bit for bit (the samples are
 drawn once and cut into contiguous pieces), and finished pieces are checkpointed as they arrive.
 """
@@ -41,7 +41,7 @@ def cluster():
 
 
 @pytest.mark.parametrize("pieces", [1, 3, 8])
-def test_process_pool_gives_the_single_process_answer(single, pieces):
+def test_local_workers_give_the_single_process_answer(single, pieces):
     same(single, hovering_area(M, **KW, executor=Executor(workers=2, pieces=pieces)))
 
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import is_choice, real_array
+from .._display import Summarized
 from .._enums import REGION_LABELS, Region, Status, region_mask
 from .._progress import check_progress, progress_bar
 from .._serial import Saveable
@@ -41,8 +42,8 @@ def max_angular_gap(phi) -> float:
     return float(max(np.max(np.diff(a)), a[0] + 2 * np.pi - a[-1]))
 
 
-@dataclass(frozen=True)
-class CriticalCurve(Saveable):
+@dataclass(frozen=True, repr=False)
+class CriticalCurve(Summarized, Saveable):
     """The lowest invariant curve inside a set of no-impact regions (see :func:`critical_curve`).
 
     Attributes
@@ -100,6 +101,38 @@ class CriticalCurve(Saveable):
             If the orbit does not fill the circle at the default resolution (too few points).
         """
         return Curve.from_orbit(self.phi, self.K)
+
+    def _summary(self) -> list:
+        return [
+            ("K0", self.K0),
+            ("K_pred", self.K_pred),
+            ("K_min", self.K_min),
+            ("K_max", self.K_max),
+            ("rotation", self.rotation),
+            ("rotation_pred", self.rotation_pred),
+            ("digits", self.digits),
+            ("line", self.line),
+            ("hovers", self.hovers),
+            ("points", len(self.phi)),
+        ]
+
+    def to_xarray(self):
+        """The curve as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): the critical orbit
+        ``phi``, ``K`` over dimension ``point``, the numbers as scalar variables, units, ``line``,
+        ``hovers``, ``note`` and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import critical_curve_dataset
+
+        return critical_curve_dataset(self)
 
 
 def critical_curve(

@@ -17,7 +17,8 @@ import numpy as np
 from .._checks import check_memory, flag, integer, real_number, thread_count
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
-from .._progress import check_progress, progress_bar
+from .._display import Summarized
+from .._progress import check_progress, progress_bar, stop_hook
 from .._serial import Saveable
 from ..interface import require_map
 from ..parallel.checkpoint import Checkpoint
@@ -117,8 +118,8 @@ class HoveringComponents:
         integer("orbit_steps", self.orbit_steps, 0, 2**62)
 
 
-@dataclass(frozen=True)
-class HoveringArea(Saveable):
+@dataclass(frozen=True, repr=False)
+class HoveringArea(Summarized, Saveable):
     """Measured area of the hovering set HOV(eps) (see :func:`hovering_area`).
 
     Attributes
@@ -195,6 +196,36 @@ class HoveringArea(Saveable):
     component: np.ndarray | None = field(default=None, repr=False)
     period: np.ndarray | None = field(default=None, repr=False)
 
+    def _summary(self) -> list:
+        return [
+            ("area", f"{self.area:.6g} +- {self.error:.2g}"),
+            ("theory", self.theory),
+            ("area_both_sides", self.area_both_sides),
+            ("n_samples", self.n_samples),
+            ("N", max(self.areas) if self.areas else None),
+            ("K_low", self.box[2]),
+            ("floor_touched", self.floor_touched),
+            ("unresolved", self.unresolved),
+        ]
+
+    def to_xarray(self):
+        """The estimate as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): the numbers as
+        scalar variables, ``area_at_N`` over dimension ``n_steps`` (N/4, N/2, N), the sample points
+        over ``sample`` when kept; units, ``box`` and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import hovering_area_dataset
+
+        return hovering_area_dataset(self)
+
 
 def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | None = None) -> tuple:
     """Samples lo..hi-1 ``(phi, K)`` of the box ``[-pi, pi) x [K_low, 0)``: one uniform point per cell
@@ -242,7 +273,7 @@ def _flow_threads(m, n_threads: int) -> int:
 def _piece(m, samples, K_low, seed, lo, hi, n_steps: int, n_threads: int):
     """The outcomes of samples lo..hi-1 (a piece of a distributed run: it draws its own samples)."""
     phi, K = _stratified(samples, K_low, seed, lo, hi)
-    return _outcomes(m, phi, K, n_steps, n_threads)
+    return _outcomes(m, phi, K, n_steps, n_threads, stop_hook() or False)
 
 
 def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> dict:
@@ -503,7 +534,7 @@ def hovering_area(
     executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
         Where it runs (:func:`hovering.parallel.executor.as_executor`): ``None`` in this process on
         ``n_threads`` core threads; otherwise the samples are cut into pieces run on that many local
-        worker processes (``int``), a Dask scheduler (address), a Dask client, or as an
+        worker threads (``int``), a Dask scheduler (address), a Dask client, or as an
         :class:`~hovering.parallel.Executor` says (a Dask LocalCluster, the number of pieces, a
         checkpoint file that keeps finished pieces, keyed by every parameter that changes them). The
         result is identical to the single-process one for the same seed: each piece draws its own

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import integer, is_choice, real_number
+from .._display import Summarized, status_counts
+from .._enums import Status
 from .._serial import Saveable
 from ..curve import Above, Below, Curve
 from ..interface import require_map
@@ -26,8 +28,8 @@ from .zone import ImpactZone
 __all__ = ["TransitResult", "transit"]
 
 
-@dataclass(frozen=True)
-class TransitResult(Saveable):
+@dataclass(frozen=True, repr=False)
+class TransitResult(Summarized, Saveable):
     """What :func:`transit` measured (one entry per orbit where an array).
 
     Attributes
@@ -108,6 +110,36 @@ class TransitResult(Saveable):
         exposure = float(np.sum(np.where(self.crossed, self.first_passage, self.steps_done)))
         gamma = k / max(exposure, 1.0)
         return gamma, gamma / math.sqrt(k)
+
+    def _summary(self) -> list:
+        rate = self.escape_rate
+        return [
+            ("direction", self.direction),
+            ("s", f"{self.start_s:g} -> {self.target_s:g}"),
+            ("n_orbits", len(self.phi0)),
+            ("n_steps", self.n_steps),
+            ("fraction", f"{self.fraction:.4g} +- {self.fraction_error:.2g}"),
+            ("escape_rate", "none crossed" if rate is None else f"{rate[0]:.4g} +- {rate[1]:.2g}"),
+            ("status", status_counts(self.status, Status)),
+        ]
+
+    def to_pandas(self):
+        """One row per orbit as a :class:`pandas.DataFrame` (needs ``hovering[pandas]``): the start,
+        ``first_passage``, ``crossed``, ``steps_done``, the K and s extremes, ``status`` (named) and
+        the returns from each region; ``direction``, the levels and ``n_steps`` in ``df.attrs``.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ImportError
+            Without pandas, naming ``pip install 'hovering[pandas]'``.
+        """
+        from .._interop import transit_frame
+
+        return transit_frame(self)
 
     def _validate_loaded(self) -> None:
         n = self.phi0.shape[0] if isinstance(self.phi0, np.ndarray) and self.phi0.ndim == 1 else -1

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 
+from .._extras import require
 from ..flow.system import Harmonic, Tan, _terms
 
 __all__ = ["scipy_return_map", "heyoka_return_map"]
@@ -17,7 +18,7 @@ __all__ = ["scipy_return_map", "heyoka_return_map"]
 
 def scipy_return_map(sys, z0, rtol: float):
     """One return of the flow by scipy's ``solve_ivp`` (DOP853, atol = rtol / 100) with events, for the
-    work-precision comparison (scipy must be installed). Walls reflect; a crossing of a wall's line
+    work-precision comparison (scipy must be installed: hovering[scipy]). Walls reflect; a crossing of a wall's line
     beside / above the step does nothing; the section is the first p1 sign change + -> - after q1's
     minimum or a reflection. Events within 1e-9 of a restart are ignored (a restart sits on the
     event it handled). Grazing and corner hits are not classified: this is a reference for regular
@@ -28,7 +29,7 @@ def scipy_return_map(sys, z0, rtol: float):
     ndarray or None
         The state at the return (None if it did not return within 50 segments).
     """
-    from scipy.integrate import solve_ivp
+    solve_ivp = require("scipy.integrate", "the scipy reference of the accuracy diagram").solve_ivp
 
     V1, V2, eps, qw1, qw2 = sys.V1, sys.V2, sys.eps, sys.qw1, sys.qw2
     terms = _terms(sys.coupling) if eps != 0 else []

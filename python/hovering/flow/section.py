@@ -8,6 +8,7 @@ import numpy as np
 
 from .._checks import integer, is_choice, real_array, real_number, thread_count
 from .._core import flow as _core_flow
+from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
 from .._pickle import reduce_record
 from .._progress import check_progress, progress_bar
@@ -83,8 +84,8 @@ def _threads(n_threads, python_defined: bool) -> int:
     return 1 if n == 0 and python_defined else n
 
 
-@dataclass(frozen=True)
-class ReturnMapResult(Saveable):
+@dataclass(frozen=True, repr=False)
+class ReturnMapResult(Summarized, Saveable):
     """Images of points of Sigma_h under the return map, one entry per initial condition.
 
     Attributes
@@ -146,6 +147,28 @@ class ReturnMapResult(Saveable):
     def count(self, status) -> int:
         """Number of orbits with the given :class:`FlowStatus` (or its name, or the Status of that name)."""
         return int(np.count_nonzero(self.status == status_code(FlowStatus, status)))
+
+    def _summary(self) -> list:
+        return [("n", int(self.status.shape[0])), ("status", status_counts(self.status, FlowStatus))]
+
+    def to_xarray(self):
+        """The returns as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): one entry per
+        start along dimension ``start``; ``theta``, ``I``, ``time``, ``energy_error``,
+        ``integrator_steps``, ``status`` (named in its flag attrs), ``itinerary``, ``region`` and the
+        image state ``z`` over (``start``, ``component``: q1, p1, q2, p2); units and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import return_map_dataset
+
+        return return_map_dataset(self)
 
 
 class Section:

@@ -1,6 +1,6 @@
 """Where work runs and how finished work is kept.
 
-:class:`Executor` (the one ``executor=`` argument: local processes, a Dask cluster, pieces, a
+:class:`Executor` (the one ``executor=`` argument: local threads, a Dask cluster, pieces, a
 checkpoint) lives in :mod:`hovering.parallel.executor`; the one checkpoint format (JSON lines keyed
 by a canonical record of the parameters) in :mod:`hovering.parallel.checkpoint`.
 """

@@ -1,12 +1,22 @@
 """Where work runs: :class:`Executor` (the one ``executor=`` argument of the functions that can
-split their work) and the machinery behind it: a local process pool, a Dask ``LocalCluster``, or an
+split their work) and the machinery behind it: local threads, a Dask ``LocalCluster``, or an
 existing Dask cluster, behind one small interface.
 
 ``executor=`` takes what scipy's ``workers=`` would, and a little more: ``None`` (this process,
-the core's threads), an ``int`` (that many local worker processes), a scheduler address (``str``),
+the core's threads), an ``int`` (that many pieces at a time on threads of this process), a
+scheduler address (``str``),
 a ``distributed.Client``, a :class:`concurrent.futures.Executor` of the caller's (not shut down
 here), or an :class:`Executor` for the rest (a Dask ``LocalCluster``, the number
 of pieces, a checkpoint file that keeps finished pieces).
+
+Local runs (``executor=2``, ``Executor(workers=2)``) run their pieces on threads of this process:
+the core releases the GIL, so they run in parallel, and no process is started. A process pool's
+workers would import the caller's script again (spawn and forkserver both do, to find
+``__main__``), so a top-level script without an ``if __name__ == "__main__":`` guard would run its
+own parallel call again in each worker and die with BrokenProcessPool; fork copies the parent's
+threads' locks in whatever state they are in (unsafe, and deprecated by Python 3.12 in a threaded
+process). Threads need no guard and no pickling. Ctrl-C reaches only the main thread: it sets the
+run's stop event, which each piece's core calls poll (:func:`hovering._progress.stoppable`).
 
 A *piece* is a picklable function call (maps, systems and results pickle: tests/package/test_pickle.py).
 :func:`run_pieces` submits them all, yields each result as it arrives (so the caller checkpoints
@@ -18,16 +28,21 @@ which order, the pieces ran.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import multiprocessing
+import logging
 import os
+import threading
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 from .._checks import integer
 from .._deprecated import renamed_argument
+from .._extras import require
+from .._progress import stoppable
 
 __all__ = ["Executor", "as_executor", "executor", "run_pieces"]
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -37,11 +52,12 @@ class Executor:
     Parameters
     ----------
     workers : int, optional
-        Local worker processes (1 to 4096): a process pool, or with ``dask`` a Dask LocalCluster
-        of that many single-threaded workers. Default 2 when neither ``client`` nor ``scheduler``
-        is given.
+        Local workers (1 to 4096): that many pieces at a time on threads of this process (no
+        ``__main__`` guard needed), or with ``dask`` a Dask LocalCluster of that many
+        single-threaded worker processes. Default 2 when neither ``client`` nor ``scheduler`` is
+        given.
     dask : bool, optional
-        With ``workers``: a Dask LocalCluster instead of a process pool.
+        With ``workers``: a Dask LocalCluster (worker processes) instead of local threads.
     client : distributed.Client, optional
         An existing Dask client: its cluster runs the pieces (the client is not closed).
     scheduler : str, optional
@@ -61,6 +77,9 @@ class Executor:
         For a worker or piece count out of range, a client that is not a ``distributed.Client``, a
         pool that is not a ``concurrent.futures.Executor``, an empty scheduler address, more than one
         of ``client``, ``scheduler`` and ``pool``, or ``dask`` with one of them.
+    ImportError
+        For a Dask run (``client``, ``scheduler`` or ``dask``) without Dask installed, naming
+        ``pip install 'hovering[distributed]'``.
     """
 
     workers: int | None = None
@@ -88,12 +107,10 @@ class Executor:
             object.__setattr__(self, "pieces", integer("pieces", self.pieces, 1, 2**31 - 1))
         if self.scheduler is not None and (not isinstance(self.scheduler, str) or not self.scheduler):
             raise ValueError(f"scheduler must be an address such as 'tcp://host:8786', got {self.scheduler!r}")
-        if self.client is not None:
-            try:
-                import distributed
-            except ImportError:  # pragma: no cover - distributed is a dependency
-                raise ValueError("a Dask client needs dask[distributed] (pip install 'dask[distributed]')") from None
-            if not isinstance(self.client, distributed.Client):
+        if self.client is not None or self.scheduler is not None or self.dask:
+            # before any work: a run that needs Dask says which extra installs it
+            distributed = require("distributed", "a Dask run (client=, scheduler= or dask=True)")
+            if self.client is not None and not isinstance(self.client, distributed.Client):
                 raise ValueError(f"client must be a distributed.Client, got {self.client!r}")
 
     def where(self) -> dict:
@@ -114,7 +131,7 @@ def as_executor(value) -> Executor | None:
     Parameters
     ----------
     value : None, int, str, distributed.Client, concurrent.futures.Executor or Executor
-        ``None`` (this process), a number of local worker processes, a Dask scheduler address, a
+        ``None`` (this process), a number of local workers (threads), a Dask scheduler address, a
         Dask client, the caller's pool, or an :class:`Executor`.
 
     Returns
@@ -183,22 +200,41 @@ def from_old_arguments(func: str, executor_value, old: dict, allowed=OLD_ARGUMEN
     return Executor(**given)
 
 
+def _stoppable_call(stop: threading.Event, fn, args):
+    """fn(*args) on a pool thread, its core calls stopped once ``stop`` is set (see the module docstring)."""
+    with stoppable(stop):
+        return fn(*args)
+
+
 class _Local:
-    """concurrent.futures on spawned processes (no fork: the core's thread pool does not survive it)."""
+    """Pieces on threads of this process (see the module docstring: why not processes)."""
+
+    name = "threads of this process"
 
     def __init__(self, workers: int):
-        self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        self.pool = cf.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="hovering-piece")
         self.workers = workers
         self.threads_per_piece = _share(workers)
+        self.stop = threading.Event()
 
     def submit(self, fn, *args):
-        return self.pool.submit(fn, *args)
+        if self.stop is None:
+            return self.pool.submit(fn, *args)
+        return self.pool.submit(_stoppable_call, self.stop, fn, args)
 
     def as_completed(self, futures):
-        return cf.as_completed(futures)
+        # Waits of 0.1 s, not one long wait: the main thread runs Python between them, so Ctrl-C
+        # (also one that does not interrupt a blocking wait: _thread.interrupt_main) is seen at once.
+        pending = set(futures)
+        while pending:
+            done, pending = cf.wait(pending, timeout=0.1, return_when=cf.FIRST_COMPLETED)
+            yield from done
 
     def cancel(self, futures):
-        for f in futures:
+        self.left = list(futures)
+        if self.stop is not None:
+            self.stop.set()  # the running pieces end within ~0.1 s
+        for f in self.left:
             f.cancel()
 
     def close(self):
@@ -208,18 +244,27 @@ class _Local:
 class _Given(_Local):
     """The caller's concurrent.futures pool: used, never shut down here."""
 
+    name = "the caller's pool"
+
     def __init__(self, pool):
         self.pool = pool
         # concurrent.futures keeps the size private; 4 pieces per worker only sets the default piece count.
         self.workers = max(1, int(getattr(pool, "_max_workers", 0) or (os.cpu_count() or 1)))
         self.threads_per_piece = _share(self.workers)
+        # Threads of this process can be told to stop; another process's cannot (an Event does not pickle).
+        self.stop = threading.Event() if isinstance(pool, cf.ThreadPoolExecutor) else None
 
     def close(self):
-        pass
+        if self.stop is not None and self.stop.is_set():
+            # Ctrl-C or a failed piece: wait for the pieces that were running (they stop within
+            # ~0.1 s), so none is left computing behind the caller's back; the pool stays open.
+            cf.wait(self.left)
 
 
 class _Dask:
     """A distributed.Client (given, or on a LocalCluster / scheduler address made here)."""
+
+    name = "a Dask cluster"
 
     def __init__(self, client, own: bool, cluster=None):
         self.client, self.own, self.cluster = client, own, cluster
@@ -260,14 +305,14 @@ def executor(workers: int | None = None, client=None, scheduler: str | None = No
     Parameters
     ----------
     workers : int, optional
-        Worker processes (>= 1): a local process pool, or with ``dask`` a Dask LocalCluster of that
-        many single-threaded workers.
+        Local workers (>= 1): a pool of that many threads of this process, or with ``dask`` a Dask
+        LocalCluster of that many single-threaded worker processes.
     client : distributed.Client, optional
         An existing Dask client (its cluster runs the pieces; not closed here).
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``).
     dask : bool, optional
-        With ``workers``: a Dask LocalCluster instead of a process pool.
+        With ``workers``: a Dask LocalCluster instead of local threads.
     pool : concurrent.futures.Executor, optional
         The caller's pool (used, not shut down).
 
@@ -334,13 +379,24 @@ def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Callable | 
     futures = {}
     for i, args in enumerate(pieces):
         futures[ex.submit(fn, *args)] = i
+    n = len(futures)
+    _log.info(
+        "%d pieces of %s on %s (%d workers)",
+        n,
+        getattr(fn, "__qualname__", fn),
+        getattr(ex, "name", type(ex).__name__),
+        ex.workers,
+    )
     try:
         for f in ex.as_completed(list(futures)):
             i = futures.pop(f)
             res = f.result()
             if on_result is not None:
                 on_result(i, res)
+            _log.debug("piece %d done (%d of %d)", i, n - len(futures), n)
             yield i, res
-    except BaseException:
+    except BaseException as e:
+        if futures:
+            _log.info("%s: %d of %d pieces not finished, cancelled", type(e).__name__, len(futures), n)
         ex.cancel(list(futures))
         raise

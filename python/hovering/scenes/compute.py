@@ -1284,7 +1284,7 @@ def compute(
     workers, client, scheduler, dask : optional
         Deprecated (removed in 0.4.0): the fields of ``executor=Executor(...)``; each warns.
     executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
-        Sweep scenes: run the points as pieces on local worker processes (``int``), a Dask
+        Sweep scenes: run the points as pieces on local worker threads (``int``), a Dask
         scheduler (address), a Dask client, or as a :class:`~hovering.parallel.Executor` says (a Dask
         LocalCluster); each point is checkpointed as it arrives and the result is the one-process
         result. Other scenes: ignored (they are one computation). A scene's pieces are its points and

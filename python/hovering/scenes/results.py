@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _serial
+from .._display import Summarized
 from .._enums import Region, Status
 from .._output import write_text
 from .._provenance import provenance
@@ -380,8 +381,8 @@ class TorusResult:
             raise ValueError(f"trajectory has shape {self.trajectory.shape}; it must be (m, 5): t, q1, p1, q2, p2")
 
 
-@dataclass
-class SceneResult:
+@dataclass(repr=False)
+class SceneResult(Summarized):
     """What every scene result has.
 
     Attributes
@@ -409,6 +410,14 @@ class SceneResult:
         for k, v in (self.meta.get("timings") or {}).items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise ValueError(f"meta.timings.{k} must be a number of seconds, got {type(v).__name__}")
+
+    def _summary(self) -> list:
+        out = [("scene", self.scene.name), ("kind", self.scene.kind)]
+        out += [(k, self.meta[k]) for k in ("quick", "n_steps", "samples", "version") if self.meta.get(k) is not None]
+        timings = self.meta.get("timings") or {}
+        if timings:
+            out.append(("seconds", sum(v for v in timings.values() if isinstance(v, (int, float)))))
+        return out
 
     def summary(self) -> dict:
         """The numbers shown, as a JSON-able dict (what the CLI prints and the sidecar JSON holds).
@@ -455,7 +464,7 @@ class SceneResult:
         return npz, side
 
 
-@dataclass
+@dataclass(repr=False)
 class OrbitSceneResult(SceneResult):
     """Result of a ``portrait`` or ``critical_orbits`` scene.
 
@@ -500,7 +509,7 @@ class OrbitSceneResult(SceneResult):
         raise KeyError(f"no panel {id!r}; panels: {[p.id for p in self.panels]}")
 
 
-@dataclass
+@dataclass(repr=False)
 class HoveringAreaResult(SceneResult):
     """Result of a ``hovering_area`` scene.
 
@@ -512,6 +521,47 @@ class HoveringAreaResult(SceneResult):
 
     series: list = field(default_factory=list)
 
+    def _summary(self) -> list:
+        eps = [float(e) for x in self.series for e in x.eps]
+        rng = f"{min(eps):g}..{max(eps):g}" if eps else "none"
+        return super()._summary() + [("series", [x.label for x in self.series]), ("eps", rng), ("points", len(eps))]
+
+    def to_pandas(self):
+        """The sweep as a :class:`pandas.DataFrame` (needs ``hovering[pandas]``): one row per
+        (series label, eps), indexed by both; columns ``area``, ``error``, ``theory``,
+        ``floor_touched``, ``K_low``, ``Omega0``, ``theta_w``.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ImportError
+            Without pandas, naming ``pip install 'hovering[pandas]'``.
+        """
+        from .._interop import series_frame
+
+        return series_frame(self)
+
+    def to_xarray(self):
+        """The sweep as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): dimensions
+        ``series`` (the labels) and ``eps`` (NaN where a series has no point at that eps), the
+        columns of :meth:`to_pandas` as variables; units, the scene and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import series_dataset
+
+        return series_dataset(self)
+
     def _validate_loaded(self) -> None:
         super()._validate_loaded()
         for i, x in enumerate(self.series):
@@ -519,7 +569,7 @@ class HoveringAreaResult(SceneResult):
                 raise ValueError(f"series[{i}] must be a SeriesResult, got {type(x).__name__}")
 
 
-@dataclass
+@dataclass(repr=False)
 class FlowPortraitResult(SceneResult):
     """Result of a ``flow_portrait`` scene: the same starts under the flow and its model.
 
@@ -549,7 +599,7 @@ class FlowPortraitResult(SceneResult):
     work: dict = field(default_factory=dict)
 
 
-@dataclass
+@dataclass(repr=False)
 class FlowHoveringResult(SceneResult):
     """Result of a ``flow_hovering_area`` scene (one row per eps).
 
@@ -580,8 +630,51 @@ class FlowHoveringResult(SceneResult):
     unresolved: np.ndarray = None
     reused: int = 0
 
+    def _summary(self) -> list:
+        out = super()._summary() + [("eps", self.eps), ("models", list(self.models))]
+        if self.flow_area is not None and len(self.flow_area):
+            out.append(("flow_area", f"{np.nanmin(self.flow_area):.4g}..{np.nanmax(self.flow_area):.4g}"))
+        return out
 
-@dataclass
+    def to_pandas(self):
+        """The sweep as a :class:`pandas.DataFrame` (needs ``hovering[pandas]``): one row per eps
+        (the index); the flow's columns (``flow_area``, ``flow_error``, ``flow_both_sides``,
+        ``theory``, ``K_low``, ``b1``, ``seconds``, ``unresolved``) and ``{model}_{area, error,
+        agree}`` for each model.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ImportError
+            Without pandas, naming ``pip install 'hovering[pandas]'``.
+        """
+        from .._interop import flow_sweep_frame
+
+        return flow_sweep_frame(self)
+
+    def to_xarray(self):
+        """The sweep as an :class:`xarray.Dataset` (needs ``hovering[xarray]``): the flow's
+        columns over dimension ``eps``, each model's ``area``, ``error``, ``agree`` as
+        ``model_area`` ... over (``model``, ``eps``); units, the scene and provenance in attrs.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            Without xarray, naming ``pip install 'hovering[xarray]'``.
+        """
+        from .._interop import flow_sweep_dataset
+
+        return flow_sweep_dataset(self)
+
+
+@dataclass(repr=False)
 class TangentToriResult(SceneResult):
     """Result of a ``tangent_tori`` scene (fig:two-tang).
 
@@ -606,7 +699,7 @@ class TangentToriResult(SceneResult):
                 raise ValueError(f"tori[{i}] must be a TorusResult, got {type(x).__name__}")
 
 
-@dataclass
+@dataclass(repr=False)
 class SigmaStructureResult(SceneResult):
     """Result of a ``sigma_structure`` scene (fig:structure_Sigma), all from the flow.
 
@@ -719,7 +812,7 @@ class CornerTrajectory:
         _trajectory("trajectory", self.trajectory)
 
 
-@dataclass
+@dataclass(repr=False)
 class CornerDirectionsResult(SceneResult):
     """Result of a ``corner_directions`` scene (fig:corner_directions), all from the flow.
 
@@ -792,7 +885,7 @@ class WallPoint:
             raise ValueError(f"itinerary: a string of {len(self.itinerary)} characters; allowed: at most {MAX_TEXT}")
 
 
-@dataclass
+@dataclass(repr=False)
 class WallTangencyResult(SceneResult):
     """Result of a ``wall_tangency`` scene (fig:Sigma_0_wall).
 
@@ -866,7 +959,7 @@ class WallSegment:
             raise ValueError(f"itinerary: a string of {len(self.itinerary)} characters; allowed: at most {MAX_TEXT}")
 
 
-@dataclass
+@dataclass(repr=False)
 class WallSectionResult(SceneResult):
     """Result of a ``wall_section`` scene (fig:wallsection), all from the flow.
 
