@@ -115,7 +115,10 @@ def _rst_text(text: str) -> str:
 
 def write_scene_gallery(scenes: Path, where: Path) -> None:
     """One ``scene_<name>.py`` per scene file, its text taken from the file's comments and title."""
-    _write(where / "README.rst", "Scenes\n======\n\nEvery example scene (examples/scenes), the paper's figures among them, run in quick mode.\n")
+    _write(
+        where / "README.rst",
+        "Scenes\n======\n\nEvery example scene (examples/scenes), the paper's figures among them, run in quick mode.\n",
+    )
     for path in sorted(scenes.glob("*.toml")):
         text = path.read_text()
         data = tomllib.loads(text)

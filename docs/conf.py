@@ -50,6 +50,7 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 
+
 def _literal_pipes(app, what, name, obj, options, lines):
     """Docstrings write |HOV|, |J_R| and |x| as mathematics: escape the bars outside inline
     literals, or reStructuredText reads them as substitution references."""

@@ -260,6 +260,24 @@ def transit_frame(t):
     return df
 
 
+def barrier_frame(b):
+    """:meth:`hovering.BarrierScan.to_pandas`: one row per start."""
+    pd = _pd("BarrierScan.to_pandas()")
+    cols = {
+        name: getattr(b, name)
+        for name in ("s0", "phi0", "K0", "kind", "period", "rotation", "decided_by", "steps_done", "s_min", "s_max")
+    }
+    cols["impact_fraction"] = b.impact_fraction
+    cols["cone"] = b.cone
+    cols["status"] = pd.Categorical([Status(int(s)).name for s in b.status], categories=[s.name for s in Status])
+    # the cut above each start (none above the last)
+    cols["barrier_above"] = np.append(b.barrier, False)
+    cols["margin_above"] = np.append(b.margin, np.nan)
+    df = pd.DataFrame(cols, index=pd.RangeIndex(len(b.s0), name="start"))
+    df.attrs.update(line=b.line, n_steps=int(b.n_steps), n_bins=int(b.n_bins), complete=bool(b.complete))
+    return df
+
+
 _SERIES_COLUMNS = ("area", "error", "theory", "floor_touched", "K_low", "Omega0", "theta_w")
 
 

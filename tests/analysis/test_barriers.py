@@ -189,6 +189,12 @@ def test_results_save_and_load(tmp_path):
     take = [0, 100, 200, 300, 400, 500, 600]  # keep=7 over 600 returns: evenly strided, ends included
     assert np.array_equal(r.phi, full.phi[:, take], equal_nan=True)
     assert np.array_equal(r.K, full.K[:, take], equal_nan=True)
+    # a short repr, and a table with one row per start (pandas is in the test extra)
+    assert len(repr(r)) < 400 and "barriers=" in repr(r) and "<table>" in r._repr_html_()
+    df = r.to_pandas()
+    assert list(df.index) == list(range(6)) and np.array_equal(df["s_max"].to_numpy(), r.s_max)
+    assert np.array_equal(df["barrier_above"].to_numpy()[:-1], r.barrier) and not df["barrier_above"].iloc[-1]
+    assert df.attrs["line"] == "L1" and list(df["kind"]) == list(r.kind)
     back = hovering.load(hovering.save(r, tmp_path / "scan.npz"))
     assert back.summary() == r.summary()
     assert np.array_equal(back.margin, r.margin, equal_nan=True)

@@ -34,7 +34,9 @@ def _entries(index: str) -> set[str]:
 def test_every_public_name_has_an_api_entry(tmp_path):
     _generate.write_api_pages(tmp_path)
     entries = _entries((tmp_path / "index.rst").read_text())
-    top = {n for n in hovering.__all__ if not n.startswith("__") and not isinstance(getattr(hovering, n), types.ModuleType)}
+    top = {
+        n for n in hovering.__all__ if not n.startswith("__") and not isinstance(getattr(hovering, n), types.ModuleType)
+    }
     assert {f"hovering.{n}" for n in top} <= entries
     for sub in _generate.SUBPACKAGES:
         mod = importlib.import_module(sub)

@@ -5,7 +5,6 @@ the documentation cannot drift from the API): README.md's example, and the user 
 from __future__ import annotations
 
 import pathlib
-
 import shutil
 
 import numpy as np

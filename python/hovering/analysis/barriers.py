@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import integer, is_choice, real_number
+from .._display import Summarized, status_counts
 from .._enums import Region, Status
 from .._serial import Saveable
 from ..interface import require_map
@@ -78,8 +79,8 @@ class Layer:
     impacting: bool
 
 
-@dataclass(frozen=True)
-class BarrierScan(Saveable):
+@dataclass(frozen=True, repr=False)
+class BarrierScan(Summarized, Saveable):
     """What :func:`barrier_scan` found (arrays: one entry per start, in order of rising s).
 
     Attributes
@@ -187,6 +188,41 @@ class BarrierScan(Saveable):
                 )
             )
         return out
+
+    def _summary(self) -> list:
+        return [
+            ("line", self.line),
+            ("n_starts", len(self)),
+            ("n_steps", self.n_steps),
+            ("barriers", int(self.barrier.sum())),
+            ("layers", len(self.layers)),
+            (
+                "classes",
+                {k: int(np.count_nonzero(self.kind == k)) for k in ("circle", "islands", "chaotic", "undecided")},
+            ),
+            ("spanning 0.1..0.9", int(self.spanning(0.1, 0.9).size)),
+            ("status", status_counts(self.status, Status)),
+            ("complete", self.complete),
+        ]
+
+    def to_pandas(self):
+        """One row per start as a :class:`pandas.DataFrame` (needs ``hovering[pandas]``): the start
+        (s0, phi0, K0), its class, period, rotation, the s extremes, the impact fraction, the
+        converse-KAM verdict, ``status`` (named), and whether the cut above it is a barrier (with
+        its margin); ``line``, ``n_steps`` in ``df.attrs``.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ImportError
+            Without pandas, naming ``pip install 'hovering[pandas]'``.
+        """
+        from .._interop import barrier_frame
+
+        return barrier_frame(self)
 
     def spanning(self, lo: float = 0.1, hi: float = 0.9) -> np.ndarray:
         """Indices of the orbits that visited both ``s <= lo`` and ``s >= hi``.
