@@ -55,7 +55,7 @@ def test_verbose_shows_the_package_log_and_quiet_only_the_numbers(tmp_path, caps
         assert "demo done in" in capsys.readouterr().out
         assert main(["-q", *demo, "--out", str(tmp_path / "d.png")]) == 0
         out = capsys.readouterr()
-        assert "demo done in" not in out.out and "eps = 0.3" in out.out and out.err == ""
+        assert "demo done in" not in out.out and "scene demo (flow_portrait)" in out.out and out.err == ""
     finally:
         main_level = logging.getLogger("hovering")
         for h in [h for h in main_level.handlers if getattr(h, "_hovering_cli", False)]:
