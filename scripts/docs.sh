@@ -9,5 +9,5 @@ bash scripts/setup.sh
 python -m pip install -q --disable-pip-version-check ".[docs]" --config-settings=build-dir="build/{wheel_tag}"
 export MPLBACKEND=Agg
 rm -rf docs/_build/html docs/api/generated docs/gallery
-python -m sphinx -W --keep-going -n -b html docs docs/_build/html "$@"
+python -m sphinx -W --keep-going -b html docs docs/_build/html "$@"
 echo "docs: docs/_build/html/index.html"
