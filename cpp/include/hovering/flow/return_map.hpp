@@ -33,8 +33,8 @@ enum class FlowStatus : std::int8_t {
 Status orbit_status(FlowStatus s);
 
 /// The names FlowOptions::stepper takes, its default first (bound as hovering.flow.STEPPERS).
-inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd",   "rkck",   "rkf45",  "rk4",  "rk2",
-                                                         "msadams", "rk4imp", "rk2imp", "exact"};
+inline constexpr std::array<const char*, 10> kSteppers = {"rk8pd",  "rkck",   "rkf45",  "rk4",    "rk2",
+                                                          "msadams", "rk4imp", "rk2imp", "taylor", "exact"};
 
 /// Integrator settings.
 /// Stepper "exact" is the flow in closed form where the system has one (eps = 0 with Harmonic or
@@ -42,7 +42,7 @@ inline constexpr std::array<const char*, 9> kSteppers = {"rk8pd",   "rkck",   "r
 /// quadratic coupling: the normal modes of the linear flow); it ignores rtol and atol, and its
 /// "steps" are events passed (uncoupled) or closed-form steps of 1/8 period (linear).
 struct FlowOptions {
-    std::string stepper = "rk8pd";     ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd), msadams, or exact
+    std::string stepper = "rk8pd";     ///< GSL explicit RK (rk2, rk4, rkf45, rkck, rk8pd), msadams, rk4imp, rk2imp, taylor or exact
     double rtol = 1e-10;               ///< relative tolerance of the step control (not read by "exact")
     double atol = 1e-12;               ///< absolute tolerance of the step control (not read by "exact")
     double event_tol = 1e-15;          ///< time accuracy of located events (Newton on exact steps)

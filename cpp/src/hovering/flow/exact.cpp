@@ -37,6 +37,8 @@ bool quadratic(const Coupling& c) {
     return true;
 }
 
+}  // namespace
+
 std::string describe(const FlowSystem& s) {
     std::string c;
     for (const auto& t : s.coupling.terms) {
@@ -46,8 +48,6 @@ std::string describe(const FlowSystem& s) {
     return "V1 = " + s.V1->name() + ", V2 = " + s.V2->name() + ", eps = " + fmt(s.eps) +
            ", Vc = " + (c.empty() ? "0" : c);
 }
-
-}  // namespace
 
 ExactKind exact_kind(const FlowSystem& s, const FlowOptions& o) {
     if (o.stepper != "exact") return ExactKind::None;

@@ -27,6 +27,9 @@ enum class ExactKind { None, Angles, Linear };
 /// Angles or Linear, or std::invalid_argument naming what the system has and what "exact" needs.
 ExactKind exact_kind(const FlowSystem& s, const FlowOptions& o);
 
+/// "V1 = ..., V2 = ..., eps = ..., Vc = ...": the system named in error messages.
+std::string describe(const FlowSystem& s);
+
 /// q'' = -K q in closed form through the normal modes of the symmetric K.
 class LinearFlow {
 public:

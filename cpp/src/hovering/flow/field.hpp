@@ -167,6 +167,9 @@ private:
 };
 
 inline Force::Force(const Potential* pot) : p(pot) {
+    // Numerical answers energy questions by quadrature but its force is its base's: the same
+    // inlined (and, for Tan, polynomial) force serves both.
+    while (const auto* w = dynamic_cast<const Numerical*>(pot)) pot = w->base().get();
     if (const auto* h = dynamic_cast<const Harmonic*>(pot)) {
         kind = Kind::Harmonic;
         a = h->omega() * h->omega();

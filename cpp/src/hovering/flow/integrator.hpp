@@ -11,11 +11,12 @@
 #include "hovering/flow/exact.hpp"
 #include "hovering/flow/field.hpp"
 #include "hovering/flow/return_map.hpp"
+#include "hovering/flow/taylor.hpp"
 
 namespace hovering::detail {
 
-/// The GSL stepper type of a name (null for "exact": no GSL stepper); throws std::invalid_argument
-/// naming the allowed ones.
+/// The GSL stepper type of a name (null for "exact" and "taylor": no GSL stepper); throws
+/// std::invalid_argument naming the allowed ones.
 const gsl_odeiv2_step_type* stepper_type(const std::string& name);
 
 /// Owns the GSL objects of one integration, reused from return to return by one worker.
@@ -27,7 +28,9 @@ const gsl_odeiv2_step_type* stepper_type(const std::string& name);
 /// msadams needs GSL's driver (it reads the control through it) and its history cannot restart
 /// inside a step, so its events are located on an rk8pd extension of the step, subdivided until
 /// rk8pd's own error estimate meets the tolerances. Stepper "exact" holds no GSL object: a step is
-/// the closed-form flow over hmax, the extension the closed form itself (exact.hpp).
+/// the closed-form flow over hmax, the extension the closed form itself (exact.hpp). Stepper
+/// "taylor" holds no GSL object either: a step is the Taylor polynomial through its start, of the
+/// order and length the tolerances set, and the extension that polynomial (taylor.hpp).
 class Integrator {
 public:
     Integrator(const FlowSystem& s, const FlowOptions& o);
@@ -40,7 +43,7 @@ public:
     /// State dimension (4 plus one per Tan potential).
     int dim() const { return field_.dim; }
     /// Order of the stepper (8 for rk8pd; "exact": 8, only the first trial step reads it, and exact steps ignore it).
-    int order() const { return step_ ? int(gsl_odeiv2_step_order(step_)) : 8; }
+    int order() const { return taylor_ ? taylor_->order() : step_ ? int(gsl_odeiv2_step_order(step_)) : 8; }
     /// The closed form of stepper "exact" (None for the GSL steppers).
     ExactKind exact_kind() const { return kind_; }
     /// Longest step the stepper allows (infinite but for the linear flow: 1/8 of its fastest mode's period).
@@ -80,6 +83,7 @@ private:
     double qlim1_, qlim2_;  // the wells' edges (infinite for unbounded potentials)
     ExactKind kind_ = ExactKind::None;
     std::unique_ptr<LinearFlow> linear_;  // stepper "exact", linear flow
+    std::unique_ptr<Taylor> taylor_;      // stepper "taylor"
     AngleOscillator osc_[2];              // stepper "exact", uncoupled flow (step loop only)
     int order_ = 8;                       // one-step methods: the stepper's order, for the step-size rule
     double grow_below_ = 0.43;            // 0.9^order: below this scaled error the step grows

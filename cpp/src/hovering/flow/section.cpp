@@ -5,6 +5,7 @@
 
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/exact.hpp"
+#include "hovering/flow/taylor.hpp"
 #include "hovering/flow/integrator.hpp"
 #include "hovering/flow/return_map.hpp"
 
@@ -33,6 +34,10 @@ void FlowOptions::validate() const {
 void FlowOptions::validate(const FlowSystem& s) const {
     validate();
     detail::exact_kind(s, *this);
+    if (stepper == "taylor") {
+        const std::string why = detail::taylor_unsupported(s);
+        if (!why.empty()) bad(why);
+    }
 }
 
 bool try_section_point(const FlowSystem& s, double h, double theta, double I, std::array<double, 4>& z,
