@@ -42,14 +42,15 @@ def _one(sec, theta, I, **kw):
 DEPTHS = [1e-4, 1e-6, 1e-8, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14]
 
 
+@pytest.mark.parametrize("stepper", ["rk8pd", "taylor"])
 @pytest.mark.parametrize("d", DEPTHS)
-def test_grazing_the_right_wall_at_depth(sec, d):
+def test_grazing_the_right_wall_at_depth(sec, d, stepper):
     # q1's minimum is qw1 - d while q2 sits at its own minimum (below qw2: the wall is there).
     h1 = V1.V(QW1 - d)
     H2 = H - h1
     I, W = V2.action(H2), V2.frequency(H2)
     th0 = float(wrap(np.pi - W * np.pi))
-    r = _one(sec, th0, I)
+    r = _one(sec, th0, I, stepper=stepper)
     if d >= 1e-11:  # deeper than grazing_tol = 1e-12: a reflection, with the exact return
         assert r.status[0] == FlowStatus.OK and r.itinerary[0] == "R"
         t1 = np.arccos(QW1 / np.sqrt(2 * h1))
@@ -62,13 +63,14 @@ def test_grazing_the_right_wall_at_depth(sec, d):
         assert r.status[0] in (FlowStatus.OK, FlowStatus.GRAZING)
 
 
+@pytest.mark.parametrize("stepper", ["rk8pd", "taylor"])
 @pytest.mark.parametrize("d", DEPTHS)
-def test_grazing_the_upper_wall_at_depth(sec, d):
+def test_grazing_the_upper_wall_at_depth(sec, d, stepper):
     # q2's minimum is qw2 - d while q1 is at its minimum, left of qw1 (the upper wall is there).
     H2 = V2.V(QW2 - d)
     I, W = V2.action(H2), V2.frequency(H2)
     th0 = float(wrap(np.pi - W * np.pi))
-    r = _one(sec, th0, I)
+    r = _one(sec, th0, I, stepper=stepper)
     if d >= 1e-11:
         assert r.status[0] == FlowStatus.OK and r.itinerary[0] == "1"
         # the reflection maps theta_w2 to -theta_w2: the angle jumps by -2 theta_w2
@@ -141,7 +143,7 @@ def test_energies_at_the_step_energy(dh):
 
 
 @pytest.mark.parametrize("gap", [None, 1e-6, 1e-8])
-@pytest.mark.parametrize("stepper", ["rkck", "rkf45", "rk8pd"])
+@pytest.mark.parametrize("stepper", ["rkck", "rkf45", "rk8pd", "taylor"])
 def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
     qlim = np.pi / (2 * V2.alpha)
     qw2 = QW2 if gap is None else -(1 - gap) * qlim

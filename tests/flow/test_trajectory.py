@@ -203,7 +203,7 @@ def test_bad_trajectory_arguments_are_named(kwargs, match):
             fm.section.return_map([0.1], [0.3], **{k: v for k, v in kwargs.items() if k != "record"})
 
 
-@pytest.mark.parametrize("stepper", ["rk8pd", "rkf45", "rk4", "msadams"])
+@pytest.mark.parametrize("stepper", ["rk8pd", "rkf45", "rk4", "msadams", "taylor"])
 def test_every_stepper_records_without_changing_the_orbit(stepper):
     # The samples are extra stepper steps from the accepted steps' starts (msadams: its rk8pd
     # extension); none of them touches the state the integration goes on from. Each orbit is

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <cstdlib>
 #include <type_traits>
 
 #include "hovering/detail/common.hpp"
@@ -71,9 +70,7 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol)
     if (!why.empty()) bad(why);
     // Jorba & Zou's order for the tolerance: the truncation error of the p-th order polynomial at
     // their step is ~ tol.
-    const char* fe = std::getenv("TAYF");
-    ln_f_ = fe ? std::atof(fe) : -2.0;
-    p_ = std::clamp(int(std::ceil(1.0 + std::log(rtol) / ln_f_)), 2, kMaxTaylorOrder);
+    p_ = std::clamp(int(std::ceil(1.0 - 0.5 * std::log(rtol))), 2, kMaxTaylorOrder);
     const Force* forces[2] = {&f.f1, &f.f2};
     for (int i = 0; i < 2; ++i) {
         Osc& o = osc_[i];
@@ -95,6 +92,10 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol)
         pow1_[0] = pow2_[0] = 1.0;  // q^0 = 1: the constant series
     }
     std::memset(c_, 0, sizeof c_);
+    for (int k = 0; k < kMaxTaylorOrder; ++k) {
+        inv_[k] = 1.0 / (k + 1);
+        for (int i = 0; i < 2; ++i) binv_[i][k] = osc_[i].b / (k + 1);
+    }
     coefficients_ = osc_[0].kind == Kind::Tan ? pick<Kind::Tan>(osc_[1].kind, ckind_)
                                               : pick<Kind::Harmonic>(osc_[1].kind, ckind_);
 }
@@ -124,42 +125,51 @@ void Taylor::coefficients() {
             g_[0][k] = eps_ * bilinear_c_ * c_[2][k];
             g_[1][k] = eps_ * bilinear_c_ * c_[0][k];
         }
-        const double inv = 1.0 / (k + 1);
+        const double inv = inv_[k];
         for (int i = 0; i < 2; ++i) {
             const Osc& o = osc_[i];
             double force;
             if (kinds[i] == Kind::Tan) {
-                // w = 1 + u^2, du/dt = b w p, force a u w. Of the k-th coefficients of u w and
-                // w p only the terms u_0 w_k and w_k p_0 need w_k: the rest are summed alongside
-                // w_k's own sum, so the three run in parallel rather than one after another
-                // (the order loop is bound by these chains' latency, not by arithmetic).
+                // w = 1 + u^2, du/dt = b w p, force a u w. The order loop is bound by latency:
+                // each order waits for the last one's coefficients. So every sum adds its old
+                // terms first (they are ready early and overlap the previous order's tail) and
+                // the newest last: u_k in w_k's sum; w_k, p_k, u_k and w_{k-1} in the products.
                 const double* u = c_[o.aux];
                 const double* q = c_[o.p];
                 double* w = w_[i];
                 double a0 = 0, a1 = 0, b0 = 0, b1 = 0, s0 = 0, s1 = 0;
-                int j = 0;
-                for (; j + 1 < k; j += 2) {
+                int j = 1;
+                for (; j + 1 <= k - 2; j += 2) {
                     a0 += w[j] * q[k - j];
                     b0 += w[j] * u[k - j];
                     a1 += w[j + 1] * q[k - j - 1];
                     b1 += w[j + 1] * u[k - j - 1];
                 }
-                for (; j < k; ++j) {
+                for (; j <= k - 2; ++j) {
                     a0 += w[j] * q[k - j];
                     b0 += w[j] * u[k - j];
                 }
                 const int half = (k + 1) / 2;
-                for (j = 0; j + 1 < half; j += 2) {
+                for (j = 1; j + 1 < half; j += 2) {
                     s0 += u[j] * u[k - j];
                     s1 += u[j + 1] * u[k - j - 1];
                 }
                 for (; j < half; ++j) s0 += u[j] * u[k - j];
                 double sq = 2 * (s0 + s1);
-                if (k % 2 == 0) sq += u[k / 2] * u[k / 2];
-                const double wk = (k == 0 ? 1.0 : 0.0) + sq;
+                if (k % 2 == 0 && k > 0) sq += u[k / 2] * u[k / 2];
+                double A = a0 + a1, B = b0 + b1;
+                if (k >= 2) {
+                    A += w[k - 1] * q[1];
+                    B += w[k - 1] * u[1];
+                }
+                if (k >= 1) {
+                    A += w[0] * q[k];
+                    B += w[0] * u[k];
+                }
+                const double wk = k == 0 ? 1 + u[0] * u[0] : sq + two_u0_[i] * u[k];
                 w[k] = wk;
-                force = o.a * ((b0 + b1) + u[0] * wk);
-                c_[o.aux][k + 1] = o.b * ((a0 + a1) + wk * q[0]) * inv;
+                force = o.a * (B + u[0] * wk);
+                c_[o.aux][k + 1] = (A + wk * q[0]) * binv_[i][k];
             } else {
                 force = o.a * c_[o.q][k];
             }
@@ -184,6 +194,8 @@ Taylor::Coefficients Taylor::pick(Kind k2, CKind c) {
 
 bool Taylor::expand(const double* y0, double* h) {
     for (int i = 0; i < n_; ++i) c_[i][0] = y0[i];
+    for (int i = 0; i < 2; ++i)
+        if (osc_[i].aux >= 0) two_u0_[i] = 2 * y0[osc_[i].aux];
     (this->*coefficients_)();
     double norm0 = 0, normp1 = 0, normp = 0;
     bool finite = true;
@@ -191,16 +203,19 @@ bool Taylor::expand(const double* y0, double* h) {
         norm0 = std::max(norm0, std::fabs(c_[i][0]));
         normp1 = std::max(normp1, std::fabs(c_[i][p_ - 1]));
         normp = std::max(normp, std::fabs(c_[i][p_]));
-        for (int k = 0; k <= p_; ++k) finite = finite && std::isfinite(c_[i][k]);
+        // A non-finite coefficient reaches every later one (each is a sum over all below it).
+        finite = finite && std::isfinite(c_[i][p_ - 1]) && std::isfinite(c_[i][p_]);
     }
     if (!finite) return false;
-    const double scale = std::max(norm0, scale_floor_);
-    double rho = std::numeric_limits<double>::infinity();
-    if (normp1 > 0) rho = std::min(rho, std::pow(scale / normp1, 1.0 / (p_ - 1)));
-    if (normp > 0) rho = std::min(rho, std::pow(scale / normp, 1.0 / p_));
+    // rho = min_j (scale / ||x_j||)^(1/j), j = p - 1, p, in logarithms: two logs and one exp
+    // instead of two pows (a fifth of a step's time at low orders).
+    const double ls = std::log(std::max(norm0, scale_floor_));
+    double lrho = std::numeric_limits<double>::infinity();
+    if (normp1 > 0) lrho = std::min(lrho, (ls - std::log(normp1)) / (p_ - 1));
+    if (normp > 0) lrho = std::min(lrho, (ls - std::log(normp)) / p_);
     // Jorba & Zou's safety factors: e^-2 from the Cauchy estimate of the remainder, and
     // exp(-0.7 / (p - 1)) for the coefficients beyond p that the estimate does not see.
-    *h = rho * std::exp(ln_f_ - 0.7 / (p_ - 1));
+    *h = std::exp(lrho - 2.0 - 0.7 / (p_ - 1));
     return true;
 }
 

@@ -56,7 +56,6 @@ private:
     Coefficients coefficients_ = nullptr;
     int n_ = 4, p_ = 8;
     double scale_floor_;  // atol / rtol
-    double ln_f_ = -2;
     struct Osc {
         Kind kind = Kind::Harmonic;
         double a = 0, b = 0;
@@ -70,6 +69,8 @@ private:
     // Coefficients: c_[i][k] of variable i; per Tan oscillator w = 1 + u^2; powers of q1, q2.
     double c_[kMaxDim][kMaxTaylorOrder + 1];
     double w_[2][kMaxTaylorOrder + 1];
+    double inv_[kMaxTaylorOrder], binv_[2][kMaxTaylorOrder];  // 1 / (k + 1), b / (k + 1)
+    double two_u0_[2] = {0, 0};                                 // 2 u_0 of each Tan oscillator
     double g_[2][kMaxTaylorOrder + 1];  // coupling gradient series
     std::vector<double> pow1_, pow2_;   // (deg + 1) x (P + 1): q^m series, m = 0 .. deg
 };

@@ -1,0 +1,198 @@
+"""Stepper "taylor": Taylor's method on the flow's polynomial field (issue 22).
+
+Checked against exact answers: the eps = 0 flow in closed form (stepper "exact": action-angle
+variables, impacts included) and the linear flow of Harmonic x Harmonic with a bilinear coupling
+(its normal modes), on the wall and step systems; against an independent integrator (GSL's rk8pd
+at its tightest) where the field has no closed form (Tan well, polynomial coupling); and on what
+the product promises of every stepper: per-orbit statuses, the same orbit alone or in a batch,
+clear errors for the systems it does not cover.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hovering
+from hovering import FlowStatus, Harmonic, Section, StepSystem, Tan, paper
+from hovering.paper import QW1, QW2, V1, V2, H
+
+
+def wrap(a):
+    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+
+
+def _starts(sec, n, seed=0):
+    """Random (theta, I) on both sides of the tangent torus of the right wall."""
+    V1s, V2s = sec.sys.V1, sec.sys.V2
+    I_tan = V2s.action(sec.h - V1s.V(sec.sys.qw1))
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-np.pi, np.pi, n), I_tan * rng.uniform(0.3, 1.3, n)
+
+
+def _harmonic_pair(eps, geometry="step"):
+    return StepSystem(
+        V1=Harmonic(1.0),
+        V2=Harmonic(np.sqrt(2.0)),
+        coupling=hovering.Bilinear(),
+        eps=eps,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry=geometry,
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# accuracy against exact flows
+
+
+@pytest.mark.parametrize("geometry", ["wall", "step"])
+@pytest.mark.parametrize("tol", [1e-6, 1e-9, 1e-12])
+def test_error_follows_the_tolerance_at_eps0(geometry, tol):
+    # eps = 0: the closed form is the reference (its own error ~1e-14, README). Jorba-Zou's order
+    # and step put the truncation error per step at ~tol relative to the state; a return takes
+    # ~35 steps, impacts and the section located on the step's polynomial. Bound: 10 tol + 1e-13
+    # (measured: 0.15 tol at 1e-6, 0.04 tol at 1e-9, 0.2 tol at 1e-12 on these 300 orbits; the
+    # 1e-13 floor is the reference's and rounding over ~35 steps).
+    sec = Section(StepSystem(V1=V1, V2=V2, qw1=QW1, qw2=QW2, geometry=geometry), H)
+    th, I = _starts(sec, 300)
+    ref = sec.return_map(th, I, stepper="exact")
+    r = sec.return_map(th, I, stepper="taylor", rtol=tol, atol=tol)
+    ok = (ref.status == FlowStatus.OK) & (r.status == FlowStatus.OK)
+    assert ok.sum() >= 250
+    assert np.array_equal(r.status, ref.status)  # no orbit classified differently (corner, grazing)
+    assert np.array_equal(np.asarray(r.itinerary)[ok], np.asarray(ref.itinerary)[ok])
+    err = max(np.abs(wrap(r.theta[ok] - ref.theta[ok])).max(), np.abs(r.I[ok] - ref.I[ok]).max())
+    assert err <= 10 * tol + 1e-13
+
+
+@pytest.mark.parametrize("eps", [0.05, -0.05])
+def test_coupled_linear_flow_matches_its_normal_modes(eps):
+    # Harmonic x Harmonic with eps q1 q2: the flow is linear, stepper "exact" propagates its
+    # normal modes. Error in the state after the return, at rtol 1e-13 (measured max 3e-14; bound
+    # 2e-12 leaves room for the ~1/sqrt(d) amplification of a shallow impact).
+    sec = Section(_harmonic_pair(eps), 1.0)
+    th, I = _starts(sec, 200, seed=1)
+    ref = sec.return_map(th, I, stepper="exact")
+    r = sec.return_map(th, I, stepper="taylor", rtol=1e-13, atol=1e-13)
+    ok = (ref.status == FlowStatus.OK) & (r.status == FlowStatus.OK)
+    assert ok.sum() >= 150 and np.array_equal(r.status, ref.status)
+    assert np.abs(r.z[ok] - ref.z[ok]).max() <= 2e-12
+    assert np.abs(r.time[ok] - ref.time[ok]).max() <= 2e-12
+
+
+def test_reaches_the_rounding_floor_in_few_steps():
+    # At rtol 1e-15 (order 19) the state after one return is as close to the normal modes as
+    # rounding lets any integrator come (measured on 400 orbits: median 3.8e-15, max 6.3e-14 for
+    # Taylor and for rk8pd at 1e-15 alike; the max comes from shallow impacts, whose time error
+    # grows as 1/sqrt(depth)), in ~12 steps per return where rk8pd takes ~99.
+    sec = Section(_harmonic_pair(0.05), 1.0)
+    th, I = _starts(sec, 200, seed=2)
+    ref = sec.return_map(th, I, stepper="exact")
+    r = sec.return_map(th, I, stepper="taylor", rtol=1e-15, atol=1e-15)
+    rk = sec.return_map(th, I, stepper="rk8pd", rtol=1e-15, atol=1e-15)
+    ok = (ref.status == FlowStatus.OK) & (r.status == FlowStatus.OK) & (rk.status == FlowStatus.OK)
+    assert ok.sum() >= 150
+    err = np.abs(r.z[ok] - ref.z[ok]).max(axis=1)
+    assert np.median(err) <= 1e-14 and err.max() <= 3e-13
+    assert np.median(err) <= 2 * np.median(np.abs(rk.z[ok] - ref.z[ok]).max(axis=1))
+    assert r.steps[ok].mean() <= 0.25 * rk.steps[ok].mean()
+
+
+@pytest.mark.parametrize(
+    "system",
+    [
+        "readme",
+        "tutorial",
+    ],
+)
+def test_agrees_with_rk8pd_where_no_closed_form_exists(system):
+    # The coupled Tan well (README system, bilinear) and a Tan well in q1 with a polynomial
+    # coupling q1 q2 + 0.5 q1^2 q2 (the tutorial's system): no closed form, so the independent
+    # integrator is the reference. Both at 1e-13: they must agree within 2e-11 in (theta, I) and
+    # in the state (measured 1e-12; each carries its own ~1e-12 error over a return).
+    if system == "readme":
+        sys = paper.system(0.05)
+        h = H
+    else:
+        sys = StepSystem(
+            V1=Tan(omega=1.0, alpha=0.5),
+            V2=Harmonic(omega=0.7),
+            coupling=hovering.Polynomial({(1, 1): 1.0, (2, 1): 0.5}),
+            eps=0.02,
+            qw1=-1.0,
+            qw2=-0.5,
+        )
+        h = 1.0
+    sec = Section(sys, h)
+    th, I = _starts(sec, 100, seed=3)
+    a = sec.return_map(th, I, stepper="rk8pd", rtol=1e-13, atol=1e-13)
+    b = sec.return_map(th, I, stepper="taylor", rtol=1e-13, atol=1e-13)
+    ok = (a.status == FlowStatus.OK) & (b.status == FlowStatus.OK)
+    assert ok.sum() >= 80
+    assert np.array_equal(np.asarray(a.itinerary)[ok], np.asarray(b.itinerary)[ok])
+    assert np.abs(wrap(a.theta[ok] - b.theta[ok])).max() <= 2e-11
+    assert np.abs(a.I[ok] - b.I[ok]).max() <= 2e-11
+    assert np.abs(a.z[ok] - b.z[ok]).max() <= 2e-11
+
+
+def test_energy_is_kept_over_long_orbits():
+    # 2000 returns of the README system at rtol 1e-12: the energy error of every return stays at
+    # the tolerance's level (measured max 2e-13; bound 1e-11), the orbit never stops.
+    fm = hovering.FlowMap(paper.system(0.05), H, coordinates="section", stepper="taylor", rtol=1e-12, atol=1e-12)
+    th, I = _starts(fm.section, 4, seed=4)
+    r = fm.iterate(th, I, 2000, record=("energy_error",))
+    assert np.all(r.status == 0)
+    assert np.nanmax(r.energy_error) <= 1e-11
+
+
+# ------------------------------------------------------------------------------------------------
+# what every stepper promises
+
+
+def test_an_orbit_is_the_same_alone_in_a_batch_and_on_any_thread_count():
+    sec = Section(paper.system(0.05), H)
+    th, I = _starts(sec, 40, seed=5)
+    kw = dict(stepper="taylor", rtol=1e-11, atol=1e-11)
+    batch1 = sec.return_map(th, I, n_threads=1, **kw)
+    batch2 = sec.return_map(th, I, n_threads=2, **kw)
+    alone = sec.return_map(th[7:8], I[7:8], n_threads=1, **kw)
+    assert np.array_equal(batch1.z, batch2.z) and np.array_equal(batch1.z[7], alone.z[0])
+
+
+def test_numerical_wrapper_is_the_same_flow():
+    # Numerical(V) answers energy questions by quadrature but has V's force: the integrator sees
+    # the same polynomial field, so from the same states the returned states are the same bit for
+    # bit (the core's batch entry point, which takes states).
+    from hovering._core import flow as core
+
+    kw = dict(coupling=hovering.Bilinear(), eps=0.05, qw1=QW1, qw2=QW2)
+    plain = StepSystem(V1=V1, V2=V2, **kw)
+    wrapped = StepSystem(V1=hovering.Numerical(V1), V2=hovering.Numerical(V2), **kw)
+    z0 = np.ascontiguousarray(Section(plain, H).point(*_starts(Section(plain, H), 10, seed=6)))
+    opt = core.FlowOptions(stepper="taylor", rtol=1e-11, atol=1e-11)
+    a = core.return_maps(plain.core, z0, opt, 1)
+    b = core.return_maps(wrapped.core, z0, opt, 1)
+    assert np.all(np.asarray(a["status"]) == 0) and np.array_equal(a["z"], b["z"])
+
+
+def test_a_runaway_orbit_gets_its_status_and_the_batch_goes_on():
+    # An indefinite coupled potential (eps = -0.5 with Harmonic(0.2) x Harmonic(0.2)) runs away:
+    # that orbit ends NON_FINITE at its last finite state; its neighbours in the batch return.
+    sys = StepSystem(V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall")
+    s = Section(sys, 0.3)
+    th = np.linspace(-np.pi, np.pi, 41)[10:14]
+    r = s.return_map(th, np.full(4, 0.5), stepper="taylor", rtol=1e-10, atol=1e-10)
+    assert FlowStatus.NON_FINITE in set(r.status)
+    bad = r.status == FlowStatus.NON_FINITE
+    assert np.isfinite(r.z[bad]).all() and r.time[bad].min() > 100
+
+
+def test_unsupported_potential_is_refused_before_any_work():
+    custom = hovering.CustomPotential(lambda q: 0.5 * q * q, lambda q: q, name="quad")
+    sys = StepSystem(V1=custom, V2=V2, qw1=QW1, qw2=QW2)
+    sec = Section(sys, H)
+    with pytest.raises(ValueError, match=r"stepper 'taylor' needs V1 and V2 each Harmonic or Tan.*rk8pd"):
+        sec.return_map([0.1], [0.2], stepper="taylor")
+    with pytest.raises(ValueError, match=r"stepper 'taylor'"):
+        hovering.FlowMap(sys, H, coordinates="section", stepper="taylor")
