@@ -5,7 +5,7 @@ return (scipy's ``solve_ivp``, heyoka.py's Taylor integrator). Sits above the mo
 
 from .references import heyoka_return_map, scipy_return_map
 from .tolerance import choose_setting
-from .work_precision import FLOW_STEPPERS_DEFAULT, WorkPrecision, exact_available, work_precision
+from .work_precision import FLOW_STEPPERS_DEFAULT, WorkPrecision, exact_available, stepper_applies, work_precision
 
 __all__ = [
     "WorkPrecision",
@@ -13,6 +13,7 @@ __all__ = [
     "choose_setting",
     "exact_available",
     "FLOW_STEPPERS_DEFAULT",
+    "stepper_applies",
     "scipy_return_map",
     "heyoka_return_map",
 ]

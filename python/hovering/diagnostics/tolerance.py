@@ -14,7 +14,7 @@ import numpy as np
 
 from .._checks import integer, real_number
 from ..interface import register
-from .work_precision import _EXACT_ERROR, _best_time, _default_actions, _flow, exact_available
+from .work_precision import _EXACT_ERROR, _best_time, _default_actions, _flow, exact_available, stepper_applies
 
 __all__ = ["choose_setting"]
 
@@ -24,7 +24,7 @@ def choose_setting(
     section,
     accuracy: float,
     returns: int = 1,
-    steppers: Sequence[str] = ("rk8pd", "rkck"),
+    steppers: Sequence[str] | None = None,
     n_points: int = 16,
     seed: int = 0,
 ) -> dict:
@@ -45,7 +45,7 @@ def choose_setting(
     returns : int, optional
         After how many returns (1 .. 1e5; the measurement iterates that far, 4 points).
     steppers : sequence of str, optional
-        Candidates.
+        Candidates (default: taylor where it applies, rk8pd, rkck).
     n_points, seed : int, optional
         Starting points of the measurement.
 
@@ -83,6 +83,8 @@ def choose_setting(
             "reference": "exact (closed-form flow)",
             "returns": returns,
         }
+    if steppers is None:
+        steppers = tuple(st for st in ("taylor", "rk8pd", "rkck") if stepper_applies(section, st))
     tols = tuple(10.0**-k for k in range(3, 15))
     wp = _flow(
         section,

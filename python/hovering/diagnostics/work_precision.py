@@ -38,11 +38,12 @@ from ..flow.section import STEPPERS, Section
 from ..normal.flowmap import FlowMap
 from .references import heyoka_return_map, scipy_return_map
 
-__all__ = ["WorkPrecision", "work_precision", "exact_available", "FLOW_STEPPERS_DEFAULT"]
+__all__ = ["WorkPrecision", "work_precision", "exact_available", "stepper_applies", "FLOW_STEPPERS_DEFAULT"]
 
-#: Steppers of the default flow diagram (rk4 and rk2 reach 1e-10 only at ~100x rk8pd's cost).
-FLOW_STEPPERS_DEFAULT = ("rk8pd", "rkck", "rkf45", "msadams")
-_FLOW_TOLERANCES = (1e-6, 1e-8, 1e-10, 1e-12)
+#: Steppers of the default flow diagram (rk4 and rk2 reach 1e-10 only at ~100x rk8pd's cost);
+#: those that do not apply to a system (taylor: Harmonic and Tan potentials only) are left out.
+FLOW_STEPPERS_DEFAULT = ("taylor", "rk8pd", "rkck", "rkf45", "msadams")
+_FLOW_TOLERANCES = (1e-6, 1e-8, 1e-10, 1e-12, 1e-14)
 _FLOW_TOLERANCES_QUICK = (1e-6, 1e-9, 1e-12)
 #: Documented error bound of the closed-form flow (rounding of O(1) angles over a few events).
 _EXACT_ERROR = 1e-13
@@ -281,6 +282,31 @@ def _section_distance(th_a, I_a, th_b, I_b) -> np.ndarray:
     return np.maximum(np.abs(_wrap(np.asarray(th_a) - th_b)), np.abs(np.asarray(I_a) - I_b))
 
 
+def stepper_applies(section, stepper: str) -> bool:
+    """Whether a stepper applies to this section's system (the core's own check, no integration).
+
+    Parameters
+    ----------
+    section : Section
+        The system (its energy is not read).
+    stepper : str
+        One of :data:`hovering.flow.STEPPERS`.
+
+    Returns
+    -------
+    bool
+        False for ``"exact"`` without a closed-form flow and for ``"taylor"`` on a potential
+        without Taylor recurrences (a :class:`~hovering.CustomPotential`).
+    """
+    from .._core import flow as _core_flow
+
+    try:
+        _core_flow.FlowOptions(stepper=stepper).validate_for(section.sys.core)
+    except ValueError:
+        return False
+    return True
+
+
 def exact_available(section) -> bool:
     """Whether the flow of this section's system has the closed-form ``stepper="exact"``."""
     try:
@@ -308,20 +334,23 @@ def _default_actions(section, n: int, rng) -> np.ndarray:
 
 
 def _reference_run(section, theta, I, n_threads):
-    """One return by the reference: exact where available, else rk8pd at 1e-14 (error estimated)."""
+    """One return by the reference: exact where available, else the most accurate integrator that
+    applies (taylor at rtol 1e-16, order 20; else rk8pd at 1e-14), its own error estimated by its
+    distance to the next tolerance up (1e-15 / 1e-13)."""
     if exact_available(section):
         r = section.return_map(theta, I, stepper="exact", n_threads=n_threads)
         return r, {"method": "exact (closed-form flow)", "error": 0.0, "stepper": "exact", "rtol": None}
-    r = section.return_map(theta, I, rtol=1e-14, atol=1e-14, n_threads=n_threads)
-    r2 = section.return_map(theta, I, rtol=1e-13, atol=1e-13, n_threads=n_threads)
+    stepper, rtol, rtol2 = ("taylor", 1e-16, 1e-15) if stepper_applies(section, "taylor") else ("rk8pd", 1e-14, 1e-13)
+    r = section.return_map(theta, I, stepper=stepper, rtol=rtol, atol=rtol, n_threads=n_threads)
+    r2 = section.return_map(theta, I, stepper=stepper, rtol=rtol2, atol=rtol2, n_threads=n_threads)
     ok = (r.status == 0) & (r2.status == 0)
     est = float(np.max(_section_distance(r.theta[ok], r.I[ok], r2.theta[ok], r2.I[ok]), initial=0.0))
     return r, {
-        "method": "rk8pd rtol 1e-14",
+        "method": f"{stepper} rtol {rtol:g}",
         "error": est,
-        "stepper": "rk8pd",
-        "rtol": 1e-14,
-        "note": "own error estimated as its distance to rk8pd at rtol 1e-13",
+        "stepper": stepper,
+        "rtol": rtol,
+        "note": f"own error estimated as its distance to {stepper} at rtol {rtol2:g}",
     }
 
 
@@ -368,7 +397,7 @@ def _flow(
             **(
                 {"stepper": "exact"}
                 if refinfo["stepper"] == "exact"
-                else {"rtol": refinfo["rtol"], "atol": refinfo["rtol"]}
+                else {"stepper": refinfo["stepper"], "rtol": refinfo["rtol"], "atol": refinfo["rtol"]}
             ),
         )
         for m in long_ms:
@@ -615,7 +644,7 @@ def work_precision(
         (default 1e2, 1e3, 1e4, 1e5). Hovering area: (samples, n_steps) pairs, the largest being
         the reference (default (400, 250), (1600, 500), (6400, 1000), (25600, 2000)).
     steppers : sequence, optional
-        Flow: GSL steppers (default ``FLOW_STEPPERS_DEFAULT``). Rotation: SIMD sin accuracies in ulp
+        Flow: steppers (default ``FLOW_STEPPERS_DEFAULT``, those that apply to the system). Rotation: SIMD sin accuracies in ulp
         (default 1.0 and 3.5).
     quantity : {"auto", "return", "rotation", "hovering_area"}, optional
         ``auto``: one return for the flow, the rotation number for a truncated map.
@@ -680,7 +709,10 @@ def work_precision(
         section = target.section if isinstance(target, FlowMap) else target
         tols = tuple(_FLOW_TOLERANCES_QUICK if quick else _FLOW_TOLERANCES) if tolerances is None else tuple(tolerances)
         tols = tuple(real_number("tolerance", t, 1e-16, False, 1, True) for t in tols)
-        sts = tuple(("rk8pd", "rkck") if quick else FLOW_STEPPERS_DEFAULT) if steppers is None else tuple(steppers)
+        if steppers is None:
+            sts = tuple(st for st in (("taylor", "rk8pd") if quick else FLOW_STEPPERS_DEFAULT) if stepper_applies(section, st))
+        else:
+            sts = tuple(steppers)
         for st in sts:
             if not is_choice(st, STEPPERS):
                 raise ValueError(f"stepper must be one of {STEPPERS}, got {st!r}")
