@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "hovering/flow/return_map.hpp"
+#include "hovering/flow/taylor.hpp"
 #include "testing.hpp"
 
 using namespace hovering;
@@ -217,4 +218,64 @@ TEST_CASE("section coordinates at the bottom of well 2; section points next to t
                "theta = %.17g: (%.17g, %.17g, %.17g) vs (%.17g, %.17g, %.17g)", th, zn[0], zn[2], zn[3], zc[0], zc[2],
                zc[3]);
     }
+}
+
+TEST_CASE("stepper taylor: the series of the exact solution, and exact eps = 0 returns", "[flow]") {
+    FlowSystem s;
+    s.V1 = std::make_shared<Harmonic>(1.3);
+    s.V2 = std::make_shared<Tan>(1.4, 0.7);
+    s.coupling = Coupling::bilinear();
+    s.qw1 = -1.0;
+    s.qw2 = -0.5;
+    s.geometry = Geometry::Step;
+    FlowOptions o;
+    o.stepper = "taylor";
+    o.rtol = o.atol = 1e-13;
+    o.validate(s);
+
+    // eps = 0, one step of the expansion: q1 is exactly q0 cos(w t) + (p0 / w) sin(w t), and the
+    // Tan oscillator keeps u = tan(alpha q2) and its energy. Over a step of <= 0.3 time units at
+    // tol 1e-13 the truncation error is ~1e-13 relative (Jorba-Zou), rounding ~1e-15.
+    s.eps = 0.0;
+    detail::Field f(s);
+    detail::Taylor T(f, s, o.rtol, o.atol);
+    double y0[detail::kMaxDim] = {0.4, -0.9, 0.3, 0.8, 0.0, 0.0};
+    f.sync_aux(y0);
+    double hstep = 0;
+    CHECKF(T.expand(y0, &hstep) && hstep > 0.05 && std::isfinite(hstep), "expansion and step %g", hstep);
+    const double w = 1.3, E2 = 0.5 * y0[3] * y0[3] + s.V2->V(y0[2]);
+    for (double t : {0.0, 0.05, 0.5 * hstep, hstep}) {
+        double y[detail::kMaxDim];
+        T.eval(t, y);
+        const double q1 = y0[0] * std::cos(w * t) + y0[1] / w * std::sin(w * t);
+        CHECKF(std::fabs(y[0] - q1) < 1e-13, "t=%g: q1 %.17g vs exact %.17g", t, y[0], q1);
+        CHECKF(std::fabs(y[4] - std::tan(0.7 * y[2])) < 1e-12, "t=%g: u %.17g vs tan(alpha q2) %.17g", t, y[4],
+               std::tan(0.7 * y[2]));
+        CHECKF(std::fabs(0.5 * y[3] * y[3] + s.V2->V(y[2]) - E2) < 1e-13, "t=%g: H2 drifted", t);
+    }
+
+    // Whole returns at eps = 0 against the closed form (stepper "exact"), impacts on the infinite
+    // wall included (q1's amplitude exceeds |qw1| for I < ~0.1): 5e-12.
+    s.geometry = Geometry::Wall;
+    FlowOptions ex;
+    ex.stepper = "exact";
+    const double h = 1.0;
+    int impacts = 0;
+    for (double I : {0.02, 0.06, 0.3}) {
+        for (double th : {-2.5, -0.4, 0.0, 1.1, 3.0}) {
+            const auto z0 = section_point(s, h, th, I);
+            const ReturnResult a = return_map(s, z0, o), b = return_map(s, z0, ex);
+            CHECKF(a.status == b.status && a.itinerary == b.itinerary, "I=%g th=%g: status/itinerary differ", I, th);
+            impacts += a.itinerary != "u" && a.itinerary != "0";
+            for (int k = 0; k < 4; ++k)
+                CHECKF(std::fabs(a.z[std::size_t(k)] - b.z[std::size_t(k)]) < 5e-12, "I=%g th=%g: z[%d] %.15g vs %.15g",
+                       I, th, k, a.z[std::size_t(k)], b.z[std::size_t(k)]);
+        }
+    }
+    CHECKF(impacts >= 3, "only %d returns with impacts", impacts);
+
+    // A Numerical wrapper has its base's force, hence its recurrences.
+    FlowSystem c = s;
+    c.V1 = std::make_shared<Numerical>(s.V1);
+    CHECKF(detail::taylor_unsupported(c).empty(), "Numerical(Harmonic) has the recurrences of its base");
 }
