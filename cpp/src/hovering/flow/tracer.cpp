@@ -124,48 +124,67 @@ void Tracer::sample(const double* y0, const double* d0, double t0, double t_end)
 
 ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
     if (in_.exact_kind() == ExactKind::Angles && event_driven_) return trace_angles(z0, first_crossing, cancel);
+    begin(z0, first_crossing);
+    while (!step(cancel)) {
+    }
+    return end();
+}
+
+void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing) {
     const FlowSystem& s = s_;
-    const FlowOptions& opt = o_;
-    const int n = in_.dim();
-    const Field& field = in_.field();
-    const bool labels = labels_;
-    DenseRecorder* const dense = dense_;
-    ReturnResult r;
-    const double H0 = s.energy(z0.data());
-    double y[kMaxDim] = {z0[0], z0[1], z0[2], z0[3]}, t = 0;
-    field.sync_aux(y);
+    Ret& R = ret_;
+    R = Ret{};
+    R.H0 = s.energy(z0.data());
+    double* y = R.y;
+    for (int i = 0; i < 4; ++i) y[i] = z0[std::size_t(i)];
+    for (int i = 4; i < kMaxDim; ++i) y[i] = 0;
+    in_.field().sync_aux(y);
     in_.restart();
     // Step bound: a fraction of the shorter oscillator period, so one step never holds both a
     // minimum and a maximum of q1 or q2 (two sign changes of p would cancel); 1/8 leaves a factor 4
     // for the O(eps) period shifts of the coupled flow.
     const double T1 = s.V1->period(std::max(1e-12, 0.5 * y[1] * y[1] + s.V1->V(y[0])));
     const double T2 = s.V2->period(std::max(1e-12, 0.5 * y[3] * y[3] + s.V2->V(y[2])));
-    const double hmax = std::min(0.125 * std::min(T1, T2), in_.max_step());
+    R.hmax = std::min(0.125 * std::min(T1, T2), in_.max_step());
     // First trial step hmax rtol^(1/order): about the step the tolerance allows on these
     // oscillations (0.06 hmax for rk8pd at 1e-10), so a return does not spend 4-5 steps ramping up
     // from a tiny one; it depends on the options only, so every return is reproducible alone.
-    double dt = hmax * std::pow(std::max(opt.rtol, 1e-16), 1.0 / in_.order());
-    double dy[kMaxDim];
-    field(y, dy);
-    bool seen_negative = false, armed = first_crossing, crossed = false;
-    int impacts = 0;
+    R.dt = R.hmax * std::pow(std::max(o_.rtol, 1e-16), 1.0 / in_.order());
+    in_.field()(y, R.dy);
+    R.armed = first_crossing;
+}
+
+bool Tracer::step(const std::atomic<bool>* cancel) {
+    const FlowSystem& s = s_;
+    const FlowOptions& opt = o_;
+    const int n = in_.dim();
+    const Field& field = in_.field();
+    const bool labels = labels_;
+    DenseRecorder* const dense = dense_;
+    Ret& R = ret_;
+    ReturnResult& r = R.r;
+    double* const y = R.y;
+    double* const dy = R.dy;
+    double& t = R.t;
+    bool& done = R.done;
+    bool& crossed = R.crossed;
     const bool right = s.geometry != Geometry::None, upper = s.geometry == Geometry::Step;
     const bool is_step = s.geometry == Geometry::Step;
-    bool done = false;
-    while (!done) {
-        if (halted(r, cancel)) break;
+    {
+        if (halted(r, cancel)) return R.over = true;
         double y0[kMaxDim], d0[kMaxDim];
         for (int i = 0; i < n; ++i) {
             y0[i] = y[i];
             d0[i] = dy[i];
         }
         const double t0 = t;
+        const double hmax = R.hmax;
         double h = 0;
-        const Integrator::Advance adv = in_.advance(y, dy, &dt, hmax, &h);
+        const Integrator::Advance adv = in_.advance(y, dy, &R.dt, hmax, &h);
         ++r.steps;
         if (adv != Integrator::Advance::Ok) {  // y is the last good state, at time t
             r.status = adv == Integrator::Advance::OutsideWell ? FlowStatus::OutsideWell : FlowStatus::NonFinite;
-            break;
+            return R.over = true;
         }
         t = t0 + h;
         const double* d1 = dy;
@@ -237,7 +256,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
         };
         if (right) wall(0, s.qw1, Ev::Right, Ev::GrazeRight);
         if (upper) wall(2, s.qw2, Ev::Upper, Ev::GrazeUpper);
-        if (armed && y0[1] > 0 && y[1] <= 0) {
+        if (R.armed && y0[1] > 0 && y[1] <= 0) {
             Candidate c{};
             c.kind = Ev::Section;
             ++work_.section_searches;
@@ -280,14 +299,14 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
                 stop(FlowStatus::Grazing);
                 break;
             }
-            if (impacts >= opt.max_impacts) {
+            if (R.impacts >= opt.max_impacts) {
                 stop(FlowStatus::ImpactLimit);
                 break;
             }
             // Elastic reflection (eq:R1, eq:R2), placed exactly on the wall so that the restart
             // (g = 0, moving away) cannot find the same impact again.
             for (int i = 0; i < n; ++i) y[i] = c.y[i];
-            ++impacts;
+            ++R.impacts;
             if (is_right) {
                 y[0] = s.qw1;
                 y[1] = -y[1];
@@ -311,16 +330,21 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
             reflected = true;
             break;
         }
-        if (done) break;
+        if (done) return R.over = true;
         if (dense && !reflected) sample(y0, d0, t0, t);
         // A return passes q1's minimum (p1 from - to +, or a right-wall reflection) and then its
         // maximum (p1 from + to -). Arming the section only after the minimum makes a start with
         // p1 = +-1e-14 (a point computed on Sigma_h) safe from being taken for its own return.
-        seen_negative = seen_negative || y0[1] < 0 || y[1] < 0;
-        armed = armed || (seen_negative && y[1] > 0);
-    }
-    finish(r, y, t, done, crossed, H0);
-    return r;
+        R.seen_negative = R.seen_negative || y0[1] < 0 || y[1] < 0;
+        R.armed = R.armed || (R.seen_negative && y[1] > 0);
+        }
+    return false;
+}
+
+ReturnResult Tracer::end() {
+    Ret& R = ret_;
+    finish(R.r, R.y, R.t, R.done, R.crossed, R.H0);
+    return std::move(R.r);
 }
 
 bool Tracer::halted(ReturnResult& r, const std::atomic<bool>* cancel) const {

@@ -60,6 +60,19 @@ public:
     /// the tangential curve starts at q1's minimum). cancel is polled every 256 steps.
     ReturnResult trace(const std::array<double, 4>& z0, bool first_crossing = false,
                        const std::atomic<bool>* cancel = nullptr);
+    /// trace() in pieces, for drivers that interleave several returns (a lane group): begin a
+    /// return from z0 (not for the event-driven closed form, stepper "exact" at eps = 0) ...
+    void begin(const std::array<double, 4>& z0, bool first_crossing = false);
+    /// ... take one accepted step with its events (true: the return is over) ...
+    bool step(const std::atomic<bool>* cancel = nullptr);
+    /// ... and collect its result. trace() is begin, step until over, end.
+    ReturnResult end();
+    /// The state (with its auxiliary variables) the next step() starts from.
+    const double* next_start() const { return ret_.y; }
+    /// Whether begin() and step() apply (every stepper but the event-driven closed form).
+    bool steps_apply() const { return !(in_.exact_kind() == ExactKind::Angles && event_driven_); }
+    /// The integrator (a lane group expands its Taylor series for it).
+    Integrator& integrator() { return in_; }
     /// Whether returns are labelled (itinerary, crossings of q1 = qw1 above the step; default on).
     /// Off, the itinerary stays "" and no crossing is tracked; the orbit is the same bit for bit.
     void set_labels(bool on) { labels_ = on; }
@@ -75,6 +88,17 @@ public:
 
 private:
     enum class Ev { Section, Right, Upper, GrazeRight, GrazeUpper };
+    // The state of the return in progress (begin / step / end).
+    struct Ret {
+        ReturnResult r;
+        double y[kMaxDim] = {}, dy[kMaxDim] = {};
+        double t = 0, dt = 0, hmax = 0, H0 = 0;
+        int impacts = 0;
+        bool seen_negative = false, armed = false, crossed = false;
+        bool done = false;  // the return found its end event (section, corner, graze, limit)
+        bool over = false;  // step() will take no more steps
+    };
+    Ret ret_;
     struct Candidate {
         double tau;
         Ev kind;
