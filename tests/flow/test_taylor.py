@@ -150,14 +150,60 @@ def test_energy_is_kept_over_long_orbits():
 # what every stepper promises
 
 
-def test_an_orbit_is_the_same_alone_in_a_batch_and_on_any_thread_count():
-    sec = Section(paper.system(0.05), H)
-    th, I = _starts(sec, 40, seed=5)
-    kw = dict(stepper="taylor", rtol=1e-11, atol=1e-11)
+@pytest.fixture
+def restore_level():
+    """Put back the SIMD level selected before the test (process-wide state)."""
+    from hovering._core import truncated as core
+
+    before = core.simd_level()
+    yield core
+    core.set_simd_level(before)
+
+
+@pytest.mark.parametrize("system", ["step05", "wall0", "tutorial"])
+def test_an_orbit_is_the_same_alone_in_a_lane_group_and_on_any_thread_count(system):
+    # A batch traces four orbits in lock-step, their Taylor series expanded together in SIMD
+    # lanes; alone (one orbit per call) an orbit takes the scalar path. Same operations in the same
+    # order, no FMA contraction: bit for bit the same returns, impacts and trajectories included.
+    if system == "step05":
+        sec = Section(paper.system(0.05), H)
+    elif system == "wall0":
+        sec = Section(StepSystem(V1=V1, V2=V2, qw1=QW1, qw2=QW2, geometry="wall"), H)
+    else:
+        sys = StepSystem(
+            V1=Tan(omega=1.0, alpha=0.5),
+            V2=Harmonic(omega=0.7),
+            coupling=hovering.Polynomial({(1, 1): 1.0, (2, 1): 0.5}),
+            eps=0.02,
+            qw1=-1.0,
+            qw2=-0.5,
+        )
+        sec = Section(sys, 1.0)
+    th, I = _starts(sec, 37, seed=5)  # 37: the last lane group is not full
+    kw = dict(stepper="taylor", rtol=1e-11, atol=1e-11, trajectory_dt=0.25)
     batch1 = sec.return_map(th, I, n_threads=1, **kw)
     batch2 = sec.return_map(th, I, n_threads=2, **kw)
-    alone = sec.return_map(th[7:8], I[7:8], n_threads=1, **kw)
-    assert np.array_equal(batch1.z, batch2.z) and np.array_equal(batch1.z[7], alone.z[0])
+    assert np.array_equal(batch1.z, batch2.z) and np.array_equal(batch1.steps, batch2.steps)
+    assert np.count_nonzero(batch1.status == FlowStatus.OK) >= 30
+    for i in range(th.size):
+        alone = sec.return_map(th[i : i + 1], I[i : i + 1], n_threads=1, **kw)
+        assert np.array_equal(batch1.z[i], alone.z[0]) and batch1.itinerary[i] == alone.itinerary[0]
+        assert np.array_equal(batch1.trajectory_of(i), alone.trajectory_of(0))
+
+
+def test_every_simd_level_gives_the_same_orbits(restore_level):
+    # The 4-orbit kernel is compiled per instruction set (baseline SSE2, AVX2, AVX-512) and chosen
+    # at run time with the truncated map's (HOVERING_SIMD, set_simd_level): every level this CPU
+    # runs must give the same returns bit for bit.
+    core = restore_level
+    sec = Section(paper.system(0.05), H)
+    th, I = _starts(sec, 24, seed=8)
+    outs = {}
+    for level in core.simd_levels():
+        core.set_simd_level(level)
+        outs[level] = sec.return_map(th, I, stepper="taylor", rtol=1e-12, atol=1e-12, n_threads=1).z
+    first = next(iter(outs.values()))
+    assert all(np.array_equal(first, z) for z in outs.values()), list(outs)
 
 
 def test_numerical_wrapper_is_the_same_flow():

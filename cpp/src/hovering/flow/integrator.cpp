@@ -113,8 +113,9 @@ Integrator::Advance Integrator::advance(double* y, double* d, double* h, double 
     if (taylor_) {
         // The step is chosen a priori (no error to reject); only a step that leaves a bounded well
         // is shortened (halved on the same polynomial, as the GSL steppers' rejected trials).
+        // A lane group may have expanded this state already (Taylor::expand_group).
         double hn = 0;
-        if (!taylor_->expand(y, &hn)) return Advance::Failed;
+        if (!taylor_->expanded_at(y, &hn) && !taylor_->expand(y, &hn)) return Advance::Failed;
         double step = std::min(hn, hmax);
         double y1[kMaxDim];
         for (;;) {

@@ -44,6 +44,8 @@ public:
     int dim() const { return field_.dim; }
     /// Order of the stepper (8 for rk8pd; "exact": 8, only the first trial step reads it, and exact steps ignore it).
     int order() const { return taylor_ ? taylor_->order() : step_ ? int(gsl_odeiv2_step_order(step_)) : 8; }
+    /// The Taylor expansion of stepper "taylor" (null for the others).
+    Taylor* taylor() { return taylor_.get(); }
     /// The closed form of stepper "exact" (None for the GSL steppers).
     ExactKind exact_kind() const { return kind_; }
     /// Longest step the stepper allows (infinite but for the linear flow: 1/8 of its fastest mode's period).

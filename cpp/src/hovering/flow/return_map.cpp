@@ -103,31 +103,54 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     const TrajectoryOutput& traj = out.trajectory;
     std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        detail::Tracer tracer(s, opt);
-        detail::DenseRecorder rec;
-        for (std::int64_t i; cur.pop(i);) {
-            const std::array<double, 4> a{z0[4 * i], z0[4 * i + 1], z0[4 * i + 2], z0[4 * i + 3]};
-            ReturnResult r;
-            if (traj.truncated) traj.truncated[i] = 0;
-            if (cancel && cancel->load(std::memory_order_relaxed)) {
-                r.z = a;
-                r.status = FlowStatus::Interrupted;
-            } else if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]) && std::isfinite(a[3]))) {
-                r.z = a;
-                r.status = FlowStatus::OffSection;
-            } else {
-                if (traj.active()) {
-                    rec.start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
-                    tracer.set_dense(&rec);
-                }
-                r = tracer.trace(a, false, cancel);
-                if (traj.truncated) traj.truncated[i] = rec.truncated ? 1 : 0;
-            }
+        // Returns side by side (4 lanes for stepper "taylor"): each lane takes the next orbit as
+        // soon as its return is over; an orbit's result does not depend on its lane or partners.
+        detail::TracerGroup group(s, opt);
+        const int L = group.lanes();
+        std::vector<detail::DenseRecorder> rec(static_cast<std::size_t>(L));
+        std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
+        auto done = [&](std::int64_t i, const ReturnResult& r) {
             write(i, r);
             if (progress) progress->fetch_add(1, std::memory_order_relaxed);
+        };
+        // Lane l takes orbits until one needs tracing (those that do not are written at once).
+        auto fill = [&](int l) {
+            for (std::int64_t i; cur.pop(i);) {
+                const std::array<double, 4> a{z0[4 * i], z0[4 * i + 1], z0[4 * i + 2], z0[4 * i + 3]};
+                if (traj.truncated) traj.truncated[i] = 0;
+                ReturnResult r;
+                r.z = a;
+                if (cancel && cancel->load(std::memory_order_relaxed)) {
+                    r.status = FlowStatus::Interrupted;
+                } else if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]) &&
+                             std::isfinite(a[3]))) {
+                    r.status = FlowStatus::OffSection;
+                } else {
+                    if (traj.active()) {
+                        rec[std::size_t(l)].start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
+                        group.lane(l).set_dense(&rec[std::size_t(l)]);
+                    }
+                    idx[std::size_t(l)] = i;
+                    group.start(l, a, false, cancel);
+                    return;
+                }
+                done(i, r);
+            }
+        };
+        for (int l = 0; l < L; ++l) fill(l);
+        while (group.any_busy()) {
+            const unsigned over = group.step(cancel);
+            for (int l = 0; l < L; ++l) {
+                if (!((over >> l) & 1u)) continue;
+                const std::int64_t i = idx[std::size_t(l)];
+                const ReturnResult r = group.collect(l);
+                if (traj.truncated) traj.truncated[i] = rec[std::size_t(l)].truncated ? 1 : 0;
+                done(i, r);
+                fill(l);
+            }
         }
         if (out.work) {
-            const FlowWork w = tracer.work();
+            const FlowWork w = group.work();
             std::lock_guard<std::mutex> lock(mu);
             *out.work += w;
         }

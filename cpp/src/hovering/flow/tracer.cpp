@@ -374,4 +374,57 @@ void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool 
     work_.steps += r.steps;
 }
 
+TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.stepper == "taylor") {
+    const int n = taylor_ ? 4 : 1;
+    for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o));
+}
+
+void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
+    Tracer& t = lane(l);
+    busy_ |= 1u << l;
+    if (!t.steps_apply()) {  // the event-driven closed form: a whole return at once
+        done_[l] = t.trace(z0, first_crossing, cancel);
+        ready_ |= 1u << l;
+        return;
+    }
+    t.begin(z0, first_crossing);
+}
+
+unsigned TracerGroup::step(const std::atomic<bool>* cancel) {
+    unsigned over = ready_;
+    const unsigned stepping = busy_ & ~ready_;
+    if (taylor_ && (stepping & (stepping - 1))) {  // two or more lanes: expand them together
+        Taylor* tt[4];
+        const double* y[4];
+        double h[4];
+        bool ok[4];
+        int m = 0;
+        for (int l = 0; l < lanes(); ++l)
+            if ((stepping >> l) & 1u) {
+                tt[m] = lane(l).integrator().taylor();
+                y[m] = lane(l).next_start();
+                ++m;
+            }
+        Taylor::expand_group(tt, y, h, ok, m);
+    }
+    for (int l = 0; l < lanes(); ++l)
+        if (((stepping >> l) & 1u) && lane(l).step(cancel)) over |= 1u << l;
+    ready_ |= over;
+    return over;
+}
+
+ReturnResult TracerGroup::collect(int l) {
+    const unsigned bit = 1u << l;
+    ReturnResult r = (ready_ & bit) && !lane(l).steps_apply() ? std::move(done_[l]) : lane(l).end();
+    busy_ &= ~bit;
+    ready_ &= ~bit;
+    return r;
+}
+
+FlowWork TracerGroup::work() const {
+    FlowWork w;
+    for (const auto& t : t_) w += t->work();
+    return w;
+}
+
 }  // namespace hovering::detail

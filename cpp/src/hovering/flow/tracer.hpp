@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <memory>
 #include <vector>
 
 #include "hovering/flow/exact.hpp"
@@ -126,6 +127,38 @@ private:
     bool labels_ = true;
     bool event_driven_ = true;
     DenseRecorder* dense_ = nullptr;
+};
+
+/// Several returns traced side by side by one worker. With stepper "taylor" four lanes: every
+/// round expands the Taylor series of all busy lanes at once (Taylor::expand_group, SIMD lanes),
+/// then each lane takes its step, events and reflections on its own; other steppers, one lane.
+/// Either way a lane's return is bit for bit what Tracer::trace() gives it alone.
+class TracerGroup {
+public:
+    /// Lanes of one system with integrator options o (s must outlive the group).
+    TracerGroup(const FlowSystem& s, const FlowOptions& o);
+    /// How many returns run side by side (4 for stepper "taylor", else 1).
+    int lanes() const { return int(t_.size()); }
+    /// Lane l's tracer (labels, dense output, work).
+    Tracer& lane(int l) { return *t_[std::size_t(l)]; }
+    /// Whether lane l holds a return that has not been collected.
+    bool busy(int l) const { return (busy_ >> l) & 1u; }
+    /// Whether any lane does.
+    bool any_busy() const { return busy_ != 0; }
+    /// Start a return in the idle lane l (as Tracer::trace).
+    void start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel);
+    /// One step of every busy lane; the set of lanes whose return is over (bit l: lane l).
+    unsigned step(const std::atomic<bool>* cancel);
+    /// Collect lane l's finished return; the lane is idle again.
+    ReturnResult collect(int l);
+    /// Everything the lanes counted (FlowWork).
+    FlowWork work() const;
+
+private:
+    std::vector<std::unique_ptr<Tracer>> t_;
+    ReturnResult done_[4];  // returns traced whole at start (the event-driven closed form)
+    unsigned busy_ = 0, ready_ = 0;
+    bool taylor_ = false;
 };
 
 }  // namespace hovering::detail

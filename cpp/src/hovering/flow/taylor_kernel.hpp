@@ -1,0 +1,192 @@
+#pragma once
+// The Taylor recurrences of the flow's field (internal), written once for a value type V: double
+// for one orbit (taylor.cpp), a vector of 4 doubles for 4 orbits in lock-step (taylor_lanes.cpp,
+// compiled again per instruction set). The same operations in the same order on every lane, and
+// no contraction into FMAs (-ffp-contract=off), so an orbit's coefficients are the same bit for
+// bit alone or in a lane group, on any instruction set.
+
+#include <array>
+#include <vector>
+
+#include "hovering/flow/field.hpp"
+
+namespace hovering::detail {
+
+/// Highest order the tolerances can ask for (rtol >= 1e-30 gives p <= 36).
+inline constexpr int kMaxTaylorOrder = 40;
+/// Coefficients stored per variable (orders 0 .. kMaxTaylorOrder).
+inline constexpr int kTaylorStride = kMaxTaylorOrder + 1;
+/// Highest power of q1 or q2 in a coupling (FlowSystem::validate).
+inline constexpr int kMaxCouplingDegree = 20;
+
+/// Everything the recurrences read besides the coefficients: fixed per system and tolerance.
+struct TaylorModel {
+    int n = 4;                                          ///< state dimension
+    int p = 8;                                          ///< order
+    Kind kind[2] = {Kind::Harmonic, Kind::Harmonic};    ///< force kinds (Harmonic or Tan)
+    double a[2] = {0, 0};                               ///< Harmonic: omega^2; Tan: omega^2 / alpha
+    int aux[2] = {-1, -1};                              ///< Tan: index of u = tan(alpha q)
+    double eps = 0;                                     ///< coupling strength
+    CKind ckind = CKind::None;                          ///< coupling kind
+    double bilinear_c = 0;                              ///< Bilinear: the coefficient
+    std::vector<std::array<double, 3>> terms;           ///< General: (c, i, j)
+    int deg1 = 0, deg2 = 0;                             ///< General: highest powers the gradient needs
+    double inv[kMaxTaylorOrder] = {};                   ///< 1 / (k + 1)
+    double binv[2][kMaxTaylorOrder] = {};               ///< Tan: alpha / (k + 1)
+};
+
+/// Work arrays of one expansion (V per entry): state coefficients c, Tan's w = 1 + u^2, the
+/// coupling gradient g, powers of q1 and q2 (General coupling).
+template <class V>
+struct TaylorSeries {
+    V c[kMaxDim][kTaylorStride];
+    V w[2][kTaylorStride];
+    V g[2][kTaylorStride];
+    V pow1[(kMaxCouplingDegree + 1) * kTaylorStride];
+    V pow2[(kMaxCouplingDegree + 1) * kTaylorStride];
+};
+
+namespace taylor_detail {
+
+// sum_{j=0}^{k} a_j b_{k-j} with four partial sums (shorter dependency chains).
+template <class V>
+inline V cauchy(const V* a, const V* b, int k, V zero) {
+    V r0 = zero, r1 = zero, r2 = zero, r3 = zero;
+    int j = 0;
+    for (; j + 3 <= k; j += 4) {
+        r0 += a[j] * b[k - j];
+        r1 += a[j + 1] * b[k - j - 1];
+        r2 += a[j + 2] * b[k - j - 2];
+        r3 += a[j + 3] * b[k - j - 3];
+    }
+    for (; j <= k; ++j) r0 += a[j] * b[k - j];
+    return (r0 + r1) + (r2 + r3);
+}
+
+template <class V, Kind K1, Kind K2, CKind C>
+void series(const TaylorModel& m, TaylorSeries<V>& S) {
+    constexpr int P = kTaylorStride;
+    constexpr Kind kinds[2] = {K1, K2};
+    const V zero = S.c[0][0] - S.c[0][0] + 0.0;  // +0 in every lane, for either V
+    const int p = m.p;
+    V (*c)[P] = S.c;
+    if constexpr (C == CKind::General) {
+        // q^0 = 1 is the constant series; its higher coefficients stay 0.
+        for (int k = 0; k < P; ++k) {
+            S.pow1[k] = k == 0 ? zero + 1.0 : zero;
+            S.pow2[k] = k == 0 ? zero + 1.0 : zero;
+        }
+    }
+    V two_u0[2] = {zero, zero};
+    for (int i = 0; i < 2; ++i)
+        if (m.aux[i] >= 0) two_u0[i] = 2.0 * c[m.aux[i]][0];
+    for (int k = 0; k < p; ++k) {
+        if constexpr (C == CKind::General) {
+            // Powers of q1, q2 up to the degrees the gradient needs (q^1 is the state's own series).
+            for (int e = 1; e <= m.deg1; ++e)
+                S.pow1[e * P + k] = e == 1 ? c[0][k] : cauchy(&S.pow1[(e - 1) * P], c[0], k, zero);
+            for (int e = 1; e <= m.deg2; ++e)
+                S.pow2[e * P + k] = e == 1 ? c[2][k] : cauchy(&S.pow2[(e - 1) * P], c[2], k, zero);
+            V g1 = zero, g2 = zero;
+            for (const auto& t : m.terms) {
+                const int i = int(t[1]), j = int(t[2]);
+                // d/dq1 c q1^i q2^j = c i q1^(i-1) q2^j.
+                if (i > 0) g1 += t[0] * i * cauchy(&S.pow1[(i - 1) * P], &S.pow2[j * P], k, zero);
+                if (j > 0) g2 += t[0] * j * cauchy(&S.pow1[i * P], &S.pow2[(j - 1) * P], k, zero);
+            }
+            S.g[0][k] = m.eps * g1;
+            S.g[1][k] = m.eps * g2;
+        } else if constexpr (C == CKind::Bilinear) {
+            S.g[0][k] = m.eps * m.bilinear_c * c[2][k];
+            S.g[1][k] = m.eps * m.bilinear_c * c[0][k];
+        }
+        const double inv = m.inv[k];
+        for (int i = 0; i < 2; ++i) {
+            const int qi = 2 * i, pi = 2 * i + 1;
+            V force;
+            if (kinds[i] == Kind::Tan) {
+                // w = 1 + u^2, du/dt = b w p, force a u w. The order loop is bound by latency:
+                // each order waits for the last one's coefficients. So every sum adds its old
+                // terms first (they are ready early and overlap the previous order's tail) and
+                // the newest last: u_k in w_k's sum; w_k, p_k, u_k and w_{k-1} in the products.
+                const V* u = c[m.aux[i]];
+                const V* q = c[pi];
+                V* w = S.w[i];
+                V a0 = zero, a1 = zero, b0 = zero, b1 = zero, s0 = zero, s1 = zero;
+                int j = 1;
+                for (; j + 1 <= k - 2; j += 2) {
+                    a0 += w[j] * q[k - j];
+                    b0 += w[j] * u[k - j];
+                    a1 += w[j + 1] * q[k - j - 1];
+                    b1 += w[j + 1] * u[k - j - 1];
+                }
+                for (; j <= k - 2; ++j) {
+                    a0 += w[j] * q[k - j];
+                    b0 += w[j] * u[k - j];
+                }
+                const int half = (k + 1) / 2;
+                for (j = 1; j + 1 < half; j += 2) {
+                    s0 += u[j] * u[k - j];
+                    s1 += u[j + 1] * u[k - j - 1];
+                }
+                for (; j < half; ++j) s0 += u[j] * u[k - j];
+                V sq = 2.0 * (s0 + s1);
+                if (k % 2 == 0 && k > 0) sq += u[k / 2] * u[k / 2];
+                V A = a0 + a1, B = b0 + b1;
+                if (k >= 2) {
+                    A += w[k - 1] * q[1];
+                    B += w[k - 1] * u[1];
+                }
+                if (k >= 1) {
+                    A += w[0] * q[k];
+                    B += w[0] * u[k];
+                }
+                const V wk = k == 0 ? 1.0 + u[0] * u[0] : sq + two_u0[i] * u[k];
+                w[k] = wk;
+                force = m.a[i] * (B + u[0] * wk);
+                c[m.aux[i]][k + 1] = (A + wk * q[0]) * m.binv[i][k];
+            } else {
+                force = m.a[i] * c[qi][k];
+            }
+            if constexpr (C != CKind::None) force += S.g[i][k];
+            c[qi][k + 1] = c[pi][k] * inv;
+            c[pi][k + 1] = -force * inv;
+        }
+    }
+}
+
+template <class V, Kind K1, Kind K2>
+void series_c(const TaylorModel& m, TaylorSeries<V>& S) {
+    if (m.ckind == CKind::None)
+        series<V, K1, K2, CKind::None>(m, S);
+    else if (m.ckind == CKind::Bilinear)
+        series<V, K1, K2, CKind::Bilinear>(m, S);
+    else
+        series<V, K1, K2, CKind::General>(m, S);
+}
+
+}  // namespace taylor_detail
+
+/// Coefficients 1 .. p of S.c from its coefficients 0 (the starting states).
+template <class V>
+void taylor_series(const TaylorModel& m, TaylorSeries<V>& S) {
+    using namespace taylor_detail;
+    const bool t1 = m.kind[0] == Kind::Tan, t2 = m.kind[1] == Kind::Tan;
+    if (t1 && t2)
+        series_c<V, Kind::Tan, Kind::Tan>(m, S);
+    else if (t1)
+        series_c<V, Kind::Tan, Kind::Harmonic>(m, S);
+    else if (t2)
+        series_c<V, Kind::Harmonic, Kind::Tan>(m, S);
+    else
+        series_c<V, Kind::Harmonic, Kind::Harmonic>(m, S);
+}
+
+/// One build of the 4-orbit kernel (taylor_lanes.cpp): its instruction set and entry point.
+struct TaylorLaneKernels {
+    const char* level;  ///< "sse2", "avx2", "avx512", ...
+    /// Expand count <= 4 starting states y[l] (m.n entries each) into out[l] (m.n x kTaylorStride).
+    void (*expand4)(const TaylorModel& m, const double* const* y, int count, double* const* out);
+};
+
+}  // namespace hovering::detail
