@@ -130,6 +130,11 @@ public:
 
 private:
     FlowStep advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const;
+    // advance() in two halves around the trace (for interleaved returns): the start state of the
+    // return from (x, y) (false: none, st then holds the OffSection step), and the step a finished
+    // return makes.
+    bool advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st) const;
+    FlowStep advance_end(ReturnResult ret, bool inverse) const;
     FlowSystem s_;
     double h_;
     FlowOptions opt_;

@@ -63,18 +63,21 @@ double FlowMap::rotation_of(double x, double y, Region r, double x1) const {
     return ref + wrap(adv - ref);
 }
 
-FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const {
-    FlowStep st;
-    st.x = st.y = kNaN;
+bool FlowMap::advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st) const {
     auto [th, I] = to_section(x, y);
     if (inverse) th = -th;  // R2: theta -> -theta (section_point accepts [-pi, pi])
-    std::array<double, 4> z{};
-    if (!try_section_point(s_, h_, th, I, z)) {
-        st.ret.status = FlowStatus::OffSection;
-        st.ret.z = {kNaN, kNaN, kNaN, kNaN};
-        return st;
-    }
-    st.ret = tr.trace(z, false, cancel);
+    if (try_section_point(s_, h_, th, I, z)) return true;
+    st = FlowStep{};
+    st.x = st.y = kNaN;
+    st.ret.status = FlowStatus::OffSection;
+    st.ret.z = {kNaN, kNaN, kNaN, kNaN};
+    return false;
+}
+
+FlowStep FlowMap::advance_end(ReturnResult ret, bool inverse) const {
+    FlowStep st;
+    st.x = st.y = kNaN;
+    st.ret = std::move(ret);
     if (st.ret.status != FlowStatus::Ok) return st;
     // ret.energy_error is |H(image) - H(start)|; the start solves H = h to rounding (1e-16).
     auto c = section_coordinates(s_, st.ret.z.data());
@@ -87,6 +90,13 @@ FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, 
     st.y = y1;
     st.region = region_of(st.ret.itinerary);
     return st;
+}
+
+FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const {
+    std::array<double, 4> z{};
+    FlowStep st;
+    if (!advance_start(x, y, inverse, z, st)) return st;
+    return advance_end(tr.trace(z, false, cancel), inverse);
 }
 
 FlowStep FlowMap::step(double x, double y) const {
@@ -225,77 +235,133 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 4));
     std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        detail::Tracer tr(s_, opt_);
-        tr.set_labels(opt.labels);
-        detail::DenseRecorder rec;
+        // Orbits side by side, one per lane of a TracerGroup (4 for stepper "taylor": their Taylor
+        // series are expanded together); each lane runs its orbit's returns one after another
+        // and takes the next orbit when it ends. An orbit is bit for bit what it is alone.
+        detail::TracerGroup group(s_, opt_);
+        const int L = group.lanes();
+        for (int l = 0; l < L; ++l) group.lane(l).set_labels(opt.labels);
         detail::ProgressShare progress(opt.progress, 1);
-        for (std::int64_t i; cur.pop(i);) {
-            double x = x0[i], y = y0[i], rot = 0, y_lo = y0[i], y_hi = y0[i];
+        struct Orbit {
+            std::int64_t i = -1;
+            double x = 0, y = 0, rot = 0, y_lo = 0, y_hi = 0;
             std::int64_t res[kRegionCount] = {};
-            if (out.exit_step) out.exit_step[i] = -1;
-            if (out.stop_step) out.stop_step[i] = -1;
-            if (traj.truncated) traj.truncated[i] = 0;
-            std::array<double, 4> z{};
-            if (!state(x, y, z)) {
-                record_point(i, 0, x, y, nullptr);
-                finish(i, x, y, 0.0, 0, Status::OffSection, 0, y_lo, y_hi, res, 0);
-                progress.add(ns);
-                continue;
-            }
-            if (traj.active()) {
-                rec.start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
-                tr.set_dense(&rec);
-            }
-            record_point(i, 0, x, y, &z);
-            Status status = Status::Ok;
             std::int64_t k = 0, returns = 0;
             bool reported = false;
             int visited = 0;
-            // The start counts: an orbit that starts in the set stops there, having taken no return.
-            if (stop.active() && stop.reached(wrap(x), y)) status = Status::Stopped;
-            for (; k < ns && status == Status::Ok; ++k) {
-                if (cancelled()) {
-                    status = Status::Interrupted;
-                    break;
-                }
-                const FlowStep st = advance(tr, x, y, false, opt.cancel);
-                if (st.ret.status != FlowStatus::Ok) {
-                    status = orbit_status(st.ret.status);
-                    break;
-                }
-                rec.offset += st.ret.time;  // the orbit's clock runs on into the next return
-                const int r = int(st.region);
-                if (r >= 0) {
-                    visited |= 1 << r;
-                    ++res[r];
-                }
-                returns = k + 1;
-                if (k % every == 0) record_return(i, k, st);
-                if (opt.exit_mask && !reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
-                    if (out.exit_step) out.exit_step[i] = k;
-                    reported = true;
-                    if (opt.stop_on_exit) {  // recorded above, not taken
-                        status = Status::Exited;
-                        break;
-                    }
-                }
-                if (out.rotation) rot += rotation_of(x, y, st.region, st.x);
-                x = st.x;
-                y = st.y;
-                y_lo = std::min(y_lo, y);
-                y_hi = std::max(y_hi, y);
-                if ((k + 1) % every == 0) record_point(i, k + 1, x, y, nullptr);
-                progress.add(1);
-                if (stop.active() && stop.reached(x, y)) status = Status::Stopped;
-            }
-            finish(i, x, y, rot, k, status, visited, y_lo, y_hi, res, returns);
-            if (traj.truncated) traj.truncated[i] = rec.truncated ? 1 : 0;
+            Status status = Status::Ok;
+            detail::DenseRecorder rec;
+        };
+        std::vector<Orbit> lane(static_cast<std::size_t>(L));
+        // The end of lane l's orbit: its outputs, its recorded tails, the progress it will not make.
+        auto close = [&](Orbit& o) {
+            finish(o.i, o.x, o.y, o.rot, o.k, o.status, o.visited, o.y_lo, o.y_hi, o.res, o.returns);
+            if (traj.truncated) traj.truncated[o.i] = o.rec.truncated ? 1 : 0;
             // The returns an orbit that stopped early will not take are accounted for (not when
             // cancelled: the count then shows how far the run got).
-            if (status != Status::Interrupted) progress.add(ns - k);
+            if (o.status != Status::Interrupted) progress.add(ns - o.k);
+            o.i = -1;
+        };
+        // Start lane l's next return, or end its orbit (false).
+        auto next_return = [&](int l) {
+            Orbit& o = lane[std::size_t(l)];
+            if (!(o.k < ns && o.status == Status::Ok)) return false;
+            if (cancelled()) {
+                o.status = Status::Interrupted;
+                return false;
+            }
+            std::array<double, 4> z{};
+            FlowStep st;
+            if (!advance_start(o.x, o.y, false, z, st)) {
+                o.status = orbit_status(st.ret.status);
+                return false;
+            }
+            group.start(l, z, false, opt.cancel);
+            return true;
+        };
+        // After lane l's return: the bookkeeping of one iteration (false: the orbit ends here).
+        auto after_return = [&](Orbit& o, const FlowStep& st) {
+            if (st.ret.status != FlowStatus::Ok) {
+                o.status = orbit_status(st.ret.status);
+                return false;
+            }
+            const std::int64_t k = o.k;
+            o.rec.offset += st.ret.time;  // the orbit's clock runs on into the next return
+            const int r = int(st.region);
+            if (r >= 0) {
+                o.visited |= 1 << r;
+                ++o.res[r];
+            }
+            o.returns = k + 1;
+            if (k % every == 0) record_return(o.i, k, st);
+            if (opt.exit_mask && !o.reported && !(r >= 0 && ((opt.exit_mask >> r) & 1u))) {
+                if (out.exit_step) out.exit_step[o.i] = k;
+                o.reported = true;
+                if (opt.stop_on_exit) {  // recorded above, not taken
+                    o.status = Status::Exited;
+                    return false;
+                }
+            }
+            if (out.rotation) o.rot += rotation_of(o.x, o.y, st.region, st.x);
+            o.x = st.x;
+            o.y = st.y;
+            o.y_lo = std::min(o.y_lo, o.y);
+            o.y_hi = std::max(o.y_hi, o.y);
+            if ((k + 1) % every == 0) record_point(o.i, k + 1, o.x, o.y, nullptr);
+            progress.add(1);
+            if (stop.active() && stop.reached(o.x, o.y)) o.status = Status::Stopped;
+            ++o.k;
+            return true;
+        };
+        // Lane l takes orbits until one has a return to trace.
+        auto open = [&](int l) {
+            Orbit& o = lane[std::size_t(l)];
+            for (std::int64_t i; cur.pop(i);) {
+                o.i = i;
+                o.x = x0[i];
+                o.y = o.y_lo = o.y_hi = y0[i];
+                o.rot = 0;
+                std::fill(o.res, o.res + kRegionCount, std::int64_t(0));
+                o.k = o.returns = 0;
+                o.reported = false;
+                o.visited = 0;
+                o.status = Status::Ok;
+                if (out.exit_step) out.exit_step[i] = -1;
+                if (out.stop_step) out.stop_step[i] = -1;
+                if (traj.truncated) traj.truncated[i] = 0;
+                std::array<double, 4> z{};
+                if (!state(o.x, o.y, z)) {
+                    record_point(i, 0, o.x, o.y, nullptr);
+                    finish(i, o.x, o.y, 0.0, 0, Status::OffSection, 0, o.y_lo, o.y_hi, o.res, 0);
+                    progress.add(ns);
+                    o.i = -1;
+                    continue;
+                }
+                o.rec = detail::DenseRecorder{};
+                if (traj.active()) {
+                    o.rec.start(&traj.points[i], &traj.kinds[i], traj.dt, traj.max_points_per_orbit);
+                    group.lane(l).set_dense(&o.rec);
+                }
+                record_point(i, 0, o.x, o.y, &z);
+                // The start counts: an orbit that starts in the set stops there, having taken no return.
+                if (stop.active() && stop.reached(wrap(o.x), o.y)) o.status = Status::Stopped;
+                if (next_return(l)) return;
+                close(o);
+            }
+        };
+        for (int l = 0; l < L; ++l) open(l);
+        while (group.any_busy()) {
+            const unsigned over = group.step(opt.cancel);
+            for (int l = 0; l < L; ++l) {
+                if (!((over >> l) & 1u)) continue;
+                Orbit& o = lane[std::size_t(l)];
+                if (after_return(o, advance_end(group.collect(l), false)) && next_return(l)) continue;
+                close(o);
+                open(l);
+            }
         }
         if (out.work) {
-            const FlowWork w = tr.work();
+            const FlowWork w = group.work();
             std::lock_guard<std::mutex> lock(mu);
             *out.work += w;
         }
