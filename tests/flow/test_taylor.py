@@ -191,6 +191,27 @@ def test_an_orbit_is_the_same_alone_in_a_lane_group_and_on_any_thread_count(syst
         assert np.array_equal(batch1.trajectory_of(i), alone.trajectory_of(0))
 
 
+def test_flowmap_orbits_are_the_same_alone_and_in_lane_groups():
+    # FlowMap.iterate runs four orbits per worker side by side (each lane takes the next orbit
+    # when its own ends); FlowMap.returns one return per point the same way. Neither may change
+    # an orbit: 13 orbits of 25 returns in normal coordinates, and backward returns, each alone.
+    fm = hovering.FlowMap(paper.system(-0.05), H, stepper="taylor", rtol=1e-11, atol=1e-11)
+    phi = np.linspace(-3.0, 3.0, 13)
+    K = np.linspace(-0.03, 0.02, 13)
+    rec = ("orbit", "regions", "energy_error")
+    both = [fm.iterate(phi, K, 25, record=rec, n_threads=t) for t in (1, 2)]
+    assert np.array_equal(both[0].phi, both[1].phi, equal_nan=True)
+    assert np.count_nonzero(both[0].status == 0) >= 10
+    back = fm.returns(phi, K, inverse=True, n_threads=2)
+    for i in range(phi.size):
+        alone = fm.iterate(phi[i : i + 1], K[i : i + 1], 25, record=rec, n_threads=1)
+        assert np.array_equal(both[0].phi[i], alone.phi[0], equal_nan=True)
+        assert np.array_equal(both[0].K[i], alone.K[0], equal_nan=True)
+        assert both[0].status[i] == alone.status[0]
+        one = fm.returns(phi[i : i + 1], K[i : i + 1], inverse=True, n_threads=1)
+        assert np.array_equal(back.phi[i : i + 1], one.phi, equal_nan=True)
+
+
 def test_every_simd_level_gives_the_same_orbits(restore_level):
     # The 4-orbit kernel is compiled per instruction set (baseline SSE2, AVX2, AVX-512) and chosen
     # at run time with the truncated map's (HOVERING_SIMD, set_simd_level): every level this CPU

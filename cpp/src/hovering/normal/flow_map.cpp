@@ -127,15 +127,32 @@ void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inver
     const int threads = detail::worker_count(n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        detail::Tracer tr(s_, opt_);
-        for (std::int64_t i; cur.pop(i);) {
-            if (cancel && cancel->load(std::memory_order_relaxed)) {
-                out[i] = FlowStep{};
-                out[i].x = out[i].y = kNaN;
-                out[i].ret.status = FlowStatus::Interrupted;
-                continue;
+        // One return per point, side by side in a TracerGroup (4 lanes for taylor).
+        detail::TracerGroup group(s_, opt_);
+        const int L = group.lanes();
+        std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
+        auto fill = [&](int l) {
+            for (std::int64_t i; cur.pop(i);) {
+                std::array<double, 4> z{};
+                if (cancel && cancel->load(std::memory_order_relaxed)) {
+                    out[i] = FlowStep{};
+                    out[i].x = out[i].y = kNaN;
+                    out[i].ret.status = FlowStatus::Interrupted;
+                } else if (advance_start(x[i], y[i], inverse, z, out[i])) {
+                    idx[std::size_t(l)] = i;
+                    group.start(l, z, false, cancel);
+                    return;
+                }
             }
-            out[i] = advance(tr, x[i], y[i], inverse, cancel);
+        };
+        for (int l = 0; l < L; ++l) fill(l);
+        while (group.any_busy()) {
+            const unsigned over = group.step(cancel);
+            for (int l = 0; l < L; ++l) {
+                if (!((over >> l) & 1u)) continue;
+                out[idx[std::size_t(l)]] = advance_end(group.collect(l), inverse);
+                fill(l);
+            }
         }
     });
 }
