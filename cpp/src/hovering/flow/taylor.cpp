@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <type_traits>
@@ -28,6 +29,36 @@ namespace {
 const Potential* unwrap(const Potential* v) {
     while (const auto* w = dynamic_cast<const Numerical*>(v)) v = w->base().get();
     return v;
+}
+
+// log2 and exp2 to ~1e-7 relative, for the step rule only: a step length is a heuristic, and
+// libm's log and exp took 15% of a return's time (three logs and an exp per step). Both are exact
+// functions of their argument's bits, so every lane and instruction set agrees.
+double fast_log2(double x) {
+    std::uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    const int e = int((b >> 52) & 0x7ff) - 1023;
+    b = (b & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;  // mantissa in [1, 2)
+    double m;
+    std::memcpy(&m, &b, sizeof m);
+    // ln(m) = 2 atanh(t), t = (m - 1) / (m + 1), |t| <= 1/3 on [1, 2): the odd series to t^11
+    // is within 1e-7.
+    const double t = (m - 1) / (m + 1), t2 = t * t;
+    const double series = t * (2 + t2 * (2.0 / 3 + t2 * (2.0 / 5 + t2 * (2.0 / 7 + t2 * (2.0 / 9 + t2 * (2.0 / 11))))));
+    return e + series * 1.4426950408889634;
+}
+
+double fast_exp2(double x) {
+    if (!(x < 1023)) return x != x ? x : std::numeric_limits<double>::infinity();
+    if (x < -1022) return 0.0;
+    const double n = std::floor(x), f = x - n;  // 2^x = 2^n 2^f, f in [0, 1)
+    const double y = f * 0.6931471805599453;    // e^y, y in [0, ln 2): Taylor to y^9 within 1e-8
+    const double ey =
+        1 + y * (1 + y * (0.5 + y * (1.0 / 6 + y * (1.0 / 24 + y * (1.0 / 120 + y * (1.0 / 720 + y * (1.0 / 5040 + y * (1.0 / 40320 + y / 362880))))))));
+    std::uint64_t b = std::uint64_t(int(n) + 1023) << 52;
+    double two_n;
+    std::memcpy(&two_n, &b, sizeof two_n);
+    return ey * two_n;
 }
 
 template <int N>
@@ -89,10 +120,10 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) : 
     const std::string why = taylor_unsupported(s);
     if (!why.empty()) bad(why);
     m_.n = f.dim;
-    // Jorba & Zou's order for the tolerance: the truncation error of the p-th order polynomial at
-    // their step is ~ tol.
-    m_.p = std::clamp(int(std::ceil(1.0 - 0.5 * std::log(rtol))), 2, kMaxTaylorOrder);
-    factor_ = std::exp(-2.0 - 0.7 / (m_.p - 1));
+    // The order for the tolerance: the truncation error of the p-th order polynomial at the step
+    // f rho is ~ f^p = tol.
+    m_.p = std::clamp(int(std::ceil(1.0 + std::log(rtol) / kLogStepFraction)), 2, kMaxTaylorOrder);
+    factor_ = std::exp(kLogStepFraction - 0.7 / (m_.p - 1));
     const Force* forces[2] = {&f.f1, &f.f2};
     for (int i = 0; i < 2; ++i) {
         m_.kind[i] = forces[i]->kind;
@@ -133,15 +164,14 @@ bool Taylor::finish(double* h) {
     }
     valid_ = finite;
     if (!finite) return false;
-    // rho = min_j (scale / ||x_j||)^(1/j), j = p - 1, p, in logarithms: two logs and one exp
-    // instead of two pows.
-    const double ls = std::log(std::max(norm0, scale_floor_));
+    // rho = min_j (scale / ||x_j||)^(1/j), j = p - 1, p, in base-2 logarithms.
+    const double ls = fast_log2(std::max(norm0, scale_floor_));
     double lrho = std::numeric_limits<double>::infinity();
-    if (normp1 > 0) lrho = std::min(lrho, (ls - std::log(normp1)) / (p - 1));
-    if (normp > 0) lrho = std::min(lrho, (ls - std::log(normp)) / p);
-    // Jorba & Zou's safety factors: e^-2 from the Cauchy estimate of the remainder, and
-    // exp(-0.7 / (p - 1)) for the coefficients beyond p that the estimate does not see.
-    *h = h_ = std::exp(lrho) * factor_;
+    if (normp1 > 0) lrho = std::min(lrho, (ls - fast_log2(normp1)) / (p - 1));
+    if (normp > 0) lrho = std::min(lrho, (ls - fast_log2(normp)) / p);
+    // The step fraction f and Jorba & Zou's exp(-0.7 / (p - 1)) for the coefficients beyond p that
+    // the estimate does not see (factor_).
+    *h = h_ = fast_exp2(lrho) * factor_;
     return true;
 }
 
