@@ -11,7 +11,7 @@
 
 #include "hovering/detail/common.hpp"
 #include "hovering/flow/exact.hpp"
-#include "hovering/truncated/map.hpp"
+#include "hovering/detail/simd_level.hpp"
 
 // The builds of taylor_lanes.cpp (see there and CMakeLists.txt).
 extern "C" {
@@ -31,31 +31,35 @@ const Potential* unwrap(const Potential* v) {
     return v;
 }
 
-// log2 and exp2 to ~1e-7 relative, for the step rule only: a step length is a heuristic, and
-// libm's log and exp took 15% of a return's time (three logs and an exp per step). Both are exact
-// functions of their argument's bits, so every lane and instruction set agrees.
+// log2 to ~3e-3 and exp2 to ~2e-5, for the step rule only: libm's log and exp took 15% of a
+// return's time (three logs and an exp per step), and a step length needs less. An error d in a
+// log2 changes the step's truncation error by a factor 2^(2 d) (< 1.01); an error e in exp2 by
+// (1 + e)^p (< 1.001 at p <= 40). Both are fixed functions of their argument's bits, so every
+// lane and instruction set agrees.
 double fast_log2(double x) {
     std::uint64_t b;
     std::memcpy(&b, &x, sizeof b);
-    const int e = int((b >> 52) & 0x7ff) - 1023;
+    int e = int((b >> 52) & 0x7ff) - 1023;
     b = (b & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;  // mantissa in [1, 2)
     double m;
     std::memcpy(&m, &b, sizeof m);
-    // ln(m) = 2 atanh(t), t = (m - 1) / (m + 1), |t| <= 1/3 on [1, 2): the odd series to t^11
-    // is within 1e-7.
-    const double t = (m - 1) / (m + 1), t2 = t * t;
-    const double series = t * (2 + t2 * (2.0 / 3 + t2 * (2.0 / 5 + t2 * (2.0 / 7 + t2 * (2.0 / 9 + t2 * (2.0 / 11))))));
-    return e + series * 1.4426950408889634;
+    if (m > 1.4142135623730951) {  // to [sqrt(1/2), sqrt(2)): |m - 1| <= 0.42
+        m *= 0.5;
+        ++e;
+    }
+    // ln(1 + z), |z| <= 0.42: the series to z^5 is within 2e-3 (ln 2 times that in log2).
+    const double z = m - 1;
+    const double ln = z * (1 + z * (-0.5 + z * (1.0 / 3 + z * (-0.25 + z * 0.2))));
+    return e + ln * 1.4426950408889634;
 }
 
 double fast_exp2(double x) {
     if (!(x < 1023)) return x != x ? x : std::numeric_limits<double>::infinity();
     if (x < -1022) return 0.0;
-    const double n = std::floor(x), f = x - n;  // 2^x = 2^n 2^f, f in [0, 1)
-    const double y = f * 0.6931471805599453;    // e^y, y in [0, ln 2): Taylor to y^9 within 1e-8
-    const double ey =
-        1 + y * (1 + y * (0.5 + y * (1.0 / 6 + y * (1.0 / 24 + y * (1.0 / 120 + y * (1.0 / 720 + y * (1.0 / 5040 + y * (1.0 / 40320 + y / 362880))))))));
-    std::uint64_t b = std::uint64_t(int(n) + 1023) << 52;
+    const double n = std::floor(x);
+    const double y = (x - n) * 0.6931471805599453;  // 2^(x - n) = e^y, y in [0, ln 2): to y^6, 2e-5
+    const double ey = 1 + y * (1 + y * (0.5 + y * (1.0 / 6 + y * (1.0 / 24 + y * (1.0 / 120 + y / 720)))));
+    const std::uint64_t b = std::uint64_t(int(n) + 1023) << 52;
     double two_n;
     std::memcpy(&two_n, &b, sizeof two_n);
     return ey * two_n;
@@ -63,26 +67,40 @@ double fast_exp2(double x) {
 
 template <int N>
 void horner(const double (*c)[kTaylorStride], int p, double tau, double* y) {
-    // The variables innermost: their chains are independent and overlap.
-    double r[N];
-    for (int i = 0; i < N; ++i) r[i] = c[i][p];
-    for (int k = p - 1; k >= 0; --k)
-        for (int i = 0; i < N; ++i) r[i] = r[i] * tau + c[i][k];
-    for (int i = 0; i < N; ++i) y[i] = r[i];
+    // Estrin's scheme: pairs c_k + c_{k+1} tau, then pairs of pairs with tau^2, tau^4, ...: a
+    // dependency chain of depth log2(p) instead of Horner's p (at orders 20-30 Horner's chain,
+    // not the arithmetic, set the cost), the variables innermost so that their work overlaps.
+    double a[N][kTaylorStride];
+    int m = p + 1;
+    for (int k = 0; k < m / 2; ++k)
+        for (int i = 0; i < N; ++i) a[i][k] = c[i][2 * k] + c[i][2 * k + 1] * tau;
+    if (m % 2)
+        for (int i = 0; i < N; ++i) a[i][m / 2] = c[i][m - 1];
+    m = (m + 1) / 2;
+    double t = tau * tau;
+    while (m > 1) {
+        for (int k = 0; k < m / 2; ++k)
+            for (int i = 0; i < N; ++i) a[i][k] = a[i][2 * k] + a[i][2 * k + 1] * t;
+        if (m % 2)
+            for (int i = 0; i < N; ++i) a[i][m / 2] = a[i][m - 1];
+        m = (m + 1) / 2;
+        t *= t;
+    }
+    for (int i = 0; i < N; ++i) y[i] = a[i][0];
 }
 
 // The build of the 4-orbit kernel for the SIMD level the core runs (the truncated map's choice:
 // one owner of HOVERING_SIMD and set_simd_level), looked up once per thread and level.
 const TaylorLaneKernels& lane_kernels() {
-    thread_local std::string level;
+    thread_local const char* level = nullptr;
     thread_local const TaylorLaneKernels* k = &hovering_taylor_base;
-    const std::string now = simd_level();
-    if (now != level) {
+    const char* now = selected_simd_level();
+    if (now != level) {  // the level names are static strings: a pointer compare per call
         level = now;
         k = &hovering_taylor_base;
 #if defined(HOVERING_LANES_DISPATCH)
-        if (level == hovering_taylor_avx2.level) k = &hovering_taylor_avx2;
-        if (level == hovering_taylor_avx512.level) k = &hovering_taylor_avx512;
+        if (std::strcmp(level, hovering_taylor_avx2.level) == 0) k = &hovering_taylor_avx2;
+        if (std::strcmp(level, hovering_taylor_avx512.level) == 0) k = &hovering_taylor_avx512;
 #endif
     }
     return *k;
@@ -167,8 +185,8 @@ bool Taylor::finish(double* h) {
     // rho = min_j (scale / ||x_j||)^(1/j), j = p - 1, p, in base-2 logarithms.
     const double ls = fast_log2(std::max(norm0, scale_floor_));
     double lrho = std::numeric_limits<double>::infinity();
-    if (normp1 > 0) lrho = std::min(lrho, (ls - fast_log2(normp1)) / (p - 1));
-    if (normp > 0) lrho = std::min(lrho, (ls - fast_log2(normp)) / p);
+    if (normp1 > 0) lrho = std::min(lrho, (ls - fast_log2(normp1)) * m_.inv[p - 2]);
+    if (normp > 0) lrho = std::min(lrho, (ls - fast_log2(normp)) * m_.inv[p - 1]);
     // The step fraction f and Jorba & Zou's exp(-0.7 / (p - 1)) for the coefficients beyond p that
     // the estimate does not see (factor_).
     *h = h_ = fast_exp2(lrho) * factor_;

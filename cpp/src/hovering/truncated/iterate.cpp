@@ -11,6 +11,7 @@
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
+#include "hovering/detail/simd_level.hpp"
 #include "hovering/truncated/classify.hpp"
 #include "hovering/truncated/lanes.hpp"
 #include "hovering/truncated/map.hpp"
@@ -201,6 +202,10 @@ int simd_width() {
 }
 
 std::string simd_level() {
+    return lanes().level;
+}
+
+const char* detail::selected_simd_level() {
     return lanes().level;
 }
 
