@@ -103,7 +103,7 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     const TrajectoryOutput& traj = out.trajectory;
     std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        // Returns side by side (4 lanes for stepper "taylor"): each lane takes the next orbit as
+        // Returns side by side (8 lanes for stepper "taylor"): each lane takes the next orbit as
         // soon as its return is over; an orbit's result does not depend on its lane or partners.
         detail::TracerGroup group(s, opt);
         const int L = group.lanes();

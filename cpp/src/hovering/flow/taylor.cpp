@@ -117,9 +117,10 @@ void Taylor::expand_group(Taylor* const* t, const double* const* y, double* h, b
         ok[0] = t[0]->expand(y[0], &h[0]);
         return;
     }
-    double* out[4];
+    double* out[kMaxTaylorGroup];
     for (int l = 0; l < count; ++l) out[l] = &t[l]->work_.c[0][0];
-    lane_kernels().expand4(t[0]->m_, y, count, out);
+    const TaylorLaneKernels& k = lane_kernels();
+    (count <= 4 ? k.expand4 : k.expand8)(t[0]->m_, y, count, out);
     for (int l = 0; l < count; ++l) ok[l] = t[l]->finish(&h[l]);
 }
 
@@ -159,6 +160,9 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) : 
             m_.deg1 = std::max(m_.deg1, int(t[1]));
             m_.deg2 = std::max(m_.deg2, int(t[2]));
         }
+        pow_.assign(std::size_t(m_.deg1 + 1 + m_.deg2 + 1) * kTaylorStride, 0.0);
+        work_.pow1 = pow_.data();
+        work_.pow2 = pow_.data() + std::size_t(m_.deg1 + 1) * kTaylorStride;
     }
     std::memset(work_.c, 0, sizeof work_.c);
 }

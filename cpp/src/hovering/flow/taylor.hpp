@@ -21,11 +21,13 @@
 // error; the polynomial of the step is its continuous extension, so every event is located on
 // the very polynomial the step took (same accuracy at no further expansion).
 //
-// Several orbits can be expanded at once (expand_group): 4 in the lanes of one SIMD register, on
+// Several orbits can be expanded at once (expand_group): 4 in the lanes of one SIMD register (8 in
+// two), on
 // the widest instruction set this CPU runs (taylor_lanes.cpp), bit for bit what each would get
 // alone.
 
 #include <string>
+#include <vector>
 
 #include "hovering/flow/field.hpp"
 #include "hovering/flow/system.hpp"
@@ -36,6 +38,9 @@ namespace hovering::detail {
 /// Why stepper "taylor" does not apply to s ("" when it does): it needs Harmonic or Tan
 /// potentials (also wrapped in Numerical); a Python-defined potential has no recurrences.
 std::string taylor_unsupported(const FlowSystem& s);
+
+/// Most orbits expand_group expands at once.
+inline constexpr int kMaxTaylorGroup = 8;
 
 /// ln f: a step is the fraction f of the estimated radius of convergence (see the file comment).
 inline constexpr double kLogStepFraction = -1.2;
@@ -48,12 +53,14 @@ class Taylor {
 public:
     /// For the field f of system s (throws std::invalid_argument where taylor_unsupported says why).
     Taylor(const Field& f, const FlowSystem& s, double rtol, double atol);
+    Taylor(const Taylor&) = delete;  // work_ points into pow_
+    Taylor& operator=(const Taylor&) = delete;
     /// The order p.
     int order() const { return m_.p; }
     /// Expand the solution through y0 (dim entries): false if a coefficient is not finite. The
     /// step the tolerances allow goes to *h (infinite for a polynomial solution of degree < p).
     bool expand(const double* y0, double* h);
-    /// expand() for count <= 4 orbits of the same system and tolerances at once (SIMD lanes):
+    /// expand() for count <= kMaxTaylorGroup orbits of the same system and tolerances at once (SIMD lanes):
     /// t[l] expanded through y[l], its step to h[l], ok[l] as expand() returns. Bit for bit the
     /// result of t[l]->expand(y[l], &h[l]).
     static void expand_group(Taylor* const* t, const double* const* y, double* h, bool* ok, int count);
@@ -71,6 +78,7 @@ private:
     double h_ = 0;        // the step of the current expansion
     bool valid_ = false;  // c_ holds an expansion
     TaylorSeries<double> work_;  // one orbit's recurrences; work_.c is the current expansion
+    std::vector<double> pow_;    // General coupling: work_'s powers of q1, q2
 };
 
 }  // namespace hovering::detail

@@ -36,14 +36,15 @@ struct TaylorModel {
 };
 
 /// Work arrays of one expansion (V per entry): state coefficients c, Tan's w = 1 + u^2, the
-/// coupling gradient g, powers of q1 and q2 (General coupling).
+/// coupling gradient g; for a General coupling pow1, pow2 point to (deg + 1) x kTaylorStride
+/// entries each for the powers of q1 and q2 (the caller's, sized by TaylorModel::deg1, deg2).
 template <class V>
 struct TaylorSeries {
     V c[kMaxDim][kTaylorStride];
     V w[2][kTaylorStride];
     V g[2][kTaylorStride];
-    V pow1[(kMaxCouplingDegree + 1) * kTaylorStride];
-    V pow2[(kMaxCouplingDegree + 1) * kTaylorStride];
+    V* pow1 = nullptr;
+    V* pow2 = nullptr;
 };
 
 namespace taylor_detail {
@@ -67,7 +68,7 @@ template <class V, Kind K1, Kind K2, CKind C>
 void series(const TaylorModel& m, TaylorSeries<V>& S) {
     constexpr int P = kTaylorStride;
     constexpr Kind kinds[2] = {K1, K2};
-    const V zero = S.c[0][0] - S.c[0][0] + 0.0;  // +0 in every lane, for either V
+    const V zero = V{} + 0.0;  // +0 in every lane, for any V
     const int p = m.p;
     V (*c)[P] = S.c;
     if constexpr (C == CKind::General) {
@@ -187,6 +188,8 @@ struct TaylorLaneKernels {
     const char* level;  ///< "sse2", "avx2", "avx512", ...
     /// Expand count <= 4 starting states y[l] (m.n entries each) into out[l] (m.n x kTaylorStride).
     void (*expand4)(const TaylorModel& m, const double* const* y, int count, double* const* out);
+    /// The same for count <= 8 (two 4-double vectors).
+    void (*expand8)(const TaylorModel& m, const double* const* y, int count, double* const* out);
 };
 
 }  // namespace hovering::detail

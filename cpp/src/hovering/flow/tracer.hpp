@@ -129,7 +129,7 @@ private:
     DenseRecorder* dense_ = nullptr;
 };
 
-/// Several returns traced side by side by one worker. With stepper "taylor" four lanes: every
+/// Several returns traced side by side by one worker. With stepper "taylor" eight lanes: every
 /// round expands the Taylor series of all busy lanes at once (Taylor::expand_group, SIMD lanes),
 /// then each lane takes its step, events and reflections on its own; other steppers, one lane.
 /// Either way a lane's return is bit for bit what Tracer::trace() gives it alone.
@@ -137,7 +137,7 @@ class TracerGroup {
 public:
     /// Lanes of one system with integrator options o (s must outlive the group).
     TracerGroup(const FlowSystem& s, const FlowOptions& o);
-    /// How many returns run side by side (4 for stepper "taylor", else 1).
+    /// How many returns run side by side (kMaxTaylorGroup for stepper "taylor", else 1).
     int lanes() const { return int(t_.size()); }
     /// Lane l's tracer (labels, dense output, work).
     Tracer& lane(int l) { return *t_[std::size_t(l)]; }
@@ -156,7 +156,7 @@ public:
 
 private:
     std::vector<std::unique_ptr<Tracer>> t_;
-    ReturnResult done_[4];  // returns traced whole at start (the event-driven closed form)
+    ReturnResult done_[kMaxTaylorGroup];  // returns traced whole at start (the event-driven closed form)
     unsigned busy_ = 0, ready_ = 0;
     bool taylor_ = false;
 };

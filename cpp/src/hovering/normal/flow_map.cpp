@@ -127,7 +127,7 @@ void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inver
     const int threads = detail::worker_count(n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        // One return per point, side by side in a TracerGroup (4 lanes for taylor).
+        // One return per point, side by side in a TracerGroup (8 lanes for taylor).
         detail::TracerGroup group(s_, opt_);
         const int L = group.lanes();
         std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
@@ -252,7 +252,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 4));
     std::mutex mu;
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
-        // Orbits side by side, one per lane of a TracerGroup (4 for stepper "taylor": their Taylor
+        // Orbits side by side, one per lane of a TracerGroup (8 for stepper "taylor": their Taylor
         // series are expanded together); each lane runs its orbit's returns one after another
         // and takes the next orbit when it ends. An orbit is bit for bit what it is alone.
         detail::TracerGroup group(s_, opt_);
