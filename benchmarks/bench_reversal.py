@@ -50,7 +50,11 @@ def main():
     ms = (100, 1000) if a.quick else (100, 10_000, 100_000)
     systems = {"wall, eps = 0": paper.section(0.0, "wall"), "step, eps = 0.05": paper.section(0.05)}
     print(f"{a.points} points per system, {a.threads} threads; reversal error median / max (failed orbits: n/a)\n")
-    print(f"{'system':18s} {'setting':16s} " + " ".join(f"{f'm = {m:g}':>22s}" for m in ms) + "   us/return (forward, per thread)")
+    print(
+        f"{'system':18s} {'setting':16s} "
+        + " ".join(f"{f'm = {m:g}':>22s}" for m in ms)
+        + "   us/return (forward, per thread)"
+    )
     for name, sec in systems.items():
         rng = np.random.default_rng(0)
         theta = rng.uniform(-np.pi, np.pi, a.points)
@@ -60,11 +64,13 @@ def main():
             for m in ms:
                 err, dt = reversal(sec.sys, sec.h, stepper, tol, theta, I, m, a.threads)
                 good = err[np.isfinite(err)]
-                cells.append(
-                    f"{np.median(good):9.2e} / {good.max():9.2e}" if good.size else f"{'n/a':>21s}"
-                )
+                cells.append(f"{np.median(good):9.2e} / {good.max():9.2e}" if good.size else f"{'n/a':>21s}")
                 cost.append(dt)
-            print(f"{name:18s} {stepper + f' {tol:g}':16s} " + " ".join(f"{c:>22s}" for c in cells) + f"   {1e6 * min(cost):7.2f}")
+            print(
+                f"{name:18s} {stepper + f' {tol:g}':16s} "
+                + " ".join(f"{c:>22s}" for c in cells)
+                + f"   {1e6 * min(cost):7.2f}"
+            )
 
 
 if __name__ == "__main__":

@@ -246,7 +246,9 @@ def test_numerical_wrapper_is_the_same_flow():
 def test_a_runaway_orbit_gets_its_status_and_the_batch_goes_on():
     # An indefinite coupled potential (eps = -0.5 with Harmonic(0.2) x Harmonic(0.2)) runs away:
     # that orbit ends NON_FINITE at its last finite state; its neighbours in the batch return.
-    sys = StepSystem(V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall")
+    sys = StepSystem(
+        V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
+    )
     s = Section(sys, 0.3)
     th = np.linspace(-np.pi, np.pi, 41)[10:14]
     r = s.return_map(th, np.full(4, 0.5), stepper="taylor", rtol=1e-10, atol=1e-10)

@@ -710,7 +710,9 @@ def work_precision(
         tols = tuple(_FLOW_TOLERANCES_QUICK if quick else _FLOW_TOLERANCES) if tolerances is None else tuple(tolerances)
         tols = tuple(real_number("tolerance", t, 1e-16, False, 1, True) for t in tols)
         if steppers is None:
-            sts = tuple(st for st in (("taylor", "rk8pd") if quick else FLOW_STEPPERS_DEFAULT) if stepper_applies(section, st))
+            sts = tuple(
+                st for st in (("taylor", "rk8pd") if quick else FLOW_STEPPERS_DEFAULT) if stepper_applies(section, st)
+            )
         else:
             sts = tuple(steppers)
         for st in sts:
