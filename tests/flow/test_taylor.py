@@ -265,3 +265,20 @@ def test_unsupported_potential_is_refused_before_any_work():
         sec.return_map([0.1], [0.2], stepper="taylor")
     with pytest.raises(ValueError, match=r"stepper 'taylor'"):
         hovering.FlowMap(sys, H, coordinates="section", stepper="taylor")
+
+
+def test_accuracy_targets_consider_taylor_where_it_applies():
+    # The work-precision ladder and accuracy targets (FlowMap(accuracy=...)) take taylor among their
+    # candidates on systems it covers, and leave it out, without an error, where it does not.
+    from hovering.diagnostics import choose_setting, stepper_applies, work_precision
+
+    sec = Section(paper.system(0.05), H)
+    assert stepper_applies(sec, "taylor") and stepper_applies(sec, "rk8pd") and not stepper_applies(sec, "exact")
+    wp = work_precision(sec, quick=True, n_points=4, returns=(1,))
+    assert {r["method"] for r in wp.table} == {"taylor", "rk8pd"}
+    # taylor's error follows its tolerance (0.3-3x measured) on this system too
+    assert all(r["error"] <= 10 * r["tolerance"] + 1e-13 for r in wp.table if r["method"] == "taylor")
+    custom = hovering.CustomPotential(lambda q: 0.5 * q * q, lambda q: q, name="quad")
+    csec = Section(StepSystem(V1=custom, V2=V2, qw1=QW1, qw2=QW2), H)
+    assert not stepper_applies(csec, "taylor")
+    assert choose_setting(csec, 1e-5, n_points=2)["method"] in ("rk8pd", "rkck")

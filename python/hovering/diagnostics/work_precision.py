@@ -216,6 +216,10 @@ class WorkPrecision:
             )
         unit = self.rows[0]["unit"] if self.rows else "call"
         ax.set_xlabel(f"seconds per {unit} (one thread)")
+        # Times span one or two decades: labelled minor ticks (2e-5, 3e-5, ...) would overlap.
+        from matplotlib.ticker import LogFormatterSciNotation
+
+        ax.xaxis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(1, 0.4)))
         ax.set_ylabel(
             {
                 "flow": "max error of one return (section coordinates)",

@@ -7,11 +7,10 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <type_traits>
 
 #include "hovering/detail/common.hpp"
-#include "hovering/flow/exact.hpp"
 #include "hovering/detail/simd_level.hpp"
+#include "hovering/flow/exact.hpp"
 
 // The builds of taylor_lanes.cpp (see there and CMakeLists.txt).
 extern "C" {
