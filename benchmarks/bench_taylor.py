@@ -76,6 +76,7 @@ import numpy as np
 
 import hovering as hv
 from hovering import paper
+from hovering.diagnostics.work_precision import _best_time
 from hovering.flow.system import Bilinear, Harmonic, Tan
 
 try:
@@ -130,13 +131,8 @@ def state_error(za, zb) -> np.ndarray:
 
 
 def best_of(fn, repeat: int):
-    """Best wall time of repeat calls and the last result."""
-    best, out = math.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+    """Best wall time of repeat calls and the last result (the work-precision harness's timer)."""
+    return _best_time(fn, repeat)
 
 
 # ----------------------------------------------------------------------------------- heyoka.py
