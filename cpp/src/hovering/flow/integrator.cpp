@@ -115,7 +115,7 @@ Integrator::Advance Integrator::advance(double* y, double* d, double* h, double 
         // is shortened (halved on the same polynomial, as the GSL steppers' rejected trials).
         // A lane group may have expanded this state already (Taylor::expand_group).
         double hn = 0;
-        if (!taylor_->expanded_at(y, &hn) && !taylor_->expand(y, &hn)) return Advance::Failed;
+        if (!taylor_->expanded_at(y, &hn) && !taylor_->expand(y, hmax, &hn)) return Advance::Failed;
         double step = std::min(hn, hmax);
         double y1[kMaxDim];
         for (;;) {
@@ -243,7 +243,7 @@ void Integrator::exact(const double* y0, const double* d0, double dt, double* y1
         // start (none does today) gets that start's expansion.
         if (!taylor_->expanded_at(y0)) {
             double unused;
-            taylor_->expand(y0, &unused);
+            taylor_->expand(y0, dt, &unused);
         }
         taylor_->eval(dt, y1);
         return;

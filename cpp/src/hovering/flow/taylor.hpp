@@ -26,8 +26,10 @@
 // the widest instruction set this CPU runs (taylor_lanes.cpp), bit for bit what each would get
 // alone.
 
+#include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
-#include <vector>
 
 #include "hovering/flow/field.hpp"
 #include "hovering/flow/system.hpp"
@@ -48,37 +50,47 @@ inline constexpr double kLogStepFraction = -1.2;
 /// The instruction set expand_group runs on this CPU ("avx512", "avx2" or the build's baseline).
 const char* taylor_lane_level();
 
+/// Coefficients of up to kMaxTaylorGroup expansions, lane-interleaved as the lane kernel writes
+/// them (TaylorLaneKernels), and a count of the expansions that overwrote them.
+struct alignas(64) TaylorLanes {
+    double c[std::size_t(kMaxDim) * kTaylorStride * kMaxTaylorGroup];  ///< the coefficients
+    std::uint64_t round = 0;                                            ///< expansions written so far
+};
+
 /// The Taylor expansion of the flow through one point, and its step rule (see the file comment).
 class Taylor {
 public:
     /// For the field f of system s (throws std::invalid_argument where taylor_unsupported says why).
     Taylor(const Field& f, const FlowSystem& s, double rtol, double atol);
-    Taylor(const Taylor&) = delete;  // work_ points into pow_
+    Taylor(const Taylor&) = delete;  // c_ points into own_ or a group's lanes
     Taylor& operator=(const Taylor&) = delete;
     /// The order p.
     int order() const { return m_.p; }
     /// Expand the solution through y0 (dim entries): false if a coefficient is not finite. The
-    /// step the tolerances allow goes to *h (infinite for a polynomial solution of degree < p).
-    bool expand(const double* y0, double* h);
-    /// expand() for count <= kMaxTaylorGroup orbits of the same system and tolerances at once (SIMD lanes):
-    /// t[l] expanded through y[l], its step to h[l], ok[l] as expand() returns. Bit for bit the
-    /// result of t[l]->expand(y[l], &h[l]).
-    static void expand_group(Taylor* const* t, const double* const* y, double* h, bool* ok, int count);
-    /// Whether the current expansion is the one through y0 (bit for bit), and its step.
+    /// step the tolerances allow goes to *h (infinite for a polynomial solution of degree < p); the
+    /// polynomial at min(*h, hmax) is ready for eval().
+    bool expand(const double* y0, double hmax, double* h);
+    /// expand() for count <= kMaxTaylorGroup orbits of the same system and tolerances at once (SIMD
+    /// lanes), their coefficients in lanes (which stay t[l]'s until lanes is written again): t[l]
+    /// expanded through y[l] with step bound hmax[l]. Bit for bit t[l]->expand(y[l], hmax[l], .).
+    static void expand_group(Taylor* const* t, const double* const* y, const double* hmax, TaylorLanes& lanes,
+                             int count);
+    /// Whether the current expansion is the one through y0 (bit for bit) and finite, and its step.
     bool expanded_at(const double* y0, double* h = nullptr) const;
-    /// The expansion at time tau from its point (Horner): dim entries.
+    /// The current expansion at time tau from its point: dim entries.
     void eval(double tau, double* y) const;
 
 private:
-    // The step rule and the finiteness check, on the coefficients in c_.
-    bool finish(double* h);
+    // Adopt lane `lane` of buf (width lanes per row) and what the kernel gave it.
+    void take(const TaylorLanes* buf, int lane, int width, const TaylorStep& st);
     TaylorModel m_;
-    double scale_floor_;  // atol / rtol
-    double factor_;       // exp(-2 - 0.7 / (p - 1))
-    double h_ = 0;        // the step of the current expansion
-    bool valid_ = false;  // c_ holds an expansion
-    TaylorSeries<double> work_;  // one orbit's recurrences; work_.c is the current expansion
-    std::vector<double> pow_;    // General coupling: work_'s powers of q1, q2
+    std::unique_ptr<TaylorLanes> own_;   // expand()'s coefficients
+    const TaylorLanes* buf_ = nullptr;   // where the current coefficients are
+    std::uint64_t round_ = 0;            // buf_->round when they were written
+    const double* c_ = nullptr;          // variable 0, order 0 of this expansion in buf_
+    int width_ = 4;                      // lanes per row of buf_
+    TaylorStep step_{};                  // step, step taken and end state of the current expansion
+    bool valid_ = false;                 // an expansion with finite coefficients is current
 };
 
 }  // namespace hovering::detail

@@ -1,9 +1,10 @@
 #pragma once
-// The Taylor recurrences of the flow's field (internal), written once for a value type V: double
-// for one orbit (taylor.cpp), a vector of 4 doubles for 4 orbits in lock-step (taylor_lanes.cpp,
-// compiled again per instruction set). The same operations in the same order on every lane, and
-// no contraction into FMAs (-ffp-contract=off), so an orbit's coefficients are the same bit for
-// bit alone or in a lane group, on any instruction set.
+// The Taylor recurrences of the flow's field and the evaluation of its polynomial (internal),
+// written once for a value type V: a vector of 4 or 8 doubles for orbits in lock-step
+// (taylor_lanes.cpp, compiled again per instruction set), double for evaluating one orbit's
+// polynomial at an event (taylor.cpp). The same operations in the same order on every lane, and no
+// contraction into FMAs (-ffp-contract=off), so an orbit's numbers are the same bit for bit alone
+// or in a lane group, on any instruction set.
 
 #include <array>
 #include <vector>
@@ -33,14 +34,17 @@ struct TaylorModel {
     int deg1 = 0, deg2 = 0;                             ///< General: highest powers the gradient needs
     double inv[kMaxTaylorOrder] = {};                   ///< 1 / (k + 1)
     double binv[2][kMaxTaylorOrder] = {};               ///< Tan: alpha / (k + 1)
+    double scale_floor = 1;                             ///< step rule: atol / rtol
+    double factor = 0;                                  ///< step rule: exp(ln f - 0.7 / (p - 1))
 };
 
-/// Work arrays of one expansion (V per entry): state coefficients c, Tan's w = 1 + u^2, the
-/// coupling gradient g; for a General coupling pow1, pow2 point to (deg + 1) x kTaylorStride
-/// entries each for the powers of q1 and q2 (the caller's, sized by TaylorModel::deg1, deg2).
+/// Work arrays of one expansion (V per entry): c points to the state coefficients (the caller's,
+/// kMaxDim rows), Tan's w = 1 + u^2, the coupling gradient g; for a General coupling pow1, pow2
+/// point to (deg + 1) x kTaylorStride entries each for the powers of q1 and q2 (the caller's, sized
+/// by TaylorModel::deg1, deg2).
 template <class V>
 struct TaylorSeries {
-    V c[kMaxDim][kTaylorStride];
+    V (*c)[kTaylorStride] = nullptr;
     V w[2][kTaylorStride];
     V g[2][kTaylorStride];
     V* pow1 = nullptr;
@@ -183,13 +187,50 @@ void taylor_series(const TaylorModel& m, TaylorSeries<V>& S) {
         series_c<V, Kind::Harmonic, Kind::Harmonic>(m, S);
 }
 
-/// One build of the 4-orbit kernel (taylor_lanes.cpp): its instruction set and entry point.
+/// The polynomial of order p at tau for n <= kMaxDim variables: y[i] = sum_k c(i, k) tau^k.
+template <class V, class Coef>
+void estrin(Coef c, int n, int p, V tau, V* y) {
+    // Estrin's scheme: pairs c_k + c_{k+1} tau, then pairs of pairs with tau^2, tau^4, ...: a
+    // dependency chain of depth log2(p) instead of Horner's p (at orders 20-30 Horner's chain,
+    // not the arithmetic, set the cost), the variables innermost so that their work overlaps.
+    V a[kMaxDim][kTaylorStride / 2 + 1];
+    int m = p + 1;
+    for (int k = 0; k < m / 2; ++k)
+        for (int i = 0; i < n; ++i) a[i][k] = c(i, 2 * k) + c(i, 2 * k + 1) * tau;
+    if (m % 2)
+        for (int i = 0; i < n; ++i) a[i][m / 2] = c(i, m - 1);
+    m = (m + 1) / 2;
+    V t = tau * tau;
+    while (m > 1) {
+        for (int k = 0; k < m / 2; ++k)
+            for (int i = 0; i < n; ++i) a[i][k] = a[i][2 * k] + a[i][2 * k + 1] * t;
+        if (m % 2)
+            for (int i = 0; i < n; ++i) a[i][m / 2] = a[i][m - 1];
+        m = (m + 1) / 2;
+        t = t * t;
+    }
+    for (int i = 0; i < n; ++i) y[i] = a[i][0];
+}
+
+/// What the lane kernel gives each orbit besides its coefficients.
+struct TaylorStep {
+    double h;               ///< the step the tolerances allow (infinite for a polynomial of degree < p)
+    double tau;             ///< min(h, hmax): the step taken unless it leaves a bounded well
+    double y[kMaxDim];      ///< the polynomial at tau
+    bool ok;                ///< every coefficient finite (else h, tau and y mean nothing)
+};
+
+/// One build of the lane kernel (taylor_lanes.cpp): its instruction set and entry points.
 struct TaylorLaneKernels {
     const char* level;  ///< "sse2", "avx2", "avx512", ...
-    /// Expand count <= 4 starting states y[l] (m.n entries each) into out[l] (m.n x kTaylorStride).
-    void (*expand4)(const TaylorModel& m, const double* const* y, int count, double* const* out);
-    /// The same for count <= 8 (two 4-double vectors).
-    void (*expand8)(const TaylorModel& m, const double* const* y, int count, double* const* out);
+    /// Expand count <= 4 starting states y[l] (m.n entries each) into c, lane-interleaved
+    /// (c[(i kTaylorStride + k) 4 + l]: variable i, order k, lane l; 32-byte aligned), apply the
+    /// step rule with step bound hmax[l] and evaluate each polynomial at its step: out[l].
+    void (*expand4)(const TaylorModel& m, const double* const* y, const double* hmax, int count, double* c,
+                    TaylorStep* out);
+    /// The same for count <= 8 (two 4-double vectors; c[(i kTaylorStride + k) 8 + l]).
+    void (*expand8)(const TaylorModel& m, const double* const* y, const double* hmax, int count, double* c,
+                    TaylorStep* out);
 };
 
 }  // namespace hovering::detail

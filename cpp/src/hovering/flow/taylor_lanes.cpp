@@ -31,6 +31,7 @@ typedef double V4 __attribute__((vector_size(32)));
 struct V8 {
     V4 a, b;
     double& operator[](int l) { return l < 4 ? a[l] : b[l - 4]; }
+    double operator[](int l) const { return l < 4 ? a[l] : b[l - 4]; }
     V8& operator+=(const V8& o) {
         a += o.a;
         b += o.b;
@@ -46,12 +47,82 @@ inline V8 operator*(const V8& x, double s) { return {x.a * s, x.b * s}; }
 inline V8 operator+(double s, const V8& x) { return {s + x.a, s + x.b}; }
 inline V8 operator+(const V8& x, double s) { return {x.a + s, x.b + s}; }
 
+typedef long long I4 __attribute__((vector_size(32)));
+
+// log2 to ~3e-3 and exp2 to ~2e-5, for the step rule only: libm's log and exp took 15% of a
+// return's time (three logs and an exp per step), and a step length needs less. An error d in a
+// log2 changes the step's truncation error by a factor 2^(2 d) (< 1.01); an error e in exp2 by
+// (1 + e)^p (< 1.001 at p <= 40). Both are fixed functions of their argument's bits, so every
+// lane and instruction set agrees. x >= 0 here.
+inline V4 log2_fast(V4 x) {
+    I4 b = (I4)x;
+    I4 e = ((b >> 52) & 0x7ff) - 1023;
+    b = (b & 0x000fffffffffffffLL) | 0x3ff0000000000000LL;  // mantissa in [1, 2)
+    V4 m = (V4)b;
+    const I4 high = m > 1.4142135623730951;  // to [sqrt(1/2), sqrt(2)): |m - 1| <= 0.42
+    m = high ? m * 0.5 : m;
+    e -= high;  // true is -1
+    // ln(1 + z), |z| <= 0.42: the series to z^5 is within 2e-3 (ln 2 times that in log2).
+    const V4 z = m - 1.0;
+    const V4 ln = z * (1.0 + z * (-0.5 + z * (1.0 / 3 + z * (-0.25 + z * 0.2))));
+    return __builtin_convertvector(e, V4) + ln * 1.4426950408889634;
+}
+
+inline V4 exp2_fast(V4 x) {
+    const V4 inf = V4{} + __builtin_inf();
+    const I4 in_range = (x >= -1022.0) & (x < 1023.0);
+    const V4 xc = in_range ? x : V4{};  // no conversion of what is out of range
+    I4 n = __builtin_convertvector(xc, I4);  // toward zero: floor is one lower below a non-integer < 0
+    n += __builtin_convertvector(n, V4) > xc;
+    const V4 y = (xc - __builtin_convertvector(n, V4)) * 0.6931471805599453;  // 2^(x - n) = e^y, y in [0, ln 2): to y^6, 2e-5
+    const V4 ey = 1.0 + y * (1.0 + y * (0.5 + y * (1.0 / 6 + y * (1.0 / 24 + y * (1.0 / 120 + y / 720)))));
+    const V4 r = ey * (V4)((n + 1023) << 52);
+    return in_range ? r : x < -1022.0 ? V4{} : x != x ? x : inf;
+}
+
+// The step rule (taylor.hpp) on four lanes of coefficients c(i, k); *ok: all coefficients finite.
+template <class Coef>
+V4 step_rule(const detail::TaylorModel& m, Coef c, I4* ok) {
+    const int p = m.p;
+    const V4 zero = V4{};
+    const I4 sign = I4{} + 0x7fffffffffffffffLL;
+    V4 norm0 = zero, normp1 = zero, normp = zero;
+    I4 finite = I4{} - 1;
+    for (int i = 0; i < m.n; ++i) {
+        const V4 a0 = (V4)((I4)c(i, 0) & sign), a1 = (V4)((I4)c(i, p - 1) & sign), a2 = (V4)((I4)c(i, p) & sign);
+        norm0 = norm0 < a0 ? a0 : norm0;
+        normp1 = normp1 < a1 ? a1 : normp1;
+        normp = normp < a2 ? a2 : normp;
+        // A non-finite coefficient reaches every later one (each is a sum over all below it).
+        finite &= (a1 <= __DBL_MAX__) & (a2 <= __DBL_MAX__);
+    }
+    *ok = finite;
+    // rho = min_j (scale / ||x_j||)^(1/j), j = p - 1, p, in base-2 logarithms.
+    const V4 floor = zero + m.scale_floor;
+    const V4 ls = log2_fast(norm0 < floor ? floor : norm0);
+    V4 lrho = zero + __builtin_inf();
+    const V4 r1 = (ls - log2_fast(normp1)) * m.inv[p - 2], r2 = (ls - log2_fast(normp)) * m.inv[p - 1];
+    lrho = normp1 > 0.0 && r1 < lrho ? r1 : lrho;
+    lrho = normp > 0.0 && r2 < lrho ? r2 : lrho;
+    // The step fraction f and Jorba & Zou's exp(-0.7 / (p - 1)) for the coefficients beyond p that
+    // the estimate does not see (m.factor).
+    return exp2_fast(lrho) * m.factor;
+}
+
+inline V4 half(const V4& v, int) { return v; }
+inline V4 half(const V8& v, int j) { return j ? v.b : v.a; }
+inline V4 min_lanes(V4 a, V4 b) { return b < a ? b : a; }  // std::min(a, b)
+inline V8 min_lanes(V8 a, V8 b) { return {min_lanes(a.a, b.a), min_lanes(a.b, b.b)}; }
+
 template <class V, int L>
-void expand(const detail::TaylorModel& m, const double* const* y, int count, double* const* out) {
-    // On the stack (26 kB for 8 lanes): every worker has its own, and nothing is read before it is
-    // written (taylor_series fills orders 1 .. p from 0 and its own work rows). A General
-    // coupling's powers (up to 110 kB) live in a buffer of the thread's, grown once.
+void expand(const detail::TaylorModel& m, const double* const* y, const double* hmax, int count, double* cbuf,
+            detail::TaylorStep* out) {
+    // The coefficients go straight to the caller's lane-interleaved rows (where events read them);
+    // the work rows are on the stack (<= 8 kB), nothing read before it is written (taylor_series
+    // fills orders 1 .. p from 0 and its own work rows). A General coupling's powers (up to 110 kB)
+    // live in a buffer of the thread's, grown once.
     detail::TaylorSeries<V> S;
+    S.c = reinterpret_cast<V(*)[detail::kTaylorStride]>(cbuf);
     if (m.ckind == detail::CKind::General) {
         thread_local std::vector<V> pow;
         const std::size_t rows = std::size_t(m.deg1 + 1 + m.deg2 + 1) * detail::kTaylorStride;
@@ -59,12 +130,29 @@ void expand(const detail::TaylorModel& m, const double* const* y, int count, dou
         S.pow1 = pow.data();
         S.pow2 = pow.data() + std::size_t(m.deg1 + 1) * detail::kTaylorStride;
     }
-    for (int i = 0; i < m.n; ++i)
-        for (int l = 0; l < L; ++l) S.c[i][0][l] = y[l < count ? l : 0][i];  // idle lanes repeat lane 0
+    V hm;
+    for (int l = 0; l < L; ++l) {
+        const int src = l < count ? l : 0;  // idle lanes repeat lane 0
+        for (int i = 0; i < m.n; ++i) S.c[i][0][l] = y[src][i];
+        hm[l] = hmax[src];
+    }
     detail::taylor_series(m, S);
-    for (int l = 0; l < count; ++l)
-        for (int i = 0; i < m.n; ++i)
-            for (int k = 0; k <= m.p; ++k) out[l][std::size_t(i) * detail::kTaylorStride + std::size_t(k)] = S.c[i][k][l];
+    V h;
+    I4 ok[L / 4];
+    for (int j = 0; j < L / 4; ++j) {
+        const V4 hj = step_rule(m, [&](int i, int k) { return half(S.c[i][k], j); }, &ok[j]);
+        for (int l = 0; l < 4; ++l) h[4 * j + l] = hj[l];
+    }
+    const V tau = min_lanes(h, hm);
+    V ye[detail::kMaxDim];
+    detail::estrin<V>([&](int i, int k) { return S.c[i][k]; }, m.n, m.p, tau, ye);
+    for (int l = 0; l < count; ++l) {
+        detail::TaylorStep& o = out[l];
+        o.h = h[l];
+        o.tau = tau[l];
+        for (int i = 0; i < m.n; ++i) o.y[i] = ye[i][l];
+        o.ok = ok[l / 4][l % 4] != 0;
+    }
 }
 
 constexpr const char* kLevel =

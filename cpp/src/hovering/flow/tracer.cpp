@@ -379,6 +379,7 @@ TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.
     // second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;
     for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o));
+    if (taylor_) coef_ = std::make_unique<TaylorLanes>();
 }
 
 void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
@@ -398,16 +399,16 @@ unsigned TracerGroup::step(const std::atomic<bool>* cancel) {
     if (taylor_ && (stepping & (stepping - 1))) {  // two or more lanes: expand them together
         Taylor* tt[kMaxTaylorGroup];
         const double* y[kMaxTaylorGroup];
-        double h[kMaxTaylorGroup];
-        bool ok[kMaxTaylorGroup];
+        double hmax[kMaxTaylorGroup];
         int m = 0;
         for (int l = 0; l < lanes(); ++l)
             if ((stepping >> l) & 1u) {
                 tt[m] = lane(l).integrator().taylor();
                 y[m] = lane(l).next_start();
+                hmax[m] = lane(l).next_hmax();
                 ++m;
             }
-        Taylor::expand_group(tt, y, h, ok, m);
+        Taylor::expand_group(tt, y, hmax, *coef_, m);
     }
     for (int l = 0; l < lanes(); ++l)
         if (((stepping >> l) & 1u) && lane(l).step(cancel)) over |= 1u << l;

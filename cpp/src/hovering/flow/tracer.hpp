@@ -70,6 +70,8 @@ public:
     ReturnResult end();
     /// The state (with its auxiliary variables) the next step() starts from.
     const double* next_start() const { return ret_.y; }
+    /// The longest step the next step() may take (the return's step bound).
+    double next_hmax() const { return ret_.hmax; }
     /// Whether begin() and step() apply (every stepper but the event-driven closed form).
     bool steps_apply() const { return !(in_.exact_kind() == ExactKind::Angles && event_driven_); }
     /// The integrator (a lane group expands its Taylor series for it).
@@ -157,6 +159,7 @@ public:
 private:
     std::vector<std::unique_ptr<Tracer>> t_;
     ReturnResult done_[kMaxTaylorGroup];  // returns traced whole at start (the event-driven closed form)
+    std::unique_ptr<TaylorLanes> coef_;   // stepper "taylor": the lanes' coefficients of the last round
     unsigned busy_ = 0, ready_ = 0;
     bool taylor_ = false;
 };
