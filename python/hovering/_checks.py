@@ -53,20 +53,28 @@ def real_number(name: str, value, lo=None, lo_open=True, hi=None, hi_open=True) 
     -------
     float
     """
-    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
-        value = value.item()  # a 0-d array is a number, as numpy scalars are
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a real number, got {_short(value)}")
-    try:
-        v = float(value)
-    except OverflowError:
-        raise ValueError(f"{name} must be a real number within the range of a double, got {_short(value)}") from None
+    if type(value) is float:  # the common case, without the ABC checks of _real_value
+        v = value
+    else:
+        v = _real_value(name, value)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {v}")
     if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and (v >= hi if hi_open else v > hi)):
         rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{')' if hi_open else ']'}"
         raise ValueError(f"{name} must lie in {rng}, got {v}")
     return v
+
+
+def _real_value(name: str, value) -> float:
+    """float(value) for any real number type (numpy scalars, 0-d arrays, Fractions), else a ValueError."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()  # a 0-d array is a number, as numpy scalars are
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {_short(value)}")
+    try:
+        return float(value)
+    except OverflowError:
+        raise ValueError(f"{name} must be a real number within the range of a double, got {_short(value)}") from None
 
 
 def integer(name: str, value, lo: int, hi: int) -> int:

@@ -83,7 +83,7 @@ std::string taylor_unsupported(const FlowSystem& s) {
     return "";
 }
 
-Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) : own_(std::make_unique<TaylorLanes>()) {
+Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) {
     const std::string why = taylor_unsupported(s);
     if (!why.empty()) bad(why);
     m_.n = f.dim;
@@ -115,6 +115,9 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) : 
 bool Taylor::expand(const double* y0, double hmax, double* h) {
     // One orbit takes the 4-lane kernel: latency-bound, it costs about what a scalar build would,
     // and there is one implementation of the recurrences, the step rule and the evaluation.
+    // Allocated at first use, uninitialised (the kernel writes before anything reads): a lane of a
+    // group may never expand alone, and a return map of one point builds eight lanes.
+    if (!own_) own_.reset(new TaylorLanes);
     TaylorStep out;
     lane_kernels().expand4(m_, &y0, &hmax, 1, own_->c, &out);
     ++own_->round;

@@ -379,7 +379,7 @@ TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.
     // second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;
     for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o));
-    if (taylor_) coef_ = std::make_unique<TaylorLanes>();
+    if (taylor_) coef_.reset(new TaylorLanes);  // uninitialised: each round writes what it reads
 }
 
 void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
