@@ -20,7 +20,11 @@ What is measured (one run, all ratios from this run; times are this machine's, i
    1e-6 .. 1e-14 each method's FASTEST setting whose error is within it is shown (time per
    return, its tolerance) with the ratios heyoka / ours (ours = the faster of taylor and rk8pd
    at that target). Timing: best of --repeat runs, the methods interleaved at each tolerance
-   (rotating order) so that this VM's drifts hit all alike; one thread everywhere.
+   (rotating order) so that this VM's drifts hit all alike; one thread everywhere. Every timed
+   call follows an untimed call of the same method and setting: a call right after another
+   method's (whose code and data evicted its own from the caches) or after an idle pause was
+   measured up to 1.4x (after the other method) and 2x (after 50 ms idle) slower than a warm one
+   on this VM, whichever method it was; warm calls are what a long computation sees.
 
    Methods:
      taylor, rk8pd   hovering Section.return_map (public API, one call for all starts, n_threads=1;
@@ -473,6 +477,7 @@ def work_precision(key, label, sec, args):
         for i, tol in enumerate(grid):
             k = (rep + i) % len(names)
             for m in names[k:] + names[:k]:
+                runs[m](tol)  # warm-up, untimed: see the module docstring
                 z, count, secs = runs[m](tol)
                 best[m, tol] = min(best.get((m, tol), math.inf), secs / count)
                 last[m, tol] = z
@@ -610,6 +615,7 @@ def flowmap_part(args):
     best, statuses = dict.fromkeys(names, math.inf), {}
     for rep in range(args.repeat + 1):  # the first round warms up (thread pool, caches) and is not kept
         for name in names[rep % len(names) :] + names[: rep % len(names)]:
+            configs[name]()  # warm-up, untimed: see the module docstring
             count, secs, st = configs[name]()
             if st is not None:
                 statuses[name] = st
