@@ -1,6 +1,9 @@
 // The smooth flow's return map against exact results (eps = 0) and time reversal (eps != 0).
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include "hovering/flow/return_map.hpp"
 #include "hovering/flow/taylor.hpp"
@@ -278,4 +281,63 @@ TEST_CASE("stepper taylor: the series of the exact solution, and exact eps = 0 r
     FlowSystem c = s;
     c.V1 = std::make_shared<Numerical>(s.V1);
     CHECKF(detail::taylor_unsupported(c).empty(), "Numerical(Harmonic) has the recurrences of its base");
+}
+
+TEST_CASE("stepper taylor: lane groups own their coefficients until the next round", "[flow]") {
+    // The README system at eps = 0.05; eight different states, tolerance 1e-12.
+    FlowSystem s;
+    s.V1 = std::make_shared<Harmonic>(1.0);
+    s.V2 = std::make_shared<Tan>(1.4, 0.7);
+    s.coupling = Coupling::bilinear();
+    s.eps = 0.05;
+    s.qw1 = -1.0;
+    s.qw2 = -0.5;
+    s.geometry = Geometry::Step;
+    detail::Field f(s);
+    const int n = detail::kMaxTaylorGroup;
+    std::vector<std::unique_ptr<detail::Taylor>> t;
+    std::vector<std::array<double, detail::kMaxDim>> y(static_cast<std::size_t>(n));
+    for (int l = 0; l < n; ++l) {
+        t.push_back(std::make_unique<detail::Taylor>(f, s, 1e-12, 1e-12));
+        auto& v = y[std::size_t(l)];
+        v = {0.3 - 0.1 * l, -0.5 + 0.13 * l, 0.2 + 0.05 * l, 0.4 - 0.07 * l, 0.0, 0.0};
+        f.sync_aux(v.data());
+    }
+    detail::Taylor* tp[detail::kMaxTaylorGroup];
+    const double* yp[detail::kMaxTaylorGroup];
+    double hmax[detail::kMaxTaylorGroup];
+    for (int l = 0; l < n; ++l) {
+        tp[l] = t[std::size_t(l)].get();
+        yp[l] = y[std::size_t(l)].data();
+        hmax[l] = 0.5;
+    }
+    detail::TaylorLanes lanes;
+    detail::Taylor::expand_group(tp, yp, hmax, lanes, n);
+
+    // A lone expansion of the same state is bit for bit what the group gave each lane: the step,
+    // the state at the step's end, and the polynomial at other times.
+    detail::Taylor alone(f, s, 1e-12, 1e-12);
+    for (int l = 0; l < n; ++l) {
+        double hg = 0, ha = 0;
+        CHECKF(tp[l]->expanded_at(yp[l], &hg), "lane %d: expanded at its state after the round", l);
+        CHECKF(alone.expand(yp[l], hmax[l], &ha) && ha == hg, "lane %d: step %.17g alone, %.17g in the group", l, ha, hg);
+        for (double tau : {std::min(hg, hmax[l]), 0.37 * hg, 0.0}) {
+            double a[detail::kMaxDim], g[detail::kMaxDim];
+            alone.eval(tau, a);
+            tp[l]->eval(tau, g);
+            for (int i = 0; i < f.dim; ++i)
+                CHECKF(a[i] == g[i], "lane %d tau %g: y[%d] %.17g alone, %.17g in the group", l, tau, i, a[i], g[i]);
+        }
+    }
+    // Expanding lane 0 alone moves it to its own buffer and leaves the group's lanes valid.
+    double h = 0;
+    CHECKF(tp[0]->expand(yp[1], 0.5, &h), "lane 0 re-expanded alone");
+    CHECKF(!tp[0]->expanded_at(yp[0]) && tp[0]->expanded_at(yp[1]), "lane 0 follows its own expansion");
+    CHECKF(tp[5]->expanded_at(yp[5]), "lane 5 still holds its round's coefficients");
+    // A new round of lanes 0-2 overwrites the group's buffer: lanes 3-7, not in it, must see that
+    // their coefficients are gone, lane 3 too, whose state the buffer holds again (in another slot).
+    const double* yq[3] = {yp[3], yp[1], yp[2]};
+    detail::Taylor::expand_group(tp, yq, hmax, lanes, 3);
+    CHECKF(tp[0]->expanded_at(yp[3]) && tp[1]->expanded_at(yp[1]), "the new round's lanes hold it");
+    for (int l = 3; l < n; ++l) CHECKF(!tp[l]->expanded_at(yp[l]), "lane %d: stale coefficients reported current", l);
 }
