@@ -329,6 +329,17 @@ TEST_CASE("stepper taylor: lane groups own their coefficients until the next rou
                 CHECKF(a[i] == g[i], "lane %d tau %g: y[%d] %.17g alone, %.17g in the group", l, tau, i, a[i], g[i]);
         }
     }
+    // A step's end comes from the lanes' Estrin, any other time from the scalar one: the same bits
+    // (b's step end, set by its bound hmax = h / 2, is a time a evaluates in scalar).
+    {
+        detail::Taylor a(f, s, 1e-12, 1e-12), b(f, s, 1e-12, 1e-12);
+        double ha = 0, hb = 0;
+        CHECKF(a.expand(yp[2], HUGE_VAL, &ha) && b.expand(yp[2], 0.5 * ha, &hb) && ha == hb, "steps %g, %g", ha, hb);
+        double ya[detail::kMaxDim], yb[detail::kMaxDim];
+        a.eval(0.5 * ha, ya);
+        b.eval(0.5 * ha, yb);
+        for (int i = 0; i < f.dim; ++i) CHECKF(ya[i] == yb[i], "y[%d]: scalar %.17g, lanes %.17g", i, ya[i], yb[i]);
+    }
     // Expanding lane 0 alone moves it to its own buffer and leaves the group's lanes valid.
     double h = 0;
     CHECKF(tp[0]->expand(yp[1], 0.5, &h), "lane 0 re-expanded alone");
@@ -339,5 +350,15 @@ TEST_CASE("stepper taylor: lane groups own their coefficients until the next rou
     const double* yq[3] = {yp[3], yp[1], yp[2]};
     detail::Taylor::expand_group(tp, yq, hmax, lanes, 3);
     CHECKF(tp[0]->expanded_at(yp[3]) && tp[1]->expanded_at(yp[1]), "the new round's lanes hold it");
+    for (int l = 0; l < 3; ++l) {  // a round of four lanes (one register) is bit for bit a lone expansion too
+        double hg = 0, ha = 0;
+        CHECKF(tp[l]->expanded_at(yq[l], &hg) && alone.expand(yq[l], hmax[l], &ha) && ha == hg, "lane %d of 3", l);
+        for (double tau : {std::min(hg, hmax[l]), 0.61 * hg}) {
+            double a[detail::kMaxDim], g[detail::kMaxDim];
+            alone.eval(tau, a);
+            tp[l]->eval(tau, g);
+            for (int i = 0; i < f.dim; ++i) CHECKF(a[i] == g[i], "lane %d of 3, tau %g: y[%d] differs", l, tau, i);
+        }
+    }
     for (int l = 3; l < n; ++l) CHECKF(!tp[l]->expanded_at(yp[l]), "lane %d: stale coefficients reported current", l);
 }

@@ -30,7 +30,7 @@ const Potential* unwrap(const Potential* v) {
     return v;
 }
 
-// The build of the 4-orbit kernel for the SIMD level the core runs (the truncated map's choice:
+// The build of the lane kernel for the SIMD level the core runs (the truncated map's choice:
 // one owner of HOVERING_SIMD and set_simd_level), looked up once per thread and level.
 const TaylorLaneKernels& lane_kernels() {
     thread_local const char* level = nullptr;
@@ -55,11 +55,11 @@ const char* taylor_lane_level() {
 
 void Taylor::expand_group(Taylor* const* t, const double* const* y, const double* hmax, TaylorLanes& lanes,
                           int count) {
-    TaylorStep out[kMaxTaylorGroup];
+    TaylorStep out[kMaxTaylorGroup] = {};  // y beyond dim is not written, but copied
     const TaylorLaneKernels& k = lane_kernels();
     const int width = count <= 4 ? 4 : 8;
+    ++lanes.round;  // first: were the kernel ever to throw midway, no lane would trust its rows
     (width == 4 ? k.expand4 : k.expand8)(t[0]->m_, y, hmax, count, lanes.c, out);
-    ++lanes.round;
     for (int l = 0; l < count; ++l) t[l]->take(&lanes, l, width, out[l]);
 }
 
@@ -118,9 +118,9 @@ bool Taylor::expand(const double* y0, double hmax, double* h) {
     // Allocated at first use, uninitialised (the kernel writes before anything reads): a lane of a
     // group may never expand alone, and a return map of one point builds eight lanes.
     if (!own_) own_.reset(new TaylorLanes);
-    TaylorStep out;
-    lane_kernels().expand4(m_, &y0, &hmax, 1, own_->c, &out);
+    TaylorStep out{};
     ++own_->round;
+    lane_kernels().expand4(m_, &y0, &hmax, 1, own_->c, &out);
     take(own_.get(), 0, 4, out);
     *h = step_.h;
     return valid_;
@@ -135,6 +135,10 @@ bool Taylor::expanded_at(const double* y0, double* h) const {
 }
 
 void Taylor::eval(double tau, double* y) const {
+    if (!valid_ || buf_->round != round_) {  // no caller does this: every one checks expanded_at first
+        for (int i = 0; i < m_.n; ++i) y[i] = std::numeric_limits<double>::quiet_NaN();
+        return;
+    }
     if (tau == step_.tau) {  // the step's end, evaluated in the lanes already (the same bits)
         for (int i = 0; i < m_.n; ++i) y[i] = step_.y[i];
         return;

@@ -22,9 +22,9 @@
 // the very polynomial the step took (same accuracy at no further expansion).
 //
 // Several orbits can be expanded at once (expand_group): 4 in the lanes of one SIMD register (8 in
-// two), on
-// the widest instruction set this CPU runs (taylor_lanes.cpp), bit for bit what each would get
-// alone.
+// two), on the instruction set the core's SIMD level selects (taylor_lanes.cpp), bit for bit what
+// each would get alone; the lanes also apply the step rule and evaluate each polynomial at its
+// step's end.
 
 #include <cstddef>
 #include <cstdint>
@@ -51,10 +51,10 @@ inline constexpr double kLogStepFraction = -1.2;
 const char* taylor_lane_level();
 
 /// Coefficients of up to kMaxTaylorGroup expansions, lane-interleaved as the lane kernel writes
-/// them (TaylorLaneKernels), and a count of the expansions that overwrote them.
+/// them (TaylorLaneKernels), and a count of the kernel calls that wrote them.
 struct alignas(64) TaylorLanes {
     double c[std::size_t(kMaxDim) * kTaylorStride * kMaxTaylorGroup];  ///< the coefficients
-    std::uint64_t round = 0;                                            ///< expansions written so far
+    std::uint64_t round = 0;                                            ///< kernel calls that wrote c so far
 };
 
 /// The Taylor expansion of the flow through one point, and its step rule (see the file comment).
@@ -77,7 +77,8 @@ public:
                              int count);
     /// Whether the current expansion is the one through y0 (bit for bit) and finite, and its step.
     bool expanded_at(const double* y0, double* h = nullptr) const;
-    /// The current expansion at time tau from its point: dim entries.
+    /// The current expansion at time tau from its point: dim entries (NaN unless expanded_at
+    /// would find the expansion current: a later round overwrote a group's coefficients).
     void eval(double tau, double* y) const;
 
 private:

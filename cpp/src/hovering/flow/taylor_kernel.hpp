@@ -217,7 +217,7 @@ struct TaylorStep {
     double h;               ///< the step the tolerances allow (infinite for a polynomial of degree < p)
     double tau;             ///< min(h, hmax): the step taken unless it leaves a bounded well
     double y[kMaxDim];      ///< the polynomial at tau
-    bool ok;                ///< every coefficient finite (else h, tau and y mean nothing)
+    bool ok;                ///< orders p - 1 and p finite, hence all (else h, tau and y mean nothing)
 };
 
 /// One build of the lane kernel (taylor_lanes.cpp): its instruction set and entry points.

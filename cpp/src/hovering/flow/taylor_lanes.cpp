@@ -118,7 +118,8 @@ template <class V, int L>
 void expand(const detail::TaylorModel& m, const double* const* y, const double* hmax, int count, double* cbuf,
             detail::TaylorStep* out) {
     // The coefficients go straight to the caller's lane-interleaved rows (where events read them);
-    // the work rows are on the stack (<= 8 kB), nothing read before it is written (taylor_series
+    // the work rows and the evaluation's are on the stack (about 19 kB for eight lanes), nothing
+    // read before it is written (taylor_series
     // fills orders 1 .. p from 0 and its own work rows). A General coupling's powers (up to 110 kB)
     // live in a buffer of the thread's, grown once.
     detail::TaylorSeries<V> S;
