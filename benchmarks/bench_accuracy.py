@@ -8,7 +8,7 @@ error(1e4) / error(1)), and writes the diagrams to docs/accuracy_*.png.
 Every stepper of the default diagram (taylor, rk8pd, rkck, rkf45, msadams) and, when heyoka.py is
 installed, its Taylor integrator's curve.
 
-Run: python benchmarks/bench_accuracy.py [--quick]   (about 6 minutes; --quick: 40 s)
+Run: python benchmarks/bench_accuracy.py [--quick]   (about 10 minutes with heyoka.py installed, 6 without; --quick: 40 s)
 """
 
 from __future__ import annotations
