@@ -2,20 +2,21 @@
 
 What is measured (one run, all ratios from this run; times are this machine's, indicative only):
 
-1. Work-precision of ONE return of the flow to Sigma_h, on four systems (h = 1, step corner (-1, -0.5)):
+1. Work-precision of ONE return of the flow to Sigma_h, on five systems (h = 1, step corner (-1, -0.5)):
      (a) wall only, eps = 0          V1 = Harmonic(1), V2 = Tan(1.4, 0.7)
      (b) step, eps = 0               same potentials
      (c) step, eps = 0.05            the README system (bilinear coupling q1 q2)
      (d) step, eps = 0.05            V1 = Harmonic(1), V2 = Harmonic(sqrt 2), bilinear coupling
+     (e) wall only, eps = 0.05       V1 = Harmonic(1), V2 = Tan(1.4, 0.7), bilinear coupling
    ~200 random starts per system (theta uniform, I = I_tan * U(0.3, 1.3) as bench_flow.py: both
    sides of the tangency, every region visited; the counts are printed). Each method runs a grid
    of tolerances (half decades 1e-4 .. 1e-16, rtol = atol = tol); its error is measured two ways
    against an exact reference: max over orbits of max(|wrap(d theta)|, |d I|) after the return,
    and of max |d z| over the state z = (q1, p1, q2, p2) after the return. The reference is
-   stepper="exact" (closed form) for (a), (b), (d); for (c), which has none, hovering "taylor" at
-   rtol = atol = 1e-16, whose own error is estimated by its distance to rk8pd at 1e-14 (printed;
-   targets below it are "n/r": not resolved, and taylor at 1e-16, the reference itself, is left
-   out of (c)'s curve). Only orbits that every method at every tolerance returned OK (hovering
+   stepper="exact" (closed form) for (a), (b), (d); for (c) and (e), which have none, hovering
+   "taylor" at rtol = atol = 1e-16, whose own error is estimated by its distance to rk8pd at 1e-14
+   (printed; targets below it are "n/r": not resolved, and taylor at 1e-16, the reference itself,
+   is left out of their curves). Only orbits that every method at every tolerance returned OK (hovering
    status OK, heyoka: a return found) are compared; exclusions are printed. Per target error
    1e-6 .. 1e-14 each method's FASTEST setting whose error is within it is shown (time per
    return, its tolerance) with the ratios heyoka / ours (ours = the faster of taylor and rk8pd
@@ -62,7 +63,7 @@ What is measured (one run, all ratios from this run; times are this machine's, i
    OK, e.g. GRAZING: dips within grazing_tol = 1e-12 are reported, not guessed); heyoka (1call
    form) "missed" = impacts != 1 or no return.
 
-Run (hovering, numpy, heyoka.py installed; a full run takes ~2 minutes on this 2-core VM, --quick ~5 s):
+Run (hovering, numpy, heyoka.py installed; a full run takes ~4 minutes on this 2-core VM, --quick ~10 s):
 
     python bench_taylor.py                      # everything
     python bench_taylor.py --quick              # smoke run: few points, decade grid, small parts 2/3
@@ -100,14 +101,20 @@ TIME_LIMIT = int(hy.taylor_outcome.time_limit)
 
 
 def systems() -> dict:
-    """The four systems of the comparison: key -> (description, Section)."""
+    """The five systems of the comparison: key -> (description, Section)."""
     d = paper.system(0.05, V2=Harmonic(math.sqrt(2.0)))
     return {
         "a": ("wall, eps = 0, V2 = Tan(1.4, 0.7)", paper.section(0.0, "wall")),
         "b": ("step, eps = 0, V2 = Tan(1.4, 0.7)", paper.section(0.0)),
         "c": ("step, eps = 0.05 (README system)", paper.section(0.05)),
         "d": ("step, eps = 0.05, V2 = Harmonic(sqrt 2)", hv.Section(d, H)),
+        "e": ("wall, eps = 0.05, V2 = Tan(1.4, 0.7)", paper.section(0.05, "wall")),
     }
+
+
+#: Systems without a closed form: their reference is taylor at 1e-16, its own error estimated by its
+#: distance to rk8pd at 1e-14.
+NO_CLOSED_FORM = ("c", "e")
 
 
 def tangent_action(sec) -> float:
@@ -424,8 +431,8 @@ def tolerance_grid(quick: bool):
 
 def reference(key, sec, th, I):
     """Reference states, their OK mask, a description, an estimate of the reference's own error
-    (section, state): 0 for the closed form, the distance to rk8pd 1e-14 for (c), and the itineraries."""
-    if key != "c":
+    (section, state): 0 for the closed form, the distance to rk8pd 1e-14 for (c) and (e), and the itineraries."""
+    if key not in NO_CLOSED_FORM:
         r = sec.return_map(th, I, stepper="exact", n_threads=1)
         return r.z, r.status == hv.FlowStatus.OK, 'stepper="exact" (closed form)', (0.0, 0.0), r.itinerary
     r = sec.return_map(th, I, stepper="taylor", rtol=1e-16, atol=1e-16, n_threads=1)
@@ -446,7 +453,7 @@ def work_precision(key, label, sec, args):
         regions[it] = regions.get(it, 0) + 1
     print(f"\n=== ({key}) {label}: {n} starts, itineraries of the reference {regions}")
     print(f"    reference: {ref_name}", end="")
-    if key == "c":
+    if key in NO_CLOSED_FORM:
         print(
             f"; its distance to rk8pd at 1e-14 (its own error estimate): section {ref_err[0]:.1e}, state {ref_err[1]:.1e}"
         )
@@ -497,7 +504,7 @@ def work_precision(key, label, sec, args):
     print("; runs with failures: " + ", ".join(f"{m} {t:.0e}: {k}" for m, t, k in bad) if bad else "")
     curves = {m: [] for m in names}  # method -> [(tol, section err, state err, us)]
     for m, tol, es, ez, _ok, us in rows:
-        if key == "c" and m == "taylor" and tol == 1e-16:
+        if key in NO_CLOSED_FORM and m == "taylor" and tol == 1e-16:
             continue  # the reference itself
         curves[m].append((tol, float(np.max(es[mask])), float(np.max(ez[mask])), us))
     print("    work-precision: max error in (theta, I) over the compared orbits, us per return")
@@ -718,7 +725,7 @@ def main(argv=None) -> None:
     """Parse the options and print the parts asked for."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke run: few points, decade grid, small parts 2 and 3")
-    ap.add_argument("--systems", default="a,b,c,d", help="comma-separated subset of a,b,c,d (part 1)")
+    ap.add_argument("--systems", default="a,b,c,d,e", help="comma-separated subset of a,b,c,d,e (part 1)")
     ap.add_argument("--parts", default="1,2,3", help="comma-separated subset of 1,2,3")
     ap.add_argument("--n", type=int, default=None, help="starts per system (default 200, --quick 24)")
     ap.add_argument("--repeat", type=int, default=None, help="timed repeats (default 7, --quick 2)")
@@ -731,7 +738,7 @@ def main(argv=None) -> None:
     all_sys = systems()
     unknown = [k for k in keys if k not in all_sys]
     if unknown or not parts <= {"1", "2", "3"}:
-        ap.error(f"--systems takes a subset of a,b,c,d and --parts of 1,2,3; got {args.systems!r}, {args.parts!r}")
+        ap.error(f"--systems takes a subset of a,b,c,d,e and --parts of 1,2,3; got {args.systems!r}, {args.parts!r}")
     print(
         f"hovering {hv.__version__}, heyoka.py {hy.__version__} (SIMD batch {hy.recommended_simd_size()}), "
         f"numpy {np.__version__}; one thread unless said; {'QUICK run' if args.quick else 'full run'}"
