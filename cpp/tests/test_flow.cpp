@@ -360,5 +360,10 @@ TEST_CASE("stepper taylor: lane groups own their coefficients until the next rou
             for (int i = 0; i < f.dim; ++i) CHECKF(a[i] == g[i], "lane %d of 3, tau %g: y[%d] differs", l, tau, i);
         }
     }
-    for (int l = 3; l < n; ++l) CHECKF(!tp[l]->expanded_at(yp[l]), "lane %d: stale coefficients reported current", l);
+    for (int l = 3; l < n; ++l) {
+        CHECKF(!tp[l]->expanded_at(yp[l]), "lane %d: stale coefficients reported current", l);
+        double g[detail::kMaxDim];
+        tp[l]->eval(0.1, g);  // what another orbit's round left there is never evaluated
+        for (int i = 0; i < f.dim; ++i) CHECKF(std::isnan(g[i]), "lane %d: stale eval y[%d] = %g", l, i, g[i]);
+    }
 }
