@@ -160,6 +160,9 @@ def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
         FlowStatus.CORNER,
         FlowStatus.GRAZING,
         FlowStatus.IMPACT_LIMIT,
+        # rtol 1e-2 leaves energy errors up to ~11 on h = 1000 near the chart's edge (H2 -> h):
+        # a return whose (theta, I) then names no point, or another one, says so
+        FlowStatus.OFF_SECTION,
     }
     stopped = r.status != FlowStatus.OK
     assert np.all(r.time[stopped] > 0)  # where it stopped, in time
@@ -168,6 +171,7 @@ def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
     # and at a sane tolerance the same orbits return regularly (the status was the tolerance's doing)
     good = s.return_map(th, I, rtol=1e-10, atol=1e-10, stepper=stepper)
     assert np.count_nonzero(good.status == FlowStatus.OUTSIDE_WELL) == 0
+    assert np.count_nonzero(good.status == FlowStatus.OFF_SECTION) == 0
 
 
 def test_outside_well_status_names():

@@ -235,7 +235,13 @@ def test_tangential_curve_says_when_it_is_not_a_graph():
         hv.TangentialCurve(hv.Section(system(0.8), 1.0))
     with pytest.raises(ValueError, match="not a minimum of q1"):
         hv.TangentialCurve(hv.Section(system(1.0), 1.0))
-    assert hv.FlowMap(system(0.6), h=1.0, coordinates="section").step(0.1, 0.3)[1] > 0  # theta, I still work
+    fs = hv.FlowMap(system(0.6), h=1.0, coordinates="section")
+    assert fs.step(0.1, 0.2)[1] > 0  # theta, I still work
+    # ... but not every return lands on Sigma_h's chart: from (0.1, 0.3) the next maximum of q1
+    # lies at q1 = -0.23 < 0, which no (theta, I) describes; it is OFF_SECTION, not a misnamed point
+    r = hv.Section(system(0.6), 1.0).return_map([0.1], [0.3])
+    assert r.status[0] == hv.FlowStatus.OFF_SECTION and r.z[0, 0] < 0 and np.isnan(r.I[0])
+    assert np.isnan(fs.step(0.1, 0.3)[1])
 
 
 def test_truncated_model_of_the_system_needs_no_hand_scaling(fm005):

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "hovering/detail/common.hpp"
+#include "hovering/detail/poly_roots.hpp"
 
 namespace hovering::detail {
 
@@ -99,15 +100,25 @@ void Integrator::restart() {
 
 Integrator::Advance Integrator::advance(double* y, double* d, double* h, double hmax, double* h_done) {
     const int n = field_.dim;
-    if (kind_ != ExactKind::None) {  // no error to control: every step is hmax long
-        double y1[kMaxDim];
-        exact(y, d, hmax, y1);
-        bool finite = true;
-        for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y1[i]);
-        if (!finite) return Advance::Failed;
-        for (int i = 0; i < n; ++i) y[i] = y1[i];
-        field_(y, d);
-        *h = *h_done = hmax;
+    if (kind_ != ExactKind::None) {  // no error to control: every step is hmax long, or shorter for events
+        double y1[kMaxDim], d1[kMaxDim];
+        double step = hmax;
+        for (;;) {
+            exact(y, d, step, y1);
+            bool finite = true;
+            for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y1[i]);
+            if (!finite) return Advance::Failed;
+            field_(y1, d1);
+            if (!(step > kMinEventStep * hmax) || !ambiguous(y, d, y1, d1, step)) break;
+            step *= 0.5;
+            ++event_cuts_;
+        }
+        for (int i = 0; i < n; ++i) {
+            y[i] = y1[i];
+            d[i] = d1[i];
+        }
+        *h = hmax;
+        *h_done = step;
         return Advance::Ok;
     }
     if (taylor_) {
@@ -116,7 +127,7 @@ Integrator::Advance Integrator::advance(double* y, double* d, double* h, double 
         // A lane group may have expanded this state already (Taylor::expand_group).
         double hn = 0;
         if (!taylor_->expanded_at(y, &hn) && !taylor_->expand(y, hmax, &hn)) return Advance::Failed;
-        double step = std::min(hn, hmax);
+        double step = taylor_cut(std::min(hn, hmax));
         double y1[kMaxDim];
         for (;;) {
             taylor_->eval(step, y1);
@@ -156,15 +167,19 @@ Integrator::Advance Integrator::advance(double* y, double* d, double* h, double 
             bool finite = st == GSL_SUCCESS;
             for (int i = 0; i < n; ++i) finite = finite && std::isfinite(y[i]);
             *h_done = t_ms_ - t0;
+            bool cut = false;
             if (finite && *h_done > 0 && inside(y)) {
                 field_(y, d);
-                return Advance::Ok;
+                if (!(*h_done > kMinEventStep * hmax) || !ambiguous(y0, d0, y, d, *h_done)) return Advance::Ok;
+                cut = true;
+                ++event_cuts_;
             }
             const double tried = *h_done;
             restore();
-            if (!finite || !(tried > 0)) return left_well ? Advance::OutsideWell : Advance::Failed;
-            // Outside a well: forget the multistep history (it holds the bad step) and retry shorter.
-            left_well = true;
+            if (!cut && (!finite || !(tried > 0))) return left_well ? Advance::OutsideWell : Advance::Failed;
+            // Outside a well, or two sign changes of an event velocity: forget the multistep history
+            // (it holds the step) and retry shorter.
+            left_well = left_well || !cut;
             gsl_odeiv2_driver_reset(driver_);
             t_ms_ = t0;
             *h = 0.5 * tried;
@@ -180,14 +195,16 @@ Integrator::Advance Integrator::advance(double* y, double* d, double* h, double 
         left_well = left_well || (finite && !in);
         double hn = h0;
         const int adj = in ? hadjust(y, err, &hn) : GSL_ODEIV_HADJ_DEC;
-        if (adj != GSL_ODEIV_HADJ_DEC) {
+        const bool events_ok = adj == GSL_ODEIV_HADJ_DEC || !(h0 > kMinEventStep * hmax) || !ambiguous(y0, d0, y, dout, h0);
+        if (adj != GSL_ODEIV_HADJ_DEC && events_ok) {
             for (int i = 0; i < n; ++i) d[i] = dout[i];
             *h_done = h0;
             *h = hn;
             return Advance::Ok;
         }
+        if (!events_ok) ++event_cuts_;
         restore();
-        *h = in ? hn : 0.5 * h0;
+        *h = in && events_ok ? hn : 0.5 * h0;
         if (!(*h >= 1e-14 * hmax) || !std::isfinite(*h)) {  // the tolerance cannot be met
             return left_well ? Advance::OutsideWell : Advance::Failed;
         }
@@ -277,6 +294,47 @@ void Integrator::exact(const double* y0, const double* d0, double dt, double* y1
         gsl_odeiv2_step_reset(step_);
         gsl_odeiv2_step_apply(step_, 0.0, dt, y1, err, din, nullptr, &sys_);
     }
+}
+
+double Integrator::taylor_cut(double step) {
+    if (!watched_ || !std::isfinite(step)) return step;
+    const int p = taylor_->order();
+    double b[kMaxTaylorOrder + 1];
+    RootBracket br[2];
+    double cut = step;
+    for (int w = 0; w < 2; ++w) {
+        if (!((watched_ >> w) & 1u) || !taylor_->scaled_coefficients(2 * w + 1, step, b)) continue;
+        // The step's own polynomial is the solution it takes: its sign changes are exact, so the
+        // step ends between the first two (on the same polynomial: no new expansion).
+        if (isolate_roots(b, p, br, 2) == 2) cut = std::min(cut, 0.5 * (br[0].hi + br[1].lo) * step);
+    }
+    if (cut < step) ++event_cuts_;
+    return cut;
+}
+
+bool Integrator::ambiguous(const double* y0, const double* d0, const double* y1, const double* d1, double h) const {
+    for (int w = 0; w < 2; ++w) {
+        if (!((watched_ >> w) & 1u)) continue;
+        const int qi = 2 * w, pi = qi + 1;
+        // The velocity as the derivative of q's quintic Hermite interpolant (q, p, p' at both
+        // ends), in s = tau / h; its distance to the cubic Hermite of p (p, p' at both ends), one
+        // order less accurate, bounds its error: sign changes are counted for P and P -+ that bound.
+        const double q0 = y0[qi], v0 = h * y0[pi], a0 = h * h * d0[pi];
+        const double q1 = y1[qi], v1 = h * y1[pi], a1 = h * h * d1[pi];
+        const double c3 = -10 * q0 - 6 * v0 - 1.5 * a0 + 0.5 * a1 - 4 * v1 + 10 * q1;
+        const double c4 = 15 * q0 + 8 * v0 + 1.5 * a0 - a1 + 7 * v1 - 15 * q1;
+        const double c5 = -6 * q0 - 3 * v0 - 0.5 * a0 + 0.5 * a1 - 3 * v1 + 6 * q1;
+        double P[5] = {v0, a0, 3 * c3, 4 * c4, 5 * c5};  // h times the velocity
+        const double e2 = -3 * v0 - 2 * a0 + 3 * v1 - a1, e3 = 2 * v0 + a0 - 2 * v1 + a1;
+        const double margin = std::fabs(P[2] - e2) + std::fabs(P[3] - e3) + std::fabs(P[4]) +
+                              1e-13 * (std::fabs(v0) + std::fabs(v1));
+        RootBracket br[2];
+        for (const double shift : {0.0, margin, -margin}) {
+            P[0] = v0 + shift;
+            if (isolate_roots(P, 4, br, 2) == 2) return true;
+        }
+    }
+    return false;
 }
 
 }  // namespace hovering::detail

@@ -19,6 +19,10 @@ namespace hovering::detail {
 /// std::invalid_argument naming the allowed ones.
 const gsl_odeiv2_step_type* stepper_type(const std::string& name);
 
+/// Shortest step, relative to the step bound, that advance() shortens further for events: two
+/// sign changes of a velocity closer than this are a tangency, below any sign test.
+inline constexpr double kMinEventStep = 1e-7;
+
 /// Owns the GSL objects of one integration, reused from return to return by one worker.
 ///
 /// For one-step methods the adaptive loop drives GSL's stepper and step-size control directly
@@ -70,6 +74,11 @@ public:
     void prepare_extension(const double* y0, const double* d0, double h);
     /// The continuous extension of the current step at length dt from y0 (derivative d0).
     void exact(const double* y0, const double* d0, double dt, double* y1);
+    /// Coordinates whose velocity may change sign at most once in a step (bit 0: p1, bit 1: p2),
+    /// which the event search relies on (tracer.cpp): advance() shortens a step until it holds.
+    void set_watched(unsigned mask) { watched_ = mask; }
+    /// Steps shortened so far because a watched velocity changed sign twice in them.
+    long long event_cuts() const { return event_cuts_; }
 
 private:
     Field field_;
@@ -87,6 +96,14 @@ private:
     std::unique_ptr<LinearFlow> linear_;  // stepper "exact", linear flow
     std::unique_ptr<Taylor> taylor_;      // stepper "taylor"
     AngleOscillator osc_[2];              // stepper "exact", uncoupled flow (step loop only)
+    unsigned watched_ = 0;                // set_watched
+    long long event_cuts_ = 0;            // event_cuts
+    // Taylor: the end (<= step) of a step on the current polynomial that holds at most one sign
+    // change of each watched velocity.
+    double taylor_cut(double step);
+    // The other steppers: whether the step (y0, d0) -> (y1, d1) of length h may hold two sign
+    // changes of a watched velocity, judged on its Hermite interpolant with a margin.
+    bool ambiguous(const double* y0, const double* d0, const double* y1, const double* d1, double h) const;
     int order_ = 8;                       // one-step methods: the stepper's order, for the step-size rule
     double grow_below_ = 0.43;            // 0.9^order: below this scaled error the step grows
 };

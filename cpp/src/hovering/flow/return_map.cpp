@@ -88,7 +88,7 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     if (n == 0) return;
     auto write = [&](std::int64_t i, const ReturnResult& r) {
         for (int k = 0; k < 4; ++k)
-            if (out.z) out.z[4 * i + k] = r.status == FlowStatus::OffSection ? kNaN : r.z[std::size_t(k)];
+            if (out.z) out.z[4 * i + k] = r.z[std::size_t(k)];  // a start off Sigma_h is NaN already
         if (out.time) out.time[i] = r.time;
         if (out.status) out.status[i] = static_cast<std::int8_t>(r.status);
         if (out.region)

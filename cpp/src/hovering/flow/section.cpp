@@ -60,11 +60,33 @@ bool try_section_point(const FlowSystem& s, double h, double theta, double I, st
     // p1 = 0: V1(q1) + eps Vc(q1, q2) = h - H2; the root with q1 > 0 (near q1's maximum).
     const double rest = h - e2;
     auto F = [&](double q1) { return s.V1->V(q1) + (s.eps != 0 ? s.eps * s.coupling.value(q1, q2) : 0.0) - rest; };
-    if (!(F(0.0) < 0))
-        return fail("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): h - H2(I) = " +
-                    fmt(rest) + " leaves no energy for oscillator 1 (h must exceed H2(I) = " + fmt(e2) + ")");
     const double lim = s.V1->q_limit();
     double lo = 0, hi = std::isfinite(lim) ? 0.5 * lim : 1.0;
+    if (!(F(0.0) < 0)) {
+        // H2 >= h can still leave a maximum of q1 > 0 where eps Vc < 0 (strong coupling): F dips
+        // below 0 and rises through it again, at Sigma_h's point (F' > 0 there: dp1/dt < 0). The
+        // last rise through 0 on a grid of (0, B], B where F is positive and past V1's growth.
+        if (s.eps == 0 || !(rest > -1e300))
+            return fail("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): h - H2(I) = " +
+                        fmt(rest) + " leaves no energy for oscillator 1 (h must exceed H2(I) = " + fmt(e2) + ")");
+        double B = hi;
+        for (int k = 0; k < 60 && !(F(B) > 0 && s.V1->V(B) > 2 * std::fabs(rest) + 1); ++k)
+            B = std::isfinite(lim) ? lim - 0.5 * (lim - B) : 2 * B;
+        constexpr int kGrid = 256;
+        int last = -1;
+        double prev = F(0.0);
+        for (int k = 1; k <= kGrid; ++k) {
+            const double f = F(B * k / kGrid);
+            if (prev < 0 && f >= 0) last = k;
+            prev = f;
+        }
+        if (last < 0)
+            return fail("no point of Sigma_h at (theta, I) = (" + fmt(theta) + ", " + fmt(I) + "): h - H2(I) = " +
+                        fmt(rest) + " leaves no energy for oscillator 1 (h must exceed H2(I) = " + fmt(e2) +
+                        ", and V1 + eps Vc stays above h - H2 for q1 > 0)");
+        lo = B * (last - 1) / kGrid;
+        hi = B * last / kGrid;
+    }
     for (int k = 0; F(hi) < 0; ++k) {
         if (k > 200) return fail("no point of Sigma_h: V1 + eps Vc never reaches h - H2(I) = " + fmt(rest));
         lo = hi;

@@ -149,4 +149,15 @@ void Taylor::eval(double tau, double* y) const {
                    m_.p, tau, y);
 }
 
+bool Taylor::scaled_coefficients(int i, double h, double* out) const {
+    if (!valid_ || buf_->round != round_) return false;
+    const std::size_t w = std::size_t(width_);
+    double hk = 1;
+    for (int k = 0; k <= m_.p; ++k) {
+        out[k] = c_[(std::size_t(i) * kTaylorStride + std::size_t(k)) * w] * hk;
+        hk *= h;
+    }
+    return true;
+}
+
 }  // namespace hovering::detail

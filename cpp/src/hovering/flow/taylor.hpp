@@ -80,6 +80,9 @@ public:
     /// The current expansion at time tau from its point: dim entries (NaN unless expanded_at
     /// would find the expansion current: a later round overwrote a group's coefficients).
     void eval(double tau, double* y) const;
+    /// The p + 1 coefficients of variable i of the current expansion, scaled to the step length h
+    /// (c_k h^k: the polynomial in s = tau / h); false unless an expansion is current.
+    bool scaled_coefficients(int i, double h, double* out) const;
 
 private:
     // Adopt lane `lane` of buf (width lanes per row) and what the kernel gave it.

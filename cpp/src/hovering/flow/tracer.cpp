@@ -44,26 +44,27 @@ double lower_bound(double q0, double v0, double a0, double q1, double v1, double
     return lo - 4 * dev - between - 1e-12 * (1 + std::fabs(q0));
 }
 
-// Root of y[idx](tau) - off on [0, hi] (values of opposite signs), where y(tau) is one step of
-// the stepper of length tau from y0: a continuous extension of the accepted step with the
-// stepper's own accuracy. The first guess is the root of the cubic Hermite interpolant through
-// y0, y1 = y(hi) and their derivatives d0, d1; Newton's method on exact steps (d/dtau y[idx] is
-// rhs[idx] of the stepped state, to the stepper's accuracy) then converges in ~2 steps. The last
-// correction delta (|delta| <= sqrt(time_tol)) moves the state along its derivative, leaving an
-// error ~ delta^2 |z''| / 2 ~ time_tol |z''| / 2.
-double locate(Integrator& in, const double* y0, const double* d0, const double* y1, const double* d1, int idx,
-              double off, double hi, double time_tol, double* yout) {
+// Root of y[idx](tau) - off on [lo, hi] (values of opposite signs at the ends, whose states are
+// ylo, yhi with derivatives dlo, dhi), where y(tau) is one step of the stepper of length tau from
+// the step's start y0: a continuous extension of the accepted step with the stepper's own
+// accuracy. The first guess is the root of the cubic Hermite interpolant through the two ends;
+// Newton's method on exact steps (d/dtau y[idx] is rhs[idx] of the stepped state, to the
+// stepper's accuracy) then converges in ~2 steps. The last correction delta (|delta| <=
+// sqrt(time_tol)) moves the state along its derivative, leaving an error ~ delta^2 |z''| / 2 ~
+// time_tol |z''| / 2.
+double locate_in(Integrator& in, const double* y0, const double* d0, double lo, const double* ylo, const double* dlo,
+                 double hi, const double* yhi, const double* dhi, int idx, double off, double time_tol, double* yout) {
     const int n = in.dim();
-    const double f0 = y0[idx] - off, f1 = y1[idx] - off;
+    const double f0 = ylo[idx] - off, f1 = yhi[idx] - off;
     if (f0 == 0) {
-        for (int i = 0; i < n; ++i) yout[i] = y0[i];
-        return 0.0;
+        for (int i = 0; i < n; ++i) yout[i] = ylo[i];
+        return lo;
     }
     if (f1 == 0) {
-        for (int i = 0; i < n; ++i) yout[i] = y1[i];
+        for (int i = 0; i < n; ++i) yout[i] = yhi[i];
         return hi;
     }
-    const double guess = hermite_root(f0, d0[idx], f1, d1[idx], hi);
+    const double guess = lo + hermite_root(f0, dlo[idx], f1, dhi[idx], hi - lo);
     in.prepare_extension(y0, d0, hi);
     double dy[kMaxDim];
     auto fdf = [&](double tau, double* f, double* df) {
@@ -73,18 +74,27 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
         *df = dy[idx];
     };
     double delta = 0;
-    double tau = newton_bracketed(fdf, 0.0, f0 > 0, hi, guess, std::sqrt(time_tol), &delta);
-    if (delta != 0 && tau + delta >= 0 && tau + delta <= hi && std::fabs(delta) <= std::sqrt(time_tol)) {
+    double tau = newton_bracketed(fdf, lo, f0 > 0, hi, guess, std::sqrt(time_tol), &delta);
+    if (delta != 0 && tau + delta >= lo && tau + delta <= hi && std::fabs(delta) <= std::sqrt(time_tol)) {
         tau += delta;
         for (int i = 0; i < n; ++i) yout[i] += delta * dy[i];
     }
     return tau;
 }
 
+// locate_in on the whole step [0, hi] from its start y0.
+double locate(Integrator& in, const double* y0, const double* d0, const double* y1, const double* d1, int idx,
+              double off, double hi, double time_tol, double* yout) {
+    return locate_in(in, y0, d0, 0.0, y0, d0, hi, y1, d1, idx, off, time_tol, yout);
+}
+
 }  // namespace
 
 Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) {
     cands_.reserve(8);
+    // The events below read each step's two ends and at most one turn of q1 (section, right wall)
+    // and of q2 (upper wall) inside it: the integrator ends steps so that no more turns occur.
+    in_.set_watched(1u | (s.geometry == Geometry::Step ? 2u : 0u));
 }
 
 FlowWork Tracer::work() const {
@@ -203,6 +213,11 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
             if (std::min(y0[qi], y[qi]) - 0.25 * a * h * h - 1e-12 * (1 + std::fabs(y0[qi])) > level) return true;
             return bound(qi) > level;
         };
+        // Whether coordinate qi stays below level on the whole step (the same parabola bound).
+        auto stays_below = [&](int qi, double level) {
+            const double a = std::max(std::fabs(d0[qi + 1]), std::fabs(d1[qi + 1]));
+            return std::max(y0[qi], y[qi]) + 0.25 * a * h * h + 1e-12 * (1 + std::fabs(y0[qi])) < level;
+        };
         // Whether the wall of coordinate gi cannot be present anywhere on this step: the upper
         // wall needs q1 < qw1, the step's right wall q2 < qw2.
         auto wall_absent = [&](int gi) {
@@ -252,6 +267,25 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
                     for (int i = 0; i < n; ++i) c.y[i] = ym[i];
                     cands_.push_back(c);
                 }
+            } else if (g0 <= 0 && g1 <= 0 && y0[pi] > 0 && y[pi] < 0) {
+                // Turning back inside the step: g may rise above 0 and fall through it again (a
+                // crossing toward the wall after q's maximum; g0 = 0 right after a reflection
+                // off this wall: a second impact within the step).
+                if (stays_below(gi, off)) return;
+                double ym[kMaxDim], dm[kMaxDim];
+                ++work_.wall_searches;
+                const double tm = locate(in_, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
+                if (!(ym[gi] - off > 0)) return;
+                if (wall_absent(gi)) {
+                    if (gi == 0) note_crossing();
+                    return;
+                }
+                field(ym, dm);
+                Candidate c;
+                c.kind = cross;
+                ++work_.wall_searches;
+                c.tau = locate_in(in_, y0, d0, tm, ym, dm, h, y, d1, gi, off, opt.event_tol, c.y);
+                cands_.push_back(c);
             }
         };
         if (right) wall(0, s.qw1, Ev::Right, Ev::GrazeRight);
@@ -335,7 +369,9 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
         // A return passes q1's minimum (p1 from - to +, or a right-wall reflection) and then its
         // maximum (p1 from + to -). Arming the section only after the minimum makes a start with
         // p1 = +-1e-14 (a point computed on Sigma_h) safe from being taken for its own return.
-        R.seen_negative = R.seen_negative || y0[1] < 0 || y[1] < 0;
+        // A step from p1 = 0 exactly (a start on Sigma_h) with p1' < 0 dips below 0 before any
+        // later sign change, even when it ends with p1 > 0 (a shallow minimum inside the step).
+        R.seen_negative = R.seen_negative || y0[1] < 0 || y[1] < 0 || (y0[1] == 0 && d0[1] < 0);
         R.armed = R.armed || (R.seen_negative && y[1] > 0);
         }
     return false;
@@ -371,7 +407,27 @@ void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool 
         ++work_.label_operations;
     }
     r.energy_error = std::fabs(s_.energy(r.z.data()) - H0);
+    if (r.status == FlowStatus::Ok && !on_chart(r.z, H0)) r.status = FlowStatus::OffSection;
     work_.steps += r.steps;
+}
+
+bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
+    // A return is a maximum of q1 at energy h; Sigma_h's chart (try_section_point) holds one such
+    // maximum per (theta, I): the root of V1 + eps Vc = h - H2 with q1 > 0 and dp1/dt < 0. At
+    // strong coupling a maximum of q1 can lie elsewhere (q1 < 0, another root): its (theta, I)
+    // would name a different point, so such a return is not reported Ok.
+    if (!(z[0] > 0)) return false;
+    const std::array<double, 2> c = section_coordinates(s_, z.data());
+    if (!(c[1] > 0)) return std::isfinite(c[1]);  // I = 0: oscillator 2 at rest, the chart's centre
+    std::array<double, 4> p{};
+    if (!try_section_point(s_, h, c[0], c[1], p, nullptr)) return false;
+    // The same root moves by the return's energy error e over dF/dq1 = -dp1/dt (F(q1) = e at
+    // the return); a distinct root lies O(1) away, or the two merge where dp1/dt = 0 (Sigma_h's
+    // edge) and the return is not on its chart anyway.
+    double dz[4];
+    s_.rhs(z.data(), dz);
+    const double e = std::fabs(s_.energy(z.data()) - h);
+    return std::fabs(p[0] - z[0]) <= 1e-9 * (1 + std::fabs(z[0])) + 4 * e / std::fabs(dz[1]);
 }
 
 TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.stepper == "taylor") {

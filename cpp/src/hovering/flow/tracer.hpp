@@ -119,6 +119,9 @@ private:
     /// stopped (state y at time t), the "0" / "u" label of an Ok return without impact, the energy
     /// error against H0, and the step count.
     void finish(ReturnResult& r, const double* y, double t, bool done, bool crossed, double H0);
+    // Whether the return's end z is the point of Sigma_h (energy h) that its section coordinates
+    // name (see finish()).
+    bool on_chart(const std::array<double, 4>& z, double h) const;
     // Uniform samples in [t0, t_end) of the angle flow from the angles of o at t0.
     void sample_angles(const AngleOscillator* o, double t0, double t_end);
     const FlowSystem& s_;

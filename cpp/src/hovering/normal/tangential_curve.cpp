@@ -126,6 +126,11 @@ std::pair<double, double> trace_back(detail::Tracer& tr, double h, double s, dou
     const FlowSystem& sys = tr.system();
     const auto zw = wall_point(sys, h, s, I0);
     const ReturnResult r = tr.trace({zw[0], 0.0, zw[2], -zw[3]}, true);
+    if (r.status == FlowStatus::OffSection)
+        bad("the tangential curve is not a graph over (theta, I): traced back from wall angle " + fmt(s) +
+            ", its point is a maximum of q1 (q1 = " + fmt(r.z[0]) + ", q2 = " + fmt(r.z[2]) +
+            ") that Sigma_h's chart does not hold (q1 <= 0, H2 > h, or another root of H = h): the coupling (eps = " +
+            fmt(sys.eps) + ") is too strong here");
     if (r.status != FlowStatus::Ok)
         bad("the tangential curve could not be traced back from wall angle " + fmt(s) + " (integration status " +
             std::to_string(int(r.status)) + ")");
