@@ -61,7 +61,7 @@ from scipy.optimize import brentq
 
 __all__ = ["harmonic", "tan", "reference_return", "energy"]
 
-N_SAMPLE = 32          # samples per accepted step
+N_SAMPLE = 32  # samples per accepted step
 MAX_IMPACTS = 10000
 
 
@@ -158,12 +158,25 @@ def energy(V1, V2, coupling, eps, y):
     float or ndarray
     """
     q1, p1, q2, p2 = np.asarray(y, float)
-    return (0.5 * p1 * p1 + _pot(V1, q1, 0) + 0.5 * p2 * p2 + _pot(V2, q2, 0)
-            + eps * _vc(_terms(coupling), q1, q2, 0, 0))
+    return 0.5 * p1 * p1 + _pot(V1, q1, 0) + 0.5 * p2 * p2 + _pot(V2, q2, 0) + eps * _vc(_terms(coupling), q1, q2, 0, 0)
 
 
-def reference_return(V1, V2, coupling, eps, geometry, qw1, qw2, z0, rtol=1e-13, atol=1e-13,
-                     t_max=1000.0, corner_tol=1e-9, grazing_tol=1e-12, step_fraction=128):
+def reference_return(
+    V1,
+    V2,
+    coupling,
+    eps,
+    geometry,
+    qw1,
+    qw2,
+    z0,
+    rtol=1e-13,
+    atol=1e-13,
+    t_max=1000.0,
+    corner_tol=1e-9,
+    grazing_tol=1e-12,
+    step_fraction=128,
+):
     """One return to Sigma_h = {p1 = 0, dp1/dt < 0} from ``z0``, by DOP853 with robust event search.
 
     Parameters
@@ -206,8 +219,7 @@ def reference_return(V1, V2, coupling, eps, geometry, qw1, qw2, z0, rtol=1e-13, 
     active = (0, 1, 2, 3) if is_step else (0, 2) if has_walls else (2,)  # the g_k that matter
 
     def force(q1, q2):
-        return (-_pot(V1, q1, 1) - eps * _vc(terms, q1, q2, 1, 0),
-                -_pot(V2, q2, 1) - eps * _vc(terms, q1, q2, 0, 1))
+        return (-_pot(V1, q1, 1) - eps * _vc(terms, q1, q2, 1, 0), -_pot(V2, q2, 1) - eps * _vc(terms, q1, q2, 0, 1))
 
     def rhs(t, y):
         f1, f2 = force(y[0], y[2])
@@ -225,13 +237,13 @@ def reference_return(V1, V2, coupling, eps, geometry, qw1, qw2, z0, rtol=1e-13, 
 
     def gfun(Y):
         f1, f2 = force(Y[0], Y[2])
-        return (np.array([Y[0] - qw1, Y[2] - qw2, Y[1], Y[3]]),
-                np.array([Y[1], Y[3], f1, f2]))
+        return (np.array([Y[0] - qw1, Y[2] - qw2, Y[1], Y[3]]), np.array([Y[1], Y[3], f1, f2]))
 
     def comp(sol, k, deriv):
         def f(t):
             g, d = gfun(sol(t)[:, None])
             return float((d if deriv else g)[k, 0])
+
         return f
 
     def root(sol, k, a, b):
@@ -254,8 +266,9 @@ def reference_return(V1, V2, coupling, eps, geometry, qw1, qw2, z0, rtol=1e-13, 
 
     def finish(status, t, y):
         y = np.asarray(y, float)
-        out.update(status=status, time=float(t), z=y.copy(),
-                   energy_error=abs(float(energy(V1, V2, coupling, eps, y)) - h0))
+        out.update(
+            status=status, time=float(t), z=y.copy(), energy_error=abs(float(energy(V1, V2, coupling, eps, y)) - h0)
+        )
         return out
 
     if not in_wells(z0[:, None]):
@@ -268,13 +281,11 @@ def reference_return(V1, V2, coupling, eps, geometry, qw1, qw2, z0, rtol=1e-13, 
         # --- integrate one chunk, refining max_step until every step obeys the cap rule
         while True:
             t_end = min(t + step_fraction * cap, t_max * (1 + 1e-12) + 1e-12)
-            sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol,
-                            dense_output=True, max_step=cap)
+            sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=cap)
             ts = sol.t
             if sol.status != 0 or len(ts) < 2:
                 return finish("failed", t, y)
-            T = (ts[:-1, None] + (ts[1:] - ts[:-1])[:, None]
-                 * np.arange(N_SAMPLE)[None, :] / N_SAMPLE).ravel()
+            T = (ts[:-1, None] + (ts[1:] - ts[:-1])[:, None] * np.arange(N_SAMPLE)[None, :] / N_SAMPLE).ravel()
             T = np.append(T, ts[-1])
             Y = sol.sol(T)
             if not in_wells(Y):
