@@ -26,11 +26,11 @@ import os
 
 import numpy as np
 import pytest
-from helpers import scipy_flow
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import hovering as hv
+from helpers import scipy_flow
 
 _FUZZ = bool(os.environ.get("HOVERING_FUZZ"))
 EXAMPLES = 200 if _FUZZ else 10
