@@ -9,6 +9,7 @@
 #include "hovering/detail/poly_roots.hpp"
 #include "testing.hpp"
 
+using hovering::detail::at_most_one_root;
 using hovering::detail::isolate_roots;
 using hovering::detail::RootBracket;
 
@@ -54,6 +55,8 @@ TEST_CASE("isolate_roots: every sign change in (0, 1], in order, each bracket ho
         const int n = isolate_roots(p.data(), int(p.size()) - 1, br, 8);
         INFO(hovering_test::msg("trial %d: %d roots inside, degree %d", trial, k, int(p.size()) - 1));
         REQUIRE(n == k);
+        // the O(n) bounds in front of the isolation never claim one root where there are two
+        CHECK(at_most_one_root(p.data(), int(p.size()) - 1) == (k <= 1));
         for (int i = 0; i < n; ++i) {
             CHECK(br[i].lo <= inside[std::size_t(i)]);
             CHECK(br[i].hi >= inside[std::size_t(i)]);

@@ -88,6 +88,24 @@ inline bool isolate(const double* b, int n, double u, double v, int depth, RootB
 
 }  // namespace poly_detail
 
+/// Whether P(s) = sum_{k<=n} b[k] s^k provably keeps one sign on [0, 1] (a bound, O(n): the
+/// range of b0 + b1 s + b2 s^2 widened by sum_{k>=3} |b_k|); false says nothing.
+inline bool keeps_sign(const double* b, int n) {
+    double tail = 0;
+    for (int k = 3; k <= n; ++k) tail += std::fabs(b[k]);
+    const double b2 = n >= 2 ? b[2] : 0.0, b1 = n >= 1 ? b[1] : 0.0;
+    double lo = std::min(b[0], b[0] + b1 + b2), hi = std::max(b[0], b[0] + b1 + b2);
+    if (b2 != 0) {
+        const double v = -b1 / (2 * b2);  // the quadratic's vertex
+        if (v > 0 && v < 1) {
+            const double q = b[0] + v * (b1 + v * b2);
+            lo = std::min(lo, q);
+            hi = std::max(hi, q);
+        }
+    }
+    return lo > tail || hi < -tail;
+}
+
 /// Brackets (in time order, at most max_out) of the sign changes of P(s) = sum_{k<=n} b[k] s^k on
 /// (0, 1]; returns how many were written. A root at s = 0 itself is not counted (P is divided by
 /// s while b[0] == 0: the orbit leaves a wall or the section there). n <= kMaxRootDegree.
@@ -111,6 +129,17 @@ inline int isolate_roots(const double* b, int n, RootBracket* out, int max_out) 
     int count = 0;
     poly_detail::isolate(c, n, 0.0, 1.0, 0, out, &count, max_out);
     return count;
+}
+
+/// Whether P(s) = sum_{k<=n} b[k] s^k has at most one sign change on (0, 1]: O(n) bounds on P
+/// and on P' (monotone: Rolle) settle nearly every step; the rest are isolated.
+inline bool at_most_one_root(const double* b, int n) {
+    if (n <= 1 || keeps_sign(b, n)) return true;
+    double d[kMaxRootDegree + 1];
+    for (int k = 0; k < n; ++k) d[k] = (k + 1) * b[k + 1];
+    if (keeps_sign(d, n - 1)) return true;
+    RootBracket br[2];
+    return isolate_roots(b, n, br, 2) < 2;
 }
 
 }  // namespace hovering::detail

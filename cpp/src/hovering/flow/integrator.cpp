@@ -306,7 +306,8 @@ double Integrator::taylor_cut(double step) {
         if (!((watched_ >> w) & 1u) || !taylor_->scaled_coefficients(2 * w + 1, step, b)) continue;
         // The step's own polynomial is the solution it takes: its sign changes are exact, so the
         // step ends between the first two (on the same polynomial: no new expansion).
-        if (isolate_roots(b, p, br, 2) == 2) cut = std::min(cut, 0.5 * (br[0].hi + br[1].lo) * step);
+        if (!at_most_one_root(b, p) && isolate_roots(b, p, br, 2) == 2)
+            cut = std::min(cut, 0.5 * (br[0].hi + br[1].lo) * step);
     }
     if (cut < step) ++event_cuts_;
     return cut;
