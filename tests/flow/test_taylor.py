@@ -304,3 +304,29 @@ def test_taylor_error_near_a_tan_wells_edge_stays_in_the_documented_band(h):
         dth = np.abs((r.theta - ref.theta + np.pi) % (2 * np.pi) - np.pi)
         dI = np.abs(r.I - ref.I) / np.maximum(1.0, np.abs(ref.I))
         assert np.max(np.maximum(dth, dI)[ok]) < 60 * rtol, (h, rtol)
+
+
+def test_taylor_on_a_degree_20_coupling_meets_its_tolerance():
+    # A coupling q1^20 made the Taylor coefficients grow up to order ~20 before their geometric
+    # decay: at rtol 1e-6 (order 13) the step rule overestimated the radius and the return time
+    # was off by 8e-3 (rk8pd 3e-6). The order is now at least the coupling's degree + 4. Reference:
+    # rk8pd at 1e-13; bound 1e-5 = 10 x rtol over a ~30-step return.
+    sys_ = StepSystem(
+        V1=Harmonic(1.0),
+        V2=Harmonic(1.4),
+        coupling=hovering.Polynomial({(1, 1): 1.0, (20, 0): 0.5}),
+        eps=0.05,
+        qw1=-1,
+        qw2=-0.5,
+        geometry="step",
+    )
+    sec = Section(sys_, 3.0)
+    rng = np.random.default_rng(0)
+    th, I = rng.uniform(-3, 3, 300), rng.uniform(0.05, 0.9, 300)
+    _, ok, _ = sec._points(th, I)
+    th, I = th[ok][:200], I[ok][:200]
+    ref = sec.return_map(th, I, stepper="rk8pd", rtol=1e-13, atol=1e-13)
+    r = sec.return_map(th, I, stepper="taylor", rtol=1e-6, atol=1e-6)
+    both = (r.status == FlowStatus.OK) & (ref.status == FlowStatus.OK)
+    assert both.sum() > 150
+    assert np.max(np.abs(r.time - ref.time)[both]) < 1e-5
