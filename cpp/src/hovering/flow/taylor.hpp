@@ -8,11 +8,13 @@
 // (k + 1), f_k from Cauchy products of lower coefficients; taylor_kernel.hpp), and no field is
 // evaluated.
 //
-// Order and step follow Jorba & Zou (2005), as heyoka does, with one change: a step is the
-// fraction f = exp(-1.2) of rho (the radius of convergence estimated from the last two
-// coefficients, rho = min_{j = p-1, p} (scale / ||x_j||)^(1/j), scale = max of the state's
-// infinity norm and atol / rtol: relative control above, absolute below), times exp(-0.7 / (p - 1)),
-// at the order p = ceil(1 - ln(tol) / 1.2) that makes f^p = tol. Jorba & Zou take f = exp(-2), the
+// Order and step follow Jorba & Zou (2005), as heyoka does, with two changes. Each variable is
+// measured against its own scale: rho = min_{j = p-1, p} min_i (s_i / |x_ij|)^(1/j), s_i = max(|x_i0|,
+// atol / rtol) (relative control per component, as GSL's; one norm for the whole state let a
+// small position err relative to a large momentum or tan(alpha q) near a Tan well's edge). And a
+// step is the fraction f = exp(-1.2) of that radius of convergence, times exp(-0.7 / (p - 1)),
+// at the order p = ceil(1 - ln(tol) / 1.2) that makes f^p = tol (at least the coupling's degree + 4,
+// below which the coefficients have not begun the decay the rule extrapolates). Jorba & Zou take f = exp(-2), the
 // optimum when a step costs p^2; with four orbits expanded per SIMD register the expansion is
 // cheap and a step's fixed costs (events, evaluation, bookkeeping) dominate, so fewer, longer
 // steps of higher order win: measured 25-30% less time per return on the Tan systems than with
