@@ -7,9 +7,13 @@ A system that is not the paper's: a Tan well ``V1 = Tan(omega=1, alpha=0.5)`` in
 ``{q1 < -1, q2 < -0.5}`` at energy h = 1. The checklist, in the order to run it:
 
 1. **the onset parameters** (sec:parametersdef): Omega0, tau0, tau1, lambda, theta_w - they say
-   which regime the truncated model is in (Omega0 mod 2 pi sets the sign of eps that hovers);
+   which regime the truncated model is in;
 2. **b1 and the effective eps**: the model acts with ``eps b1`` (b1: the first sine mode of the
-   measured forcing f of eq:defoff), which can be much larger than eps;
+   measured forcing f of eq:defoff), which can be much larger than eps. The sign of eps that
+   hovers is ``sign(sin(Omega0 / 2) * b1)``, for every Omega0: its period in Omega0 is 4 pi, so
+   ``Omega0 mod 2 pi`` does not decide it (Omega0 and Omega0 + 2 pi hover for opposite signs). Where
+   b1 is 0 within its measured error (a coupling even in q2) there is no first-order forcing and the
+   higher modes decide; ``repr(fm)`` and ``fm.theory().note`` say so;
 3. **the band**: the heights K where the normal coordinates hold; starts outside it are refused;
 4. **the theory** (thm:hovering generalised to every Omega0): does it hover, and how much;
 5. **the flow and its model side by side**, then **the hovering set measured** on both and
@@ -35,7 +39,7 @@ sys = hovering.StepSystem(
 )
 fm = hovering.FlowMap(sys, h=1.0)  # rk8pd at rtol 1e-10 by default
 p = fm.onset
-print(f"Omega0 = {p.Omega0:.4f} (mod 2 pi: {p.Omega0 % (2 * np.pi):.4f}), tau0 = {p.tau0:.4f}, "
+print(f"Omega0 = {p.Omega0:.4f} (sin(Omega0/2) = {np.sin(p.Omega0 / 2):+.4f}), tau0 = {p.tau0:.4f}, "
       f"tau1 = {p.tau1:.4f}, lambda = {p.lam:.4f}, theta_w = {p.theta_w:.4f}")  # fmt: skip
 
 # %%
@@ -44,9 +48,12 @@ print(f"Omega0 = {p.Omega0:.4f} (mod 2 pi: {p.Omega0 % (2 * np.pi):.4f}), tau0 =
 # ``repr(fm)`` ends with a comment that says it: here the model acts with eps b1 = 0.090, 4.5 times
 # the coupling's eps - check it before trusting a small-eps intuition.
 b = fm.forcing_coefficients()
-print(f"b1 = {b[0]:.4f}; effective eps = eps b1 = {sys.eps * b[0]:.4f}; higher modes {np.round(b[1:4], 5)}")
+print(f"b1 = {b[0]:.4f} (error bound {fm.forcing_tolerance():.1g}); effective eps = eps b1 = {sys.eps * b[0]:.4f}; "
+      f"higher modes {np.round(b[1:4], 5)}")  # fmt: skip
 print("band:", fm.valid_band())
 th = fm.theory()
+# The sign of eps that hovers: sign(sin(Omega0/2) b1), whatever Omega0 (period 4 pi).
+print(f"sign(sin(Omega0/2) b1) = {int(np.sign(np.sin(p.Omega0 / 2) * b[0])):+d}")
 print(f"hovers: {th.hovers} (sign of eps that hovers: {th.hovering_sign:+d}); eq:hovsetsize area {th.area:.4f}")
 print(th.note)
 

@@ -223,3 +223,69 @@ def test_bad_input_is_named_before_any_work(kw, match):
     assert time.process_time() - t < 5  # refused, not computed
     with pytest.raises(ValueError, match="zone must be a hovering.ImpactZone"):
         hovering.barrier_scan(m, (0, 1))
+
+
+# ------------------------------------------------------------------------------------------------
+# The zone tools on truncated maps at eps < 0, on a flow's floor below its band, and Ctrl-C
+
+
+def test_a_scan_at_eps_below_0_runs_where_cone_orbits_leave_the_band():
+    """eps = -0.3 (the sign that does not hover): the zone reaches down to the band's floor
+    K = -pi, and the converse-KAM orbit of the lowest start (in J_0, smooth) leaves the band; its
+    region lookup raised and the whole scan was lost. Now that start is "left_domain" (it left
+    the map's domain: no circle of the smooth region passes through it) and the rest stands."""
+    m = paper.truncated_map(-0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    r = hovering.barrier_scan(m, zone, n_starts=16, n_steps=2000)
+    assert r.complete and set(r.cone) <= {"n/a", "none", "crossing", "left_domain", "not_twist"}
+    smooth = np.isin(np.asarray(m.region(r.phi0, r.K0)), (int(hovering.Region.BESIDE), int(hovering.Region.ABOVE)))
+    assert np.all(r.cone[~smooth] == "n/a") and r.cone[0] == "left_domain" and smooth[0]
+    # the verdicts of the starts whose cone orbits stay in the band are converse_kam's own
+    from hovering.analysis.orbits import converse_kam
+
+    ok = np.flatnonzero(smooth)[1:]
+    want = [converse_kam(m, r.phi0[i : i + 1], r.K0[i : i + 1], 2000).status[0] for i in ok[-3:]]
+    assert list(r.cone[ok[-3:]]) == want
+
+
+def test_interrupted_orbits_are_not_classified(monkeypatch):
+    """After Ctrl-C the orbits cut short get no verdict ("interrupted"); classifying and reducing
+    their partial orbits (millions of points) delayed the return by seconds (3.2 s measured for
+    one orbit of a 1e7-step scan, 0.1-0.25 s now). Now classify_orbits sees only the orbits that
+    ended on their own, and the cut-short ones have no s extremes (NaN)."""
+    import hovering.analysis.barriers as barriers
+
+    rows = []
+    real = barriers.classify_orbits
+
+    def spy(phi, K, **kw):
+        rows.append(phi.shape[0])
+        return real(phi, K, **kw)
+
+    monkeypatch.setattr(barriers, "classify_orbits", spy)
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    press = CtrlCOnceStarted()
+    with pytest.raises(KeyboardInterrupt) as info:
+        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, s_range=(0.5, 1.0), progress=press)
+    part = info.value.partial
+    assert np.all(part.status == hovering.Status.INTERRUPTED) and np.all(part.decided_by == "interrupted")
+    assert rows and all(n == 0 for n in rows)
+    assert np.all(np.isnan(part.s_min)) and np.all(np.isnan(part.s_max))
+
+
+def test_a_flow_zone_keeps_its_floor_torus_below_the_band_and_scans_from_it():
+    """README system at eps = -0.1: the flow's floor torus dips to K = -0.261, below the band its
+    normal coordinates are guaranteed on (from -0.257). It is an orbit of the flow, so the zone
+    keeps it (it was raised to a level orbits cross: s down to -0.037 measured on orbits started
+    at s = 0.05), and the scan starts orbits just above it (they were refused as out of band)."""
+    fm = hovering.FlowMap(paper.system(eps=-0.1), 1.0)
+    zone = hovering.impact_zone(fm, n_steps=1000)
+    lo = fm.valid_band()[0]
+    assert zone.floor_kind == "flow" and not zone.raised and zone.floor.K.min() < lo
+    assert zone.floor == fm.impact_zone_floor(n_steps=1000).curve
+    phi_low = float(zone.floor.phi[np.argmin(zone.floor.K)])
+    r = hovering.barrier_scan(fm, zone, n_starts=4, n_steps=300, line=phi_low, s_range=(0.0, 0.02))
+    assert r.K0[0] < lo and np.all(r.status == hovering.Status.OK)
+    # nothing started above the floor went below it (to the floor curve's own scatter, in s)
+    assert np.nanmin(r.s_min) >= -10 * zone.floor.max_error / np.min(zone.height(zone.floor.phi))

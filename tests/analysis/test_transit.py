@@ -125,3 +125,115 @@ def test_zone_type_is_checked_and_results_save(setup, tmp_path):
     hovering.save(r, tmp_path / "t.npz")
     back = hovering.load(tmp_path / "t.npz")
     assert np.array_equal(back.first_passage, r.first_passage) and back.target == r.target
+
+
+# ------------------------------------------------------------------------------------------------
+# Crossings that can happen: targets inside the zone (the defect: targets on its invariant edges)
+
+#: The first-mode truncated model of the system of docs/impact-zone.md's positive case (the README
+#: system with V2 = Tan(1, 0.7), eps = +0.05: onset parameters and eps b_1 = 0.05 x 1.828, rounded
+#: to 5 digits): its zone has no barrier, its orbits cross it both ways in 1e4-1e5 steps.
+TAN = dict(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+
+
+@pytest.fixture(scope="module")
+def chaotic():
+    """TAN's map in the zone from K = -0.2 (about the middle height of its flow's floor torus,
+    -0.34 .. -0.09; the model has no floor of its own) to its critical curve."""
+    m = hovering.TruncatedMap(**TAN)
+    return m, hovering.impact_zone(m, n_steps=20_000, floor=-0.2)
+
+
+def test_default_targets_lie_inside_the_zone_at_the_margin():
+    m = paper.truncated_map(0.3)
+    zone = hovering.ImpactZone(ceiling=hovering.Curve.constant(0.1), floor=hovering.Curve.constant(-0.3))
+    up = hovering.transit(m, zone, "up", n_orbits=4, n_steps=10)
+    down = hovering.transit(m, zone, "down", n_orbits=4, n_steps=10)
+    assert (up.start_s, up.target_s) == (0.05, 0.98) and (down.start_s, down.target_s) == (0.95, 0.02)
+    assert hovering.transit(m, zone, "up", n_orbits=4, n_steps=10, margin=0.1).target_s == 0.9
+    assert hovering.transit(m, zone, "down", n_orbits=4, n_steps=10, margin=0.1).target_s == 0.1
+    for bad in (0.0, 0.5, -0.1, float("nan")):
+        with pytest.raises(ValueError, match="margin"):
+            hovering.transit(m, zone, "up", n_orbits=4, n_steps=10, margin=bad)
+
+
+def test_a_chaotic_zone_is_crossed_both_ways_with_the_defaults(chaotic):
+    """The positive case: with the default targets (s = 0.98 up, 0.02 down) most orbits cross
+    (measured 17 of 24 up, 24 of 24 down in 1e5 steps); aimed at the invariant ceiling itself
+    (s = 1, the old default) none does, although the same orbits come within 0.01 of it."""
+    m, zone = chaotic
+    up = hovering.transit(m, zone, "up", n_orbits=24, n_steps=100_000)
+    down = hovering.transit(m, zone, "down", n_orbits=24, n_steps=100_000)
+    # Thresholds well under the measured counts: the chaotic orbits' details depend on the last
+    # bit of sin (SLEEF on this machine), the fractions do not.
+    assert np.count_nonzero(up.crossed) >= 10 and np.count_nonzero(down.crossed) >= 20
+    assert up.escape_rate is not None and down.escape_rate is not None
+    on_edge = hovering.transit(m, zone, "up", n_orbits=24, n_steps=100_000, target_s=1.0)
+    assert not on_edge.crossed.any()
+    assert np.max(on_edge.s_max) > 0.99  # ... while they approach it
+
+
+def test_the_positive_case_is_the_raw_orbits(chaotic):
+    """Cross-check by the raw orbits (m.iterate without a stop, the same kernel): each orbit's
+    first passage is the first state with K >= target(phi) (resp. <=) of its raw orbit, and the
+    orbits that crossed up pass the down target too, later on the same raw orbit: one orbit
+    visits both ends of the zone."""
+    m, zone = chaotic
+    n = 40_000
+    up = hovering.transit(m, zone, "up", n_orbits=12, n_steps=n)
+    down = hovering.transit(m, zone, "down", n_orbits=12, n_steps=n)
+    for r, above in ((up, True), (down, False)):
+        raw = m.iterate(r.phi0, r.K0, n, record=("orbit",))
+        hit = raw.K >= r.target(raw.phi) if above else raw.K <= r.target(raw.phi)
+        first = np.where(hit.any(axis=1), np.argmax(hit, axis=1), -1)
+        assert np.array_equal(first, r.first_passage)
+        assert np.count_nonzero(first >= 0) >= 6
+        s = zone.s(raw.phi, raw.K)
+        crossed = np.flatnonzero(first >= 0)
+        # the level reached: the zone coordinate at the first passage is past the target level, to
+        # the target curve's error (a spline through the level: estimated 1e-16 here; 1e-6 bounds
+        # it with room, far below the 0.003 by which the orbits overshoot the level in one step)
+        s_hit = s[crossed, first[crossed]]
+        assert np.all(s_hit >= r.target_s - 1e-6) if above else np.all(s_hit <= r.target_s + 1e-6)
+        if above:  # after reaching s = 0.98 they come back down past s = 0.02 (measured: 9 of 9)
+            later = [np.any(s[i, first[i] :] <= down.target_s) for i in crossed]
+            assert np.count_nonzero(later) >= len(crossed) // 2
+
+
+def test_an_orbit_escaping_past_the_target_has_crossed():
+    """A truncated map's band floor is the edge of its domain: an orbit that jumps below it ends
+    ESCAPED with its image out of the band, before the stop is tested. An image past the target
+    has passed the target (the old transit counted it as not crossed). eps = 0.7, the band floor
+    K = -pi: measured 9 stopped and 7 escaped past the target of 24."""
+    m = paper.truncated_map(0.7)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    r = hovering.transit(m, zone, "down", n_orbits=24, n_steps=20_000)
+    esc = r.status == Status.ESCAPED
+    assert esc.any() and np.all(r.crossed[esc])
+    assert np.array_equal(r.first_passage[esc], r.steps_done[esc])
+    raw = m.iterate(r.phi0[esc], r.K0[esc], 20_000, record=())
+    assert np.array_equal(raw.steps_done, r.steps_done[esc]) and np.all(raw.status == Status.ESCAPED)
+    assert np.all(raw.K_final <= r.target(raw.phi_final))
+    assert np.all(r.crossed == ((r.status == Status.STOPPED) | esc))
+
+
+def test_a_flow_zone_without_barrier_is_crossed():
+    """The flow of the positive case (README system with V2 = Tan(1, 0.7), eps = +0.05): both
+    boundaries are the flow's invariant curves, and its orbits cross the zone (measured here 6 of 6
+    down to s = 0.02 within 1,791 returns; docs/impact-zone.md: 40 of 40 down, 39 of 40 up within
+    20,000, the up direction too slow for this test). Checked on the raw flow orbits of two of
+    them: the first state at or below the target is the transit's first passage (tolerance 1e-6
+    in s: the target spline's error estimate is 2e-16, the flow's orbits are deterministic)."""
+    from hovering.flow.system import Tan
+
+    fm = hovering.FlowMap(paper.system(eps=0.05, V2=Tan(1.0, 0.7)), 1.0)
+    zone = hovering.impact_zone(fm, n_steps=1000)
+    assert zone.floor_kind == "flow"
+    down = hovering.transit(fm, zone, "down", n_orbits=6, n_steps=3000)
+    assert np.count_nonzero(down.crossed) >= 4
+    i = np.flatnonzero(down.crossed)[:2]
+    raw = fm.iterate(down.phi0[i], down.K0[i], int(down.first_passage[i].max()), record=("orbit",))
+    for j, k in enumerate(i):
+        fp = int(down.first_passage[k])
+        s = zone.s(raw.phi[j, : fp + 1], raw.K[j, : fp + 1])
+        assert s[-1] <= down.target_s + 1e-6 and np.all(s[:-1] > down.target_s - 1e-6)

@@ -82,17 +82,89 @@ def test_a_zone_saves_and_loads(tmp_path):
 
 
 def test_a_floor_below_the_band_is_raised_just_inside_it():
-    """A floor that dips below the map's band (the second system of docs/impact-zone.md: the flow's
-    floor torus at K = -0.541, its band from -0.531) is raised to 1% of the band's height above the
-    band's edge where it dips, and kept where it does not (to the spline's accuracy on a smooth
-    stretch, 1e-6 of the floor's size here)."""
+    """A given floor that dips below the map's band (the flow's floor torus given to its truncated
+    model, whose band is narrower) is raised to 1% of the zone's height above the band's edge
+    where it dips, and kept where it does not (to the spline's accuracy on a smooth stretch, 1e-6
+    of the floor's size here). The zone's height runs from the band's edge to the ceiling's top
+    (0.5 here; the band's own top, 1.0, is no scale: a truncated map's band reaches up to K ~ 1e6)."""
     m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, K_max=1.0)
     lo, hi = m.valid_band()
     floor = hovering.Curve.from_function(lambda p: lo + 0.05 * np.cos(p), n=64)
     zone = hovering.impact_zone(m, ceiling=0.5, floor=floor)
     assert zone.raised and not hovering.impact_zone(m, ceiling=0.5, floor=lo + 0.1).raised
     p = np.linspace(-np.pi, np.pi, 2001)
-    edge = lo + 0.01 * (hi - lo)
+    edge = lo + 0.01 * (0.5 - lo)
     assert np.all(zone.floor(p) > lo)
     away = np.abs(floor(p) - edge) > 0.01  # off the kinks, where the spline is smooth
     np.testing.assert_allclose(zone.floor(p)[away], np.maximum(floor(p), edge)[away], atol=1e-6)
+
+
+# ------------------------------------------------------------------------------------------------
+# The searches at both signs of eps and at large |eps|; a ValueError that says why where they fail
+
+
+def test_a_given_floor_on_a_truncated_map_is_kept():
+    """The paper's map has a band up to K ~ 1e6 (|Omega| = 1e6): a margin of 1% of the band's
+    height put a given floor at K ~ 1e4, above the ceiling, and the zone failed. Now a floor inside
+    the band is kept as given, and the ceiling is the critical curve as without it."""
+    m = paper.truncated_map(0.3)
+    zone = hovering.impact_zone(m, n_steps=5000, floor=-1.0)
+    assert zone.floor_kind == "given" and not zone.raised and zone.floor(0.3) == -1.0
+    assert zone.ceiling == hovering.impact_zone(m, n_steps=5000).ceiling
+
+
+@pytest.mark.parametrize("eps", [0.3, -0.3, 0.9, -0.9])
+def test_truncated_zones_at_both_signs_and_large_eps(eps):
+    """The ceiling is a circle that never impacts (checked on its own orbit, 20,000 steps, from
+    where it crosses the search line) above the band's floor. eps = -0.9 (the sign that does not
+    hover): no curve in the leading-order range (the circles near K = 0 dip into J_R or are
+    destroyed, k = |eps| tau0 = 0.9), which raised RuntimeError; the search now widens and finds
+    the lowest one above (K ~ 4.3-5.2, rotation near 1 - golden)."""
+    m = paper.truncated_map(eps)
+    zone = hovering.impact_zone(m, n_steps=5000)
+    assert zone.floor_kind == "band"
+    line = m.L1 if m.theory().hovers else m.L2
+    K = float(np.mean(zone.ceiling.K))
+    for _ in range(100):  # where the ceiling crosses its search line
+        K = float(zone.ceiling(float(line(K))))
+    res = m.iterate([float(line(K))], [K + 2 * zone.ceiling.max_error], 20_000, record=("residence",))
+    impacts = res.residence[0, [int(hovering.Region.UPPER), int(hovering.Region.RIGHT)]].sum()
+    assert res.status[0] == hovering.Status.OK and impacts == 0
+
+
+def test_the_ceiling_is_searched_above_the_floor():
+    """A floor at or above the critical curve leaves no zone: the lowest start above it already
+    lies on a non-impacting curve. The old search returned that curve as the ceiling (a sliver
+    zone, dipping to the floor at K = -0.299 against a critical curve at -0.47); now it says so."""
+    m = paper.truncated_map(0.5)
+    with pytest.raises(ValueError, match=r"the impact zone is empty on L1: the lowest start above the floor"):
+        hovering.impact_zone(m, n_steps=5000, floor=-0.3)
+    # below the critical curve (K = -0.47 on L1) the zone is there, its ceiling the critical curve
+    # (the grid starts higher, so the bisection ends on another start of the critical curve's
+    # fractal edge: measured 3e-5 apart in K; the band-floored zone's own ceiling is the reference)
+    zone = hovering.impact_zone(m, n_steps=5000, floor=-0.6)
+    ref = hovering.impact_zone(m, n_steps=5000).ceiling
+    assert zone.ceiling.K.min() == pytest.approx(ref.K.min(), abs=1e-4) and zone.ceiling.K.min() < -0.46
+
+
+def test_flow_searches_fail_with_a_reason_and_what_to_pass():
+    """README system: at eps = -0.3 the eps = 0 torus tangent to the upper wall (K = -0.153) lies
+    below the band of the normal coordinates (from -0.117): no floor (the search raised
+    RuntimeError); its measured truncated model at eps = +0.3 has no invariant curve in its band
+    (the leading-order range, 3 K_crit = +0.56 > the band's top, was refused by critical_curve)."""
+    fm = hovering.FlowMap(paper.system(eps=-0.3), 1.0)
+    with pytest.raises(ValueError, match=r"^no invariant curve .* that torus lies below the band .* floor="):
+        hovering.impact_zone(fm, n_steps=1000)
+    model = hovering.FlowMap(paper.system(eps=0.3), 1.0).truncated()
+    with pytest.raises(ValueError, match=r"no ceiling found for the impact zone: .* Pass K_range=.* ceiling="):
+        hovering.impact_zone(model, n_steps=2000)
+
+
+def test_flow_at_the_sign_that_does_not_hover_is_refused_not_inverted():
+    """README system at eps = +0.2 (does not hover): the flow's floor torus reaches K = 0, and the
+    orbits just above it never impact. The old ceiling search went below the floor and returned an
+    invariant curve of J_0 (K0 at the band's edge) under it, and the zone failed with "ceiling
+    below the floor"; the search now starts above the floor and says the zone is empty there."""
+    fm = hovering.FlowMap(paper.system(eps=0.2), 1.0)
+    with pytest.raises(ValueError, match="the impact zone is empty on L2"):
+        hovering.impact_zone(fm, n_steps=1000)

@@ -70,7 +70,7 @@ class CriticalCurve(Summarized, Saveable):
         Whether these parameters hover (:class:`hovering.Theory`); if not, the curve found is the
         lowest invariant curve avoiding impacts, k^{u0}, not a hovering critical curve.
     note : str
-        The theory's explanation (sign of eps sin(Omega0/2), resonance).
+        The theory's explanation (sign of eps b_1 sin(Omega0/2), vanishing modes, resonance, geometry).
     phi, K : ndarray
         The critical orbit.
     """
@@ -157,9 +157,11 @@ def critical_curve(
     leaves gaps ~ 2 pi / p). The lowest passing start of a grid over ``K_range`` is then refined
     by bisection against the grid point below it.
 
-    Where the parameters do not hover (``eps sin(Omega0/2) < 0``, thm:hovering) the lowest curve
-    avoiding impacts is k^{u0}, with its minimum near L2 at K >= 0: the default search moves to L2
-    and the result says ``hovers=False`` with the reason in ``note``.
+    Where the parameters do not hover (``eps b_1 sin(Omega0/2) < 0`` for a forcing ``b_1 sin + ...``,
+    at every Omega0: the sign of eps that hovers is ``sign(sin(Omega0/2) b_1)``, of period 4 pi in
+    Omega0; thm:hovering) the lowest curve avoiding impacts is k^{u0}, with its minimum near L2 at
+    K >= 0: the default search moves to L2 and the result says ``hovers=False`` with the reason in
+    ``note`` (:meth:`theory` of the map decides, :class:`hovering.Theory`).
 
     Parameters
     ----------
@@ -175,7 +177,7 @@ def critical_curve(
         curve k^{u0} (lowest curve in K >= 0).
     line : {"L1", "L2"} or float, optional
         Search line. Default: L1 in the hovering case, L2 otherwise (minima of the curves lie near
-        L1 when ``eps sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves). A number
+        L1 when ``eps b_1 sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves). A number
         is a vertical line phi = line (any rotational invariant curve crosses it once).
     grid : int, optional
         Grid points of the first scan (>= 2).

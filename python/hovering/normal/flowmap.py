@@ -90,6 +90,9 @@ class FlowSteps(Saveable):
     z: np.ndarray
 
 
+#: The eps at which the forcing's eps -> 0 limit is measured (a FlowMap at eps = 0).
+_EPS_LIMIT = 1e-6
+
 #: Where the flow's core names a field of IterateResult otherwise (its states are (x, y) = (phi, K)
 #: or (theta, I)).
 _CORE_NAMES = {"phi": "x", "K": "y", "phi_final": "x_final", "K_final": "y_final", "K_min": "y_min", "K_max": "y_max"}
@@ -215,20 +218,45 @@ class FlowMap(MapAnalyses):
         lift = None if p is None else (p.Omega0, p.theta_w, p.tau0, p.tau1, p.lam)
         self._core = _core_normal.FlowMap(sys.core, self.h, self._options, self.curve._c if self.curve else None, lift)
         self._forcing = None
+        self._delta = None  # the tangential curve's measured error (forcing_tolerance), on first use
 
     def __repr__(self) -> str:
         base = f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
         # What a user needs before reading any result: the perturbation the truncated model sees is
-        # eps b1 (the measured forcing's first mode), not eps; and where points of Sigma_h exist. A
+        # eps b1 (the measured forcing's first mode), not eps - or, where b1 vanishes within its
+        # measurement error, that the higher modes act; and where points of Sigma_h exist. A
         # comment, so the text still evaluates to the map.
         lo, hi = self.valid_band()
         if self.coordinates != "normal" or self.eps == 0:
             return f"{base}  # band {'K' if self.coordinates == 'normal' else 'I'} in [{lo:.4g}, {hi:.4g}]"
+        band = f"band K in [{lo:.4g}, {hi:.4g}]"
         try:
-            b1 = float(self.forcing_coefficients()[0])
+            b = self.forcing_coefficients()
+            tol = self.forcing_tolerance()
         except ValueError:  # a tangential curve that is not a graph has no forcing: say so
-            return f"{base}  # eps b1 undefined (the tangential curve is not a graph), band K in [{lo:.4g}, {hi:.4g}]"
-        return f"{base}  # effective eps = eps b1 = {self.eps * b1:.4g} (b1 = {b1:.4g}), band K in [{lo:.4g}, {hi:.4g}]"
+            return f"{base}  # eps b1 undefined (the tangential curve is not a graph), {band}"
+        b1 = float(b[0])
+        if abs(b1) > tol:
+            text = f"effective eps = eps b1 = {self.eps * b1:.4g} (b1 = {b1:.4g})"
+        else:
+            higher = [(k + 1, float(x)) for k, x in enumerate(b) if k > 0 and abs(x) > tol]
+            if higher:
+                k, x = max(higher, key=lambda kx: abs(kx[1]))
+                text = (
+                    f"b1 = {b1:.2g} is 0 within its error {tol:.2g}: the first mode vanishes (no first-order "
+                    f"forcing), the higher modes act (largest: eps b{k} = {self.eps * x:.4g}, b{k} = {x:.4g})"
+                )
+            else:
+                text = (
+                    f"no forcing: every b_k is 0 within its error {tol:.2g} (K is preserved: the circles K = const "
+                    "are invariant)"
+                )
+        geometry = ""
+        if self.sys.geometry == "wall":
+            geometry = "; geometry 'wall': no step corner, every K < 0 start impacts, nothing hovers"
+        elif self.sys.geometry == "none":
+            geometry = "; geometry 'none': no walls, nothing impacts or hovers"
+        return f"{base}  # {text}, {band}{geometry}"
 
     # ---------------------------------------------------------------- pickling and saving
     # A FlowMap is rebuilt from its constructor arguments, with its tangential curve passed in: the
@@ -589,41 +617,134 @@ class FlowMap(MapAnalyses):
         if self.coordinates != "normal":
             raise ValueError("the theory and the model live in normal coordinates: use coordinates='normal'")
 
+    def _forcing_curve(self):
+        """The tangential curve whose f (eq:defoff) is this map's forcing: its own, or at eps = 0 the
+        curve of the system at eps = 1e-6 (f's eps -> 0 limit); None at eps = 0 without a coupling."""
+        if self.curve is None:
+            raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
+        if self.eps != 0:
+            return self.curve
+        if self.sys.coupling is None:
+            return None
+        return TangentialCurve(Section(self.sys.replace(eps=_EPS_LIMIT), self.h), rtol=1e-13)
+
     def forcing_coefficients(self, n_modes: int | None = None) -> np.ndarray:
         """Sine coefficients of the measured forcing f (eq:defoff) of this section (cached).
 
         The core's one fit (:meth:`TangentialCurve.forcing_coefficients`, ``n_modes`` default
         ``FORCING_MODES``). At eps = 0 f is undefined (eq:defoff divides by eps); its eps -> 0 limit
-        is used there, measured on the system at eps = 1e-6 (zeros without a coupling).
+        is used there, measured on the system at eps = 1e-6 (zeros without a coupling). Each
+        coefficient carries a measurement error of at most :meth:`forcing_tolerance`.
         """
         n_modes = integer("n_modes", _core_normal.FORCING_MODES if n_modes is None else n_modes, 1, MAX_MODES)
         if self._forcing is None or self._forcing.size != n_modes:
-            if self.curve is None:
-                raise ValueError("the forcing needs normal coordinates (coordinates='normal')")
-            if self.eps != 0:
-                self._forcing = self.curve.forcing_coefficients(n_modes)
-            elif self.sys.coupling is None:
-                self._forcing = np.zeros(n_modes)
-            else:
-                tiny = TangentialCurve(Section(self.sys.replace(eps=1e-6), self.h), rtol=1e-13)
-                self._forcing = tiny.forcing_coefficients(n_modes)
+            curve = self._forcing_curve()
+            self._forcing = np.zeros(n_modes) if curve is None else curve.forcing_coefficients(n_modes)
         return self._forcing
+
+    #: Tolerance of the second trace of the tangential curve that measures the first one's error
+    #: (:meth:`forcing_tolerance`); 1e-14 if GSL cannot reach it.
+    _REFERENCE_RTOL = (1e-15, 1e-14)
+
+    def _curve_error(self) -> float:
+        """delta: the largest error of the interpolated I_tan^eps values the forcing fit uses (cached).
+
+        Measured: the curve traced again (same wall points) at rtol 1e-15 is compared with this
+        map's on the fit's angles, and the curve's measured interpolation error (off-grid traces)
+        is added; 0 without a forcing curve."""
+        if self._delta is None:
+            curve = self._forcing_curve()
+            if curve is None:
+                self._delta = 0.0
+                return self._delta
+            phi = _core_normal.forcing_angles(_core_normal.FORCING_SAMPLES)
+            phi = np.concatenate([phi, -phi])
+            err = None
+            for rtol in self._REFERENCE_RTOL:
+                try:
+                    ref = TangentialCurve(curve.sec, n=int(curve.s.size), rtol=rtol, n_check=0)
+                except (ValueError, RuntimeError) as e:
+                    err = e
+                    continue
+                break
+            else:
+                raise ValueError(f"the tangential curve's error could not be measured (second trace failed: {err})")
+            interp = curve.interpolation_error if math.isfinite(curve.interpolation_error) else 0.0
+            self._delta = float(np.max(np.abs(curve(phi) - ref(phi)))) + float(interp)
+        return self._delta
+
+    def forcing_tolerance(self, n_modes: int | None = None) -> float:
+        """Error bound of the measured sine coefficients b_k: a ``|b_k|`` at or below it is 0 within rounding.
+
+        The fit takes ``f_j = (I(-phi_j) - I(phi_j)) / eps`` at the ``n = FORCING_SAMPLES`` (256)
+        midpoint angles and ``b_k = (2/n) sum_j f_j sin(k phi_j)``. If every interpolated value of
+        ``I_tan^eps`` it uses is within delta of the truth, each ``f_j`` is within ``2 delta / |eps|``
+        and each ``b_k`` within ``(2/n) n (2 delta / |eps|) = 4 delta / |eps|``; the fit's own rounding
+        adds at most ``2 (n + 2) u sum_k |b_k|`` (u = 2^-53, recursive summation of n terms). So
+
+            ``tol = 4 delta / |eps| + 2 (n + 2) u sum_k |b_k|``.
+
+        delta is measured, not assumed: the largest difference on the fit's angles between this map's
+        curve and the same curve traced again at rtol 1e-15, plus the curve's measured interpolation
+        error (README system at eps = -0.05 / +0.05: delta = 5.7e-15 / 6.7e-15, tol = 4.9e-13 /
+        5.7e-13, against b_1 = 0.564; a coupling even in q2, ``q1 q2^2``, gives |b_1| = 6e-15 below
+        its tol 4.0e-13: no first-order forcing). At eps = 0
+        the forcing and delta are those of the system at eps = 1e-6. The first call traces the curve
+        once more (milliseconds for the compiled potentials); the result is cached.
+
+        Parameters
+        ----------
+        n_modes : int, optional
+            Modes of the fit whose rounding is bounded (default ``FORCING_MODES``, 8).
+
+        Returns
+        -------
+        float
+            The tolerance (0 without a forcing: eps = 0 and no coupling).
+
+        Raises
+        ------
+        ValueError
+            Without normal coordinates, where the tangential curve is not a graph, or if the second
+            trace fails.
+        """
+        b = self.forcing_coefficients(n_modes)
+        if self.eps == 0 and self.sys.coupling is None:
+            return 0.0  # no forcing at all: f = 0 exactly
+        eps_f = self.eps if self.eps != 0 else _EPS_LIMIT
+        return 4.0 * self._curve_error() / abs(eps_f) + _theory._forcing_rounding(b)
 
     def theory(self) -> _theory.Theory:
         """Leading-order predictions with this system's onset parameters and measured forcing.
 
+        :func:`hovering.theory` with the onset ``Omega0, theta_w, tau0``, the measured forcing
+        (:meth:`forcing_coefficients`), its error bound as the tolerance below which a coefficient
+        is 0 (:meth:`forcing_tolerance`) and this system's geometry. Stated for every Omega0 the
+        system can have (a physical Omega0 is often beyond 2 pi: 9.83 for the README system).
+
         Returns
         -------
         hovering.Theory
-            ``hovers``, ``hovering_sign`` (the sign of eps that hovers: that of sin(Omega0/2) b_1),
-            ``area`` (eq:hovsetsize with the measured forcing), ``K_crit``, ``rho_crit``, ``note``.
+            ``hovers``, ``hovering_sign`` (the sign of eps that hovers: ``sign(sin(Omega0/2) b_1)``,
+            period 4 pi in Omega0; set by the higher modes where b_1 is 0 within its error, e.g. a
+            coupling even in q2; 0 where nothing forces), ``area`` (eq:hovsetsize with the measured
+            forcing), ``K_crit``, ``rho_crit``, ``note`` (which says why). In the ``"wall"`` geometry
+            (no step corner) and ``"none"`` the hovering set is empty exactly: every K < 0 start
+            impacts the wall on its first return, resp. nothing impacts; ``hovers`` is False,
+            ``area`` 0 and ``hovering_sign`` 0, with the reason in ``note``.
         """
         self._require_onset()
         p = self.onset
         b = self.forcing_coefficients()
-        if not np.any(b != 0):
-            b = np.array([1.0])
-        return _theory.theory(self.eps, p.Omega0, p.theta_w, p.tau0, forcing=tuple(b))
+        return _theory.theory(
+            self.eps,
+            p.Omega0,
+            p.theta_w,
+            p.tau0,
+            forcing=tuple(float(x) for x in b),
+            geometry=self.sys.geometry,
+            forcing_tol=self.forcing_tolerance(),
+        )
 
     def L1(self, K):
         """Angle of the line L1 at heights K (def:L1L2) with the onset Omega0 and tau0."""
@@ -654,12 +775,38 @@ class FlowMap(MapAnalyses):
         Returns
         -------
         TruncatedFamily or TruncatedMap
+
+        Raises
+        ------
+        ValueError
+            Without onset parameters or normal coordinates, for an unknown ``forcing``, or in the
+            ``"wall"`` and ``"none"`` geometries: the model's arcs J_0 (crossing q1 = qw1 above the
+            step) and J_1 (one impact on the upper wall) exist only with the step's corner.
+
+        Notes
+        -----
+        Coefficients within :meth:`forcing_tolerance` of 0 (measurement noise) are set to 0, as in
+        :meth:`theory`: where b_1 vanishes (a coupling even in q2) the ``"first_mode"`` model is F_0.
         """
         self._require_onset()
         if not is_choice(forcing, ("measured", "first_mode")):
             raise ValueError(f"forcing must be 'measured' or 'first_mode', got {forcing!r}")
+        if self.sys.geometry != "step":
+            why = (
+                "an infinite wall without the step's corner: every K < 0 start impacts the wall on its first "
+                "return (one impacting arc for every K < 0, eq:fwall), which TruncatedMap and TruncatedFamily "
+                "cannot represent, and nothing hovers (FlowMap.theory() says so)"
+                if self.sys.geometry == "wall"
+                else "no walls: nothing impacts, the return map is smooth (eq:shiftstandardmap to leading order)"
+            )
+            raise ValueError(
+                f"the truncated model (eq:truncatedmap, eq:trunceps1eps2) is the step's: its arcs J_0 and J_1 need "
+                f"the step's corner; geometry {self.sys.geometry!r} has {why}. Iterate the FlowMap itself, or "
+                "model the step: FlowMap(sys.replace(geometry='step'), h)"
+            )
         p = self.onset
         b = self.forcing_coefficients(n_modes)
+        b = np.where(np.abs(b) <= self.forcing_tolerance(n_modes), 0.0, b)
         m = TruncatedMap(eps=self.eps * b[0], Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
         if forcing == "first_mode":
             return m
@@ -683,7 +830,10 @@ class FlowMap(MapAnalyses):
 
         Searched on the vertical line ``phi``: the highest start whose orbit never leaves J_0 (passes
         above the step every return, no impact) and is a regular rotational curve; the deformed
-        torus tangent to the upper wall at eps = 0 (:meth:`upper_tangent_K`).
+        torus tangent to the upper wall at eps = 0 (:meth:`upper_tangent_K`). It is an orbit of
+        the flow, so every point of it lies on the section, also where it leaves the rectangle
+        :meth:`valid_band` (which is conservative: e.g. K = -0.261 against a band from -0.257 on
+        the README system at eps = -0.1).
 
         Parameters
         ----------
@@ -692,8 +842,8 @@ class FlowMap(MapAnalyses):
         phi : float, optional
             The search line's angle.
         K_range : (float, float), optional
-            Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, inside the band
-            and below 0).
+            Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, clipped to the
+            band (from 0.95 of its lower edge) and below ``K = -1e-3``).
         **kwargs
             ``grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
 
@@ -701,16 +851,49 @@ class FlowMap(MapAnalyses):
         -------
         CriticalCurve
             ``K0`` (height on the line), ``K_min``, ``K_max`` (the curve's extent), rotation.
+
+        Raises
+        ------
+        ValueError
+            Outside normal coordinates; where the default range is empty (the eps = 0 torus and
+            its eps-neighbourhood all outside the band); and where no curve is found (the message
+            starts "no invariant curve", says why that happens - the tori below the zone destroyed
+            at this eps (README system, eps = -0.15, -0.2), or lying below the band (eps = -0.3) -
+            and what to pass: ``K_range``, more ``n_steps``, or to :func:`hovering.impact_zone` a
+            ``floor=``).
         """
         if self.coordinates != "normal":
             raise ValueError("the impact zone floor is searched in normal coordinates: use coordinates='normal'")
+        Ku = self.upper_tangent_K()
+        lo, hi = self.valid_band()
         if K_range is None:
-            Ku, d = self.upper_tangent_K(), 0.05 + 2 * abs(self.eps)
-            lo = self.valid_band()[0]
-            K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3))
-        return hook("critical_curve")(
-            self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi), search="highest", **kwargs
-        )
+            d = 0.05 + 2 * abs(self.eps)
+            K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3, hi))
+            if not K_range[0] < K_range[1]:
+                raise ValueError(
+                    f"no invariant curve can be searched below the impact zone: the torus tangent to the upper wall "
+                    f"(K = {Ku:.6g} at eps = 0) and its eps-neighbourhood lie outside the band ({lo:.6g}, {hi:.6g}) "
+                    f"where this section's normal coordinates hold (eps = {self.eps:g}); pass impact_zone a floor= "
+                    f"(a hovering.Curve or a height, e.g. floor={0.95 * lo:.4g})"
+                )
+        try:
+            return hook("critical_curve")(
+                self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi), search="highest", **kwargs
+            )
+        except RuntimeError as e:
+            below = Ku < lo
+            raise ValueError(
+                f"{e}. Below the impact zone (around the eps = 0 torus tangent to the upper wall, K = {Ku:.6g}) no "
+                f"orbit in {tuple(float(k) for k in K_range)} stayed above the step for {n_steps} returns as a "
+                "regular rotational curve: "
+                + (
+                    f"that torus lies below the band ({lo:.6g}, {hi:.6g}) where the normal coordinates hold"
+                    if below
+                    else "at this eps the tori there are destroyed or impact (or need more returns to show regular)"
+                )
+                + "; pass K_range=(K_lo, K_hi), more n_steps, or impact_zone a floor= (a hovering.Curve or a "
+                f"height, e.g. floor={0.95 * lo:.4g}, just inside the band's lower edge)"
+            ) from None
 
     def step_rotations(self, res: IterateResult, i: int) -> np.ndarray:
         """The rotation of each return of orbit i of ``res``: the angle advance ``phi_{n+1} - phi_n``

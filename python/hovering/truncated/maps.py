@@ -337,7 +337,7 @@ class _MapAPI(MapAnalyses):
 
 
 class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
-    """The paper's truncated map F_eps (eq:truncatedmap), corrected as in shared/PAPER-NOTES.md.
+    """The paper's truncated map F_eps (eq:truncatedmap), corrected as on the errata page (docs/guide/errata.md).
 
     ``Kbar = K + eps sin(phibar)``, ``phibar = phi + omega_a(K)`` for ``phi`` in the arc ``J_a(K)``;
     for ``K < 0`` the circle is cut into J_1 (length ``2 lam sqrt(-K)``), J_R (``2(pi - theta_w) +
@@ -417,7 +417,8 @@ class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     def K_crit(self) -> float:
         """eq:kcrit evaluated formally: the critical curve's height on L1 when ``eps sin(Omega0/2) > 0``.
 
-        For the other sign the value is positive and no hovering critical curve exists (thm:hovering);
+        That is the hovering case at every Omega0 (f = sin, so b_1 = 1): for Omega0 in (2 pi, 4 pi)
+        it is eps < 0 that hovers (the rule has period 4 pi in Omega0). For the other sign the value is positive and no hovering critical curve exists (thm:hovering);
         :meth:`theory` says so (``hovers``, ``note``) and gives NaN for ``K_crit`` there.
         """
         return float(_geo.K_crit(self.eps, self.theta_w, self.Omega0))

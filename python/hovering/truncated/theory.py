@@ -3,22 +3,32 @@
 All functions are vectorised over NumPy arrays. Equation labels are the paper's ``\\label`` names.
 
 The paper states its theory for ``Omega0`` in ``(0, 2 pi)`` and ``f = sin``. Written with
-``sin(Omega0 / 2)`` it holds for every ``Omega0`` (the map is ``4 pi``-periodic in ``Omega0``, and
-``Omega0 -> Omega0 + 2 pi`` is ``eps -> -eps`` with ``phi -> phi + pi``): the sign of eps that
-hovers is the sign of ``sin(Omega0 / 2)``. :func:`theory` also takes any odd forcing
-``f = sum_k b_k sin(k phi)`` (the measured forcing of a physical system has ``b_2 = O(eps)``).
+``sin(Omega0 / 2)`` it holds for every ``Omega0`` (negative ones and ``Omega0 > 2 pi`` included):
+the map is ``4 pi``-periodic in ``Omega0`` (not ``2 pi``), and ``Omega0 -> Omega0 + 2 pi`` is
+``eps -> -eps`` with ``phi -> phi + pi``. For a forcing ``f = b_1 sin(phi) + ...`` the sign of eps
+that hovers is
+
+    ``sign(sin(Omega0 / 2) * b_1)``  (lemma:mininj0jr, for every Omega0 and either sign of tau0),
+
+so ``Omega0 mod 2 pi`` does not decide it: ``Omega0`` and ``Omega0 + 2 pi`` hover for opposite
+signs of eps. :func:`theory` also takes any odd forcing ``f = sum_k b_k sin(k phi)`` (the measured
+forcing of a physical system has ``b_2 = O(eps)``, and ``b_1 = 0`` for a coupling even in q2),
+treats coefficients within a stated tolerance of 0 as absent, and states what applies in the
+``"wall"`` and ``"none"`` geometries of :class:`hovering.StepSystem` (no hovering set).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import forcing_array, integer, real_array, real_number, require_angles, require_finite
+from .._checks import forcing_array, integer, is_choice, real_array, real_number, require_angles, require_finite
 from .._core import analysis as _core_analysis
+from .._core import normal as _core_normal
 from .._enums import wrap
 from .._serial import Saveable
 
@@ -246,7 +256,8 @@ def rho2(K0, eps, Omega0, tau0):
 def K_crit(eps, theta_w, Omega0):
     """Predicted lowest height of the critical invariant curve on L1 (eq:kcrit), evaluated formally.
 
-    Negative in the hovering case ``eps sin(Omega0/2) > 0``; positive otherwise, where no
+    For ``f = sin``, at every Omega0: negative in the hovering case ``eps sin(Omega0/2) > 0``
+    (so for ``Omega0`` in ``(2 pi, 4 pi)`` it is eps < 0 that hovers); positive otherwise, where no
     hovering critical curve exists (use :func:`theory`, whose ``K_crit`` is NaN there). NaN at a
     resonant Omega0 (sin(Omega0/2) = 0); theta_w must lie in (0, pi).
 
@@ -289,8 +300,10 @@ def hovering_area_theory(eps, theta_w, Omega0):
     """Leading-order area of the hovering set (eq:hovsetsize), for every Omega0 and either sign of eps.
 
     ``|eps| (sin theta_w - theta_w cos theta_w) / |sin(Omega0/2)|`` when ``eps sin(Omega0/2) > 0``
-    (the hovering case of lemma:mininj0jr), 0 otherwise (the minima of the invariant curves lie
-    near L2, in J_R: thm:hovering's destruction). NaN at ``sin(Omega0/2) = 0`` (resonant).
+    (the hovering case of lemma:mininj0jr; ``f = sin``, so ``b_1 = 1``: the sign of eps that hovers
+    is that of ``sin(Omega0/2)``, a function of period 4 pi in Omega0), 0 otherwise (the minima
+    of the invariant curves lie near L2, in J_R: thm:hovering's destruction). NaN at
+    ``sin(Omega0/2) = 0`` (resonant). For a forcing ``b_1 sin + ...`` use :func:`theory`.
 
     Parameters
     ----------
@@ -359,6 +372,27 @@ def golden_family(eps, c, tau0=1.0, Omega_G=OMEGA_G):
 # The theory of sec:truncinvcurves for any Omega0 and any odd forcing
 
 
+#: Geometries of :class:`hovering.StepSystem` the theory speaks about.
+_GEOMETRIES = ("step", "wall", "none")
+
+#: Unit roundoff of IEEE double precision.
+_UNIT_ROUNDOFF = 2.0**-53
+
+
+def _forcing_rounding(forcing, n_samples: int | None = None) -> float:
+    """Rounding bound of sine coefficients fitted from n samples of f: ``2 (n + 2) u sum_k |b_k|``.
+
+    The package's fit (``hovering._core.normal``, ``FORCING_SAMPLES`` = 256 midpoint angles) is
+    ``b_k = (2/n) sum_j f_j sin(k phi_j)``: a sum of n terms, each at most ``(2/n) max|f| <= (2/n)
+    sum_k |b_k|`` in size, each rounded in its product and sine. Recursive summation errs by at
+    most ``gamma_{n+2} = (n + 2) u / (1 - (n + 2) u)`` times the sum of the terms' sizes, which is
+    at most ``2 sum_k |b_k|`` (u = 2^-53; ``gamma`` rounded down to ``(n + 2) u``, 1e-13 relative
+    at n = 256). A coefficient this small is indistinguishable from 0 in such a fit.
+    """
+    n = int(_core_normal.FORCING_SAMPLES) if n_samples is None else int(n_samples)
+    return 2.0 * (n + 2) * _UNIT_ROUNDOFF * float(sum(abs(x) for x in forcing))
+
+
 @dataclass(frozen=True)
 class Theory(Saveable):
     """Leading-order predictions of sec:truncinvcurves for one set of map parameters.
@@ -370,33 +404,49 @@ class Theory(Saveable):
     curve is the lowest of them that stays at K >= 0 outside J_0, so
     ``K_c = -min_{|psi| >= theta_w} eps G(psi)``; HOV is the part of J_0 between it and K = 0,
     ``|HOV| = int max(0, -K_c - eps G) dpsi`` (eq:hovsetsize for ``f = sin``), and its rotation is
-    ``Omega0 + tau0 (K_c + eps <G>)`` (eq:rhocrit). With ``eps sin(Omega0/2) < 0`` and ``f = sin``
-    this lowest curve is ``k_{eps,2}(phi, rho_2(0))``, touching K = 0 at L2 inside J_R: no
-    hovering set (thm:hovering). The corrections are O(eps^2) (the corner curves' ``lam sqrt(-K)``
-    shifts the crossing angles by O(eps) only, see the proof of thm:hovering).
+    ``Omega0 + tau0 (K_c + eps <G>)`` (eq:rhocrit). With ``eps b_1 sin(Omega0/2) < 0`` and
+    ``f = b_1 sin`` this lowest curve is ``k_{eps,2}(phi, rho_2(0))``, touching K = 0 at L2 inside
+    J_R: no hovering set (thm:hovering). The corrections are O(eps^2) (the corner curves'
+    ``lam sqrt(-K)`` shifts the crossing angles by O(eps) only, see the proof of thm:hovering).
+
+    The sign rule, for every Omega0 (negative, in (0, 2 pi), in (2 pi, 4 pi), ...) and either sign
+    of tau0: eps hovers when ``eps b_1 sin(Omega0/2) > 0``, i.e. the sign of eps that hovers is
+    ``sign(sin(Omega0/2) b_1)``, of period 4 pi in Omega0 (not 2 pi: Omega0 and Omega0 + 2 pi
+    hover for opposite signs).
 
     Attributes
     ----------
     eps, Omega0, theta_w, tau0 : float
         The parameters.
     forcing : tuple of float
-        Sine coefficients ``b_k`` of f.
+        Sine coefficients ``b_k`` of f used by the theory: the given ones, with those within
+        ``forcing_tol`` of 0 set to 0.
     area : float
         Leading-order ``|HOV|`` (0 where nothing hovers; NaN when resonant).
     hovers : bool
         Whether a hovering set is predicted (``area > 0``).
     hovering_sign : int
-        The sign of eps for which these parameters hover (+1 or -1), 0 if neither or both signs do
-        (or eps-independent degeneracies: resonance, theta_w outside (0, pi)).
+        The sign of eps for which these parameters hover (+1 or -1): ``sign(sin(Omega0/2) b_1)``
+        for ``f = b_1 sin``; for several modes, the sign whose first-order curves dip into J_0
+        (that of ``sin(Omega0/2) b_1`` while b_1 dominates; set by the higher modes when
+        ``b_1 = 0``). 0 if neither or both signs hover, if no mode forces (every ``b_k`` within
+        ``forcing_tol`` of 0), in the ``"wall"`` and ``"none"`` geometries, or at eps-independent
+        degeneracies (resonance, theta_w outside (0, pi)).
     K_crit : float
         Height of the critical curve on L1 (its minimum for ``f = sin``); NaN if nothing hovers.
     rho_crit : float
         Its rotation number; NaN if nothing hovers.
     K_lowest : float
         Height on L1 of the lowest invariant curve that avoids the impacting arcs at K = 0 (the
-        critical curve when hovering, else the curve k^{u0}, which lies in K >= 0).
+        critical curve when hovering, else the curve k^{u0}, which lies in K >= 0; NaN where no
+        arc impacts, geometry ``"none"``).
     note : str
-        Why the prediction is what it is (sign, resonance, missing twist), in words.
+        Why the prediction is what it is (sign, resonance, missing twist, vanishing modes,
+        geometry), in words.
+    forcing_tol : float
+        The tolerance below which a coefficient was taken as 0 (see :func:`theory`).
+    geometry : str
+        ``"step"`` (the paper's), ``"wall"`` or ``"none"`` (see :func:`theory`).
     """
 
     eps: float
@@ -411,6 +461,8 @@ class Theory(Saveable):
     rho_crit: float
     K_lowest: float
     note: str
+    forcing_tol: float = 0.0
+    geometry: str = "step"
 
     def G(self, psi):
         """The first-order shape ``G(psi)``, ``psi = phi + Omega0/2``, of the curves through L1."""
@@ -434,7 +486,19 @@ def _lowest(eps: float, theta_w: float, G, n: int) -> tuple:
     return area, K_low
 
 
-def _first_mode(base: dict, e: float) -> Theory:
+def _sign(x: float) -> int:
+    return 1 if x > 0 else -1 if x < 0 else 0
+
+
+def _dropped_note(dropped: list, tol: float) -> str:
+    """What the tolerance removed, in words ('' if nothing)."""
+    if not dropped:
+        return ""
+    listed = ", ".join(f"b_{k} = {x:.3g}" for k, x in dropped[:4]) + (", ..." if len(dropped) > 4 else "")
+    return f" ({listed}: within the tolerance {tol:.3g} of 0, taken as 0)"
+
+
+def _first_mode(base: dict, e: float, fields: dict) -> Theory:
     """The closed forms for f = b_1 sin (e = eps b_1): eq:kcrit, eq:rhocrit, eq:hovsetsize and k^{u0}."""
     Omega0, theta_w, tau0 = base["Omega0"], base["theta_w"], base["tau0"]
     s = math.sin(0.5 * Omega0)
@@ -442,14 +506,8 @@ def _first_mode(base: dict, e: float) -> Theory:
     K_c = -e * (1 - math.cos(theta_w)) / (2 * s)
     K_low = K_c if hovers else -e / s  # k_{eps,2}(phi, rho_2(0)) = -e (1 + cos psi) / (2 s) on L1
     area = abs(e) * (math.sin(theta_w) - theta_w * math.cos(theta_w)) / abs(s) if hovers else 0.0
-    sign = (
-        1
-        if s * (base["forcing"][0] if base["forcing"] else 0) > 0
-        else -1
-        if s * (base["forcing"][0] if base["forcing"] else 0) < 0
-        else 0
-    )
-    if e == 0:
+    sign = _sign(s * (base["forcing"][0] if base["forcing"] else 0.0))
+    if base["eps"] == 0:
         note = "eps = 0: the hovering set is empty by definition"
     elif hovers:
         note = (
@@ -473,6 +531,58 @@ def _first_mode(base: dict, e: float) -> Theory:
         rho_crit=Omega0 + e * tau0 * math.cos(theta_w) / (2 * s) if hovers else nan,
         K_lowest=K_low,
         note=note,
+        **fields,
+    )
+
+
+def _no_hovering(base: dict, fields: dict, K_lowest: float, note: str) -> Theory:
+    """A Theory with an exactly empty hovering set (area 0, hovers False, sign 0)."""
+    nan = float("nan")
+    return Theory(
+        **base,
+        area=0.0,
+        hovers=False,
+        hovering_sign=0,
+        K_crit=nan,
+        rho_crit=nan,
+        K_lowest=K_lowest,
+        note=note,
+        **fields,
+    )
+
+
+def _other_geometry(base: dict, fields: dict, geometry: str, n: int) -> Theory:
+    """What applies without the step's corner: no hovering set (see :func:`theory`)."""
+    b, eps, Omega0 = base["forcing"], base["eps"], base["Omega0"]
+    if geometry == "none":
+        return _no_hovering(
+            base,
+            fields,
+            float("nan"),
+            "geometry 'none': no walls, so nothing ever impacts and the hovering set (points that impact "
+            "under F_0) is empty for every eps; the return map is smooth (the shifted standard map "
+            "eq:shiftstandardmap to leading order) and no curve is critical",
+        )
+    # The wall: J_0 is empty, every K < 0 arc impacts, so the lowest curve avoiding the impacts is the
+    # lowest first-order curve that stays at K >= 0 on the whole circle (k^{u0}).
+    modes = [k + 1 for k, x in enumerate(b) if x != 0]
+    if eps == 0 or not modes:
+        K_low = 0.0
+    elif any(abs(math.sin(0.5 * k * Omega0)) < 1e-9 for k in modes):
+        K_low = float("nan")  # resonant: no first-order curves
+    elif modes == [1]:
+        K_low = max(0.0, -eps * b[0] / math.sin(0.5 * Omega0))
+    else:
+        probe = Theory(**base, area=0.0, hovers=False, hovering_sign=0, K_crit=0.0, rho_crit=0.0, K_lowest=0.0, note="")
+        _, K_low = _lowest(eps, 0.0, probe.G, n)
+    return _no_hovering(
+        base,
+        fields,
+        K_low,
+        "geometry 'wall': an infinite wall q1 = qw1 without the step's corner, so no orbit crosses q1 = qw1 "
+        "without hitting it: J_0 and J_1 are empty, every K < 0 point impacts on its first return (the wall "
+        "system's map eq:fwall/eq:gwall, of PnueliRomKedarTangency), and HOV, a subset of J_0, is empty for "
+        "every eps and Omega0; the step's theory (thm:hovering, eq:hovsetsize) does not apply",
     )
 
 
@@ -483,8 +593,15 @@ def theory(
     tau0: float = 1.0,
     forcing: Sequence[float] = (1.0,),
     n_grid: int = 100_001,
+    geometry: str = "step",
+    forcing_tol: float | None = None,
 ) -> Theory:
     """Leading-order hovering set, critical curve and its rotation for any Omega0 and odd forcing.
+
+    The paper's theory (thm:hovering, eq:kcrit, eq:rhocrit, eq:hovsetsize) is stated for Omega0 in
+    (0, 2 pi) and f = sin; here it holds for every Omega0, either sign of tau0 and any odd forcing
+    ``f = sum_k b_k sin(k phi)``. The sign of eps that hovers is ``sign(sin(Omega0/2) b_1)`` (period
+    4 pi in Omega0); see :class:`Theory`.
 
     Parameters
     ----------
@@ -497,6 +614,21 @@ def theory(
     n_grid : int, optional
         Points of the grids in psi for a forcing with more than one mode (the integral converges
         as n_grid^-2: ~1e-10 relative at the default; f = b_1 sin uses the closed forms).
+    geometry : {"step", "wall", "none"}, optional
+        The walls of the system (:class:`hovering.StepSystem`). ``"step"``: the paper's theory.
+        ``"wall"``: the infinite wall q1 = qw1 has no corner, so every orbit that crosses
+        q1 = qw1 hits it (J_0 is empty: every K < 0 point impacts on its first return, eq:fwall):
+        the hovering set, a subset of J_0, is empty exactly, for every eps (``area = 0``,
+        ``hovers = False``, ``hovering_sign = 0``; ``K_lowest`` is the lowest first-order curve
+        at K >= 0). ``"none"``: nothing ever impacts, the hovering set is empty by definition.
+    forcing_tol : float, optional
+        Coefficients with ``|b_k| <= forcing_tol`` are taken as 0 (rounding or measurement noise;
+        the note names them). Default: the rounding bound of the package's sine fit of 256
+        samples, ``2 (256 + 2) u sum_k |b_k|`` (u = 2^-53, i.e. 5.7e-14 times ``sum_k |b_k|``).
+        :meth:`hovering.FlowMap.theory` passes the measured forcing's own error bound
+        (:meth:`hovering.FlowMap.forcing_tolerance`). 0 keeps every nonzero coefficient.
+        Without ``b_1`` ("no first-order forcing", e.g. a coupling even in q2) the higher modes
+        decide and the note says so; without any mode the map is F_0 and nothing hovers.
 
     Returns
     -------
@@ -505,14 +637,29 @@ def theory(
     Raises
     ------
     ValueError
-        For non-finite parameters, an empty forcing or ``n_grid < 101``.
+        For non-finite parameters, an empty forcing, ``n_grid < 101``, an unknown geometry or a
+        negative ``forcing_tol``.
     """
     eps, theta_w, tau0 = (real_number(n, v) for n, v in (("eps", eps), ("theta_w", theta_w), ("tau0", tau0)))
     Omega0 = _omega0(real_number("Omega0", Omega0))
-    b = tuple(float(x) for x in forcing_array(forcing))
+    given = tuple(float(x) for x in forcing_array(forcing))
     n_grid = integer("n_grid", n_grid, 101, 10**7)
+    if not is_choice(geometry, _GEOMETRIES):
+        raise ValueError(f"geometry must be one of {_GEOMETRIES}, got {geometry!r}")
+    tol = (
+        _forcing_rounding(given)
+        if forcing_tol is None
+        else real_number("forcing_tol", forcing_tol, lo=0.0, lo_open=False)
+    )
+    b = tuple(0.0 if abs(x) <= tol else x for x in given)
+    dropped = [(k + 1, x) for k, x in enumerate(given) if x != 0 and b[k] == 0]
     nan = float("nan")
     base = dict(eps=float(eps), Omega0=float(Omega0), theta_w=float(theta_w), tau0=float(tau0), forcing=b)
+    fields = dict(forcing_tol=float(tol), geometry=geometry)
+    noise = _dropped_note(dropped, tol)
+    if geometry != "step":
+        th = _other_geometry(base, fields, geometry, int(n_grid))
+        return dataclasses.replace(th, note=th.note + noise) if noise else th
     if not 0 < theta_w < math.pi:
         return Theory(
             **base,
@@ -523,6 +670,7 @@ def theory(
             rho_crit=nan,
             K_lowest=nan,
             note=f"theta_w = {theta_w} outside (0, pi): no arc structure at the tangency",
+            **fields,
         )
     res = [k + 1 for k, x in enumerate(b) if x != 0 and abs(math.sin(0.5 * (k + 1) * Omega0)) < 1e-9]
     if res:
@@ -536,12 +684,25 @@ def theory(
             K_lowest=nan,
             note=f"resonant: sin({res[0]} Omega0 / 2) = 0 (Omega0 = {Omega0}), the first-order "
             "invariant curves do not exist there",
+            **fields,
         )
-    probe = Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan, note="")
     modes = [k + 1 for k, x in enumerate(b) if x != 0]
+    if not modes and eps != 0:
+        # f = 0: K' = K, the circles K = const are invariant (F_eps = F_0 for the truncated map);
+        # below K = 0 they keep impacting.
+        return _no_hovering(
+            base,
+            fields,
+            0.0,
+            "no forcing: every sine coefficient of f is 0" + (noise or f" (b = {given})") + ", so K is preserved to "
+            "that accuracy (K' = K + eps f = K): the circles K = const stay invariant, every orbit below K = 0 keeps impacting and no "
+            "hovering set is predicted (no first-order forcing, no higher modes)",
+        )
     if modes == [1] or not modes:
-        return _first_mode(base, float(eps) * (b[0] if modes else 0.0))
+        th = _first_mode(base, float(eps) * (b[0] if modes else 0.0), fields)
+        return dataclasses.replace(th, note=th.note + noise) if noise else th
     n = int(n_grid)
+    probe = Theory(**base, area=nan, hovers=False, hovering_sign=0, K_crit=nan, rho_crit=nan, K_lowest=nan, note="")
     area_p, _ = _lowest(1.0, theta_w, probe.G, n)
     area_m, _ = _lowest(-1.0, theta_w, probe.G, n)
     sign = 1 if area_p > 0 and area_m == 0 else -1 if area_m > 0 and area_p == 0 else 0
@@ -549,19 +710,26 @@ def theory(
     mean_G = sum(x / (2 * math.sin(0.5 * (k + 1) * Omega0)) for k, x in enumerate(b))
     hovers = area > 0
     s = math.sin(0.5 * Omega0)
-    first = f"eps b_1 sin(Omega0/2) = {eps * b[0] * s:.4g}"
+    if b[0] != 0:
+        first = f"eps b_1 sin(Omega0/2) = {eps * b[0] * s:.4g}"
+        how = f"modes 2..{modes[-1]} of f shape it at O(their size)"
+    else:
+        k_big = 1 + max(range(len(b)), key=lambda k: abs(b[k]))
+        first = (
+            f"no first-order forcing: b_1 = 0, so the paper's first-mode theory predicts nothing; the higher "
+            f"modes act (largest: eps b_{k_big} = {eps * b[k_big - 1]:.3g})"
+        )
+        how = f"set by mode{'s' if len(modes) > 1 else ''} {', '.join(str(k) for k in modes)} of f"
     if eps == 0:
         note = "eps = 0: the hovering set is empty by definition"
     elif hovers:
-        note = (
-            f"hovering: the critical curve dips into J_0 near L1 ({first}; modes 2..{len(b)} of f shape it "
-            "at O(their size))"
-        )
+        note = f"hovering: the critical curve dips into J_0 near L1 ({first}; {how})"
     else:
         note = (
             f"no hovering set: every first-order invariant curve that dips below K = 0 does so in the impacting "
             f"arcs ({first}); the lowest curve avoiding the impacts stays in K >= 0"
         )
+    note += noise
     if tau0 == 0:
         note += "; tau0 = 0 (no twist): KAM curves need not exist, the first-order curves are formal"
     return Theory(
@@ -573,4 +741,5 @@ def theory(
         rho_crit=Omega0 + tau0 * (K_low + eps * mean_G) if hovers else nan,
         K_lowest=K_low,
         note=note,
+        **fields,
     )
