@@ -171,7 +171,10 @@ def critical_curve(
         Iterates per tested orbit (>= 16).
     K_range : (float, float), optional
         Heights searched. Default: from 3 times the predicted critical height (or ``-2 |eps| /
-        |sin(Omega0/2)|`` when none is predicted) up to ``|eps| / |sin(Omega0/2)|``, in the band.
+        |sin(Omega0/2)|`` when none is predicted; ``-|eps| / (4 |sin(Omega0/2)|)`` where the sign of
+        eps does not hover, whose curve k^{u0} crosses L2 at K >= 0) up to ``|eps| /
+        |sin(Omega0/2)|``, clipped strictly inside the band (a ValueError names it if that leaves
+        nothing).
     regions : iterable, optional
         The no-impact set: ``("0u", "0")`` for the hovering critical curve, ``("0u",)`` for the
         curve k^{u0} (lowest curve in K >= 0).
@@ -246,8 +249,20 @@ def critical_curve(
     s = abs(math.sin(0.5 * th.Omega0))
     scale = abs(m.eps) * max(abs(b) for b in th.forcing) / max(s, 1e-3)
     if K_range is None:
-        K_a = 3 * th.K_crit if th.hovers else -2 * scale
-        K_range = (max(K_a, lo * (1 - 1e-9)), min(max(scale, 1e-6), hi))
+        # Hovering: the critical curve dips to ~K_crit < 0 near L1. Otherwise the lowest curve
+        # avoiding impacts is k^{u0}, crossing L2 at K >= 0: a start far below 0 would find the
+        # tori under the impact zone (a curve under its floor), so the search starts just below 0.
+        K_a = 3 * th.K_crit if th.hovers and th.K_crit < 0 else (-2 * scale if th.hovers else -0.25 * scale)
+        K_b = max(scale, 1e-6)
+        # strictly inside the band (its edges are refused below: the map is not defined past them)
+        pad = 1e-6 * min(hi - lo, 1.0)
+        K_a, K_b = min(max(K_a, lo + pad), hi - pad), min(max(K_b, lo + pad), hi - pad)
+        if not K_a < K_b:
+            raise ValueError(
+                f"the default K_range ({K_a:.6g}, {K_b:.6g}) is empty inside the band ({lo}, {hi}) "
+                f"at eps = {m.eps} (the predicted heights lie outside it): pass K_range"
+            )
+        K_range = (K_a, K_b)
     kr = real_array("K_range", K_range) if not isinstance(K_range, str) else None
     if kr is None or kr.shape != (2,):
         raise ValueError(f"K_range must be a pair (K_lo, K_hi), got {K_range!r}")
