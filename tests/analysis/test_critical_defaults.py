@@ -29,8 +29,8 @@ def test_the_non_hovering_sign_finds_k_u0_not_the_tori_under_the_zone():
     assert c.K0 > -0.01
 
 
-def test_an_empty_default_range_says_so():
-    # a band squeezed above the predicted heights: the default is empty and the error says to pass one
+def test_a_reversed_range_is_refused_by_name():
+    # a given range is checked too (the default is built inside the band, above)
     m = hv.paper.truncated_map(eps=0.05)
     with pytest.raises(ValueError, match="K_range"):
         hv.critical_curve(m, K_range=(0.5, 0.4))

@@ -1185,8 +1185,10 @@ def _zone_study(name, m, zone, scene: ImpactZoneScene, n_scan: int, n_transit: i
     sec["scan"] = time.perf_counter() - t
     t = time.perf_counter()
     kw = dict(n_orbits=scene.transit_orbits, n_steps=n_transit, **_progress_kw(progress))
-    up = transit(m, zone, "up", start_s=0.05, target_s=1.0, **kw)
-    down = transit(m, zone, "down", start_s=0.95, target_s=0.0, **kw)
+    # transit's default targets lie inside the zone (1 - margin, margin): its boundaries are
+    # invariant curves that no orbit reaches, so targets on them could never count a crossing
+    up = transit(m, zone, "up", start_s=0.05, **kw)
+    down = transit(m, zone, "down", start_s=0.95, **kw)
     sec["transit"] = time.perf_counter() - t
     return ZoneStudy(name=name, zone=zone, scan=scan, up=up, down=down, seconds=sec)
 
