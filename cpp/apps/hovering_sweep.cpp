@@ -51,6 +51,17 @@ extern "C" void on_signal(int) {
     g_cancel.store(true);
 }
 
+/// Text from a file (a plan's name and labels, a path, a message quoting them) as it is printed, one line:
+/// control characters as '?', so that no escape sequence (ESC [ ...) from a file reaches the terminal.
+std::string printable(const std::string& s) {
+    std::string out = s;
+    for (char& c : out) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (u < 0x20 || u == 0x7f) c = '?';
+    }
+    return out;
+}
+
 std::string num(double x) {
     char buf[64];
     const auto r = std::to_chars(buf, buf + sizeof buf, x);
@@ -160,6 +171,7 @@ int main(int argc, char** argv) {
     try {
         // Everything is checked before the file is touched or anything is computed.
         const Plan plan = load_plan(plan_path);
+        check_memory(plan);
         const std::string path = output_path(plan, out);
         {
             std::error_code ec;
@@ -173,13 +185,13 @@ int main(int argc, char** argv) {
         }
         Checkpoint ckpt(path);
         if (!ckpt.torn().empty())
-            std::cerr << "hovering_sweep: " << path << ": dropped " << ckpt.torn()
+            std::cerr << "hovering_sweep: " << printable(path) << ": dropped " << ckpt.torn()
                       << ", left by an interrupted run; its point is recomputed\n";
         std::size_t todo = 0;
         for (const auto& p : plan.points) todo += !ckpt.done(p.key);
-        const std::string name = plan.name.empty() ? plan_path : plan.name;
+        const std::string name = printable(plan.name.empty() ? plan_path : plan.name);
         std::cerr << name << ": " << plan.points.size() << " points, " << plan.points.size() - todo << " already in "
-                  << path << "\n";
+                  << printable(path) << "\n";
         if (todo == 0) return 0;
 
         const std::string prov = provenance(threads);
@@ -190,7 +202,7 @@ int main(int argc, char** argv) {
             const PlanPoint& p = plan.points[i];
             if (ckpt.done(p.key)) continue;  // finished (by another run, meanwhile)
             std::string what = "[" + std::to_string(i + 1) + "/" + std::to_string(plan.points.size()) + "]";
-            if (!p.label.empty()) what += " " + p.label + ",";
+            if (!p.label.empty()) what += " " + printable(p.label) + ",";
             what += " eps = " + num(plan.kind == "hovering_area" ? p.map.eps : p.system.eps);
             std::atomic<std::int64_t> done{0};
             PointRow row;
@@ -204,7 +216,8 @@ int main(int argc, char** argv) {
             }
             if (row.interrupted || g_cancel.load()) {
                 std::cerr << "hovering_sweep: interrupted during " << what << "; the " << written
-                          << " point(s) finished in this run are in " << path << " (rerun the same command to go on)\n";
+                          << " point(s) finished in this run are in " << printable(path)
+                          << " (rerun the same command to go on)\n";
                 return 130;
             }
             const bool mine = ckpt.append(p.key, row.row, prov);  // on disk (fsync) before the next point starts
@@ -217,7 +230,7 @@ int main(int argc, char** argv) {
         std::cerr << "hovering_sweep: out of memory (reduce the plan's samples or --threads)\n";
         return 2;
     } catch (const std::exception& e) {
-        std::cerr << "hovering_sweep: " << e.what() << "\n";
+        std::cerr << "hovering_sweep: " << printable(e.what()) << "\n";
         return 2;
     }
 }

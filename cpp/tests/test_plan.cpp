@@ -187,6 +187,36 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
          "points[0].models[0].Omega = an array of 3: allowed: an array of 4 to 4 entries");
 }
 
+TEST_CASE("crafted plans: refused with one bounded message, never a crash; sizes checked before a run", "[plan]") {
+    // Before: a dotted key of 100,000 parts crashed the TOML reader (one nested table per part,
+    // built recursively); now refused by a linear scan before it runs.
+    std::string deep = "x";
+    for (int i = 0; i < 100000; ++i) deep += ".a";
+    CHECK_INVALID(parse_plan(kHead + deep + " = 1\n" + kPoint, "p.toml"),
+                  "p.toml line 4: a dotted key of more than 16 parts: allowed: at most 16");
+    CHECK_INVALID(parse_plan(kHead + "[" + deep + "]\n", "p.toml"), "p.toml line 4: a dotted key of more than 16");
+    // Dots in strings, comments, numbers and a plan's own dotted keys are no key parts.
+    const std::string dots(40, '.');
+    const Plan ok =
+        parse_plan(kHead + "name = \"" + dots + "\" # " + dots + "\ncheckpoint = '''" + dots + "\n" + dots + "'''\n" +
+                       point_with("map",
+                                  "map.eps = 0.1\nmap.Omega0 = 3.883222077450933\nmap.theta_w = "
+                                  "2.356194490192345\nmap.tau0 = 1.0\nmap.tau1 = 0.5\nmap.lam = 0.5"),
+                   "p.toml");
+    CHECK(ok.name == dots);
+    // A message shows numbers as they read back (before: "-0.000000", or 300 digits for 1e300).
+    CHECK_INVALID(parse_plan(kHead + point_with("K_low", "K_low = -1e300"), "p.toml"),
+                  "p.toml: points[0]: K_low = -1e+300 lies below the map's band (lower end -3.14159");
+    // Samples beyond the memory budget: refused before anything is computed or written (before: a
+    // std::bad_alloc once the run had started).
+    const Plan huge = parse_plan(kHead + point_with("samples", "samples = 9007199254740992"), "p.toml");
+    CHECK_INVALID(check_memory(huge, std::uintmax_t(1) << 30),
+                  "plan: points[0].samples = 9007199254740992 needs 5.37e+08 GiB, more than 1 GiB (half of this "
+                  "machine's memory): allowed: at most 16777216 samples here");
+    CHECK_NOTHROW(check_memory(huge, std::uintmax_t(1) << 62));
+    CHECK_NOTHROW(check_memory(parse_plan(kHead + kPoint, "p.toml")));
+}
+
 TEST_CASE("checkpoint: header, points by key, torn and damaged lines", "[checkpoint]") {
     const std::string path = tmp("c.jsonl");
     fs::remove(path);
@@ -235,5 +265,104 @@ TEST_CASE("checkpoint: header, points by key, torn and damaged lines", "[checkpo
         CHECK(slurp(path) == first);
     }
     CHECK_INVALID(Checkpoint{fs::temp_directory_path().string()}, "is not a regular file");
+    fs::remove_all(fs::path(path).parent_path());
+}
+
+TEST_CASE("checkpoint: crafted lines are refused naming the file, the line and the field, never a crash",
+          "[checkpoint]") {
+    const std::string path = tmp("crafted.jsonl");
+    const std::string head = "{\"format\":\"hovering-checkpoint\",\"version\":1}\n";
+    const std::string good = head + "{\"key\":{\"a\":1},\"row\":{}}\n";
+    const auto deep = [](std::size_t n, const std::string& open, const std::string& close) {
+        std::string s;
+        for (std::size_t i = 0; i < n; ++i) s += open;
+        s += "1";
+        for (std::size_t i = 0; i < n; ++i) s += close;
+        return s;
+    };
+    struct Case {
+        std::string line, needle;
+    };
+    // Before: the deep keys crashed (dumping them recursed once per level: a stack overflow); 1e999
+    // and NaN said "not a line of JSON" and nothing of where; a huge integer was read as another
+    // number; a name twice kept its last value; a byte-order mark was skipped.
+    const std::vector<Case> cases = {
+        {"{\"key\":" + deep(200000, "{\"a\":", "}") + ",\"row\":{}}",
+         "line 3: not a line of JSON: nested deeper than 100 levels, in key.a.a.a"},
+        {"{\"key\":{\"b\":" + deep(1000000, "[", "]") + "},\"row\":{}}",
+         "line 3: not a line of JSON: nested deeper than 100 levels, in key.b[0][0]"},
+        {"{\"key\":{},\"row\":" + deep(100000, "{\"r\":", "}") + "}", "nested deeper than 100 levels, in row.r.r"},
+        {"{\"provenance\":" + deep(100000, "[", "]") + "}", "nested deeper than 100 levels, in provenance[0]"},
+        {"{\"key\":" + std::string(3000000, '['), "nested deeper than 100 levels, in key[0][0]"},
+        {"{\"key\":{\"x\":1e999},\"row\":{}}", "line 3: not a line of JSON: number overflow parsing '1e999'"},
+        {"{\"key\":{\"x\":1},\"row\":{\"area\":-1e999}}", "number overflow parsing '-1e999' at byte 35, in row.area"},
+        {"{\"key\":{\"n\":123456789012345678901234567890},\"row\":{}}",
+         "line 3: key.n: the integer 123456789012345678901234567890 is beyond 64 bits"},
+        {"{\"key\":{\"n\":-9223372036854775809},\"row\":{}}",
+         "line 3: key.n: the integer -9223372036854775809 is beyond"},
+        {"{\"key\":{\"x\":NaN},\"row\":{}}", "line 3: not a line of JSON: invalid literal at byte 13, in key.x"},
+        {"{\"key\":{\"x\":\"\xff\xfe\"},\"row\":{}}", "line 3: not a line of JSON: invalid string: ill-formed UTF-8"},
+        {"{\"key\":{\"s\":\"\\ud800\"},\"row\":{}}",
+         "invalid string: surrogate U+D800..U+DBFF must be followed by U+DC00..U+DFFF at byte 20, in key.s"},
+        {"{\"key\":{\"a\":[1,2,\"x\x01\"]},\"row\":{}}",
+         "invalid string: control character U+0001 (SOH) must be escaped to \\u0001 at byte 20, in key.a[2]"},
+        {"{\"key\":{\"x\":1},\"key\":{\"x\":2},\"row\":{}}", "line 3: key: the name 'key' twice in one object"},
+        {"{\"key\":{\"m\":{\"a\":1,\"a\":2}},\"row\":{}}", "line 3: key.m.a: the name 'a' twice in one object"},
+        {"{\"key\":{\"eps\":0.1,\"n\":},\"row\":{}}",
+         "line 3: not a line of JSON: unexpected '}'; expected '[', '{', or a literal at byte 23, in key.n"},
+        {"{\"key\":1,\"row\":{}}", "line 3: key must be an object, got a number 1"},
+        {"{\"key\":{},\"row\":\"" + std::string(100000, 'x') + "\"}",
+         "line 3: row must be an object, got a string \"xxx"},
+        {"{\"key\":{}}", "line 3: a point without its 'row' field"},
+        {"{\"row\":{}}", "line 3: a point without its 'key' field"},
+        {"{\"key\":{},\"row\":{},\"extra\":1}", "line 3: a point with other fields: 'extra', 'key', 'row'"},
+        {"{\"provenance\":[1]}", "line 3: provenance must be an object, got an array"},
+        {"{\"other\":1}", "line 3: neither a point"},
+        {"[1, 2]", "line 3: not a JSON object: the line is an array"},
+        {"", "line 3: not a line of JSON: unexpected end of input"},
+        {"\xEF\xBB\xBF{\"key\":{},\"row\":{}}", "line 3: not a line of JSON: a byte-order mark"},
+    };
+    for (const Case& c : cases) {
+        const std::string text = good + c.line + "\n" + "{\"key\":{\"x\":0.3},\"row\":{}}\n";
+        spit(path, text);
+        INFO(c.line.substr(0, 60));
+        CHECK_INVALID(Checkpoint{path}, path + " line 3: ");
+        CHECK_INVALID(Checkpoint{path}, c.needle);
+        try {
+            Checkpoint{path};
+        } catch (const std::invalid_argument& e) {
+            CHECK(std::string(e.what()).size() < 600);  // one bounded line
+        }
+        CHECK(slurp(path) == text);
+    }
+    // The header: a bounded message naming 'version'.
+    for (const auto& [first, needle] : std::vector<std::pair<std::string, std::string>>{
+             {"{\"format\":\"hovering-checkpoint\",\"version\":" + deep(1000000, "[", "]") + "}",
+              "line 1: the first line is not the header"},
+             {"{\"format\":\"hovering-checkpoint\",\"version\":\"" + std::string(10000000, 'x') + "\"}",
+              "line 1: a checkpoint of version \"xxx"},
+             {"{\"format\":\"hovering-checkpoint\",\"version\":1e400}",
+              "line 1: the first line is not the header {\"format\": \"hovering-checkpoint\", \"version\": 1}: another "
+              "program's file (not a line of JSON: number overflow parsing '1e400' at byte 47, in version)"},
+         }) {
+        spit(path, first + "\n");
+        CHECK_INVALID(Checkpoint{path}, path + " " + needle);
+        try {
+            Checkpoint{path};
+        } catch (const std::invalid_argument& e) {
+            CHECK(std::string(e.what()).size() < 600);
+        }
+    }
+    // One line without its newline that is not a piece of the header: another program's file,
+    // refused untouched (before: cut to nothing as a "torn" line, then written over).
+    spit(path, "my notes, one line");
+    CHECK_INVALID(Checkpoint{path}, path + " line 1: the first line is not the header");
+    CHECK(slurp(path) == "my notes, one line");
+    spit(path, "{\"format\":\"hovering-che");  // a torn header: cut off
+    {
+        Checkpoint c(path);
+        CHECK(!c.torn().empty());
+    }
+    CHECK(slurp(path).empty());
     fs::remove_all(fs::path(path).parent_path());
 }

@@ -112,4 +112,35 @@ expect_bad "is not a regular file" --plan .
 printf 'area,error\n1,2\n' > foreign.csv
 expect_bad "foreign.csv line 1: the first line is not the header" --plan sweep_small.plan.toml --out foreign.csv
 [ "$(cat foreign.csv)" = "$(printf 'area,error\n1,2')" ] || fail "the foreign file was touched"
+# Crafted checkpoint lines: exit 2 and one line naming the file, the line and the field, the file
+# untouched; never a crash (a key nested a million deep overflowed the stack: SIGSEGV).
+head -n 1 before.jsonl > deep.jsonl
+{
+  printf '{"key":{"a":'
+  head -c 1000000 /dev/zero | tr '\0' '['
+  head -c 1000000 /dev/zero | tr '\0' ']'
+  printf '},"row":{}}\n'
+} >> deep.jsonl
+cp deep.jsonl deep.before
+expect_bad "deep.jsonl line 2: not a line of JSON: nested deeper than 100 levels, in key.a[0][0]" --plan sweep_small.plan.toml --out deep.jsonl
+cmp -s deep.jsonl deep.before || fail "the crafted checkpoint was touched"
+head -n 1 before.jsonl > twice.jsonl
+printf '{"key":{"n":1,"n":2},"row":{"area":1e999}}\n' >> twice.jsonl
+expect_bad "twice.jsonl line 2: key.n: the name 'n' twice in one object" --plan sweep_small.plan.toml --out twice.jsonl
+# One line without its newline that is no piece of the header: another program's file, kept
+# (before: cut to nothing as a torn line, then written over).
+printf 'my notes, one line' > notes.txt
+expect_bad "notes.txt line 1: the first line is not the header" --plan sweep_small.plan.toml --out notes.txt
+[ "$(cat notes.txt)" = "my notes, one line" ] || fail "the one-line file was touched"
+# A plan from elsewhere cannot drive the terminal: a label's control characters (an ESC sequence)
+# are printed as '?' (before: written to stderr as they were).
+sed '0,/^label = .*/s//label = "\\u001b[31mred\\u0007"/' sweep_small.plan.toml > esc.plan.toml
+"$EXE" --plan esc.plan.toml --out esc.jsonl --threads 1 2> esc.err || fail "esc: exit $? $(cat esc.err)"
+grep -q '\[1/4\] ?\[31mred?, eps' esc.err || fail "the label was not printed as '?[31mred?': $(cat -v esc.err)"
+if grep -q "$(printf '\033')" esc.err; then fail "an ESC reached stderr: $(cat -v esc.err)"; fi
+# Samples beyond half of this machine's memory: refused before the checkpoint is created (before:
+# std::bad_alloc once the run had started).
+sed '0,/^samples = 800/s//samples = 9007199254740992/' sweep_small.plan.toml > huge.plan.toml
+expect_bad "huge.plan.toml: points[0].samples = 9007199254740992 needs" --plan huge.plan.toml --out huge.jsonl
+[ -e huge.jsonl ] && fail "a plan beyond the memory budget created its output"
 echo "all hovering_sweep plan checks passed"

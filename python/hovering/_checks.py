@@ -22,6 +22,8 @@ __all__ = [
     "is_choice",
     "thread_count",
     "forcing_array",
+    "BYTES_PER_POINT",
+    "check_points",
     "point_pair",
     "real_array",
     "require_finite",
@@ -136,21 +138,68 @@ def forcing_array(value) -> np.ndarray:
     return b
 
 
+#: Memory one point of a call on many points takes, counted at most: its two coordinates as given
+#: and as the core reads them (C-ordered copies), its image, region and status (a call that also
+#: records orbits checks those: :func:`check_memory`).
+BYTES_PER_POINT = 64
+
+
+def check_points(names: tuple, shapes: tuple) -> tuple:
+    """The shape arrays of ``shapes`` broadcast to, refused before anything is allocated when its
+    points would not fit in half of this machine's memory (at :data:`BYTES_PER_POINT` each).
+
+    Broadcasting is free (views), but the copies a call makes of its points are not: an (n, 1) and
+    a (1, n) array are n^2 points.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The arguments' names, for the message.
+    shapes : tuple of tuple
+        Their shapes.
+
+    Returns
+    -------
+    tuple
+        The broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not broadcast, or too many points (naming the shapes, the count and the
+        largest count allowed).
+    """
+    try:
+        shape = np.broadcast_shapes(*shapes)
+    except ValueError:
+        raise ValueError(
+            f"{' and '.join(names)} must have broadcastable shapes, got {' and '.join(str(s) for s in shapes)}"
+        ) from None
+    n = math.prod(shape)
+    most = physical_memory() // 2 // BYTES_PER_POINT
+    if n > most:
+        given = " and ".join(f"{a} (shape {s})" for a, s in zip(names, shapes))
+        raise ValueError(
+            f"{given} broadcast to {n} points; allowed: at most {most} (half of this machine's memory at "
+            f"{BYTES_PER_POINT} bytes a point): pass fewer points per call"
+        )
+    return shape
+
+
 def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
     """Points (phi, K) of a map: real, finite, |phi| <= 1e6, broadcast together (C-ordered); and
-    whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0)."""
+    whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0).
+    The broadcast size is checked (:func:`check_points`) before the copies are made."""
     na, nb = (f"{who}: {n}" if who else n for n in names)
     scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
     p, k = real_array(na, phi), real_array(nb, K)  # type errors first, named
     require_angles(na, p)
     require_finite(nb, k)
     try:
-        p, k = np.broadcast_arrays(p, k)
-    except ValueError:
-        raise ValueError(
-            f"{who + ': ' if who else ''}{names[0]} and {names[1]} must have broadcastable shapes, got "
-            f"{np.shape(phi)} and {np.shape(K)}"
-        ) from None
+        check_points(tuple(names), (p.shape, k.shape))
+    except ValueError as e:
+        raise ValueError(f"{who}: {e}" if who else str(e)) from None
+    p, k = np.broadcast_arrays(p, k)
     # np.ascontiguousarray would turn 0-d into 1-d; the bindings copy non-contiguous views themselves.
     return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
 

@@ -164,6 +164,30 @@ BAD.update(
             lambda: hv.corner_curves(SEC, [-0.05], n_phi=10**9),
             r"n_phi must be an integer in \[16, 65536\]",
         ),
+        # Before: MemoryError from numpy (np.tile of 488 GiB), after the tangential curve was traced.
+        "corner_curves 1e6 circles x 65536": (
+            lambda: hv.corner_curves(SEC, np.linspace(-0.1, -0.01, 10**6), n_phi=65536),
+            r"K \(1000000 circles\) x n_phi \(65536\) = 65536000000 samples, mapped at once; allowed: at most \d+",
+        ),
+        # Before: MemoryError from numpy copying the broadcast points (an (n, 1) and a (1, n) array
+        # are n^2 points), before any check of their number.
+        "iterate broadcast 1e12 starts": (
+            lambda: M.iterate(np.zeros((10**6, 1)), np.full((1, 10**6), -0.01), 10, record=()),
+            r"phi0 \(shape \(1000000, 1\)\) and K0 \(shape \(1, 1000000\)\) broadcast to 1000000000000 points; "
+            r"allowed: at most \d+ \(half of this machine's memory at 64 bytes a point\)",
+        ),
+        "step broadcast 1e12 points": (
+            lambda: M.step(np.zeros((10**6, 1)), np.full((1, 10**6), -0.01)),
+            r"step: phi \(shape \(1000000, 1\)\) and K \(shape \(1, 1000000\)\) broadcast to 1000000000000 points",
+        ),
+        "return_map broadcast 1e12 starts": (
+            lambda: SEC.return_map(np.zeros((10**6, 1)), np.full((1, 10**6), 0.5)),
+            r"theta \(shape \(1000000, 1\)\) and I \(shape \(1, 1000000\)\) broadcast to 1000000000000 points",
+        ),
+        "to_normal broadcast 1e12 points": (
+            lambda: hv.to_normal(SEC, np.zeros((10**6, 1)), np.full((1, 10**6), 0.5)),
+            r"theta \(shape \(1000000, 1\)\) and I \(shape \(1, 1000000\)\) broadcast to 1000000000000 points",
+        ),
         "forcing_coefficients n_phi=1e7": (
             lambda: hv.forcing_coefficients(SEC, 3, 10**7),
             r"n_phi .* in \[7, 65536\], got 10000000",

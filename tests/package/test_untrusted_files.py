@@ -525,6 +525,25 @@ def test_wrong_types_and_values_in_a_flowmap_record(what, genuine, tmp_path):
     _refused(hv.load, _craft(genuine["flowmap"], tmp_path / f"{what}.npz", edit), match=msg)
 
 
+def test_a_polynomial_record_with_a_repeated_power_is_refused(tmp_path):
+    # Before: {(i, j): c for ...} kept the last coefficient of a repeated power and dropped the
+    # first without a word (the system loaded with another coupling than the file lists).
+    sys_ = hv.StepSystem(
+        hv.Harmonic(1.0), hv.Tan(1.4, 0.7), coupling=hv.Polynomial({(1, 1): 1.0, (2, 0): 0.5}), eps=0.1
+    )
+    src = Path(hv.save(sys_, tmp_path / "sys"))
+
+    def terms(d):
+        return d["tree"]["data"]["__dict__"]["coupling"]["data"]["__dict__"]["terms"]["__list__"]
+
+    dup = _craft(src, tmp_path / "dup.npz", lambda d: terms(d).append({"__list__": [1, 1, 2.0]}))
+    err = _refused(hv.load, dup, match=r"root@\.coupling: terms\[2\] = \[1, 1, 2\.0\] repeats the power q1\^1 q2\^1")
+    assert str(err).startswith(f"{dup}: ")
+    short = _craft(src, tmp_path / "short.npz", lambda d: terms(d).__setitem__(0, {"__list__": [1, 1]}))
+    _refused(hv.load, short, match=r"root@\.coupling: terms\[0\] must be a term \[i, j, c\]")
+    assert hv.load(src).coupling == sys_.coupling
+
+
 @pytest.mark.parametrize("case", ["dpi", "figsize", "layout", "title"])
 def test_redraw_refuses_what_the_scene_schema_refuses(case, genuine, tmp_path, capsys):
     edit, msg = {

@@ -72,6 +72,43 @@ def test_flow_map_pieces_give_the_single_process_answer():
     same(hovering_area(fm, **kw), hovering_area(fm, **kw, executor=Executor(workers=2, pieces=3)))
 
 
+def _python_flow_map(picklable: bool):
+    """A FlowMap whose V1 is a CustomPotential (the harmonic well q^2): of lambdas, or of stdlib
+    callables that pickle by name (a process pool's worker can import them)."""
+    import functools
+    import operator
+
+    from hovering import Bilinear, CustomPotential, FlowMap, StepSystem, Tan
+
+    if picklable:
+        V1 = CustomPotential(functools.partial(pow, exp=2), functools.partial(operator.mul, 2.0), name="sq")
+    else:
+        V1 = CustomPotential(lambda q: q * q, lambda q: 2.0 * q, name="sq")
+    return FlowMap(StepSystem(V1, Tan(1.4, 0.7), coupling=Bilinear(), eps=0.05), 1.5, rtol=1e-6, atol=1e-6)
+
+
+def test_a_python_defined_potential_runs_on_threads_and_pools_or_is_refused_at_once(tmp_path):
+    # Before: every executor= run of such a map died on the pieces' checkpoint key (a TypeError
+    # about NPZ files), with or without a checkpoint; a process pool pickled the lambdas piece by
+    # piece after the pool had started.
+    import concurrent.futures as cf
+    import multiprocessing
+
+    kw = dict(n_steps=8, samples=16, seed=2, components=False)
+    fm = _python_flow_map(picklable=False)
+    single = hovering_area(fm, **kw)
+    same(single, hovering_area(fm, **kw, executor=2))  # threads: no pickling needed
+    with cf.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with pytest.raises(ValueError, match=r"the map cannot be sent to the caller's pool: it does not pickle"):
+            hovering_area(fm, **kw, executor=pool)
+        fm2 = _python_flow_map(picklable=True)
+        same(hovering_area(fm2, **kw), hovering_area(fm2, **kw, executor=Executor(pool=pool, pieces=2)))
+    # A checkpoint keys pieces by the map's record, which code has not: refused before any work.
+    with pytest.raises(ValueError, match=r"checkpoint= keys each piece by the map's record, and this map has none"):
+        hovering_area(fm, **kw, executor=Executor(workers=2, checkpoint=tmp_path / "c.jsonl"))
+    assert not (tmp_path / "c.jsonl").exists()
+
+
 def _points(path) -> list:
     """The point records of a checkpoint (its header and provenance lines left out)."""
     return [json.loads(x) for x in path.read_text().splitlines() if x.startswith('{"key":')]

@@ -259,6 +259,14 @@ BAD = [
     ("flow_portrait", ("system", "qw1"), 0.5, "system.qw1 = 0.5 is out of range"),
     ("flow_portrait", ("system", "geometry"), "wall", "system.geometry = 'wall'"),
     ("flow_portrait", ("system", "coupling"), [[1.0, 1]], "system.coupling[0] must be a term [c, i, j]"),
+    # A repeated power: before, the last coefficient silently replaced the first (Polynomial's dict).
+    (
+        "flow_portrait",
+        ("system", "coupling"),
+        [[1.0, 1, 1], [0.5, 2, 0], [2.0, 1, 1]],
+        "flow_portrait.toml.system.coupling[2] = [2.0, 1, 1] repeats the term q1^1 q2^1 of "
+        "flow_portrait.toml.system.coupling[0]; allowed: each power (i, j) once",
+    ),
     ("flow_portrait", ("section", "h"), 0.1, "section.h = 0.1 is out of range; allowed: above the step energy"),
     ("flow_portrait", ("integrator", "rtol"), 1.0, "integrator.rtol = 1.0 is out of range"),
     ("flow_portrait", ("integrator", "stepper"), "euler", "integrator.stepper = 'euler' is not allowed"),
@@ -384,3 +392,23 @@ def test_cli_explore_is_wired(capsys):
     assert "cannot open a window" in capsys.readouterr().err
     assert main(["explore", str(SCENE_DIR / "absent.toml")]) == 2
     assert "error:" in capsys.readouterr().err
+
+
+def test_a_repeated_coupling_power_is_refused_in_a_file_and_in_a_spec(tmp_path):
+    # Read from a file: the error names the file, the entry and the term it repeats.
+    text = (SCENE_DIR / "flow_portrait.toml").read_text()
+    assert 'coupling = "bilinear"' in text
+    path = tmp_path / "dup.toml"
+    path.write_text(text.replace('coupling = "bilinear"', "coupling = [[1.0, 1, 1], [2.0, 1, 1]]"))
+    with pytest.raises(ValueError, match=r"^dup\.toml\.system\.coupling\[1\] = \[2\.0, 1, 1\] repeats the term"):
+        scenes.load_scene(path, check_output=False)
+    # A spec built in Python: its system is not built with one of the two coefficients dropped.
+    from hovering.scenes.spec import PotentialSpec, SystemSpec
+
+    spec = SystemSpec(
+        PotentialSpec("harmonic", 1.0), PotentialSpec("harmonic", 1.4), coupling=((1.0, 1, 1), (2.0, 1, 1))
+    )
+    with pytest.raises(
+        ValueError, match=r"coupling\[1\] = \(2\.0, 1, 1\) repeats the power q1\^1 q2\^1 of coupling\[0\]"
+    ):
+        spec.build()

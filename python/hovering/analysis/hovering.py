@@ -276,14 +276,28 @@ def _piece(m, samples, K_low, seed, lo, hi, n_steps: int, n_threads: int):
     return _outcomes(m, phi, K, n_steps, n_threads, stop_hook() or False)
 
 
-def _piece_key(m, n_steps, K_low, seed, samples, lo, hi) -> dict:
-    """Everything that changes a piece's outcomes: the map's record (its parameters, integrator
-    options, measured curve), the counts, the box, the seed and the piece's range."""
+def _map_key(m):
+    """The map's record as a checkpoint keys it (:func:`hovering._serial.record_key`), or a
+    ValueError, before any work, for a map that has none: a potential defined in Python
+    (CustomPotential, a Potential subclass) is code, which no record holds."""
     from .._serial import record_key
 
+    try:
+        return record_key(m)
+    except TypeError as e:
+        raise ValueError(
+            f"checkpoint= keys each piece by the map's record, and this map has none ({e}); "
+            "run without a checkpoint, or with compiled potentials (Harmonic, Tan, Numerical)"
+        ) from None
+
+
+def _piece_key(m, n_steps, K_low, seed, samples, lo, hi, map_key=None) -> dict:
+    """Everything that changes a piece's outcomes: the map's record (its parameters, integrator
+    options, measured curve; ``map_key`` if already computed), the counts, the box, the seed and
+    the piece's range."""
     return {
         "hovering_area_piece": {
-            "map": record_key(m),
+            "map": _map_key(m) if map_key is None else map_key,
             "n_steps": int(n_steps),
             "K_low": float(K_low),
             "seed": int(seed),
@@ -315,16 +329,25 @@ def _piece_arrays(row, n: int) -> tuple:
 
 
 def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Executor):
+    # Checked before the pool starts: only a checkpoint needs the map's record (a map with a
+    # Python-defined potential has none, and runs without one).
+    map_key = _map_key(m) if spec.checkpoint is not None else None
+    python_defined = bool(getattr(getattr(m, "sys", None), "python_defined", False))
     with open_executor(**spec.where()) as ex:
+        ex.check_sendable(m, "the map")
         threads = n_threads if n_threads != 0 else ex.threads_per_piece
+        if python_defined and n_threads == 0:
+            threads = 1  # its calls serialise on the GIL: more core threads per piece only contend
         k = integer("pieces", spec.pieces if spec.pieces is not None else 4 * ex.workers, 1, max(1, n))
         bounds = [(n * i // k, n * (i + 1) // k) for i in range(k)]
         store = Checkpoint(spec.checkpoint) if spec.checkpoint is not None else None
         out = [None] * k
         todo = []
         for i, (lo, hi) in enumerate(bounds):
-            key = _piece_key(m, n_steps, K_low, seed, samples, lo, hi)
-            row = store.get(key, lambda r, n=hi - lo: _piece_arrays(r, n)) if store else None
+            row = None
+            if store is not None:
+                key = _piece_key(m, n_steps, K_low, seed, samples, lo, hi, map_key)
+                row = store.get(key, lambda r, n=hi - lo: _piece_arrays(r, n))
             if row is not None:
                 out[i] = _piece_arrays(row, hi - lo)
                 bar.advance(2 * (hi - lo) * n_steps)
@@ -337,7 +360,7 @@ def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Exec
             out[i] = res
             if store is not None:
                 store.put(
-                    _piece_key(m, n_steps, K_low, seed, samples, lo, hi),
+                    _piece_key(m, n_steps, K_low, seed, samples, lo, hi, map_key),
                     {"outcomes": [np.asarray(a).tolist() for a in res]},
                 )
             bar.advance(2 * (hi - lo) * n_steps)
@@ -550,7 +573,11 @@ def hovering_area(
     Raises
     ------
     ValueError
-        For counts that are not integers in range, or a K_low outside the band below 0.
+        For counts that are not integers in range, or a K_low outside the band below 0; with an
+        ``executor``, before any piece runs: for a ``checkpoint`` of a map that has no record to
+        key its pieces by (a potential defined in Python), or a map the workers cannot receive (a
+        process pool or Dask, and a map that does not pickle, e.g. a CustomPotential of lambdas;
+        threads of this process take any map).
     KeyboardInterrupt
         On Ctrl-C, within ~0.1 s.
     """

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import integer, real_number
+from .._checks import check_points, integer, real_array, real_number
+from .._checks import integer, real_array, real_number
 from .._enums import Region
 from ..interface import IterateResult
 from ..truncated import TruncatedMap
@@ -138,7 +139,7 @@ def _box_dimension(phi, K, span) -> float:
     for g in (g2 // 2, g2):
         i = np.minimum((u * g).astype(np.int64), g - 1)
         j = np.minimum((v * g).astype(np.int64), g - 1)
-        counts.append(np.unique(i * g + j).size)
+        counts.append(unique(i * g + j).size)
     return math.log2(counts[1] / counts[0])
 
 
@@ -501,7 +502,9 @@ def cone_crossing(
     Raises
     ------
     ValueError
-        For non-finite starts, n_steps < 1, a twist other than +-1 or tol outside [0, 0.1].
+        For non-finite starts, n_steps < 1, a twist other than +-1 or tol outside [0, 0.1], or
+        phi and K that broadcast to more points than half of this machine's memory holds
+        (checked before they are copied).
     KeyboardInterrupt
         On Ctrl-C; its ``partial`` attribute holds the ConeCrossing found so far.
     """
@@ -510,7 +513,9 @@ def cone_crossing(
     if tw not in (1.0, -1.0):
         raise ValueError(f"twist must be +1 or -1 (the sign of dphi'/dK), got {twist!r}")
     tol = real_number("tol", tol, lo=0.0, lo_open=False, hi=0.1)
-    p, k = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
+    p, k = real_array("phi", phi), real_array("K", K)
+    check_points(("phi", "K"), (p.shape, k.shape))  # before the copies below
+    p, k = np.broadcast_arrays(p, k)
     p, k = p.ravel().copy(), k.ravel().copy()
     if not (np.all(np.isfinite(p)) and np.all(np.isfinite(k))):
         raise ValueError("phi and K must be finite")
@@ -595,7 +600,8 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
         For a map other than TruncatedMap (TruncatedFamily: Omega(K) is a spline whose derivative is
         not exposed; FlowMap: no closed-form Jacobian - use :func:`cone_crossing` with your own),
         for tau0 = 0 (no twist), or for a start point in an impacting region (J_1, J_R: the map
-        is not smooth twist there) or outside the band.
+        is not smooth twist there) or outside the band, or phi and K that broadcast to more points
+        than half of this machine's memory holds.
     """
     if not isinstance(m, TruncatedMap):
         raise ValueError(
@@ -605,7 +611,9 @@ def converse_kam(m, phi, K, n_steps: int, tol: float = 1e-9) -> ConeCrossing:
         )
     if m.tau0 == 0:
         raise ValueError("converse_kam needs a twist map: tau0 must be nonzero, got 0")
-    p, k = np.broadcast_arrays(np.asarray(phi, dtype=float), np.asarray(K, dtype=float))
+    p, k = real_array("phi", phi), real_array("K", K)
+    check_points(("phi", "K"), (p.shape, k.shape))
+    p, k = np.broadcast_arrays(p, k)
     lo, hi = m.valid_band()
     if not (np.all(np.isfinite(p)) and np.all(np.isfinite(k))):
         raise ValueError("phi and K must be finite")

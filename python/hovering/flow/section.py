@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import integer, is_choice, real_array, real_number, thread_count
+from .._checks import check_points, integer, is_choice, real_array, real_number, thread_count
 from .._core import flow as _core_flow
 from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
@@ -240,7 +240,9 @@ class Section:
         Raises
         ------
         ValueError
-            Where no such point exists (e.g. H2(I) >= h), naming the point.
+            Where no such point exists (e.g. H2(I) >= h), naming the point; for theta and I that
+            do not broadcast, or broadcast to more points than half of this machine's memory holds
+            (:func:`hovering._checks.check_points`, before anything is allocated).
         """
         z, ok, why = self._points(theta, I)
         if not ok.all():
@@ -250,12 +252,8 @@ class Section:
     def _points(self, theta, I):
         """Points of Sigma_h, a mask of those that exist, and why the others do not."""
         t, i = real_array("theta", theta), real_array("I", I)  # type errors first, named
-        try:
-            t, i = np.broadcast_arrays(t, i)
-        except ValueError:
-            raise ValueError(
-                f"theta and I must have broadcastable shapes, got {np.shape(theta)} and {np.shape(I)}"
-            ) from None
+        check_points(("theta", "I"), (t.shape, i.shape))  # before the copies of ravel
+        t, i = np.broadcast_arrays(t, i)
         return _core_flow.section_points(
             self.sys.core, self.h, np.ascontiguousarray(t.ravel()), np.ascontiguousarray(i.ravel())
         )
@@ -365,7 +363,9 @@ class Section:
         ValueError
             For bad options (named, with the allowed range), a stepper the system does not
             admit ("exact" without a closed-form flow), non-finite / out-of-range angles,
-            bad trajectory bounds or a bad ``progress``.
+            bad trajectory bounds or a bad ``progress``; and, before anything is allocated, for
+            more starting points (after broadcasting theta with I) or trajectory points than half
+            of this machine's memory holds.
         KeyboardInterrupt
             On Ctrl-C: its ``partial`` attribute holds the ReturnMapResult with every finished
             return and status INTERRUPTED for the rest.

@@ -168,8 +168,28 @@ class Polynomial:
 
     @classmethod
     def _from_record(cls, record: dict) -> Polynomial:
-        """Inverse of :meth:`_to_record` (validated again)."""
-        return cls({(i, j): c for i, j, c in record["terms"]})
+        """Inverse of :meth:`_to_record` (validated again: a file's terms are untrusted).
+
+        Each term is ``[i, j, c]`` and each power ``(i, j)`` appears once: a dict built from a
+        repeated power would keep its last coefficient and drop the others without a word.
+        """
+        terms = record["terms"]
+        if not isinstance(terms, list) or not terms:
+            raise ValueError(f"terms must be a non-empty list of [i, j, c], got {type(terms).__name__}")
+        coefficients: dict = {}
+        for n, term in enumerate(terms):
+            if not isinstance(term, list) or len(term) != 3:
+                raise ValueError(f"terms[{n}] must be a term [i, j, c] (c q1^i q2^j), got {str(term)[:80]}")
+            i, j, c = term
+            if not all(isinstance(e, (int, np.integer)) and not isinstance(e, bool) and 0 <= e <= 20 for e in (i, j)):
+                raise ValueError(f"terms[{n}]: exponents must be integers in [0, 20], got {str(term)[:80]}")
+            if (i, j) in coefficients:
+                raise ValueError(
+                    f"terms[{n}] = {str(term)[:80]} repeats the power q1^{i} q2^{j} of an earlier term; "
+                    "allowed: each power (i, j) once"
+                )
+            coefficients[(i, j)] = c
+        return cls(coefficients)
 
     def __reduce__(self):
         """Pickle as the record."""

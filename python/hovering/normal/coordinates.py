@@ -16,7 +16,7 @@ import operator
 
 import numpy as np
 
-from .._checks import MAX_MODES, integer, real_array, require_angles, require_finite, require_type
+from .._checks import MAX_MODES, check_points, integer, real_array, require_angles, require_finite, require_type
 from .._core import normal as _core_normal
 from .._enums import wrap
 from .._pickle import reduce_record
@@ -293,10 +293,8 @@ def _finite_pair(na, a, nb, b):
     a, b = real_array(na, a), real_array(nb, b)
     require_angles(na, a)
     require_finite(nb, b)
-    try:
-        a, b = np.broadcast_arrays(np.asarray(wrap(a), dtype=float), b)
-    except ValueError:
-        raise ValueError(f"{na} and {nb} must have broadcastable shapes, got {np.shape(a)} and {np.shape(b)}") from None
+    check_points((na, nb), (a.shape, b.shape))  # before the copies below
+    a, b = np.broadcast_arrays(np.asarray(wrap(a), dtype=float), b)
     return np.array(a), np.array(b)
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import integer, real_array, require_finite
+from .._checks import integer, physical_memory, real_array, require_finite
 from .._enums import wrap
 from .._serial import Saveable
 from ..flow.section import FlowStatus, Section
@@ -19,6 +19,9 @@ from .coordinates import TangentialCurve, _curve_of, _section
 __all__ = ["CornerCurves", "corner_curves"]
 
 _TWO_PI = 2 * np.pi
+#: Memory a circle sample takes while the circles are mapped (its start, return-map result,
+#: itinerary and label): ~300 bytes measured, counted as 512.
+_BYTES_PER_SAMPLE = 512
 
 
 def _labels(sec, curve, phi, K, rtol):
@@ -97,7 +100,9 @@ def corner_curves(
     Raises
     ------
     ValueError
-        If the section is not a step system, or for bad counts.
+        If the section is not a step system, or for bad counts (naming the value and the allowed
+        range), among them more circle samples (``K.size * n_phi``) than half of this machine's
+        memory holds, refused before anything is allocated.
     """
     if _section("sec", sec).sys.geometry != "step":
         raise ValueError(f"corner curves need geometry 'step', got {sec.sys.geometry!r}")
@@ -109,6 +114,14 @@ def corner_curves(
         raise ValueError(f"K must be a number or a 1-D array of circles, got shape {Ks.shape}")
     Ks = np.atleast_1d(Ks)
     require_finite("K", Ks)
+    # Checked before anything is allocated or traced: every circle's samples are mapped at once.
+    most = physical_memory() // 2 // _BYTES_PER_SAMPLE
+    if Ks.size * n_phi > most:
+        raise ValueError(
+            f"K ({Ks.size} circles) x n_phi ({n_phi}) = {Ks.size * n_phi} samples, mapped at once; allowed: at "
+            f"most {most} (half of this machine's memory at {_BYTES_PER_SAMPLE} bytes a sample): fewer circles "
+            "per call, or a smaller n_phi"
+        )
     curve = _curve_of(sec, curve)
     nK = Ks.size
     ph = -np.pi + _TWO_PI * np.arange(n_phi) / n_phi

@@ -240,6 +240,9 @@ class _Local:
     def close(self):
         self.pool.shutdown(wait=True, cancel_futures=True)
 
+    def check_sendable(self, obj, what: str) -> None:
+        """Nothing to check: a thread of this process takes ``obj`` as it is (no pickling)."""
+
 
 class _Given(_Local):
     """The caller's concurrent.futures pool: used, never shut down here."""
@@ -253,6 +256,17 @@ class _Given(_Local):
         self.threads_per_piece = _share(self.workers)
         # Threads of this process can be told to stop; another process's cannot (an Event does not pickle).
         self.stop = threading.Event() if isinstance(pool, cf.ThreadPoolExecutor) else None
+
+    def check_sendable(self, obj, what: str) -> None:
+        """Refuse at once (ValueError) an ``obj`` that another process's pool could not receive.
+
+        A process pool pickles each piece in a feeder thread: an object that does not pickle (a
+        CustomPotential of lambdas) would fail there, one piece at a time, after the pool started.
+        """
+        if self.stop is None:  # not threads of this process: the pieces are pickled
+            from multiprocessing.reduction import ForkingPickler
+
+            _sendable(ForkingPickler.dumps, obj, what, self.name)
 
     def close(self):
         if self.stop is not None and self.stop.is_set():
@@ -285,11 +299,35 @@ class _Dask:
     def cancel(self, futures):
         self.client.cancel(list(futures))
 
+    def check_sendable(self, obj, what: str) -> None:
+        """Refuse at once (ValueError) an ``obj`` Dask could not send to its workers (cloudpickle)."""
+        try:
+            import cloudpickle
+
+            dumps = cloudpickle.dumps
+        except ImportError:  # pragma: no cover - distributed depends on cloudpickle
+            import pickle
+
+            dumps = pickle.dumps
+        _sendable(dumps, obj, what, self.name)
+
     def close(self):
         if self.own:
             self.client.close()
             if self.cluster is not None:
                 self.cluster.close()
+
+
+def _sendable(dumps: Callable, obj, what: str, where: str) -> None:
+    """``dumps(obj)``, or a ValueError naming what cannot be sent to ``where`` and why."""
+    try:
+        dumps(obj)
+    except Exception as e:  # PicklingError, TypeError, AttributeError: whatever the pickler raises
+        raise ValueError(
+            f"{what} cannot be sent to {where}: it does not pickle ({type(e).__name__}: {str(e)[:300]}); "
+            "use executor=<number of threads> (threads of this process need no pickling), or define "
+            "the potential's V and dV at module level"
+        ) from None
 
 
 def _share(workers: int) -> int:
@@ -319,7 +357,9 @@ def executor(workers: int | None = None, client=None, scheduler: str | None = No
     Yields
     ------
     object
-        ``submit(fn, *args)``, ``as_completed(futures)``, ``cancel(futures)``, ``workers``,
+        ``submit(fn, *args)``, ``as_completed(futures)``, ``cancel(futures)``,
+        ``check_sendable(obj, what)`` (a ValueError, before any piece is submitted, for an object
+        the workers could not receive: it does not pickle for a process pool or Dask), ``workers``,
         ``threads_per_piece`` (core threads a piece should use: this machine's cores shared among
         local workers; 0, all of a worker's cores, on a given cluster).
 

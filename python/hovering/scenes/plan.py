@@ -103,14 +103,11 @@ def _system(spec, eps: float) -> dict:
             d["alpha"] = float(p.alpha)
         return d
 
-    # Repeated (i, j) terms: the last coefficient in the first place, as the dict of hovering.Polynomial.
-    terms: dict = {}
-    for c, i, j in spec.coupling:
-        terms[(int(i), int(j))] = float(c)
+    # Each (i, j) once: the schema (and SystemSpec.build) refuse a repeated power.
     return {
         "V1": pot(spec.V1),
         "V2": pot(spec.V2),
-        "coupling": [[c, i, j] for (i, j), c in terms.items()],
+        "coupling": [[float(c), int(i), int(j)] for c, i, j in spec.coupling],
         "eps": float(eps),
         "qw1": float(spec.qw1),
         "qw2": float(spec.qw2),

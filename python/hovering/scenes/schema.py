@@ -837,11 +837,20 @@ def _coupling(where: str, value) -> tuple:
             f"{where} must be 'bilinear', 'none' or a list of 1..64 terms [c, i, j] (c q1^i q2^j), got {value!r}"
         )
     terms = []
+    first: dict = {}  # (i, j) -> the entry that gave it
     for k, term in enumerate(value):
         tw = f"{where}[{k}]"
         if not isinstance(term, list) or len(term) != 3:
             raise ValueError(f"{tw} must be a term [c, i, j] (c q1^i q2^j), got {term!r}")
-        terms.append((_real(f"{tw}[0]", term[0]), _int(f"{tw}[1]", term[1], 0, 20), _int(f"{tw}[2]", term[2], 0, 20)))
+        c, i, j = _real(f"{tw}[0]", term[0]), _int(f"{tw}[1]", term[1], 0, 20), _int(f"{tw}[2]", term[2], 0, 20)
+        if (i, j) in first:
+            # A dict of terms would keep only the last: the first coefficient would vanish silently.
+            raise ValueError(
+                f"{tw} = {term!r} repeats the term q1^{i} q2^{j} of {where}[{first[(i, j)]}]; allowed: each "
+                f"power (i, j) once (write the sum of the coefficients as one term)"
+            )
+        first[(i, j)] = k
+        terms.append((c, i, j))
     return tuple(terms)
 
 

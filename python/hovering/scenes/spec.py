@@ -353,13 +353,27 @@ class SystemSpec:
         Returns
         -------
         StepSystem
+
+        Raises
+        ------
+        ValueError
+            For a coupling that lists a power (i, j) twice (a scene file cannot: the schema
+            refuses it), naming both terms.
         """
         if not self.coupling:
             c = None
         elif self.coupling == ((1.0, 1, 1),):
             c = Bilinear()
         else:
-            c = Polynomial({(int(i), int(j)): float(v) for v, i, j in self.coupling})
+            terms: dict = {}
+            for k, (v, i, j) in enumerate(self.coupling):
+                if (int(i), int(j)) in terms:
+                    raise ValueError(
+                        f"coupling[{k}] = {(v, i, j)!r} repeats the power q1^{i} q2^{j} of coupling"
+                        f"[{list(terms).index((int(i), int(j)))}]; allowed: each power (i, j) once"
+                    )
+                terms[(int(i), int(j))] = float(v)
+            c = Polynomial(terms)
         return StepSystem(
             V1=self.V1.build(),
             V2=self.V2.build(),

@@ -278,7 +278,9 @@ class _MapAPI(MapAnalyses):
         ------
         ValueError
             For non-finite initial points, a negative ``n_steps``, an unknown ``record`` key,
-            region or kernel, an ``every`` below 1, or a ``stop`` that is not Above / Below.
+            region or kernel, an ``every`` below 1, or a ``stop`` that is not Above / Below; and,
+            before anything is allocated, for more starts (after broadcasting phi0 with K0) or
+            records than half of this machine's memory holds, naming the count and the limit.
         KeyboardInterrupt
             On Ctrl-C during a long run; its ``partial`` attribute holds the IterateResult with
             every orbit's state at the interruption (status ``INTERRUPTED``).

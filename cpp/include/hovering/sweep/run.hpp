@@ -42,6 +42,18 @@ PointRow run_point(const Plan& plan, std::size_t i, int n_threads = 0, const std
 /// grid rounds samples up, so this is a close estimate).
 double point_work(const Plan& plan, std::size_t i);
 
+/// Memory one sample of a point takes while it is measured (its start, its outcomes under F_0 and
+/// F_eps, steps done, regions visited, membership), counted as Python's hovering.hovering_area does.
+constexpr double kBytesPerSample = 64;
+
+/// Half of this machine's physical memory: what a run may take (Python's hovering_area budget).
+std::uintmax_t memory_budget();
+
+/// Refuse, before anything is computed or written (std::invalid_argument naming the plan, the point
+/// and its samples, and the largest count allowed), a point whose samples need more than `budget`
+/// bytes: without it a run died on std::bad_alloc after creating its checkpoint.
+void check_memory(const Plan& plan, std::uintmax_t budget = memory_budget());
+
 /// The checkpoint format this program reads and writes.
 constexpr int kCheckpointVersion = 1;
 

@@ -42,8 +42,12 @@ std::string num(double x) {
 /// A value as the message shows it (TOML's spelling; tables and arrays by their kind).
 std::string show(const toml::node& n) {
     if (auto s = n.as_string()) {
-        std::string v = s->get();
-        if (v.size() > 60) v = v.substr(0, 57) + "...";
+        std::string v;
+        for (const char ch : s->get().substr(0, 60)) {  // one clean line: no control character
+            const unsigned char c = static_cast<unsigned char>(ch);
+            v.push_back(c < 0x20 || c == 0x7f ? '?' : ch);
+        }
+        if (s->get().size() > 60) v = v.substr(0, 57) + "...";
         return "'" + v + "'";
     }
     if (auto i = n.as_integer()) return std::to_string(i->get());
@@ -351,9 +355,53 @@ PlanPoint read_point(Table& t, const std::string& kind) {
     return p;
 }
 
+/// Most parts of one dotted key or table header (`a.b.c = 1`, `[a.b.c]`): a plan's have at most 3,
+/// and the TOML reader builds one nested table per part, recursively (100,000 parts crashed it).
+constexpr std::size_t kMaxKeyParts = 16;
+
+/// Refuse (std::invalid_argument naming the line) a dotted key of more than kMaxKeyParts parts,
+/// before the TOML reader sees the text. A linear scan that skips strings and comments and counts
+/// the dots of each stretch between `= , [ ] { }` and line ends (a number or a date has at most one).
+void check_key_parts(const std::string& text, const std::string& where) {
+    std::size_t line = 1, dots = 0;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '#') {
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+        } else if (c == '"' || c == '\'') {
+            const bool multi = text.compare(i, 3, std::string(3, c)) == 0;
+            i += multi ? 3 : 1;
+            for (; i < text.size(); ++i) {
+                if (text[i] == '\n') {
+                    ++line;
+                    if (!multi) break;  // an unterminated string: the TOML reader says so
+                } else if (c == '"' && text[i] == '\\') {
+                    if (i + 1 < text.size() && text[i + 1] == '\n') ++line;
+                    ++i;
+                } else if (text[i] == c && (!multi || text.compare(i, 3, std::string(3, c)) == 0)) {
+                    if (multi) {
+                        i += 2;
+                        while (i + 1 < text.size() && text[i + 1] == c) ++i;  // """" ends with a quote
+                    }
+                    break;
+                }
+            }
+        } else if (c == '.') {
+            if (++dots >= kMaxKeyParts)
+                throw std::invalid_argument(where + " line " + std::to_string(line) + ": a dotted key of more than " +
+                                            std::to_string(kMaxKeyParts) + " parts: allowed: at most " +
+                                            std::to_string(kMaxKeyParts) + " (a plan's keys have at most 3)");
+        } else if (c == '\n' || c == '=' || c == ',' || c == '[' || c == ']' || c == '{' || c == '}') {
+            dots = 0;
+            line += c == '\n';
+        }
+    }
+}
+
 }  // namespace
 
 Plan parse_plan(const std::string& text, const std::string& where) {
+    check_key_parts(text, where);
     toml::table root;
     try {
         root = toml::parse(text, where);

@@ -1,8 +1,10 @@
 // The core objects of a plan's point; see plan_build.hpp.
 #include "hovering/sweep/plan_build.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "hovering/flow/potential.hpp"
 
@@ -13,6 +15,14 @@ TruncatedMap build_map(const MapParams& m) {
 }
 
 namespace {
+
+/// A double as a message shows it: the shortest text that reads back as it (std::to_string prints
+/// six decimals: a tiny band's edge read "-0.000000", a huge K_low some 300 digits).
+std::string num(double x) {
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
+}
 
 std::shared_ptr<const Potential> potential(const PotentialSpec& p) {
     if (p.kind == "tan") return std::make_shared<Tan>(p.omega, p.alpha);
@@ -32,8 +42,7 @@ FlowSystem build_system(const SystemSpec& sp, double eps) {
     s.qw2 = sp.qw2;
     s.geometry = sp.geometry == "step" ? Geometry::Step : sp.geometry == "wall" ? Geometry::Wall : Geometry::None;
     if (eps != 0 && s.coupling.terms.empty())
-        throw std::invalid_argument("system.eps = " + std::to_string(eps) +
-                                    " needs a coupling (system.coupling is empty)");
+        throw std::invalid_argument("system.eps = " + num(eps) + " needs a coupling (system.coupling is empty)");
     s.validate();
     return s;
 }
@@ -68,8 +77,8 @@ void check_point(const std::string& kind, const PlanPoint& p) {
     if (kind == "hovering_area") {
         const TruncatedMap m = build_map(p.map);
         if (!(m.band().lo < p.K_low))
-            throw std::invalid_argument("K_low = " + std::to_string(p.K_low) +
-                                        " lies below the map's band (lower end " + std::to_string(m.band().lo) + ")");
+            throw std::invalid_argument("K_low = " + num(p.K_low) + " lies below the map's band (lower end " +
+                                        num(m.band().lo) + ")");
         return;
     }
     const FlowSystem s = build_system(p.system, p.system.eps);
