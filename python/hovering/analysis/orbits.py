@@ -139,7 +139,7 @@ def _box_dimension(phi, K, span) -> float:
     for g in (g2 // 2, g2):
         i = np.minimum((u * g).astype(np.int64), g - 1)
         j = np.minimum((v * g).astype(np.int64), g - 1)
-        counts.append(unique(i * g + j).size)
+        counts.append(np.unique(i * g + j).size)
     return math.log2(counts[1] / counts[0])
 
 
