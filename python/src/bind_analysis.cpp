@@ -21,6 +21,16 @@ py::array_t<T> as_array(const std::vector<T>& v) {
     return py::array_t<T>(py::ssize_t(v.size()), v.data());
 }
 
+/// 0/1 flags as a NumPy bool array, filled here: NumPy's own cast (astype) releases the GIL for a large
+/// array and takes it back inside this binding's frames, which a daemon thread must not do while the
+/// interpreter exits (python/src/gil.hpp; CPython ends it there, through our C++ frames).
+py::array_t<bool> as_bool_array(const std::vector<std::int8_t>& v) {
+    py::array_t<bool> a(py::ssize_t(v.size()));
+    bool* p = a.mutable_data();
+    for (std::size_t i = 0; i < v.size(); ++i) p[i] = v[i] != 0;
+    return a;
+}
+
 template <class T>
 std::vector<T> as_vector(const py::array_t<T, py::array::c_style | py::array::forcecast>& a, std::int64_t n,
                          const char* name) {
@@ -136,8 +146,8 @@ void register_analysis(py::module_& m) {
             d["area_both_sides"] = h.area_both_sides;
             d["unresolved"] = h.unresolved;
             if (keep_points) {
-                d["hovering"] = as_array(h.hovering).attr("astype")("bool");
-                d["both_sides"] = as_array(h.both_sides).attr("astype")("bool");
+                d["hovering"] = as_bool_array(h.hovering);
+                d["both_sides"] = as_bool_array(h.both_sides);
             }
             return d;
         },

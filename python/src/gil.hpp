@@ -29,6 +29,18 @@
 // While the finalising thread itself waits in a long computation (a hovering call in a later atexit
 // callback), it cannot finalise: other threads (its own workers) may pass then, and it waits for
 // them before it takes the GIL back.
+//
+// The GIL a Python caller holds is not ours, but Python code our frames run on its thread may hand
+// it to another thread and take it back: any bytecode (the interpreter's periodic switch) and
+// NumPy's casts and copies of large arrays (astype). Taken back after finalisation began, CPython
+// ends the thread there, and the unwinding runs our frames' destructors without the GIL
+// (Py_DECREF: a crash) or aborts at a noexcept frame (std::terminate).
+// Such code runs inside a pass as well (a Gil: on a thread that holds the GIL it only takes the
+// pass; on_main_thread in signals.hpp), or is not called from a binding at all (hovering_estimate
+// fills its bool arrays itself). The same holds for NumPy's own C++ (np.unique's hash table takes
+// the GIL back in a destructor): the package's Python code run by a long call uses
+// hovering._arrays.unique instead, and a caller waiting for pieces on a thread pool parks at exit
+// (hovering.parallel.executor).
 
 #include <Python.h>
 

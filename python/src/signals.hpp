@@ -24,8 +24,13 @@
 
 namespace hovering_py {
 
-/// Whether the calling thread (GIL held) is Python's main thread.
+/// Whether the calling thread (GIL held) is Python's main thread. It runs Python code (threading's),
+/// which may hand the GIL to another thread and take it back: through the gate, as every GIL
+/// acquisition with our frames on the stack (gil.hpp); a daemon thread that calls in once the
+/// interpreter exits parks here.
 inline bool on_main_thread() {
+    const Gil gil;
+    if (!gil) GilGate::refused();
     const auto threading = py::module_::import("threading");
     return threading.attr("current_thread")().is(threading.attr("main_thread")());
 }

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import unique
 from .._checks import integer, is_choice, real_number
 from .._display import Summarized, status_counts
 from .._enums import Region, Status
@@ -185,7 +186,7 @@ class BarrierScan(Summarized, Saveable):
                     s_max=float(hi),
                     kind=kind,
                     counts=counts,
-                    periods=tuple(int(p) for p in np.unique(per[per > 0])),
+                    periods=tuple(int(p) for p in unique(per[per > 0])),
                     impacting=bool(np.any(self.impact_fraction[a : b + 1] > 0)),
                 )
             )

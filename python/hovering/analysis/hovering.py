@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import unique
 from .._checks import check_memory, flag, integer, real_number, thread_count
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
@@ -413,7 +414,7 @@ def _chain_periods(m, phi, K, one, n_K: int, n_threads: int) -> tuple:
     groups = _clusters(one, n_K)
     if not groups:
         return period, 0
-    reps = [np.unique(g[[g.size // 4, g.size // 2, (3 * g.size) // 4]]) for g in groups]
+    reps = [unique(g[[g.size // 4, g.size // 2, (3 * g.size) // 4]]) for g in groups]
     flat = np.concatenate(reps)
     res = m.iterate(phi[flat], K[flat], ORBIT_STEPS - 1, record=("orbit",), n_threads=n_threads)
     classes = classify_orbits(res)
@@ -461,7 +462,7 @@ def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_steps:
     band, band_err = part(code == COMPONENTS.index("band"))
     isl, isl_err = part(one)
     under, under_err = part(code == COMPONENTS.index("under_floor"))
-    periods = {int(q): part(one & (period == q))[0] for q in np.unique(period[one])}
+    periods = {int(q): part(one & (period == q))[0] for q in unique(period[one])}
     comp = HoveringComponents(
         band=band,
         band_error=band_err,

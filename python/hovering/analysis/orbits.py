@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import unique
 from .._checks import check_points, integer, real_array, real_number
-from .._checks import integer, real_array, real_number
 from .._enums import Region
 from ..interface import IterateResult
 from ..truncated import TruncatedMap
@@ -139,7 +139,7 @@ def _box_dimension(phi, K, span) -> float:
     for g in (g2 // 2, g2):
         i = np.minimum((u * g).astype(np.int64), g - 1)
         j = np.minimum((v * g).astype(np.int64), g - 1)
-        counts.append(np.unique(i * g + j).size)
+        counts.append(unique(i * g + j).size)
     return math.log2(counts[1] / counts[0])
 
 

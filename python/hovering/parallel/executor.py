@@ -31,6 +31,7 @@ import concurrent.futures as cf
 import logging
 import os
 import threading
+import weakref
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -200,6 +201,47 @@ def from_old_arguments(func: str, executor_value, old: dict, allowed=OLD_ARGUMEN
     return Executor(**given)
 
 
+_exit_began = threading.Event()  # set by _at_exit: the main thread has ended, the interpreter exits
+_daemon_runs: weakref.WeakSet = weakref.WeakSet()  # the runs on local threads that daemon threads started
+_hooked = False  # whether _at_exit is registered
+
+
+def _at_exit() -> None:
+    """The interpreter exits: threading's exit hooks run in the main thread once it has ended, this
+    one before concurrent.futures' (registered earlier: hooks run last first), which runs every
+    queued piece to the end and joins the pool threads. The runs of daemon threads are stopped:
+    their running pieces end within ~0.1 s, their queued pieces never start, and their callers park
+    (:func:`_park_if_exiting`). Else the exit waited for all their pieces, and then each caller went
+    on with its work (its Python code, NumPy's, the core's) as the interpreter finalised, where
+    CPython ends a daemon thread at its next taking of the GIL: inside a C++ frame that aborted the
+    process (python/src/gil.hpp)."""
+    _exit_began.set()
+    for run in list(_daemon_runs):
+        run.cancel(run.submitted)
+
+
+def _hook_exit() -> None:
+    """Register _at_exit once, after concurrent.futures' own exit hook (so that it runs first)."""
+    global _hooked
+    if _hooked:
+        return
+    _hooked = True
+    try:
+        import concurrent.futures.thread  # noqa: F401  registers concurrent.futures' hook, if not yet
+
+        threading._register_atexit(_at_exit)  # as concurrent.futures does (CPython >= 3.9)
+    except RuntimeError:  # "can't register atexit after shutdown": the exit has begun
+        _exit_began.set()
+
+
+def _park_if_exiting() -> None:
+    """On a daemon thread once the interpreter exits: sleep until the process ends (a blocked wait
+    never takes the GIL again), as the core parks a call that outlives the interpreter. A non-daemon
+    thread goes on: the exit waits for it."""
+    if _exit_began.is_set() and threading.current_thread().daemon:
+        threading.Event().wait()
+
+
 def _stoppable_call(stop: threading.Event, fn, args):
     """fn(*args) on a pool thread, its core calls stopped once ``stop`` is set (see the module docstring)."""
     with stoppable(stop):
@@ -216,11 +258,27 @@ class _Local:
         self.workers = workers
         self.threads_per_piece = _share(workers)
         self.stop = threading.Event()
+        self._watch_exit()
+
+    def _watch_exit(self) -> None:
+        """Be stopped by _at_exit if the caller is a daemon thread (nothing waits for it at exit)."""
+        self.submitted = []
+        if threading.current_thread().daemon:
+            _hook_exit()
+            _daemon_runs.add(self)
 
     def submit(self, fn, *args):
-        if self.stop is None:
-            return self.pool.submit(fn, *args)
-        return self.pool.submit(_stoppable_call, self.stop, fn, args)
+        _park_if_exiting()
+        try:
+            if self.stop is None:
+                f = self.pool.submit(fn, *args)
+            else:
+                f = self.pool.submit(_stoppable_call, self.stop, fn, args)
+        except RuntimeError:  # "cannot schedule new futures after interpreter shutdown"
+            _park_if_exiting()
+            raise
+        self.submitted.append(f)
+        return f
 
     def as_completed(self, futures):
         # Waits of 0.1 s, not one long wait: the main thread runs Python between them, so Ctrl-C
@@ -228,6 +286,7 @@ class _Local:
         pending = set(futures)
         while pending:
             done, pending = cf.wait(pending, timeout=0.1, return_when=cf.FIRST_COMPLETED)
+            _park_if_exiting()  # before the caller sees a piece that _at_exit cancelled
             yield from done
 
     def cancel(self, futures):
@@ -256,6 +315,7 @@ class _Given(_Local):
         self.threads_per_piece = _share(self.workers)
         # Threads of this process can be told to stop; another process's cannot (an Event does not pickle).
         self.stop = threading.Event() if isinstance(pool, cf.ThreadPoolExecutor) else None
+        self._watch_exit()
 
     def check_sendable(self, obj, what: str) -> None:
         """Refuse at once (ValueError) an ``obj`` that another process's pool could not receive.
