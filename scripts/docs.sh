@@ -4,9 +4,9 @@
 # scripts in examples/gallery, run now). Sets up the .venv with the docs extra first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+# One set-up with both extras: the core is built once (or reused) for the tests and the docs alike.
+bash scripts/setup.sh --extras test,docs
 . .venv/bin/activate
-python -m pip install -q --disable-pip-version-check ".[docs]" --config-settings=build-dir="build/{wheel_tag}"
 export MPLBACKEND=Agg
 rm -rf docs/_build/html docs/api/generated docs/gallery
 python -m sphinx -W --keep-going -b html docs docs/_build/html "$@"

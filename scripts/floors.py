@@ -8,6 +8,8 @@ applies inside the isolated build environment), so the suite runs against the fl
 promises. pyproject.toml stays the one place the floors are written; this only reads them.
 
 Usage: floors.py [EXTRA ...] (default: test). Exit status 2 if a requirement has no ``>=`` floor.
+       floors.py --requires build|EXTRA   the requirements as declared (one per line), for scripts
+       that install them without building the package (scripts/setup.sh, scripts/wheel.sh).
 """
 
 from __future__ import annotations
@@ -64,5 +66,22 @@ def floors(extras: list[str]) -> list[str]:
     return out
 
 
+def requires(what: str) -> list[str]:
+    """The requirement strings pyproject.toml declares for ``what``: ``"build"`` (the build system's)
+    or the name of an extra (its own lines only, not the extras it names)."""
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    if what == "build":
+        return list(meta["build-system"]["requires"])
+    optional = meta["project"].get("optional-dependencies", {})
+    if what not in optional:
+        raise SystemExit(f"floors.py: no extra {what!r} in pyproject.toml (have: build, {', '.join(optional)})")
+    return list(optional[what])
+
+
 if __name__ == "__main__":
-    print("\n".join(floors(sys.argv[1:] or ["test"])))
+    if sys.argv[1:2] == ["--requires"]:
+        if len(sys.argv) != 3:
+            raise SystemExit("floors.py --requires takes one name: build or an extra")
+        print("\n".join(requires(sys.argv[2])))
+    else:
+        print("\n".join(floors(sys.argv[1:] or ["test"])))

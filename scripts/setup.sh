@@ -4,17 +4,27 @@
 #
 #   bash scripts/setup.sh            # .venv with what pip resolves today (the newest releases)
 #   bash scripts/setup.sh --oldest   # .venv-oldest with every declared minimum (scripts/floors.py)
+#   bash scripts/setup.sh --extras test,docs   # the extras to install (default: test)
+#
+# One build of the core per venv, reused: the package is built without pip's build isolation (its
+# build requirements live in the venv, so every path the compiler sees stays the same) in a fixed
+# tree, build/<wheel tag> (build/oldest for --oldest). A later run recompiles only what changed
+# since (nothing at the same commit) and re-installs in seconds.
 #
 # PYTHON=python3.13 picks another interpreter (its venv is then .venv-python3.13[-oldest]).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 OLDEST=0
-for arg in "$@"; do
-  case "$arg" in
+EXTRAS=test
+while [ $# -gt 0 ]; do
+  case "$1" in
     --oldest) OLDEST=1 ;;
-    *) echo "setup.sh: unknown option $arg (allowed: --oldest)" >&2; exit 2 ;;
+    --extras) [ $# -ge 2 ] || { echo "setup.sh: --extras needs a comma-separated list" >&2; exit 2; }
+              EXTRAS=$2; shift ;;
+    *) echo "setup.sh: unknown option $1 (allowed: --oldest, --extras LIST)" >&2; exit 2 ;;
   esac
+  shift
 done
 
 APT_PACKAGES=(g++ pkg-config libgsl-dev libeigen3-dev libsleef-dev catch2 libtomlplusplus-dev libcli11-dev nlohmann-json3-dev)
@@ -44,7 +54,6 @@ fi
 # shellcheck disable=SC1091
 . "$VENV/bin/activate"
 python -m pip install -q --upgrade pip
-python -m pip install -q cmake ninja
 if [ "$OLDEST" = 1 ]; then
   # pip applies PIP_CONSTRAINT to the isolated build environment too (pybind11, scikit-build-core).
   mkdir -p build
@@ -55,6 +64,12 @@ if [ "$OLDEST" = 1 ]; then
 else
   BUILD_DIR="build/{wheel_tag}"
 fi
-echo "[setup] building and installing hovering (C++ core + Python module) into $VENV"
-python -m pip install -q ".[test]" --config-settings=build-dir="$BUILD_DIR"
+# The build requirements (pyproject's [build-system], at their floors with --oldest) and CMake/Ninja,
+# in the venv: the build below runs without isolation, in the same environment every time.
+mapfile -t BUILD_REQUIRES < <(python scripts/floors.py --requires build)
+python -m pip install -q cmake ninja "${BUILD_REQUIRES[@]}"
+echo "[setup] building (or re-using the build of) hovering's C++ core and installing it into $VENV"
+start=$(date +%s)
+python -m pip install -q --no-build-isolation ".[$EXTRAS]" --config-settings=build-dir="$BUILD_DIR"
+echo "[setup] build and install: $(( $(date +%s) - start )) s"
 python -c "import hovering, numpy; print('[setup] hovering', hovering.__version__, '- numpy', numpy.__version__, '- SIMD width:', hovering.simd_width())"

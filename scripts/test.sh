@@ -34,7 +34,7 @@ fi
 . "$VENV/bin/activate"
 if [ "$OLDEST" = 0 ]; then
   echo "[test] C++ unit tests (ctest)"
-  cmake -S . -B build/ctest -G Ninja -DCMAKE_BUILD_TYPE=Release -DHOVERING_BUILD_TESTS=ON >/dev/null
+  cmake -S . -B build/ctest -G Ninja -DCMAKE_BUILD_TYPE=Release -DHOVERING_BUILD_TESTS=ON -DHOVERING_BUILD_APPS=ON >/dev/null
   cmake --build build/ctest
   (cd build/ctest && ctest --output-on-failure)
 fi
