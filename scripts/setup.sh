@@ -72,4 +72,6 @@ echo "[setup] building (or re-using the build of) hovering's C++ core and instal
 start=$(date +%s)
 python -m pip install -q --no-build-isolation ".[$EXTRAS]" --config-settings=build-dir="$BUILD_DIR"
 echo "[setup] build and install: $(( $(date +%s) - start )) s"
+# scripts/wheel.sh builds its wheel in the same tree (the venv's build requirements, no recompile).
+echo "$BUILD_DIR" > "$VENV/hovering-build-dir"
 python -c "import hovering, numpy; print('[setup] hovering', hovering.__version__, '- numpy', numpy.__version__, '- SIMD width:', hovering.simd_width())"
