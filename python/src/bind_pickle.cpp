@@ -44,7 +44,10 @@ py::array_t<double> as_array(const std::vector<double>& v) {
 /// The K grid and tables a TruncatedFamily was built from, read back from its splines: Omega on the
 /// whole grid, |J_R| and |J_1| on its K <= 0 part (|J_1| splined in sqrt(-K), in reverse order);
 /// the constructor ignores |J_R| and |J_1| above 0, which come back as 0.
-py::tuple family_state(const TruncatedFamily& m) {
+// Every __getstate__ here returns py::object, the type its __setstate__ takes (pybind11 3.0.0, the
+// declared floor, requires the two to match): the setter takes any object so that a wrong state is
+// state_of's ValueError, not pybind11's TypeError.
+py::object family_state(const TruncatedFamily& m) {
     const TabulatedArcs& a = m.arcs();
     const std::vector<double>& K = a.Omega.x();
     std::vector<double> JR(K.size(), 0.0), J1(K.size(), 0.0);
@@ -68,7 +71,7 @@ void register_pickles(py::module_& core) {
     // rotation reaches 1e6 rad; the cap of the rebuilt map is the same, so the band is too.
     py::class_<TruncatedMap> tm(truncated.attr("TruncatedMap"));
     tm.def(py::pickle(
-        [](const TruncatedMap& m) {
+        [](const TruncatedMap& m) -> py::object {
             const AnalyticArcs& a = m.arcs();
             return py::make_tuple(m.eps(), a.Omega0, a.theta_w, a.tau0, a.tau1, a.lam, m.band().hi);
         },
@@ -92,7 +95,7 @@ void register_pickles(py::module_& core) {
 
     py::class_<FlowSystem> fs(flow.attr("FlowSystem"));
     fs.def(py::pickle(
-        [](const FlowSystem& s) {
+        [](const FlowSystem& s) -> py::object {
             return py::make_tuple(std::const_pointer_cast<Potential>(s.V1), std::const_pointer_cast<Potential>(s.V2),
                                   s.coupling.terms, s.eps, s.qw1, s.qw2, s.geometry);
         },
@@ -104,7 +107,7 @@ void register_pickles(py::module_& core) {
 
     py::class_<FlowOptions> fo(flow.attr("FlowOptions"));
     fo.def(py::pickle(
-        [](const FlowOptions& o) {
+        [](const FlowOptions& o) -> py::object {
             return py::make_tuple(o.stepper, o.rtol, o.atol, o.event_tol, o.max_steps, o.max_impacts, o.grazing_tol,
                                   o.corner_tol);
         },
@@ -134,7 +137,7 @@ void register_pickles(py::module_& core) {
     // interpolants exactly as measure() built them.
     py::class_<TangentialCurve, std::shared_ptr<TangentialCurve>> tc(normal.attr("TangentialCurve"));
     tc.def(py::pickle(
-        [](const TangentialCurve& c) {
+        [](const TangentialCurve& c) -> py::object {
             const auto [et, eI] = c.interpolation_error();
             return py::make_tuple(c.h(), c.eps(), c.I_tan0(), as_array(c.theta()), as_array(c.I()), et, eI);
         },
