@@ -35,8 +35,8 @@ def main():
     tm = paper.truncated_map(0.3)
     fm = paper.flow_map(-0.1)
     cases = [
-        ("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, samples=200_000), 16, "step"),
-        ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, samples=1600), 8, "return"),
+        ("truncated |HOV|, 200000 x 20000", tm, dict(n_steps=20_000, n_samples=200_000), 16, "step"),
+        ("flow |HOV|, 1600 x 1000", fm, dict(n_steps=1000, n_samples=1600), 8, "return"),
     ]
     with executor(workers=2) as ex:  # what starting the local workers costs, for reference
         t_pool, _ = timed(lambda: list(run_pieces(ex, _noop, [(0,), (1,)])))
@@ -44,7 +44,7 @@ def main():
     import distributed
 
     for name, m, kw, pieces, unit in cases:
-        work = 2 * kw["samples"] * kw["n_steps"]  # upper bound: orbits exit early
+        work = 2 * kw["n_samples"] * kw["n_steps"]  # upper bound: orbits exit early
         print(f"\n## {name} ({pieces} pieces; throughput in {unit}s of the F_0 + F_eps work bound per second)")
         t1, ref = timed(lambda: hovering_area(m, **kw, n_threads=0))
         print(f"one process, core threads = all: {t1:8.2f} s  ({work / t1:.3g} {unit}s/s)")

@@ -43,7 +43,7 @@ def main() -> None:
         for direction, start, target in (("down", 0.95, a.down_target), ("up", 0.05, a.up_target)):
             t = time.perf_counter()
             r = hovering.transit(
-                m, zone, direction, n_orbits=n_orbits, n_steps=n_steps, start_s=start, target_s=target, seed=1
+                m, zone, direction, n_orbits=n_orbits, n_steps=n_steps, start_s=start, target_s=target, rng=1
             )
             reach = np.nanmax(r.s_max) if direction == "up" else np.nanmin(r.s_min)
             print(

@@ -20,89 +20,20 @@ systems also save to NPZ without pickle (``result.save(path)``, :func:`save`, :f
 
 from __future__ import annotations
 
-from . import _core, analysis, flow, normal, paper, truncated
-from ._enums import FlowStatus, Geometry, Region, Status, region_mask, wrap
-from ._provenance import show_versions
-from ._serial import load, save
-from ._version import __version__
-from .analysis import (
-    BarrierScan,
-    ConeCrossing,
-    CriticalCurve,
-    HoveringArea,
-    HoveringComparison,
-    HoveringComponents,
-    ImpactZone,
-    ModelVerdicts,
-    OrbitClasses,
-    barrier_scan,
-    birkhoff_average,
-    classify_orbits,
-    compare_hovering,
-    cone_crossing,
-    converse_kam,
-    critical_curve,
-    hovering_area,
-    impact_zone,
-    regularity,
-    rotation_number,
-    transit,
-)
-from .curve import Above, Below, Curve
-from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
-from .explore import explore
-from .flow import (
-    Bilinear,
-    CustomPotential,
-    Harmonic,
-    Numerical,
-    OnsetParameters,
-    Polynomial,
-    Potential,
-    ReturnMapResult,
-    Section,
-    StepSystem,
-    Tan,
-    TrajectoryPoint,
-    check_potential,
-    onset_parameters,
-)
-from .interface import ReturnMap
-from .normal import (
-    CornerCurves,
-    FlowMap,
-    FlowSteps,
-    MapComparison,
-    TangentialCurve,
-    compare_maps,
-    corner_curves,
-    forcing_coefficients,
-    forcing_function,
-    from_normal,
-    tangential_curve,
-    to_normal,
-    truncated_from_flow,
-)
-from .truncated import (
-    L1,
-    L2,
-    OMEGA_G,
-    IterateResult,
-    K_crit,
-    Theory,
-    TruncatedFamily,
-    TruncatedMap,
-    golden_family,
-    hovering_area_theory,
-    k_eps1,
-    k_eps2,
-    rho1,
-    rho2,
-    rho_crit,
-)
-from .truncated.theory import theory
+import logging as _logging
+import sys as _sys
+import types as _types
+from typing import TYPE_CHECKING
 
-simd_is_avx2 = _core.truncated.simd_is_avx2
+from ._version import __version__
+
+# ruff: noqa: F405  (__all__ names what _api holds: star-imported for type checkers, loaded at first use)
+if TYPE_CHECKING:  # what type checkers and editors see; at run time the first use loads it (__getattr__)
+    from ._api import *  # noqa: F403
+
+# A library's logger: records go where the application sends them (the command line's -v), and
+# nowhere by default (no "No handlers" fallback printing warnings on stderr).
+_logging.getLogger(__name__).addHandler(_logging.NullHandler())
 
 
 def simd_width() -> int:
@@ -110,7 +41,8 @@ def simd_width() -> int:
 
     A portable build (the default, and every wheel) holds the kernel for SSE2, AVX2 and AVX-512 and
     selects at run time the widest this CPU runs; ``HOVERING_SIMD=sse2|avx2|avx512|auto`` set
-    before the import forces one (a level this CPU does not run is a ValueError at import). A
+    before the import forces one (a level this CPU does not run is a ValueError at the first use
+    of a kernel, before any computation; ``import hovering`` alone loads no core). A
     build with ``HOVERING_NATIVE=ON`` has the one kernel of the machine it was built on.
 
     Returns
@@ -118,7 +50,9 @@ def simd_width() -> int:
     int
         8 (AVX-512), 4 (AVX2) or 2 (SSE2); another platform's vector width, or 1 without SIMD.
     """
-    return _core.truncated.simd_width()
+    from ._core import truncated
+
+    return truncated.simd_width()
 
 
 __all__ = [
@@ -215,8 +149,9 @@ __all__ = [
     "barrier_scan",
 ]
 
-# Loaded when first used, so `import hovering` stays light (no matplotlib, dask or scene pipeline):
-# the scene pipeline, the figures and the module that joins them; and the old module paths
+# Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene
+# pipeline): the public API (hovering._api, at the first use of any of its names), the scene
+# pipeline, the figures and the module that joins them; and the old module paths
 # (hovering.geometry, hovering.fullmap, ...), which warn on use (hovering._deprecated).
 _LAZY_MODULES = ("pipeline", "scenes", "plot")
 _OLD_MODULES = (
@@ -234,9 +169,60 @@ _OLD_MODULES = (
 )
 
 
-def __getattr__(name: str):
-    if name in _LAZY_MODULES or name in _OLD_MODULES:
-        import importlib
+def _load_api() -> None:
+    """Import the public API (:mod:`hovering._api`: the core, numpy, the models and analyses) and
+    keep its names here, so that only the first use pays (later lookups never reach __getattr__)."""
+    import importlib
 
+    api = importlib.import_module(f"{__name__}._api")
+    g = globals()
+    for n in __all__:
+        # The API's value wins over a submodule of the same name, as the eager ``from .explore
+        # import explore`` did (importing hovering.explore set the package's attribute first).
+        if hasattr(api, n):
+            g[n] = getattr(api, n)
+
+
+def __getattr__(name: str):
+    import importlib
+
+    if name in _LAZY_MODULES or name in _OLD_MODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    if name.startswith("__") and name.endswith("__"):  # Python's probes, not names of ours
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if name in __all__:
+        # Asked again, half-loaded, while _api itself imports (``from . import analysis``): the
+        # name is not there yet, the AttributeError lets the import system import the submodule.
+        _load_api()
+        if name in globals():
+            return globals()[name]
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    # Any other submodule is imported alone: the package's own modules ask for theirs this way
+    # (``from . import _untrusted`` looks here first), also while the API is half imported.
+    import importlib.util
+
+    if name.isidentifier() and importlib.util.find_spec(f"{__name__}.{name}") is not None:
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list:
+    return sorted(set(globals()) | set(__all__))
+
+
+#: Public functions named as the submodule that holds them: the name is the function.
+_FUNCTION_MODULES = ("explore",)
+
+
+class _Package(_types.ModuleType):
+    """The package's module type. Importing a submodule sets it as its package's attribute; for
+    ``hovering.explore`` (the function, in the module hovering.explore) the function is kept, as
+    the eager ``from .explore import explore`` kept it, whenever the module is first imported."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in _FUNCTION_MODULES and isinstance(value, _types.ModuleType) and hasattr(value, name):
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package

@@ -21,6 +21,8 @@ __all__ = [
     "require_type",
     "is_choice",
     "thread_count",
+    "MAX_SEED",
+    "random_seed",
     "forcing_array",
     "BYTES_PER_POINT",
     "check_points",
@@ -119,6 +121,60 @@ def thread_count(value) -> int:
         v = None
     if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= 4096:
         raise ValueError(f"n_threads must be an integer in [0, 4096] (0 = all cores), got {value!r}")
+    return v
+
+
+#: Largest seed: what the core's numpy-compatible generator, a scene file and a checkpoint key hold
+#: (a non-negative int64).
+MAX_SEED = 2**63 - 1
+
+
+def random_seed(rng, name: str = "rng") -> int:
+    """The integer seed of a run from its ``rng`` argument (SPEC 7: None, an int or a Generator).
+
+    Every random draw of the package starts from one integer seed: the core draws
+    ``numpy.random.default_rng(seed)``'s stream itself (and jumps it ahead for each piece of a
+    distributed run), and results, checkpoints and provenance record that integer. So an int is
+    the seed as it is; a :class:`numpy.random.Generator` gives one, drawn from it once (the
+    Generator advances; the result records the seed drawn, which reproduces the run); None draws
+    one from fresh OS entropy (``numpy.random.default_rng()``), also recorded.
+
+    Parameters
+    ----------
+    rng : None, int or numpy.random.Generator
+        The argument as given.
+    name : str, optional
+        The parameter's name (for the message).
+
+    Returns
+    -------
+    int
+        The seed, in [0, :data:`MAX_SEED`].
+
+    Raises
+    ------
+    TypeError
+        For anything else (a float, a string, a bool, a legacy ``RandomState``, a ``SeedSequence``
+        or a bit generator), naming the value and what is allowed.
+    ValueError
+        For an integer outside [0, MAX_SEED], naming it and the range.
+    """
+    if rng is None or isinstance(rng, np.random.Generator):
+        gen = np.random.default_rng() if rng is None else rng
+        return int(gen.integers(0, MAX_SEED, endpoint=True))
+    if isinstance(rng, np.ndarray) and rng.ndim == 0 and rng.dtype.kind in "iu":
+        rng = rng.item()
+    try:
+        v = None if isinstance(rng, (bool, np.bool_)) else operator.index(rng)
+    except TypeError:
+        v = None
+    if v is None:
+        raise TypeError(
+            f"{name} must be None, an integer seed in [0, {MAX_SEED}] or a numpy.random.Generator "
+            f"(numpy.random.default_rng(seed)), got {' '.join(_short(rng).split())} of type {type(rng).__name__}"
+        )
+    if not 0 <= v <= MAX_SEED:
+        raise ValueError(f"{name} must be an integer seed in [0, {MAX_SEED}] (or a numpy.random.Generator), got {v}")
     return v
 
 

@@ -10,14 +10,18 @@ lazily keeps ``import hovering`` from loading what the old path points to.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 import sys
 import warnings
 from collections.abc import Callable
 from types import FrameType
+from typing import Any, TypeVar
 
-__all__ = ["REMOVED_IN", "warn", "moved_module", "renamed_argument"]
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+__all__ = ["REMOVED_IN", "message", "warn", "moved_module", "renamed_argument", "renamed_keywords"]
 
 #: The release that removes every name deprecated in this one.
 REMOVED_IN = "0.4.0"
@@ -37,6 +41,23 @@ def _user_stacklevel() -> int:
     return level
 
 
+def message(old: str, new: str) -> str:
+    """The one wording of a deprecation: what is deprecated, when it goes, what to use.
+
+    Parameters
+    ----------
+    old, new : str
+        What the caller used, and what to use instead.
+
+    Returns
+    -------
+    str
+        ``"<old> is deprecated and will be removed in hovering <REMOVED_IN>; use <new> instead"``
+        (the command line logs it for an old flag; :func:`warn` warns with it).
+    """
+    return f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead"
+
+
 def warn(old: str, new: str, stacklevel: int | None = None) -> None:
     """Warn that ``old`` is deprecated in favour of ``new``.
 
@@ -48,7 +69,7 @@ def warn(old: str, new: str, stacklevel: int | None = None) -> None:
         Passed to :func:`warnings.warn`; default: the first frame outside the package (the user's line).
     """
     warnings.warn(
-        f"{old} is deprecated and will be removed in hovering {REMOVED_IN}; use {new} instead",
+        message(old, new),
         DeprecationWarning,
         stacklevel=stacklevel if stacklevel is not None else _user_stacklevel(),
     )
@@ -98,3 +119,54 @@ def renamed_argument(func: str, old: str, new: str, stacklevel: int | None = Non
         Passed to :func:`warnings.warn`; default: the user's line (see :func:`warn`).
     """
     warn(f"{func}({old}=...)", f"{func}({new})", stacklevel=stacklevel)
+
+
+def renamed_keywords(**renames: str) -> Callable[[_F], _F]:
+    """Decorator: the keyword ``old=`` of a function still works as ``new=``, with a
+    DeprecationWarning naming ``new`` (one name per concept across the API: docs/guide/outcomes.md,
+    "One name per concept").
+
+    The signature shows only the new names (``inspect.signature`` follows ``__wrapped__``);
+    ``renames`` stays on the function as ``__renamed_keywords__`` (``{old: new}``), where the test
+    of the API's names finds the old ones. Passing both names is a TypeError, as passing one
+    argument twice is.
+
+    Parameters
+    ----------
+    **renames : str
+        ``old="new"`` for each renamed keyword.
+
+    Returns
+    -------
+    callable
+        The decorator.
+
+    Examples
+    --------
+    >>> @renamed_keywords(samples="n_samples")
+    ... def area(n_samples=10):
+    ...     return n_samples
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     area(samples=3), str(w[0].message).split(";")[1]
+    (3, ' use area(n_samples=...) instead')
+    """
+
+    def decorate(func: _F) -> _F:
+        name = func.__name__
+
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            for old, new in renames.items():
+                if old in kwargs:
+                    if new in kwargs:
+                        raise TypeError(f"{name}() got both {old}= (deprecated) and {new}=; pass {new}= only")
+                    renamed_argument(name, old, f"{new}=...")
+                    kwargs[new] = kwargs.pop(old)
+            return func(*args, **kwargs)
+
+        wrapper.__renamed_keywords__ = dict(renames)  # type: ignore[attr-defined]
+        return wrapper  # type: ignore[return-value]
+
+    return decorate

@@ -1,14 +1,15 @@
 """The optional dependencies: which feature needs which, and the one message when one is missing.
 
-numpy (and matplotlib, for the figures) is all ``pip install hovering`` brings. The rest are
-extras, each named after what it is for::
+numpy (and matplotlib, for the figures) is all installing hovering brings. The rest are extras,
+each named after what it is for (from a clone; no package index carries hovering yet, so an
+installed wheel takes the packages themselves, e.g. ``pip install xarray``)::
 
-    pip install 'hovering[distributed]'   # Dask: executor= a cluster, a scheduler or dask=True
-    pip install 'hovering[xarray]'        # to_xarray() of the results
-    pip install 'hovering[pandas]'        # to_pandas() of the tabular results
-    pip install 'hovering[progress]'      # tqdm bars (a plain-text bar without it)
-    pip install 'hovering[scipy]'         # the scipy reference integrator of the accuracy diagrams
-    pip install 'hovering[all]'           # all of them
+    pip install '.[distributed]'   # Dask: executor= a cluster, a scheduler or dask=True
+    pip install '.[xarray]'        # to_xarray() of the results
+    pip install '.[pandas]'        # to_pandas() of the tabular results
+    pip install '.[progress]'      # tqdm bars (a plain-text bar without it)
+    pip install '.[scipy]'         # the scipy reference integrator of the accuracy diagrams
+    pip install '.[all]'           # all of them
 """
 
 from __future__ import annotations
@@ -48,7 +49,8 @@ def require(module: str, feature: str) -> ModuleType:
     Raises
     ------
     ImportError
-        When it is not installed: naming the feature, the package and ``pip install 'hovering[EXTRA]'``.
+        When it is not installed: naming the feature, ``pip install PACKAGE`` and the extra that
+        brings it (``pip install '.[EXTRA]'`` in a clone).
     """
     top = module.split(".")[0]
     try:
@@ -56,5 +58,5 @@ def require(module: str, feature: str) -> ModuleType:
     except ImportError as e:
         raise ImportError(
             f"{feature} needs {top}, an optional dependency of hovering that is not installed: "
-            f"pip install 'hovering[{EXTRAS[top]}]' (or pip install {top})"
+            f"pip install {top} (hovering's extra {EXTRAS[top]!r}: pip install '.[{EXTRAS[top]}]' in a clone)"
         ) from e

@@ -482,8 +482,9 @@ def _check_meta(value, where: str = "meta") -> None:
 
 
 def _seed_of(obj) -> int | None:
-    """The random seed behind ``obj``: its own ``seed``, or its scene's (scene results)."""
-    for o in (obj, getattr(obj, "scene", None)):
+    """The random seed behind ``obj``: its own ``seed``, its scene's (scene results) or its flow
+    measurement's (:class:`hovering.HoveringComparison`)."""
+    for o in (obj, getattr(obj, "scene", None), getattr(obj, "flow", None)):
         seed = getattr(o, "seed", None)
         if isinstance(seed, int) and not isinstance(seed, bool):
             return seed

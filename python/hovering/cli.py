@@ -1,9 +1,11 @@
 """Command line of ``hovering`` (the same as ``python -m hovering``).
 
-``hovering --version`` prints the version; ``-v`` shows what the package logs (``-vv`` also its
-debug records) on stderr, ``-q`` only errors, and none of the lines below but the numbers.
+``hovering --version`` prints the version (without loading the compiled core or numpy); ``-v``
+shows what the package logs on stderr: the stages of a run as they start and end (what, how much,
+how long), each sweep point, each hovering area and transit measured (``-vv`` also its debug
+records); ``-q`` only errors, and none of the lines below but the numbers.
 
-``demo [--out PNG]``
+``demo [--out PNG] [--n-steps N] [--n-orbits N]``
     The packaged demo scene: the physical flow's return map beside its truncated model.
 ``scene SCENE.toml [--out PNG] [--quick] [--progress | --no-progress] [--workers N [--dask] | --scheduler ADDRESS]``
     One figure from a scene file (``examples/scenes``): computes, writes the result (NPZ + JSON)
@@ -38,6 +40,8 @@ import argparse
 import logging
 import sys
 import time
+
+from ._deprecated import message
 
 
 def _checked(kind, lo, hi):
@@ -80,6 +84,32 @@ def _logging(verbose: int, quiet: bool) -> None:
     h.setFormatter(logging.Formatter("%(name)s: %(levelname)s: %(message)s"))
     h._hovering_cli = True  # type: ignore[attr-defined]
     log.addHandler(h)
+
+
+#: What ``demo`` runs without flags (the packaged scene's own counts are larger: a demo is quick).
+_DEMO_DEFAULTS = {"n_orbits": 12, "n_steps": 1500}
+
+#: ``demo``'s old flags and their names now (one name per concept: the scene keys, ``explore``).
+_DEMO_RENAMED = {"--orbits": "--n-orbits", "--steps": "--n-steps"}
+
+
+def _dest(flag: str) -> str:
+    return flag[2:].replace("-", "_")
+
+
+def _demo_flags(p, args) -> None:
+    """``demo``'s counts: an old flag (``--steps``, ``--orbits``) still works, its value going to the
+    new one with a deprecation logged (users of a command line read stderr, not Python's warning
+    filters); both names at once are a usage error; neither, the default."""
+    for old, new in _DEMO_RENAMED.items():
+        value = getattr(args, "old_" + _dest(new))
+        if value is not None:
+            if getattr(args, _dest(new)) is not None:
+                p.error(f"{old} is the old name of {new}: give {new} only")
+            logging.getLogger(__name__).warning(message(f"hovering demo {old}", new))
+            setattr(args, _dest(new), value)
+        elif getattr(args, _dest(new)) is None:
+            setattr(args, _dest(new), _DEMO_DEFAULTS[_dest(new)])
 
 
 def _progress(args) -> bool:
@@ -138,7 +168,7 @@ def _demo(args) -> int:
 
     path = packaged_scene("demo")
     data = tomllib.loads(path.read_text(encoding="utf-8"))
-    data.update(n_steps=args.steps, n_orbits=args.orbits, dpi=args.dpi)
+    data.update(n_steps=args.n_steps, n_orbits=args.n_orbits, dpi=args.dpi)
     data["system"]["eps"] = args.eps
     try:
         out = output_path("--out", args.out)
@@ -301,18 +331,21 @@ def main(argv=None) -> int:
     d.add_argument(
         "--eps", type=_checked(float, -0.2, 0.2), default=-0.05, help="eps in [-0.2, 0.2] (default %(default)s)"
     )
+    # The flags are named as the scene keys and the API (n_orbits, n_steps; explore --n-steps).
     d.add_argument(
-        "--orbits",
+        "--n-orbits",
         type=_checked(int, 1, 1000),
-        default=12,
-        help="initial conditions on L1, 1..1000 (default %(default)s)",
+        default=None,
+        help=f"initial conditions on L1, 1..1000 (default {_DEMO_DEFAULTS['n_orbits']})",
     )
     d.add_argument(
-        "--steps",
+        "--n-steps",
         type=_checked(int, 1, 1_000_000),
-        default=1500,
-        help="returns per orbit, 1..1e6 (default %(default)s)",
+        default=None,
+        help=f"returns per orbit, 1..1e6 (default {_DEMO_DEFAULTS['n_steps']})",
     )
+    for old, hi in (("--orbits", 1000), ("--steps", 1_000_000)):
+        d.add_argument(old, dest="old_" + _dest(_DEMO_RENAMED[old]), type=_checked(int, 1, hi), help=argparse.SUPPRESS)
     d.add_argument(
         "--dpi", type=_checked(int, 30, 1200), default=130, help="PNG resolution, 30..1200 (default %(default)s)"
     )
@@ -366,6 +399,8 @@ def main(argv=None) -> int:
     global _quiet
     _quiet = args.quiet
     _logging(args.verbose, args.quiet)
+    if args.cmd == "demo":
+        _demo_flags(p, args)
     return {
         "demo": _demo,
         "scene": _scene,

@@ -87,7 +87,7 @@ class Curve:
     --------
     >>> import numpy as np, hovering
     >>> c = hovering.Curve.from_function(lambda phi: 0.1 * np.cos(phi), n=64)
-    >>> abs(c(0.3) - 0.1 * np.cos(0.3)) < 1e-7
+    >>> bool(abs(c(0.3) - 0.1 * np.cos(0.3)) < 1e-7)
     True
     """
 

@@ -6,6 +6,7 @@ never each other.
 
 from __future__ import annotations
 
+import importlib
 import operator
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, fields
@@ -14,6 +15,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from ._checks import _short, check_memory, integer, is_choice, real_number
+from ._deprecated import renamed_keywords
 from ._display import Summarized, status_counts
 from ._enums import Status, region_mask, status_code
 from ._serial import Saveable
@@ -36,7 +38,8 @@ __all__ = [
 
 #: Functions of the layers above the models that the models' convenience methods call
 #: (``m.hovering_area()``, ``FlowMap(accuracy=...)``): each higher module registers its own when
-#: it is imported (``import hovering`` imports all of them), so the arrows still point down.
+#: it is imported (:mod:`hovering._api` imports all of them; :func:`hook` loads it on a miss), so
+#: the arrows still point down.
 _HOOKS: dict = {}
 
 
@@ -69,14 +72,18 @@ def hook(name: str) -> Callable:
     Raises
     ------
     RuntimeError
-        If the module that owns it was never imported (``import hovering`` imports them all).
+        If no module registers it (an unknown hook name).
     """
+    if name not in _HOOKS:
+        # The owners are loaded with the public API (hovering._api), which ``import hovering``
+        # defers to the first use of a name: a model used straight from its module
+        # (``from hovering.normal import FlowMap``) can call a hook before anything loaded them.
+        # By name, as _deprecated resolves moved paths: this layer imports nothing above it.
+        importlib.import_module("hovering._api")
     try:
         return _HOOKS[name]
     except KeyError:
-        raise RuntimeError(
-            f"{name} is provided by a part of hovering that is not loaded; import hovering first"
-        ) from None
+        raise RuntimeError(f"{name} is provided by no part of hovering (known hooks: {sorted(_HOOKS)})") from None
 
 
 @runtime_checkable
@@ -129,17 +136,18 @@ class ReturnMap(Protocol):
 class MapAnalyses:
     """The analyses as methods, for every map (mixed into TruncatedMap, TruncatedFamily, FlowMap)."""
 
-    def hovering_area(self, n_steps: int = 10_000, samples: int = 100_000, **kwargs):
+    @renamed_keywords(samples="n_samples")
+    def hovering_area(self, n_steps: int = 10_000, n_samples: int = 100_000, **kwargs):
         """Area of the hovering set HOV(eps), with error estimate and theory; see :func:`hovering.hovering_area`.
 
         Parameters
         ----------
         n_steps : int, optional
             Iterates that count as "never impacts".
-        samples : int, optional
-            Sample points (stratified over the box below K = 0).
+        n_samples : int, optional
+            Sample points (stratified over the box below K = 0); formerly ``samples=`` (deprecated).
         **kwargs
-            ``K_low``, ``seed``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
+            ``K_low``, ``rng``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
             stderr; a callable ``progress(done, total)``), ``components``, ``deepen``, ``executor``.
 
         Returns
@@ -147,7 +155,7 @@ class MapAnalyses:
         HoveringArea
             ``.area``, ``.error``, ``.theory`` and diagnostics.
         """
-        return hook("hovering_area")(self, n_steps=n_steps, samples=samples, **kwargs)
+        return hook("hovering_area")(self, n_steps=n_steps, n_samples=n_samples, **kwargs)
 
     def critical_curve(self, n_steps: int = 20_000, **kwargs):
         """Lowest invariant curve in the no-impact regions; see :func:`hovering.critical_curve`.
@@ -157,7 +165,7 @@ class MapAnalyses:
         n_steps : int, optional
             Iterates per tested orbit.
         **kwargs
-            ``K_range``, ``regions``, ``line``, ``grid``, ``digits``, ``tol``, ``n_threads``,
+            ``K_range``, ``regions``, ``line``, ``n_grid``, ``digits``, ``tol``, ``n_threads``,
             ``search``, ``progress`` (True: a tqdm bar on stderr; a callable ``progress(done, total)``).
 
         Returns
@@ -265,6 +273,21 @@ class IterateResult(Summarized, Saveable):
         ``steps`` (accepted integrator steps). Effects nobody asked for cost nothing: no walls, no
         wall search; eps = 0, no coupling evaluation; no labels, no label operation; no trajectory,
         no dense sample.
+
+    Examples
+    --------
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> K0 = np.array([-0.2, 0.0, 0.5])
+    >>> res = m.iterate(m.L1(K0), K0, 100, record=("orbit", "regions", "extrema"), every=10)
+    >>> res
+    <IterateResult n_orbits=3, n_steps=100, every=10, status={OK: 3}, ...>
+    >>> res.phi.shape, res.region.shape       # the states x_0, x_10, ..., x_100 and the returns from them
+    ((3, 11), (3, 10))
+    >>> res.n_orbits, res.count(hovering.Status.OK), res.steps_done.tolist()
+    (3, 3, [100, 100, 100])
+    >>> bool(np.all(res.K_min <= res.K.min(axis=1)))   # extrema: over every state, not only the kept ones
+    True
     """
 
     phi: np.ndarray | None

@@ -6,6 +6,7 @@ phase portrait in one call. Above both the scene pipeline (computing, results) a
 from __future__ import annotations
 
 import io
+import logging
 import os
 import time
 from pathlib import Path
@@ -24,6 +25,8 @@ from .scenes.schema import output_dirs
 from .scenes.spec import SceneSpec
 
 __all__ = ["run_scene", "redraw", "phase_portrait", "draw_geometry"]
+
+_log = logging.getLogger(__name__)
 
 
 def run_scene(
@@ -106,6 +109,10 @@ def run_scene(
     finally:
         if not keep_figure:
             plt.close(fig)
+    _log.info(
+        "scene %s: figure drawn and %s, %s, %s written, %.1f s", scene.name, npz_path, json_path, png,
+        time.perf_counter() - t,
+    )  # fmt: skip
     summary = result.summary()
     summary["runtime_s"] = time.perf_counter() - t0
     summary.update(

@@ -131,7 +131,7 @@ def test_hovering_area_matches_brute_force_and_theory(eps):
     m = paper_map(eps)
     p = dict(PAPER, eps=eps)
     K_low = -2 * eps / math.sin(PAPER["Omega0"] / 2)
-    hv = m.hovering_area(n_steps=2000, samples=40_000, K_low=K_low, seed=1)
+    hv = m.hovering_area(n_steps=2000, n_samples=40_000, K_low=K_low, rng=1)
     bf, bf_sigma = brute_force_area(p, 2000, 160, 40, K_low)
     # Two independent estimates of one area (different point sets, different implementations):
     # they differ by sampling noise only; 3 combined standard deviations + both iteration errors.
@@ -146,13 +146,13 @@ def test_hovering_area_matches_brute_force_and_theory(eps):
 
 @pytest.mark.parametrize("eps", [-0.1, -0.2])
 def test_hovering_set_is_empty_for_negative_eps(eps):
-    hv = paper_map(eps).hovering_area(n_steps=4000, samples=40_000)
+    hv = paper_map(eps).hovering_area(n_steps=4000, n_samples=40_000)
     assert hv.area == 0.0 and hv.theory == 0.0
 
 
 def test_hovering_area_grows_monotonically_in_eps():
     eps = [0.05, 0.1, 0.15, 0.2, 0.25, 0.3]
-    hv = [paper_map(e).hovering_area(n_steps=4000, samples=40_000, K_low=-0.7) for e in eps]
+    hv = [paper_map(e).hovering_area(n_steps=4000, n_samples=40_000, K_low=-0.7) for e in eps]
     areas = np.array([h.area for h in hv])
     errs = np.array([h.error for h in hv])
     # Each increment exceeds the combined errors of its two ends (increments ~0.12 vs errors ~0.02).
@@ -161,7 +161,7 @@ def test_hovering_area_grows_monotonically_in_eps():
 
 def test_hovering_area_reports_errors_and_validates():
     m = paper_map(0.2)
-    hv = m.hovering_area(n_steps=400, samples=2000, keep_points=True)
+    hv = m.hovering_area(n_steps=400, n_samples=2000, keep_points=True)
     n4, n2, n1 = sorted(hv.areas)
     assert hv.areas[n4] >= hv.areas[n2] >= hv.areas[n1] == hv.area  # estimates only fall with N
     assert hv.error == pytest.approx(2 * hv.sampling_error + hv.iteration_error)
@@ -201,7 +201,7 @@ def test_golden_family_critical_rotation_and_monotone_area():
             m = hovering.TruncatedMap(eps, *hovering.golden_family(eps, c))
             devs[eps, c] = abs(m.critical_curve(n_steps=20_000).rotation - hovering.OMEGA_G)
             if eps == 0.3:
-                areas[c] = m.hovering_area(n_steps=3000, samples=30_000).area
+                areas[c] = m.hovering_area(n_steps=3000, n_samples=30_000).area
     # Measured deviations <= 0.0024 at eps 0.15 and <= 0.0098 at 0.3; bound 0.15 eps^2.
     for (eps, c), d in devs.items():
         assert d < 0.15 * eps**2, (eps, c, d)
@@ -217,7 +217,7 @@ def test_lowest_curve_above_the_step_for_both_signs():
     assert up.K_min >= 0 and dn.K_min >= 0
     assert abs(up.rotation - dn.rotation) < 1e-3
     with pytest.raises(RuntimeError, match="no invariant curve"):
-        paper_map(0.3).critical_curve(n_steps=2000, K_range=(-0.6, -0.5), grid=4)
+        paper_map(0.3).critical_curve(n_steps=2000, K_range=(-0.6, -0.5), n_grid=4)
 
 
 def test_critical_curve_is_a_rotational_curve_not_an_island():

@@ -13,7 +13,7 @@ def test_default_range_is_inside_the_band_at_large_eps(eps):
     # search refused it: "K_range must be increasing inside the band" at |eps| = 0.3.
     m = hv.paper.flow_map(eps=eps)
     lo, hi = m.valid_band()
-    c = hv.critical_curve(m, n_steps=2000, grid=16)
+    c = hv.critical_curve(m, n_steps=2000, n_grid=16)
     assert lo < c.K0 < hi
 
 
@@ -23,7 +23,7 @@ def test_the_non_hovering_sign_finds_k_u0_not_the_tori_under_the_zone():
     # below the zone's floor, and returned the band's bottom edge (K0 = -0.182) as the "curve".
     m = hv.paper.flow_map(eps=0.2)
     assert not m.theory().hovers
-    c = hv.critical_curve(m, n_steps=2000, grid=16)
+    c = hv.critical_curve(m, n_steps=2000, n_grid=16)
     assert not c.hovers
     # measured 0.0023; the band's bottom is -0.182: any K0 above -0.01 is k^{u0}'s crossing
     assert c.K0 > -0.01

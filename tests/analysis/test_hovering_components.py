@@ -66,7 +66,7 @@ def negative_eps():
     # The paper's map at eps = -0.3: eq:hovsetsize gives 0 (sin(Omega0/2) > 0), yet points hover
     # in a period-2 island chain inside J_0 below the default box (the box deepens once to reach it).
     m = paper.truncated_map(-0.3)
-    return m, hovering.hovering_area(m, n_steps=2000, samples=20_000, keep_points=True)
+    return m, hovering.hovering_area(m, n_steps=2000, n_samples=20_000, keep_points=True)
 
 
 def test_parts_sum_to_area_and_negative_eps_is_islands(negative_eps):
@@ -94,7 +94,7 @@ def test_parts_sum_to_area_and_negative_eps_is_islands(negative_eps):
 def test_positive_eps_splits_band_and_islands():
     # At eps = 0.3 the deepened box holds the band (eq:hovsetsize) and a period-2 chain below it.
     m = paper.truncated_map(0.3)
-    hv = hovering.hovering_area(m, n_steps=2000, samples=20_000)
+    hv = hovering.hovering_area(m, n_steps=2000, n_samples=20_000)
     c = hv.components
     assert c.band + c.islands + c.under_floor == pytest.approx(hv.area, rel=1e-12)
     # eq:hovsetsize is the band's leading order (0.764 at 0.3; measured C ~ 0.3 eps^2 below it).
@@ -106,7 +106,7 @@ def test_membership_matches_a_plain_loop(negative_eps):
     n_steps = 2000
     m, hv = negative_eps
     pos = paper.truncated_map(0.3)
-    hp = hovering.hovering_area(pos, n_steps=n_steps, samples=20_000, K_low=-0.7, keep_points=True)
+    hp = hovering.hovering_area(pos, n_steps=n_steps, n_samples=20_000, K_low=-0.7, keep_points=True)
     checked = 0
     for mm, h, code in ((m, hv, ISLANDS), (pos, hp, BAND), (pos, hp, 0)):
         for i in interior(h, 20_000, code, 3):
@@ -121,7 +121,7 @@ def test_membership_matches_a_plain_loop(negative_eps):
 
 def test_default_box_deepens_like_an_explicit_K_low():
     m = paper.truncated_map(-0.3)
-    kw = dict(n_steps=1000, samples=5000, components=False)
+    kw = dict(n_steps=1000, n_samples=5000, components=False)
     first = hovering.hovering_area(m, deepen=0, **kw)
     assert first.floor_touched and first.deepened == 0
     deep = hovering.hovering_area(m, **kw)
@@ -138,7 +138,7 @@ def test_deepening_stops_at_the_band_edge():
     # Islands reach the lower edge of this map's band (K = -pi): the box deepens twice, is clipped
     # to the band, and says the band ended first (51 hovering samples in its lowest tenth).
     m = hovering.TruncatedMap(eps=-0.3, Omega0=1.0, theta_w=3 * np.pi / 4, tau0=5.0, lam=0.5)
-    hv = hovering.hovering_area(m, n_steps=500, samples=2000, components=False)
+    hv = hovering.hovering_area(m, n_steps=500, n_samples=2000, components=False)
     lo = m.valid_band()[0]
     assert hv.band_edge and hv.floor_touched and hv.deepened == 2
     assert lo < hv.box[2] and hv.box[2] == pytest.approx(lo, rel=1e-8)
@@ -169,7 +169,7 @@ def test_compare_hovering_counts_match_each_models_own_run(flow_comparison):
     for v, forcing in ((cmp["onset"], "first_mode"), (cmp["measured"], "measured")):
         # The model's own hovering_area on the flow's box and seed draws the same points.
         own = hovering.hovering_area(
-            fm.truncated(forcing), n_steps=200, samples=300, K_low=flow.box[2], keep_points=True, components=False
+            fm.truncated(forcing), n_steps=200, n_samples=300, K_low=flow.box[2], keep_points=True, components=False
         )
         assert np.array_equal(own.phi, flow.phi) and np.array_equal(own.K, flow.K)
         f, mh = flow.hovering, own.hovering
@@ -190,7 +190,7 @@ def test_flow_under_the_floor():
     # lies under the flow's floor: above the eps = 0 torus tangent to the upper wall (F_0 impacts
     # there and only there: K = const at eps = 0) and below the floor curve, never beside the step.
     fm = hovering.FlowMap(paper.system(0.1), 1.0)
-    hv = hovering.hovering_area(fm, n_steps=100, samples=200, K_low=-0.2, keep_points=True)
+    hv = hovering.hovering_area(fm, n_steps=100, n_samples=200, K_low=-0.2, keep_points=True)
     c = hv.components
     assert hv.theory == 0.0 and c.floor == "flow"
     assert c.band + c.islands + c.under_floor == pytest.approx(hv.area, rel=1e-12)
@@ -208,7 +208,7 @@ def test_a_floor_that_is_not_found_loses_nothing():
     # 50 returns per tested orbit find no floor on this flow (the search raises): the area stands,
     # the one-sided points stay in `islands`, and `floor` says why.
     fm = hovering.FlowMap(paper.system(0.1), 1.0)
-    hv = hovering.hovering_area(fm, n_steps=50, samples=60, K_low=-0.2)
+    hv = hovering.hovering_area(fm, n_steps=50, n_samples=60, K_low=-0.2)
     c = hv.components
     assert c.floor.startswith("not found: no invariant curve") and c.under_floor == 0.0
     assert hv.area > 0 and c.band + c.islands == pytest.approx(hv.area, rel=1e-12)

@@ -76,7 +76,7 @@ def test_crossing_statistics_are_their_definitions(setup):
 
 def test_an_executor_gives_the_one_process_answer(setup):
     m, zone = setup
-    kw = dict(n_orbits=64, n_steps=2000, start_s=0.97, target_s=0.975, seed=3)
+    kw = dict(n_orbits=64, n_steps=2000, start_s=0.97, target_s=0.975, rng=3)
     one = hovering.transit(m, zone, "up", **kw)
     with cf.ThreadPoolExecutor(2) as pool:
         many = hovering.transit(m, zone, "up", executor=hovering.parallel.Executor(pool=pool, pieces=5), **kw)

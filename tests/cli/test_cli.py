@@ -12,7 +12,7 @@ def test_cli_demo_writes_png(tmp_path, capsys):
     from hovering.__main__ import main
 
     out = tmp_path / "demo.png"
-    rc = main(["demo", "--out", str(out), "--steps", "100", "--orbits", "3", "--dpi", "40"])
+    rc = main(["demo", "--out", str(out), "--n-steps", "100", "--n-orbits", "3", "--dpi", "40"])
     assert rc == 0
     data = out.read_bytes()
     assert len(data) > 1000 and data[:8] == b"\x89PNG\r\n\x1a\n"

@@ -8,10 +8,12 @@ from __future__ import annotations
 import ast
 import logging
 import pathlib
+import re
 import subprocess
 import sys
 
 import matplotlib.pyplot as plt
+import pytest
 
 import hovering
 from hovering.cli import main
@@ -50,7 +52,7 @@ def test_verbose_shows_the_package_log_and_quiet_only_the_numbers(tmp_path, caps
         assert "hovering.parallel.executor: INFO:" in out.err and "threads of this process" in out.err
         assert main([*argv, "--out", str(tmp_path / "b.png")]) == 0
         assert "INFO" not in capsys.readouterr().err  # warnings only, by default
-        demo = ["demo", "--steps", "100", "--orbits", "3", "--dpi", "30", "--no-progress"]
+        demo = ["demo", "--n-steps", "100", "--n-orbits", "3", "--dpi", "30", "--no-progress"]
         assert main([*demo, "--out", str(tmp_path / "c.png")]) == 0
         assert "demo done in" in capsys.readouterr().out
         assert main(["-q", *demo, "--out", str(tmp_path / "d.png")]) == 0
@@ -61,6 +63,117 @@ def test_verbose_shows_the_package_log_and_quiet_only_the_numbers(tmp_path, caps
         for h in [h for h in main_level.handlers if getattr(h, "_hovering_cli", False)]:
             main_level.removeHandler(h)
         main_level.setLevel(logging.NOTSET)
+        plt.close("all")
+
+
+def test_version_loads_neither_the_core_nor_numpy():
+    # `hovering --version` answers from the package's metadata: neither the compiled core nor numpy
+    # (seconds of imports) is loaded, through the console script's path (`from hovering.cli import
+    # main`) or python -m's (`import hovering`, then its __main__).
+    code = (
+        "import json, sys\n"
+        "from hovering.cli import main\n"
+        "try:\n"
+        "    main(['--version'])\n"
+        "except SystemExit as e:\n"
+        "    assert e.code == 0, e.code\n"
+        "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('numpy', 'matplotlib') or m == 'hovering._core')\n"
+        "print(json.dumps(heavy), file=sys.stderr)\n"
+    )
+    r = _run(sys.executable, "-c", code)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == f"hovering {hovering.__version__}"
+    assert r.stderr.strip().splitlines()[-1] == "[]", r.stderr
+    # the same through `python -m hovering`, checked from inside the run (at exit)
+    atexit = (
+        "import atexit, runpy, sys\n"
+        "atexit.register(lambda: print(sorted(m for m in sys.modules if m.split('.')[0] == 'numpy' "
+        "or m == 'hovering._core'), file=sys.stderr))\n"
+        "sys.argv = ['hovering', '--version']\n"
+        "runpy.run_module('hovering', run_name='__main__', alter_sys=True)\n"
+    )
+    r = _run(sys.executable, "-c", atexit)
+    assert r.stdout.strip() == f"hovering {hovering.__version__}" and r.stderr.strip().splitlines()[-1] == "[]", (
+        r.stdout + r.stderr
+    )
+    # and the version is the build's own: what the compiled core says it is
+    assert hovering.__version__ == dict(hovering._core.build_info())["hovering"]
+
+
+def test_version_metadata_of_another_copy_or_none_falls_back_to_the_core(monkeypatch, tmp_path):
+    # The metadata is this copy's only if its files are these files: a source tree on sys.path
+    # beside another installed hovering (another version) reads the version the core was built with.
+    from importlib import metadata
+
+    from hovering import _version
+
+    core = dict(hovering._core.build_info())["hovering"]
+
+    class Elsewhere:
+        version = "9.9.9"
+
+        def locate_file(self, path):
+            return tmp_path / path
+
+    monkeypatch.setattr(metadata, "distribution", lambda name: Elsewhere())
+    assert _version._read() == core
+
+    def missing(name):
+        raise metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(metadata, "distribution", missing)
+    assert _version._read() == core
+
+
+def _cli_log_handlers_removed():
+    log = logging.getLogger("hovering")
+    for h in [h for h in log.handlers if getattr(h, "_hovering_cli", False)]:
+        log.removeHandler(h)
+    log.setLevel(logging.NOTSET)
+
+
+def test_verbose_logs_the_stages_of_a_run_and_quiet_by_default(tmp_path, capsys):
+    demo = ["demo", "--n-steps", "20", "--n-orbits", "2", "--dpi", "30", "--no-progress"]
+    try:
+        assert main(["-v", *demo, "--out", str(tmp_path / "a.png")]) == 0
+        err = capsys.readouterr().err
+        stages = [ln for ln in err.splitlines() if ": stage " in ln]
+        # each stage starts (what it computes, how much) and ends (its time), numbered i/n
+        assert "hovering.scenes.compute: INFO: scene demo: stage 1/5 setup: " in err, err
+        assert any(ln.endswith("stage 2/5 flow: 2 orbits x 20 returns") for ln in stages), stages
+        assert re.search(r"scene demo: stage 5/5 corner curves done, \d+\.\d s", err), err
+        assert len(stages) == 10 and re.search(r"scene demo: computed in \d+\.\d s", err)
+        assert re.search(r"scene demo: figure drawn and .*a\.npz.* written, \d+\.\d s", err), err
+        # without -v: none of it (the library logs at INFO; the command line shows warnings)
+        assert main([*demo, "--out", str(tmp_path / "b.png")]) == 0
+        assert capsys.readouterr().err == ""
+    finally:
+        _cli_log_handlers_removed()
+        plt.close("all")
+    # outside the command line the library configures nothing: no handler of its own prints
+    assert all(isinstance(h, logging.NullHandler) for h in logging.getLogger("hovering").handlers)
+
+
+def test_demo_old_flags_still_work_with_a_deprecation_line(tmp_path, capsys):
+    try:
+        argv = ["demo", "--dpi", "30", "--no-progress"]
+        assert main([*argv, "--steps", "20", "--orbits", "2", "--out", str(tmp_path / "old.png")]) == 0
+        out = capsys.readouterr()
+        assert (
+            "hovering demo --steps is deprecated and will be removed in hovering 0.4.0; use --n-steps instead"
+            in out.err
+        )
+        assert "use --n-orbits instead" in out.err and "flow: 2 orbits" in out.out
+        assert main([*argv, "--n-steps", "20", "--n-orbits", "2", "--out", str(tmp_path / "new.png")]) == 0
+        new = capsys.readouterr()
+        assert new.err == "" and new.out.replace("new.", "old.").split("wrote")[0] == out.out.split("wrote")[0]
+        helps = _run(sys.executable, "-m", "hovering", "demo", "--help").stdout
+        assert "--n-steps" in helps and "--n-orbits" in helps and "--steps" not in helps.replace("--n-steps", "")
+        with pytest.raises(SystemExit):  # both names of one flag: a usage error
+            main([*argv, "--steps", "20", "--n-steps", "20", "--out", str(tmp_path / "both.png")])
+        assert "--steps is the old name of --n-steps: give --n-steps only" in capsys.readouterr().err
+    finally:
+        _cli_log_handlers_removed()
         plt.close("all")
 
 

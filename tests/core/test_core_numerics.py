@@ -96,7 +96,7 @@ def test_default_box_is_twice_the_deepest_first_order_curve():
         # NumPy's cos may differ from the C library's by an ulp on some machines: 2 ulps of slack.
         assert default_depth(m) == pytest.approx(ref, rel=4.5e-16, abs=0)
         assert default_depth(m) == pytest.approx(2 * abs(eps) / abs(math.sin(0.5 * Om)), rel=1e-12)
-        assert hv.hovering_area(m, n_steps=4, samples=1).box[2] == max(
+        assert hv.hovering_area(m, n_steps=4, n_samples=1).box[2] == max(
             -default_depth(m), m.valid_band()[0] * (1 - 1e-9)
         )
     th = hv.theory(0.1, 2.0, 2.0, forcing=(1.0, 0.4, -0.2))

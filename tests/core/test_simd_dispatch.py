@@ -9,7 +9,7 @@ Each level this CPU runs is forced in turn (``_core.truncated.set_simd_level``, 
 * a few steps agree with the scalar kernel to 1e-12, and thread count changes nothing.
 
 A level this CPU does not run, or that no build has, is a ValueError naming it and the choices
-(from ``HOVERING_SIMD``: at import).
+(from ``HOVERING_SIMD``: at the first use of a kernel, before any computation).
 The C++ side (every level vs step() at the arc starts) is in cpp/tests/test_truncated_hard.cpp and
 test_iterate.cpp; that the rest of the core holds no AVX instruction, in cpp/tests/test_portable.sh.
 """
@@ -171,11 +171,18 @@ def test_environment_variable_forces_the_level_at_start_up(restore_level):
         assert r.stdout.split() == [core.simd_level(), str(hv.simd_width())]
 
 
-def test_bad_environment_variable_is_a_clear_error_at_import():
-    # The version and the build's facts are read at import, the selected SIMD width among them: a
-    # level that cannot be had stops the import, before any computation, with the value and the choices.
+def test_bad_environment_variable_is_a_clear_error_at_first_use():
+    # The core reads HOVERING_SIMD at its first use of a kernel (``import hovering`` alone loads no
+    # core): a level that cannot be had stops there, before any computation, with the value and the
+    # choices. The first iteration and the width query both say it.
     for value, needle in (("bogus", "must be one of auto"), ("avx1024", "must be one of auto")):
-        r = _python("import hovering", HOVERING_SIMD=value)
+        first_use = "m = hovering.TruncatedMap(eps=0.3, Omega0=1.0, theta_w=2.0); m.iterate([0.0], [0.1], 10)"
+        r = _python(f"import hovering; print('imported', flush=True); {first_use}", HOVERING_SIMD=value)
+        assert r.stdout.strip() == "imported"  # a light import, then the error at the first use
+        assert r.returncode == 1
+        last = r.stderr.strip().splitlines()[-1]
+        assert last.startswith(f"ValueError: HOVERING_SIMD {needle}") and f"got '{value}'" in last, last
+        r = _python("import hovering; hovering.simd_width()", HOVERING_SIMD=value)
         assert r.returncode == 1
         last = r.stderr.strip().splitlines()[-1]
         assert last.startswith(f"ValueError: HOVERING_SIMD {needle}") and f"got '{value}'" in last, last

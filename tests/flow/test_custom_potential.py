@@ -167,11 +167,11 @@ def test_tangential_curve_and_normal_coordinates_match():
     sc = Section(step_system(Harmonic(W1), Tan(W2, ALPHA)), H)
     sp = Section(step_system(py_harmonic("callables"), py_tan("callables")), H)
     theta = np.array([-2.0, 0.5, 2.5])
-    ref = hovering.tangential_curve(sc, theta, iterations=40)
-    np.testing.assert_allclose(hovering.tangential_curve(sp, theta, iterations=40), ref, rtol=0, atol=1e-9)
-    phi, K = hovering.to_normal(sp, theta, np.full(3, 0.4), iterations=40)
+    ref = hovering.tangential_curve(sc, theta, bisections=40)
+    np.testing.assert_allclose(hovering.tangential_curve(sp, theta, bisections=40), ref, rtol=0, atol=1e-9)
+    phi, K = hovering.to_normal(sp, theta, np.full(3, 0.4), bisections=40)
     np.testing.assert_allclose(K, 0.4 - ref, rtol=0, atol=1e-9)
-    th, I = hovering.from_normal(sp, phi, K, iterations=40)
+    th, I = hovering.from_normal(sp, phi, K, bisections=40)
     np.testing.assert_allclose(I, 0.4, rtol=0, atol=1e-12)
 
 

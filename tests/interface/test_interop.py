@@ -74,7 +74,7 @@ def test_iterate_result_to_xarray_round_trip(res):
 
 
 def test_hovering_area_to_xarray_round_trip(m):
-    h = hovering.hovering_area(m, n_steps=200, samples=400, keep_points=True)
+    h = hovering.hovering_area(m, n_steps=200, n_samples=400, keep_points=True)
     ds = h.to_xarray()
     for name in ("area", "error", "sampling_error", "iteration_error", "theory", "area_both_sides"):
         assert float(ds[name]) == getattr(h, name), name
@@ -90,7 +90,7 @@ def test_hovering_area_to_xarray_round_trip(m):
 
 
 def test_critical_curve_and_return_map_to_xarray(m):
-    c = hovering.critical_curve(m, n_steps=600, grid=16)
+    c = hovering.critical_curve(m, n_steps=600, n_grid=16)
     ds = c.to_xarray()
     np.testing.assert_array_equal(ds.phi.values, c.phi)
     np.testing.assert_array_equal(ds.K.values, c.K)
@@ -196,7 +196,7 @@ def test_reprs_are_short_and_name_the_key_numbers(m):
     assert "status={" + ", ".join(f"{k}: {v}" for k, v in counts.items()) + "}" in text
     html = big._repr_html_()
     assert html.startswith("<table>") and "IterateResult" in html and len(html) < 2000
-    h = hovering.hovering_area(m, n_steps=100, samples=200)
+    h = hovering.hovering_area(m, n_steps=100, n_samples=200)
     assert f"area={h.area:.6g}" in repr(h) and "n_samples=" in repr(h) and "<td" in h._repr_html_()
-    c = hovering.critical_curve(m, n_steps=400, grid=8)
+    c = hovering.critical_curve(m, n_steps=400, n_grid=8)
     assert f"K0={c.K0:.6g}" in repr(c) and len(repr(c)) < 400

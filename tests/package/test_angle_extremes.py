@@ -106,7 +106,7 @@ def test_critical_curve_on_a_vertical_line_at_the_seam(truncated_maps):
     # line = phi is an angle input: -pi and its wrapped twin pi search the same line, and pi - 1 ulp
     # finds the same curve (continuity; the grid and bisection are the same).
     m = truncated_maps["TruncatedMap"]
-    kw = dict(n_steps=512, grid=8, K_range=(-0.6, 0.4), tol=1e-3, n_threads=1)
+    kw = dict(n_steps=512, n_grid=8, K_range=(-0.6, 0.4), tol=1e-3, n_threads=1)
     a = m.critical_curve(line=-PI, **kw)
     assert m.critical_curve(line=PI, **kw).K0 == a.K0
     assert abs(m.critical_curve(line=HIGH[0], **kw).K0 - a.K0) <= 2e-3

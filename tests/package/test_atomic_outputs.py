@@ -813,9 +813,9 @@ def meta_doc(path) -> dict:
 
 def test_saved_results_checkpoints_and_sidecars_record_provenance(tmp_path):
     m = hovering.TruncatedMap(eps=0.2, Omega0=2.1, theta_w=2.0)
-    hovering.save(m.hovering_area(n_steps=100, samples=400, seed=3), tmp_path / "h.npz")
+    hovering.save(m.hovering_area(n_steps=100, n_samples=400, rng=3), tmp_path / "h.npz")
     rec = meta_doc(tmp_path / "h.npz")["provenance"]
-    assert list(rec) == KEYS and rec == provenance()
+    assert list(rec) == KEYS and rec == provenance(seed=3)  # the result's own seed (HoveringArea.seed)
     (tmp_path / "s.toml").write_text(sweep_scene())
     assert cli("scene", "s.toml", "--quick", cwd=tmp_path).returncode == 0
     want = provenance(seed=7)  # the scene's seed

@@ -31,21 +31,30 @@ BAD = {
     "critical tol=-1": (lambda: M.critical_curve(tol=-1), r"tol must be finite and >= 1e-14 .* got -1"),
     "critical tol=nan": (lambda: M.critical_curve(tol=NAN), r"tol must be finite .* got nan"),
     # unclear errors
-    "critical grid=0": (lambda: M.critical_curve(grid=0), r"grid must be an integer in \[2, 1000000\], got 0"),
-    "critical grid=2**63": (lambda: M.critical_curve(grid=2**63), r"grid must be an integer in \[2, 1000000\]"),
+    "critical n_grid=0": (lambda: M.critical_curve(n_grid=0), r"n_grid must be an integer in \[2, 1000000\], got 0"),
+    "critical n_grid=2**63": (
+        lambda: M.critical_curve(n_grid=2**63),
+        r"n_grid must be an integer in \[2, 1000000\]",
+    ),
     "critical n_steps=0": (lambda: M.critical_curve(n_steps=0), r"n_steps must be an integer in \[16, \d+\], got 0"),
     "critical digits=nan": (lambda: M.critical_curve(digits=NAN), r"digits must be a number in \(0, 16\], got nan"),
     "critical K_range 3": (
         lambda: M.critical_curve(K_range=(-0.3, -0.2, 0.1)),
         r"K_range must be a pair \(K_lo, K_hi\)",
     ),
-    "area samples=nan": (lambda: M.hovering_area(samples=NAN), r"samples must be an integer in \[1, \d+\], got nan"),
-    "area samples=inf": (
-        lambda: M.hovering_area(samples=math.inf),
-        r"samples must be an integer in \[1, \d+\], got inf",
+    "area n_samples=nan": (
+        lambda: M.hovering_area(n_samples=NAN),
+        r"n_samples must be an integer in \[1, \d+\], got nan",
     ),
-    "area samples=2.5": (lambda: M.hovering_area(samples=2.5), r"samples must be an integer in \[1, \d+\], got 2.5"),
-    "area seed=-1": (lambda: M.hovering_area(seed=-1), r"seed must be an integer in \[0, \d+\], got -1"),
+    "area n_samples=inf": (
+        lambda: M.hovering_area(n_samples=math.inf),
+        r"n_samples must be an integer in \[1, \d+\], got inf",
+    ),
+    "area n_samples=2.5": (
+        lambda: M.hovering_area(n_samples=2.5),
+        r"n_samples must be an integer in \[1, \d+\], got 2.5",
+    ),
+    "area rng=-1": (lambda: M.hovering_area(rng=-1), r"rng must be an integer seed in \[0, \d+\].*got -1"),
     "area n_steps='100'": (
         lambda: M.hovering_area(n_steps="100"),
         r"n_steps must be an integer in \[4, \d+\], got '100'",
@@ -83,9 +92,9 @@ BAD = {
         lambda: hv.tangential_curve(SEC, [0.1], bracket=1.0),
         r"bracket must lie in \(0, 1\), got 1.0",
     ),
-    "tangential iterations=-1": (
-        lambda: hv.tangential_curve(SEC, [0.1], iterations=-1),
-        r"iterations must be an integer in \[1, 200\], got -1",
+    "tangential bisections=-1": (
+        lambda: hv.tangential_curve(SEC, [0.1], bisections=-1),
+        r"bisections must be an integer in \[1, 200\], got -1",
     ),
     "StepSystem eps='a'": (
         lambda: hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Tan(1.4, 0.7), eps="a"),
@@ -263,7 +272,7 @@ BAD.update(
             r"inverse must be True or False, got 'yes'",
         ),
         "keep_points='yes'": (
-            lambda: hv.hovering_area(M, n_steps=100, samples=100, keep_points="yes"),
+            lambda: hv.hovering_area(M, n_steps=100, n_samples=100, keep_points="yes"),
             r"keep_points must be True or False",
         ),
         "CustomPotential q_limit=True": (
@@ -306,7 +315,7 @@ def test_bad_input_is_a_named_value_error(name):
 
 def test_family_accepted_wherever_a_map_is():
     # hovering_area and critical_curve took only TruncatedMap (AttributeError 'Omega0' on a family).
-    a = hv.hovering_area(FAM, samples=400, n_steps=200, seed=1)
+    a = hv.hovering_area(FAM, n_samples=400, n_steps=200, rng=1)
     assert 0 <= a.area <= 2 * math.pi * abs(a.box[2] - a.box[3]) and a.error >= 0
 
 
@@ -378,10 +387,12 @@ def test_checkpoint_cuts_a_torn_last_line_and_appends_cleanly(tmp_path):
     [
         (["--eps", "nan"], "argument --eps: nan is out of range; allowed: [-0.2, 0.2]"),
         (["--eps", "0.5"], "argument --eps: 0.5 is out of range; allowed: [-0.2, 0.2]"),
-        (["--orbits", "-3"], "argument --orbits: -3 is out of range; allowed: [1, 1000]"),
+        (["--n-orbits", "-3"], "argument --n-orbits: -3 is out of range; allowed: [1, 1000]"),
+        (["--n-steps", "-1"], "argument --n-steps: -1 is out of range; allowed: [1, 1000000]"),
+        # the old name of --n-steps (deprecated), checked alike
         (["--steps", "-1"], "argument --steps: -1 is out of range; allowed: [1, 1000000]"),
         (["--dpi", "0"], "argument --dpi: 0 is out of range; allowed: [30, 1200]"),
-        (["--orbits", "2.5"], "argument --orbits: '2.5' is not an integer"),
+        (["--n-orbits", "2.5"], "argument --n-orbits: '2.5' is not an integer"),
         (["--out", "fig.xyz"], "--out = 'fig.xyz': matplotlib cannot write '.xyz' files"),
     ],
 )
@@ -477,6 +488,6 @@ def test_hovering_area_draws_samples_whatever_the_box(m, K_low):
     # A thin box used to get n_phi ~ sqrt(samples 2 pi / |K_low|) columns: 2.5 M points for
     # samples = 10,000 at K_low = -1e-8, 12.9 TiB for the default box at theta_w = 1e-10. The
     # stratified grid now has at most samples + n_phi <= 2 samples cells.
-    a = hv.hovering_area(m, n_steps=16, samples=1000, K_low=K_low)
+    a = hv.hovering_area(m, n_steps=16, n_samples=1000, K_low=K_low)
     assert 1000 <= a.n_samples <= 2000
     assert 0 <= a.area <= 2 * math.pi * -a.box[2]

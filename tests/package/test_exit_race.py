@@ -94,7 +94,7 @@ SCENARIO = textwrap.dedent(
         # is short and much of it is Python and NumPy after the core's (the estimate, the parts).
         m = hv.paper.truncated_map(eps=-0.05)
         ex = 2 if kind.endswith("_executor") else None
-        work = lambda: hv.hovering_area(m, samples=size, n_steps=size, executor=ex, progress=report)
+        work = lambda: hv.hovering_area(m, n_samples=size, n_steps=size, executor=ex, progress=report)
     elif kind == "critical_curve":
         m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
         work = lambda: hv.critical_curve(m, n_steps=size, progress=report)

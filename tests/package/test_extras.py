@@ -58,18 +58,18 @@ def _missing(monkeypatch, *modules):
 )
 def test_a_dask_run_without_dask_names_the_distributed_extra(monkeypatch, make):
     _missing(monkeypatch, "distributed")
-    with pytest.raises(ImportError, match=r"needs distributed, .* pip install 'hovering\[distributed\]'"):
+    with pytest.raises(ImportError, match=r"needs distributed, .* pip install distributed \(hovering's extra 'distributed': pip install '\.\[distributed\]'"):
         make()
 
 
 def test_a_dask_run_without_dask_fails_before_any_work(monkeypatch):
     _missing(monkeypatch, "distributed")
     calls = []
-    with pytest.raises(ImportError, match=r"hovering\[distributed\]"):
+    with pytest.raises(ImportError, match=r"pip install '\.\[distributed\]'"):
         hovering.hovering_area(
             paper.truncated_map(0.3),
             n_steps=8,
-            samples=4,
+            n_samples=4,
             executor="tcp://127.0.0.1:1",
             progress=lambda d, t: calls.append(d),
         )
@@ -80,8 +80,8 @@ def test_local_workers_need_no_extra(monkeypatch):
     _missing(monkeypatch, "distributed", "dask")
     m = paper.truncated_map(0.3)
     assert (
-        hovering.hovering_area(m, n_steps=40, samples=200, executor=2).area
-        == hovering.hovering_area(m, n_steps=40, samples=200).area
+        hovering.hovering_area(m, n_steps=40, n_samples=200, executor=2).area
+        == hovering.hovering_area(m, n_steps=40, n_samples=200).area
     )
 
 
@@ -91,9 +91,9 @@ def test_to_xarray_and_to_pandas_without_them_name_their_extras(monkeypatch):
     zone = hovering.impact_zone(m)
     tr = hovering.transit(m, zone, "up", n_orbits=4, n_steps=10)
     _missing(monkeypatch, "xarray", "pandas")
-    with pytest.raises(ImportError, match=r"IterateResult.to_xarray\(\) needs xarray, .* 'hovering\[xarray\]'"):
+    with pytest.raises(ImportError, match=r"IterateResult.to_xarray\(\) needs xarray, .* pip install '\.\[xarray\]'"):
         res.to_xarray()
-    with pytest.raises(ImportError, match=r"TransitResult.to_pandas\(\) needs pandas, .* 'hovering\[pandas\]'"):
+    with pytest.raises(ImportError, match=r"TransitResult.to_pandas\(\) needs pandas, .* pip install '\.\[pandas\]'"):
         tr.to_pandas()
 
 
@@ -101,7 +101,7 @@ def test_the_scipy_reference_without_scipy_names_the_scipy_extra(monkeypatch):
     from hovering.diagnostics.references import scipy_return_map
 
     _missing(monkeypatch, "scipy", "scipy.integrate")
-    with pytest.raises(ImportError, match=r"needs scipy, .* 'hovering\[scipy\]'"):
+    with pytest.raises(ImportError, match=r"needs scipy, .* pip install '\.\[scipy\]'"):
         scipy_return_map(paper.system(-0.1), np.zeros(4), 1e-8)
 
 

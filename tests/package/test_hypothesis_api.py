@@ -233,28 +233,28 @@ def test_truncated_curves(method, K):
             assert not np.any(np.isinf(np.asarray(x, dtype=float)))
 
 
-HOV = dict(n_steps=counts(64), samples=counts(200), K_low=ANY, seed=counts(10**6), n_threads=counts(4))
+HOV = dict(n_steps=counts(64), n_samples=counts(200), K_low=ANY, rng=st.one_of(counts(10**6), ANY), n_threads=counts(4))
 
 
 @pytest.mark.parametrize("param", list(HOV))
 @settings(SETTINGS, max_examples=max(8, SETTINGS.max_examples // 5))
 @given(data=st.data())
 def test_hovering_area_parameters(param, data):
-    kw = dict(n_steps=32, samples=100)
+    kw = dict(n_steps=32, n_samples=100)
     kw[param] = data.draw(HOV[param])
     a = outcome(lambda: hv.hovering_area(M, **kw), param)
     if a is not None:
         assert math.isfinite(a.area) and a.area >= 0 and math.isfinite(a.error) and a.error >= 0
 
 
-CRIT = dict(n_steps=counts(64), K_range=ANY, grid=counts(8), digits=ANY, tol=ANY, search=ANY, regions=ANY)
+CRIT = dict(n_steps=counts(64), K_range=ANY, n_grid=counts(8), digits=ANY, tol=ANY, search=ANY, regions=ANY)
 
 
 @pytest.mark.parametrize("param", list(CRIT))
 @settings(SETTINGS, max_examples=max(8, SETTINGS.max_examples // 8))
 @given(data=st.data())
 def test_critical_curve_parameters(param, data):
-    kw = dict(n_steps=64, grid=4, tol=1e-3)
+    kw = dict(n_steps=64, n_grid=4, tol=1e-3)
     kw[param] = data.draw(CRIT[param])
     try:
         c = outcome(lambda: hv.critical_curve(M, **kw), param)

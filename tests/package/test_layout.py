@@ -71,3 +71,27 @@ def test_import_hovering_is_light():
     assert not heavy, sorted(heavy)
     pipeline = {m for m in loaded if m.startswith(("hovering.scenes", "hovering.plot", "hovering.pipeline"))}
     assert not pipeline, sorted(pipeline)
+
+
+def test_import_hovering_loads_no_core_and_the_first_use_loads_the_api():
+    # `import hovering` (and `hovering --version`) load neither numpy nor the compiled core; the
+    # first use of a public name loads the API, as the eager import did; a model used straight from
+    # its module finds the analyses its methods call (hooks registered on demand); hovering.explore
+    # stays the function whichever of it and its module is imported first.
+    code = (
+        "import sys, hovering\n"
+        "light = [m for m in ('numpy', 'hovering._core', 'hovering.analysis') if m in sys.modules]\n"
+        "m = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=2.0)\n"
+        "loaded = all(m in sys.modules for m in ('numpy', 'hovering._core', 'hovering.diagnostics'))\n"
+        "print(light, loaded, callable(hovering.explore), 'hovering_area' in dir(hovering))\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.split() == ["[]", "True", "True", "True"], r.stdout + r.stderr
+    code = (
+        "import hovering.explore, hovering\n"
+        "from hovering.truncated import TruncatedMap\n"
+        "m = TruncatedMap(eps=0.2, Omega0=2.1, theta_w=2.0)\n"
+        "print(callable(hovering.explore), m.hovering_area(n_steps=40, n_samples=50).n_samples > 0)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.split() == ["True", "True"], r.stdout + r.stderr

@@ -100,17 +100,17 @@ def test_analyses_report_one_bar_for_the_whole_call(tm, fm):
     # hovering_area: F_0 and F_eps, 2 * n * N units; critical_curve: grid, bisection, final orbit
     # (its total is corrected at the end when the bisection was shorter than its bound).
     rec = Recorder()
-    area = hv.hovering_area(tm, n_steps=400, samples=500, progress=rec)
+    area = hv.hovering_area(tm, n_steps=400, n_samples=500, progress=rec)
     rec.check(2 * area.n_samples * 400)
-    assert area.area == hv.hovering_area(tm, n_steps=400, samples=500).area
+    assert area.area == hv.hovering_area(tm, n_steps=400, n_samples=500).area
     rec = Recorder()
-    cc = tm.critical_curve(n_steps=600, grid=16, tol=1e-3, progress=rec)
+    cc = tm.critical_curve(n_steps=600, n_grid=16, tol=1e-3, progress=rec)
     done = rec.calls[-1][0]
     assert rec.calls[-1] == (done, done) and done % 600 == 0 and done >= 17 * 600
     assert [d for d, _ in rec.calls] == sorted(d for d, _ in rec.calls)
-    assert cc.K0 == tm.critical_curve(n_steps=600, grid=16, tol=1e-3).K0
+    assert cc.K0 == tm.critical_curve(n_steps=600, n_grid=16, tol=1e-3).K0
     rec = Recorder()
-    flow_area = fm.hovering_area(n_steps=20, samples=30, progress=rec)
+    flow_area = fm.hovering_area(n_steps=20, n_samples=30, progress=rec)
     rec.check(2 * flow_area.n_samples * 20)
 
 
@@ -122,7 +122,7 @@ def test_progress_true_draws_a_tqdm_bar_on_stderr(tm, fm, capsys):
     fm.iterate([0.1, 0.2], [0.01, -0.02], 30, record=(), progress=True)
     err = capsys.readouterr().err
     assert "FlowMap.iterate" in err and "100%" in err and "return" in err
-    hv.hovering_area(tm, n_steps=100, samples=200, progress=True)
+    hv.hovering_area(tm, n_steps=100, n_samples=200, progress=True)
     err = capsys.readouterr().err
     assert err.count("hovering_area") >= 1 and "100%" in err and "iterate" not in err  # one bar, not three
 
@@ -147,7 +147,7 @@ def test_bad_progress_is_a_named_value_error(tm, fm, bad):
         lambda: tm.iterate([0.0], [0.1], 10, progress=bad),
         lambda: fm.iterate([0.0], [0.01], 2, progress=bad),
         lambda: fm.section.return_map([0.0], [0.3], progress=bad),
-        lambda: hv.hovering_area(tm, n_steps=8, samples=4, progress=bad),
+        lambda: hv.hovering_area(tm, n_steps=8, n_samples=4, progress=bad),
         lambda: hv.critical_curve(tm, n_steps=16, progress=bad),
     ):
         with pytest.raises(ValueError, match="progress must be True .* False .* or a callable progress"):

@@ -115,7 +115,7 @@ def _interrupted(call, after: float = 0.5):
 # bound is 30 s, generous against a loaded 2-core machine, and still minutes below the full run.
 def test_ctrl_c_stops_hovering_area():
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
-    assert _interrupted(lambda: m.hovering_area(n_steps=10**7, samples=10**6, n_threads=2)) < 30
+    assert _interrupted(lambda: m.hovering_area(n_steps=10**7, n_samples=10**6, n_threads=2)) < 30
 
 
 def test_ctrl_c_stops_critical_curve():
@@ -130,7 +130,7 @@ def test_ctrl_c_stops_critical_curve():
         geometry="step",
     )
     fm = hv.FlowMap(s, 1.0)
-    assert _interrupted(lambda: fm.critical_curve(n_steps=50_000, grid=64, n_threads=2)) < 30
+    assert _interrupted(lambda: fm.critical_curve(n_steps=50_000, n_grid=64, n_threads=2)) < 30
 
 
 def test_ctrl_c_stops_a_scene(tmp_path):

@@ -64,6 +64,7 @@ NO_THREADS = textwrap.dedent(
     import os, resource, threading
     import numpy as np
     import hovering as hv
+    hv.TruncatedMap  # the API loads at its first use: here, before the privileges go
     # Everything is imported: now forbid new threads (RLIMIT_NPROC counts threads; root ignores it,
     # so drop to 'nobody', whose process count is this one).
     resource.setrlimit(resource.RLIMIT_NPROC, (1, 1))

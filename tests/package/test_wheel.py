@@ -155,7 +155,10 @@ def test_the_wheel_runs_with_the_system_libraries_unavailable(fresh_venv, tmp_pa
     # The emptied files really are unusable in that namespace: the system's GSL cannot load...
     gsl = next(f for f in files if os.path.basename(f).startswith("libgsl.so"))
     r = subprocess.run(
-        [*wrap, sys.executable, "-c", f"import ctypes; ctypes.CDLL({gsl!r})"], capture_output=True, text=True, timeout=120
+        [*wrap, sys.executable, "-c", f"import ctypes; ctypes.CDLL({gsl!r})"],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert r.returncode != 0, "the system's libgsl still loads inside the namespace: the check would prove nothing"
     # ... and the wheel runs there all the same.

@@ -15,7 +15,7 @@ from hovering.analysis.hovering import hovering_area
 from hovering.parallel import Executor
 
 M = paper.truncated_map(0.3)
-KW = dict(n_steps=800, samples=6000, seed=7)
+KW = dict(n_steps=800, n_samples=6000, rng=7)
 
 
 def same(a, b):
@@ -68,7 +68,7 @@ def test_the_callers_own_pools_give_the_same_answer_and_stay_open(single):
 
 def test_flow_map_pieces_give_the_single_process_answer():
     fm = paper.flow_map(-0.1)
-    kw = dict(n_steps=40, samples=64, seed=1)
+    kw = dict(n_steps=40, n_samples=64, rng=1)
     same(hovering_area(fm, **kw), hovering_area(fm, **kw, executor=Executor(workers=2, pieces=3)))
 
 
@@ -94,7 +94,7 @@ def test_a_python_defined_potential_runs_on_threads_and_pools_or_is_refused_at_o
     import concurrent.futures as cf
     import multiprocessing
 
-    kw = dict(n_steps=8, samples=16, seed=2, components=False)
+    kw = dict(n_steps=8, n_samples=16, rng=2, components=False)
     fm = _python_flow_map(picklable=False)
     single = hovering_area(fm, **kw)
     same(single, hovering_area(fm, **kw, executor=2))  # threads: no pickling needed

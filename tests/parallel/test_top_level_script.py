@@ -35,10 +35,10 @@ SCRIPT = textwrap.dedent(
 
     m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4,
                               tau0=1.0, tau1=0.5, lam=0.5)
-    hp = hovering.hovering_area(m, n_steps=400, samples=3000, executor=2)
+    hp = hovering.hovering_area(m, n_steps=400, n_samples=3000, executor=2)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
-        old = hovering.hovering_area(m, n_steps=400, samples=3000, workers=2)
+        old = hovering.hovering_area(m, n_steps=400, n_samples=3000, workers=2)
     zone = hovering.impact_zone(m)
     tr = hovering.transit(m, zone, "up", n_orbits=40, n_steps=300, executor=2)
     print(repr(hp.area), repr(old.area), repr(hp.error), tr.first_passage.tolist())
@@ -56,7 +56,7 @@ def test_readme_lines_in_a_top_level_script_give_the_one_process_answer(tmp_path
     assert "BrokenProcessPool" not in run.stderr
     area, old_area, error, first_passage = run.stdout.strip().split(" ", 3)
     m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4, tau0=1.0, tau1=0.5, lam=0.5)
-    one = hovering_area(m, n_steps=400, samples=3000)
+    one = hovering_area(m, n_steps=400, n_samples=3000)
     # Exact equality: each piece draws its own contiguous range of the one sample stream and the
     # estimate only counts, so where the pieces ran cannot change a digit.
     assert float(area) == one.area and float(old_area) == one.area and float(error) == one.error
@@ -68,7 +68,7 @@ def test_local_workers_start_no_process_and_give_the_one_process_answer():
     import multiprocessing
 
     m = paper.truncated_map(0.3)
-    kw = dict(n_steps=600, samples=4000, seed=3)
+    kw = dict(n_steps=600, n_samples=4000, rng=3)
     one = hovering_area(m, **kw)
     before = set(multiprocessing.active_children())
     many = hovering_area(m, **kw, executor=Executor(workers=2, pieces=5))
@@ -86,7 +86,7 @@ def test_ctrl_c_stops_the_pieces_running_on_other_threads():
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            m.hovering_area(n_steps=10**7, samples=10**6, executor=Executor(workers=2, pieces=4))
+            m.hovering_area(n_steps=10**7, n_samples=10**6, executor=Executor(workers=2, pieces=4))
     finally:
         timer.cancel()
     assert time.perf_counter() - t0 - 0.5 < 30

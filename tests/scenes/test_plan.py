@@ -145,7 +145,7 @@ def test_the_hand_written_plan_of_the_docs_runs(sweep_exe, tmp_path):
     import hovering
 
     m = hovering.TruncatedMap(**data["points"][0]["map"])
-    assert -m.hovering_area(n_steps=4, samples=1).box[2] == -data["points"][0]["K_low"]
+    assert -m.hovering_area(n_steps=4, n_samples=1).box[2] == -data["points"][0]["K_low"]
     exe = rows_by_key(tmp_path / "hand.jsonl")
     for p in data["points"]:
         p = {**p, "theory": p.get("theory", math.nan)}

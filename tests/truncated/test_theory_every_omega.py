@@ -27,7 +27,7 @@ def test_hovering_sign_and_area_for_every_omega(Omega0, eps):
     hovers = eps * math.sin(Omega0 / 2) > 0
     assert th.hovers == hovers and m.hovers() == hovers
     assert th.hovering_sign == (1 if math.sin(Omega0 / 2) > 0 else -1)
-    hv_area = m.hovering_area(n_steps=4000, samples=20_000)
+    hv_area = m.hovering_area(n_steps=4000, n_samples=20_000)
     assert hv_area.theory == th.area
     if hovers:
         # eq:hovsetsize: 0.2546 for eps = 0.1 at the paper's parameters; measured 0.2519 +- 0.0033
@@ -87,7 +87,7 @@ def test_multimode_theory_reduces_to_the_closed_forms():
     )
     th = fam.theory()
     assert th.hovers and th.forcing == (0.8, 0.15)
-    meas = fam.hovering_area(n_steps=4000, samples=20_000)
+    meas = fam.hovering_area(n_steps=4000, n_samples=20_000)
     assert abs(meas.area - th.area) < meas.error + 0.3 * 0.1**2
 
 

@@ -20,7 +20,9 @@ applies (a TruncatedMap, starts in J_0u or J_0).
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +40,8 @@ from .orbits import classify_orbits, converse_kam
 from .zone import ImpactZone
 
 __all__ = ["BarrierScan", "Layer", "barrier_scan", "launch_points"]
+
+_log = logging.getLogger(__name__)
 
 _TWO_PI = 2.0 * math.pi
 #: Orbit points held in memory by one piece of a scan (phi, K and s: 24 bytes each).
@@ -67,6 +71,15 @@ class Layer:
         Periods of its island chains (sorted, distinct).
     impacting : bool
         Whether any of its orbits returned from an impacting region (J_1 or J_R).
+
+    Examples
+    --------
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> layer = hovering.barrier_scan(m, zone, n_starts=8, n_steps=2000).layers[0]
+    >>> layer.first, layer.last, layer.kind, layer.impacting   # one layer holds every start
+    (0, 7, 'chaotic', True)
     """
 
     first: int
@@ -122,6 +135,17 @@ class BarrierScan(Summarized, Saveable):
     phi, K : ndarray or None
         With ``keep=k``: k points of each orbit, evenly strided over its returns (NaN after an
         orbit ended), shape ``(n, k)``, for drawing.
+
+    Examples
+    --------
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> scan = hovering.barrier_scan(m, zone, n_starts=8, n_steps=2000, keep=100)
+    >>> scan.complete, scan.kind.shape, scan.margin.shape, scan.phi.shape   # per start, per cut, kept points
+    (True, (8,), (7,), (8, 100))
+    >>> print(scan.summary().splitlines()[0])
+    8 starts on L1, 2000 returns each: 0 barrier cut(s), 1 layer(s)
     """
 
     line: str
@@ -485,6 +509,19 @@ def barrier_scan(
         On Ctrl-C, with the scan so far as ``.partial`` (``complete=False``); the orbits cut short
         are not classified (``"undecided"``, decided by ``"interrupted"``), so the call returns
         within the core's reaction time.
+
+    Examples
+    --------
+    Eight starts on L1 across a zone that orbits cross (see :func:`hovering.transit`):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> scan = hovering.barrier_scan(m, zone, n_starts=8, n_steps=2000)
+    >>> len(scan), scan.s0.tolist()           # the starts, at the middles of eight equal cuts of s
+    (8, [0.0625, 0.1875, 0.3125, 0.4375, 0.5625, 0.6875, 0.8125, 0.9375])
+    >>> int(scan.barrier.sum()), len(scan.layers), scan.layers[0].kind   # no barrier: one chaotic layer
+    (0, 1, 'chaotic')
     """
     require_map("m", m)
     if not isinstance(zone, ImpactZone):
@@ -519,6 +556,7 @@ def barrier_scan(
             "narrow s_range"
         )
 
+    t0 = time.perf_counter()
     per_piece = max(1, min(n_starts, _PIECE_POINTS // (n_steps + 1)))
     cuts = [(i, min(i + per_piece, n_starts)) for i in range(0, n_starts, per_piece)]
     parts: list = [None] * len(cuts)
@@ -543,6 +581,10 @@ def barrier_scan(
     except KeyboardInterrupt:
         interrupted = True
     result = _assemble(m, line_name, n_steps, n_bins, phi0, K0, s0, cuts, parts, cone_steps, not interrupted, keep)
+    _log.info(
+        "barrier_scan on %s: %d orbits x %d steps from s in [%.3g, %.3g], %.1f s%s", line_name, n_starts, n_steps,
+        a, b, time.perf_counter() - t0, " (interrupted)" if interrupted else "",
+    )  # fmt: skip
     if interrupted:
         exc = KeyboardInterrupt("barrier_scan interrupted; the orbits so far are in .partial")
         exc.partial = result  # type: ignore[attr-defined]

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import is_choice, real_array
+from .._deprecated import renamed_keywords
 from .._display import Summarized
 from .._enums import REGION_LABELS, Region, Status, region_mask
 from .._progress import check_progress, progress_bar
@@ -73,6 +74,22 @@ class CriticalCurve(Summarized, Saveable):
         The theory's explanation (sign of eps b_1 sin(Omega0/2), vanishing modes, resonance, geometry).
     phi, K : ndarray
         The critical orbit.
+
+    Examples
+    --------
+    At the sign of eps that does not hover the search moves to L2 and finds k^{u0}, the lowest
+    curve that avoids the impacts:
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=-0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> cc = m.critical_curve(n_steps=2000)
+    >>> cc.hovers, cc.line, cc.note.split(":")[0]
+    (False, 'L2', 'impacting case')
+    >>> bool(cc.K_min >= 0), cc.phi.shape      # k^{u0} lies in K >= 0; the orbit: n_steps + 1 points
+    (True, (2001,))
+    >>> c = cc.curve                           # the orbit as a closed curve K(phi)
+    >>> bool(abs(c(float(cc.phi[0])) - cc.K[0]) < 1e-3)
+    True
     """
 
     K0: float
@@ -135,13 +152,14 @@ class CriticalCurve(Summarized, Saveable):
         return critical_curve_dataset(self)
 
 
+@renamed_keywords(grid="n_grid")
 def critical_curve(
     m,
     n_steps: int = 20_000,
     K_range: Sequence[float] | None = None,
     regions=("0u", "0"),
     line=None,
-    grid: int = 64,
+    n_grid: int = 64,
     digits: float | None = None,
     tol: float = 1e-6,
     n_threads: int = 0,
@@ -182,8 +200,9 @@ def critical_curve(
         Search line. Default: L1 in the hovering case, L2 otherwise (minima of the curves lie near
         L1 when ``eps b_1 sin(Omega0/2) > 0``, near L2 otherwise: thm:minmaxinvriantcurves). A number
         is a vertical line phi = line (any rotational invariant curve crosses it once).
-    grid : int, optional
-        Grid points of the first scan (>= 2).
+    n_grid : int, optional
+        Grid points of the first scan (>= 2). Formerly ``grid=`` (deprecated, still accepted with a
+        DeprecationWarning).
     digits : float, optional
         Regularity threshold, in (0, 16]. Default: the map's ``regularity_digits`` (8 for the
         truncated maps, exact to rounding; 6 for the flow, whose per-return integration error
@@ -214,6 +233,21 @@ def critical_curve(
     RuntimeError
         If no start in ``K_range`` passes (no invariant curve found: widen the range); the message
         says when the sign of eps does not hover.
+
+    Examples
+    --------
+    The paper's map at eps = 0.3, against eq:kcrit and eq:rhocrit (the docs' numbers use the
+    default ``n_steps=20_000``):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> cc = hovering.critical_curve(m, n_steps=5000)
+    >>> cc.hovers, cc.line
+    (True, 'L1')
+    >>> round(cc.K_pred, 4), round(cc.rotation_pred, 4)
+    (-0.2747, 3.7694)
+    >>> bool(abs(cc.K_min - cc.K_pred) < 0.01), bool(abs(cc.rotation - cc.rotation_pred) < 0.02)
+    (True, True)
     """
     progress = check_progress(progress)
     th = require_map("m", m).theory()
@@ -239,8 +273,9 @@ def critical_curve(
         raise ValueError(f"line must be 'L1', 'L2' or a finite angle, got {line!r}")
     if digits is None:
         digits = getattr(m, "regularity_digits", 8.0)
-    # grid <= 1e6: more starts than that resolve nothing the bisection does not (and cost memory).
-    for name, v, least, most in (("n_steps", n_steps, 16, 2**53), ("grid", grid, 2, 10**6)):
+    # n_grid <= 1e6: more starts than that resolve nothing the bisection does not (and cost memory).
+    grid = n_grid
+    for name, v, least, most in (("n_steps", n_steps, 16, 2**53), ("n_grid", grid, 2, 10**6)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not least <= v <= most:
             raise ValueError(f"{name} must be an integer in [{least}, {most}], got {v!r}")
     if not (isinstance(digits, (int, float, np.floating)) and 0 < digits <= 16):

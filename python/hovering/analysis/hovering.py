@@ -9,15 +9,18 @@ F_0 and F_eps act on one (phi, K) plane, as in the paper's definition and eq:hov
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._arrays import unique
-from .._checks import check_memory, flag, integer, real_number, thread_count
+from .._checks import MAX_SEED, check_memory, flag, integer, random_seed, real_number, thread_count
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
+from .._deprecated import renamed_keywords
 from .._display import Summarized
 from .._progress import check_progress, progress_bar, stop_hook
 from .._serial import Saveable
@@ -28,6 +31,8 @@ from ..parallel.executor import executor as open_executor
 from .orbits import classify_orbits
 
 __all__ = ["HoveringArea", "HoveringComponents", "hovering_area"]
+
+_log = logging.getLogger(__name__)
 
 #: Names of the per-sample codes of :attr:`HoveringArea.component` (code = index).
 COMPONENTS = ("none", "band", "islands", "under_floor")
@@ -77,6 +82,20 @@ class HoveringComponents:
         point (docs/orbit-classes.md measures the saving).
     orbit_steps : int
         Points of each classified orbit.
+
+    Examples
+    --------
+    At the sign of eps that does not hover the leading-order theory predicts no hovering set;
+    what the definition finds is a period-2 island chain:
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=-0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> hv = m.hovering_area(1000, 2000)          # N = 1000 steps, 2000 samples
+    >>> c = hv.components
+    >>> hv.theory, c.counts["band"], sorted(c.periods), c.floor
+    (0.0, 0, [2], 'none')
+    >>> bool(np.isclose(c.total, hv.area))
+    True
     """
 
     band: float
@@ -173,6 +192,24 @@ class HoveringArea(Summarized, Saveable):
         Per sample (``keep_points`` and ``components``): the part it lies in, as an index into
         ``("none", "band", "islands", "under_floor")`` (:data:`COMPONENTS`), and its chain period
         (0 outside ``islands`` or where no chain was found).
+    seed : int or None
+        The seed the samples were drawn with (:func:`hovering_area`'s ``rng``, or the seed drawn
+        from a Generator or from fresh entropy): ``hovering_area(m, ..., rng=seed)`` draws them
+        again. None in files that predate it.
+
+    Examples
+    --------
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> hv = m.hovering_area(2000, 4000)          # N = 2000 steps, 4000 samples
+    >>> sorted(hv.areas)                         # the estimates at N/4, N/2 and N
+    [500, 1000, 2000]
+    >>> print("box: phi in [%.4f, %.4f), K in [%.4f, %.1f)" % hv.box)
+    box: phi in [-3.1416, 3.1416), K in [-0.4292, 0.0)
+    >>> hv.floor_touched, hv.unresolved
+    (False, 0)
+    >>> bool(np.isclose(hv.error, 2 * hv.sampling_error + hv.iteration_error))
+    True
     """
 
     area: float
@@ -196,6 +233,12 @@ class HoveringArea(Summarized, Saveable):
     band_edge: bool = False
     component: np.ndarray | None = field(default=None, repr=False)
     period: np.ndarray | None = field(default=None, repr=False)
+    seed: int | None = None
+
+    def _validate_loaded(self) -> None:
+        """A file's seed (untrusted): None or an integer seed, as ``rng=`` takes it."""
+        if self.seed is not None:
+            integer("seed", self.seed, 0, MAX_SEED)
 
     def _summary(self) -> list:
         return [
@@ -493,12 +536,13 @@ def _measure(m, n_steps, samples, K_low, seed, n_threads, progress, spec) -> tup
     return phi, K, e
 
 
+@renamed_keywords(samples="n_samples", seed="rng")
 def hovering_area(
     m,
     n_steps: int = 10_000,
-    samples: int = 100_000,
+    n_samples: int = 100_000,
     K_low: float | None = None,
-    seed: int = 0,
+    rng: int | np.random.Generator | None = 0,
     n_threads: int = 0,
     keep_points: bool = False,
     progress=False,
@@ -529,14 +573,18 @@ def hovering_area(
         The map F_eps.
     n_steps : int, optional
         N: iterates that count as "never" (estimates at N/4 and N/2 come from the same run).
-    samples : int, optional
-        Number of sample points (rounded up to fill the grid).
+    n_samples : int, optional
+        Number of sample points (rounded up to fill the grid). Formerly ``samples=`` (deprecated,
+        still accepted with a DeprecationWarning).
     K_low : float, optional
         Bottom of the box. Default: twice the deepest leading-order critical curve (see
         :func:`default_depth`; ``-2 |eps| / |sin(Omega0/2)|`` for f = sin), clipped to the band;
         that box deepens itself (see ``deepen``). A given K_low is used as it is.
-    seed : int, optional
-        Seed of the jitter.
+    rng : int, numpy.random.Generator or None, optional
+        The jitter's randomness (SPEC 7): an integer seed in [0, 2**63 - 1] (default 0: the same
+        samples every call), a Generator (one seed is drawn from it), or None (a seed from fresh
+        OS entropy). The seed used is the result's ``seed``. Formerly ``seed=`` (deprecated, still
+        accepted with a DeprecationWarning; giving both is a TypeError).
     n_threads : int, optional
         Worker threads (0 = all cores).
     keep_points : bool, optional
@@ -553,7 +601,7 @@ def hovering_area(
         ``False``: ``components`` is None.
     deepen : int, optional
         With the default box only: how many times it may double its depth (a fresh measurement of
-        the deeper box each time, with the same ``samples``) while ``floor_touched``; it stops at
+        the deeper box each time, with the same ``n_samples``) while ``floor_touched``; it stops at
         the lower edge of the map's band (``band_edge``). 0 keeps the first box. >= 0.
     executor : None, int, str, distributed.Client or hovering.parallel.Executor, optional
         Where it runs (:func:`hovering.parallel.executor.as_executor`): ``None`` in this process on
@@ -561,7 +609,7 @@ def hovering_area(
         worker threads (``int``), a Dask scheduler (address), a Dask client, or as an
         :class:`~hovering.parallel.Executor` says (a Dask LocalCluster, the number of pieces, a
         checkpoint file that keeps finished pieces, keyed by every parameter that changes them). The
-        result is identical to the single-process one for the same seed: each piece draws its own
+        result is identical to the single-process one for the same ``rng``: each piece draws its own
         contiguous range of the samples (the core jumps the random stream ahead to it), and the
         estimate only counts.
     workers, client, scheduler, dask, pieces, checkpoint : optional
@@ -573,6 +621,8 @@ def hovering_area(
 
     Raises
     ------
+    TypeError
+        For an ``rng`` that is not None, an int or a Generator, or both ``rng`` and ``seed``.
     ValueError
         For counts that are not integers in range, or a K_low outside the band below 0; with an
         ``executor``, before any piece runs: for a ``checkpoint`` of a map that has no record to
@@ -581,14 +631,28 @@ def hovering_area(
         threads of this process take any map).
     KeyboardInterrupt
         On Ctrl-C, within ~0.1 s.
+
+    Examples
+    --------
+    A quick estimate (the paper's tables use 1e5 samples and N = 1e4: 0.4985 +- 0.0066 here):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> hv = hovering.hovering_area(m, 2000, 4000)   # N = 2000 steps, 4000 samples
+    >>> round(hv.theory, 4)                      # eq:hovsetsize
+    0.5093
+    >>> bool(abs(hv.area - hv.theory) < hv.error), bool(hv.error < 0.05)
+    (True, True)
+
+    The same measurement is a method of every map: ``m.hovering_area(2000, 4000)``.
     """
     require_map("m", m)
     n_steps = integer("n_steps", n_steps, 4, 2**53)
-    samples = integer("samples", samples, 1, 2**53)
+    samples = integer("n_samples", n_samples, 1, 2**53)
     keep_points = flag("keep_points", keep_points)
     components = flag("components", components)
     deepen = integer("deepen", deepen, 0, 64)
-    seed = integer("seed", seed, 0, 2**63 - 1)
+    seed = random_seed(rng)
     n_threads = thread_count(n_threads)
     progress = check_progress(progress)
     check_memory(f"hovering_area with {samples} samples", 64 * samples)
@@ -611,8 +675,15 @@ def hovering_area(
         dict(workers=workers, client=client, scheduler=scheduler, dask=dask, pieces=pieces, checkpoint=checkpoint),
     )
     deepened, band_edge = 0, False
+    t0 = time.perf_counter()
     while True:
+        t = time.perf_counter()
         phi, K, e = _measure(m, n_steps, samples, K_low, seed, n_threads, progress, spec)
+        _log.debug(
+            "hovering_area: box K in [%.4g, 0), %d samples x %d %ss (both maps), %s, %.1f s",
+            K_low, phi.size, n_steps, getattr(m, "_progress_unit", "step"),
+            "floor touched" if e["floor_touched"] else "floor clear", time.perf_counter() - t,
+        )  # fmt: skip
         if not (default_box and e["floor_touched"]):
             break
         if K_low <= bottom:  # the band ends first: nothing deeper to sample
@@ -626,13 +697,23 @@ def hovering_area(
     hovering, both = e["hovering"], e["both_sides"]
     comp = code = period = None
     if components:
+        t = time.perf_counter()
         comp, code, period = _split(m, phi, K, hovering, both, samples, K_low, n_steps, n_threads)
+        _log.debug(
+            "hovering_area: components (floor %s, %d orbits classified), %.1f s",
+            comp.floor, comp.orbits_classified, time.perf_counter() - t,
+        )  # fmt: skip
+    theory = float(m.theory().area)
+    _log.info(
+        "hovering_area: area %.6g +- %.2g (theory %.6g), %d samples, seed %d, %.1f s",
+        e["area"], e["error"], theory, phi.size, seed, time.perf_counter() - t0,
+    )  # fmt: skip
     return HoveringArea(
         area=e["area"],
         error=e["error"],
         sampling_error=e["sampling_error"],
         iteration_error=e["iteration_error"],
-        theory=float(m.theory().area),
+        theory=theory,
         areas={n_steps // 4: e["area_N4"], n_steps // 2: e["area_N2"], n_steps: e["area"]},
         n_samples=int(e["n_samples"]),
         box=(-math.pi, math.pi, K_low, 0.0),
@@ -649,4 +730,5 @@ def hovering_area(
         band_edge=band_edge,
         component=code if keep_points else None,
         period=period if keep_points else None,
+        seed=seed,
     )

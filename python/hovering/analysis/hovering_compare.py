@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import flag, integer, is_choice, thread_count
+from .._checks import flag, integer, is_choice, random_seed, thread_count
 from .._core import analysis as _core_analysis
+from .._deprecated import renamed_keywords
 from .._progress import check_progress, progress_bar
 from .._serial import Saveable
 from ..normal import FlowMap
@@ -47,6 +48,17 @@ class ModelVerdicts:
         The samples where the verdicts differ.
     flow_hovers : ndarray of bool
         For each of them: True where the flow hovers and the model does not, False the reverse.
+
+    Examples
+    --------
+    >>> import hovering
+    >>> fm = hovering.paper.flow_map(eps=-0.05)
+    >>> v = hovering.compare_hovering(fm, ("onset",), 200, 100)["onset"]   # 200 samples, N = 100
+    >>> v.model, v.confusion.shape, bool(v.agreement > 0.9)
+    ('onset', (2, 2), True)
+    >>> n_disagree = int(v.confusion[0, 1] + v.confusion[1, 0])
+    >>> v.phi.shape == v.K.shape == v.flow_hovers.shape == (n_disagree,)
+    True
     """
 
     model: str
@@ -83,6 +95,16 @@ class HoveringComparison(Saveable):
         Each model's verdicts, in the order asked for; also ``comparison["onset"]``.
     n_steps : int
         N of every verdict.
+
+    Examples
+    --------
+    >>> import hovering
+    >>> fm = hovering.paper.flow_map(eps=-0.05)
+    >>> cmp = hovering.compare_hovering(fm, ("onset",), 200, 100)   # 200 samples, N = 100
+    >>> cmp.n_steps, [v.model for v in cmp.models]
+    (100, ['onset'])
+    >>> bool(cmp.flow.area > 0), bool(cmp["onset"].area > 0)   # the flow and its model both hover
+    (True, True)
     """
 
     flow: HoveringArea
@@ -119,13 +141,14 @@ class HoveringComparison(Saveable):
         )
 
 
+@renamed_keywords(seed="rng")
 def compare_hovering(
     flow_map,
     models=("onset", "measured"),
     n_samples: int = 20_000,
     n_steps: int = 2000,
     K_low: float | None = None,
-    seed: int = 0,
+    rng: int | np.random.Generator | None = 0,
     n_threads: int = 0,
     progress=False,
     *,
@@ -153,8 +176,10 @@ def compare_hovering(
         N: iterates (returns of the flow) that count as "never", >= 4.
     K_low : float, optional
         Bottom of the box (default: the flow's default box, deepened while its floor is touched).
-    seed : int, optional
-        Seed of the jitter.
+    rng : int, numpy.random.Generator or None, optional
+        The jitter's randomness, as for :func:`hovering_area` (default 0; the seed used is
+        ``comparison.flow.seed``). Formerly ``seed=`` (deprecated, still accepted with a
+        DeprecationWarning; giving both is a TypeError).
     n_threads : int, optional
         Worker threads (0 = all cores).
     progress : bool or callable, optional
@@ -171,12 +196,26 @@ def compare_hovering(
 
     Raises
     ------
+    TypeError
+        For an ``rng`` that is not None, an int or a Generator, or both ``rng`` and ``seed``.
     ValueError
         Before any computation: for a map that is not a FlowMap in normal coordinates with onset
         parameters, unknown or repeated models, or counts out of range (each names the value and
         what is allowed).
     KeyboardInterrupt
         On Ctrl-C, within ~0.1 s.
+
+    Examples
+    --------
+    The README's flow at eps = -0.05 against its first-mode model, on 200 samples followed for
+    N = 100 returns (the docs' numbers use 5152 samples and N = 1000):
+
+    >>> import hovering
+    >>> fm = hovering.paper.flow_map(eps=-0.05)
+    >>> cmp = hovering.compare_hovering(fm, ("onset",), 200, 100)
+    >>> v = cmp["onset"]
+    >>> bool(v.agreement > 0.9), int(v.confusion.sum()) == cmp.flow.phi.size   # every sample judged
+    (True, True)
     """
     if not isinstance(flow_map, FlowMap):
         raise ValueError(f"flow_map must be a hovering.FlowMap, got {type(flow_map).__name__}")
@@ -192,7 +231,7 @@ def compare_hovering(
         raise ValueError(f"models must not repeat a name, got {models!r}")
     n_samples = integer("n_samples", n_samples, 1, 2**53)
     n_steps = integer("n_steps", n_steps, 4, 2**53)
-    seed = integer("seed", seed, 0, 2**63 - 1)
+    seed = random_seed(rng)
     n_threads = thread_count(n_threads)
     progress = check_progress(progress)
     components = flag("components", components)
@@ -202,9 +241,9 @@ def compare_hovering(
     flow = hovering_area(
         flow_map,
         n_steps=n_steps,
-        samples=n_samples,
+        n_samples=n_samples,
         K_low=K_low,
-        seed=seed,
+        rng=seed,
         n_threads=n_threads,
         keep_points=True,
         progress=progress,

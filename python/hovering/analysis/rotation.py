@@ -117,6 +117,18 @@ def rotation_number(res, method: str = "mean") -> np.ndarray:
     -------
     ndarray
         Shape (n_orbits,); NaN for an orbit that took no step.
+
+    Examples
+    --------
+    An invariant circle above the tangency: the weighted average converges far faster than the mean.
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> orbit = m.iterate(m.L1([0.3]), [0.3], 20_000, record=("orbit",))
+    >>> print(np.round(hovering.rotation_number(orbit, method="birkhoff"), 8))
+    [4.37764562]
+    >>> print(np.round(hovering.rotation_number(orbit), 4))   # the plain mean: error ~1/N
+    [4.3776]
     """
     _result("res", res)
     if not is_choice(method, ("mean", "birkhoff")):

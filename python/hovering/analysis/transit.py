@@ -18,12 +18,15 @@ returns.
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import integer, is_choice, real_number
+from .._checks import MAX_SEED, integer, is_choice, random_seed, real_number
+from .._deprecated import renamed_keywords
 from .._display import Summarized, status_counts
 from .._enums import Status
 from .._serial import Saveable
@@ -32,6 +35,8 @@ from ..interface import require_map
 from ..parallel.executor import as_executor, run_pieces
 from ..parallel.executor import executor as open_executor
 from .zone import ImpactZone
+
+_log = logging.getLogger(__name__)
 
 __all__ = ["TransitResult", "transit"]
 
@@ -72,6 +77,23 @@ class TransitResult(Summarized, Saveable):
         The stride of the states s was measured on.
     target : Curve or None
         The target level ``s = target_s`` as the curve the stop condition used.
+    seed : int or None
+        The seed of the start angles' jitter (:func:`transit`'s ``rng``, or the seed drawn from a
+        Generator or from fresh entropy): ``rng=seed`` starts the same orbits. None in files that
+        predate it.
+
+    Examples
+    --------
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> tr = hovering.transit(m, zone, "up", n_orbits=24, n_steps=2000)
+    >>> tr.direction, tr.start_s, tr.target_s      # the default levels, 2% inside the zone
+    ('up', 0.05, 0.98)
+    >>> tr.first_passage.shape, tr.residence.shape   # per orbit; returns per region
+    ((24,), (24, 5))
+    >>> bool(np.all(tr.crossed == (tr.first_passage >= 0))), bool(0 <= tr.fraction <= 1)
+    (True, True)
     """
 
     direction: str
@@ -90,6 +112,7 @@ class TransitResult(Summarized, Saveable):
     residence: np.ndarray
     every: int = 1
     target: Curve | None = None
+    seed: int | None = None
 
     @property
     def crossed(self) -> np.ndarray:
@@ -158,6 +181,8 @@ class TransitResult(Summarized, Saveable):
             a = getattr(self, name)
             if not isinstance(a, np.ndarray) or a.shape != (n,):
                 raise ValueError(f"{name} must have the shape of phi0 ({n},)")
+        if self.seed is not None:
+            integer("seed", self.seed, 0, MAX_SEED)
 
 
 def _target(zone: ImpactZone, s: float) -> Curve:
@@ -179,6 +204,7 @@ def _piece(m, phi, K, n_steps, stop, every, kwargs):
     return res, False
 
 
+@renamed_keywords(seed="rng")
 def transit(
     m,
     zone: ImpactZone,
@@ -188,7 +214,7 @@ def transit(
     start_s: float | None = None,
     target_s: float | None = None,
     margin: float = 0.02,
-    seed: int = 0,
+    rng: int | np.random.Generator | None = 0,
     every: int | None = None,
     executor=None,
     **iterate_kwargs,
@@ -204,7 +230,7 @@ def transit(
     direction : {"up", "down"}, optional
         Towards the ceiling (stop on ``K >= target``) or the floor (``K <= target``).
     n_orbits : int, optional
-        Orbits, started at stratified angles (one per cell of ``[-pi, pi)``, jittered by ``seed``).
+        Orbits, started at stratified angles (one per cell of ``[-pi, pi)``, jittered by ``rng``).
     n_steps : int, optional
         Steps (returns) per orbit.
     start_s, target_s : float, optional
@@ -224,8 +250,11 @@ def transit(
         s = 0.0001-0.01 going down), while a barrier keeps them tenths of the zone away, so 2%
         separates the two answers without waiting for the approach to the boundary. Ignored where
         ``target_s`` is given.
-    seed : int, optional
-        Seed of the angle jitter.
+    rng : int, numpy.random.Generator or None, optional
+        The angle jitter's randomness (SPEC 7): an integer seed in [0, 2**63 - 1] (default 0), a
+        Generator (one seed is drawn from it) or None (a seed from fresh OS entropy); the seed used
+        is the result's ``seed``. Formerly ``seed=`` (deprecated, still accepted with a
+        DeprecationWarning; giving both is a TypeError).
     every : int, optional
         Stride of the states s is measured on (default ``max(1, n_steps // 1000)``: at most 1001
         states per orbit kept); first passages and K extremes are exact at any stride.
@@ -241,6 +270,8 @@ def transit(
 
     Raises
     ------
+    TypeError
+        For an ``rng`` that is not None, an int or a Generator, or both ``rng`` and ``seed``.
     ValueError
         For a map or zone of the wrong type, a direction other than up/down, levels on the wrong
         side of each other or not finite, a margin outside (0, 0.5), counts out of range; before
@@ -248,6 +279,20 @@ def transit(
     KeyboardInterrupt
         On Ctrl-C, with the result so far (orbits cut short keep their steps) as ``.partial`` (in
         this process; on an executor the finished pieces are cancelled with the rest).
+
+    Examples
+    --------
+    Orbits started near the ceiling of a zone with no barrier fall to its floor within a few
+    thousand steps (docs/guide/transport.md runs 100,000 steps both ways):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> down = hovering.transit(m, zone, "down", n_orbits=24, n_steps=2000)
+    >>> down.start_s, down.target_s
+    (0.95, 0.02)
+    >>> bool(down.fraction > 0.5), down.escape_rate is not None   # most crossed: a rate is fitted
+    (True, True)
     """
     require_map("m", m)
     if not isinstance(zone, ImpactZone):
@@ -256,7 +301,7 @@ def transit(
         raise ValueError(f"direction must be 'up' or 'down', got {direction!r}")
     n_orbits = integer("n_orbits", n_orbits, 1, 2**31 - 1)
     n_steps = integer("n_steps", n_steps, 1, 2**53)
-    seed = integer("seed", seed, 0, 2**63 - 1)
+    seed = random_seed(rng)
     up = direction == "up"
     margin = real_number("margin", margin, lo=0.0, hi=0.5)
     start_s = real_number("start_s", 0.05 if up and start_s is None else 0.95 if start_s is None else start_s)
@@ -271,8 +316,9 @@ def transit(
     every = integer("every", every if every is not None else max(1, n_steps // 1000), 1, 2**53)
     spec = as_executor(executor)
 
-    rng = np.random.default_rng(seed)
-    phi0 = -np.pi + 2 * np.pi * (np.arange(n_orbits) + rng.random(n_orbits)) / n_orbits
+    t0 = time.perf_counter()
+    jitter = np.random.default_rng(seed).random(n_orbits)
+    phi0 = -np.pi + 2 * np.pi * (np.arange(n_orbits) + jitter) / n_orbits
     K0 = np.asarray(zone.K_at(phi0, start_s), dtype=float)
     target = _target(zone, target_s)
     stop = Above(target) if up else Below(target)
@@ -328,7 +374,13 @@ def transit(
         residence=cat("residence").astype(np.int64),
         every=every,
         target=target,
+        seed=seed,
     )
+    _log.info(
+        "transit %s: s %.3g -> %.3g, %d orbits x %d steps: %.4g crossed, %.1f s%s",
+        direction, start_s, target_s, n_orbits, n_steps, result.fraction, time.perf_counter() - t0,
+        " (interrupted)" if interrupted else "",
+    )  # fmt: skip
     if interrupted:
         exc = KeyboardInterrupt("transit interrupted; the orbits so far are in .partial")
         exc.partial = result  # type: ignore[attr-defined]

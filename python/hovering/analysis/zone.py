@@ -17,7 +17,9 @@ inside it (:func:`hovering.transit`: by default ``s = margin`` and ``1 - margin`
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +31,8 @@ from ..curve import Curve
 from ..interface import require_map
 
 __all__ = ["ImpactZone", "impact_zone"]
+
+_log = logging.getLogger(__name__)
 
 #: Angles on which a zone checks that its ceiling lies above its floor.
 _CHECK_POINTS = 4096
@@ -54,6 +58,15 @@ class ImpactZone(Saveable):
     ValueError
         If ``ceiling`` and ``floor`` are not curves, or the ceiling is not above the floor at every
         one of 4096 angles (the message names the angle and the gap).
+
+    Examples
+    --------
+    A zone given by two levels (:func:`impact_zone` finds a map's own):
+
+    >>> import hovering
+    >>> zone = hovering.ImpactZone(ceiling=hovering.Curve.constant(0.1), floor=hovering.Curve.constant(-0.2))
+    >>> round(zone.s(0.3, 0.0), 4), round(zone.K_at(0.3, 0.5), 4), round(zone.height(0.3), 4)
+    (0.6667, -0.05, 0.3)
     """
 
     ceiling: Curve
@@ -163,7 +176,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         Iterates per tested orbit of the ceiling search; the flow's floor search uses
         ``min(n_steps, 2000)``.
     **kwargs
-        Passed to :meth:`critical_curve` (``K_range``, ``line``, ``regions``, ``grid``, ``digits``,
+        Passed to :meth:`critical_curve` (``K_range``, ``line``, ``regions``, ``n_grid``, ``digits``,
         ``tol``, ``n_threads``, ``progress``, ...); ``n_threads`` and ``progress`` also to the
         flow's floor search.
 
@@ -183,11 +196,27 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         eps = +0.2, +0.3).
     KeyboardInterrupt
         On Ctrl-C (from the search's ``iterate``).
+
+    Examples
+    --------
+    The first-mode model of docs/impact-zone.md's positive case (a zone that orbits cross), with
+    a floor given at K = -0.2 (a truncated map has no floor of its own):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.0914, Omega0=7.6696, theta_w=2.2117, tau0=3.0788, tau1=1.2223, lam=1.9072)
+    >>> zone = hovering.impact_zone(m, floor=-0.2)
+    >>> zone.floor_kind, zone.raised
+    ('given', False)
+    >>> print(f"{zone.s(0.0, -0.2):.3f} {zone.s(0.0, zone.ceiling(0.0)):.3f}")   # 0 on the floor, 1 on the ceiling
+    0.000 1.000
+    >>> bool(zone.ceiling.K.min() > -0.2)      # the ceiling, the critical curve, lies above the floor
+    True
     """
     require_map("m", m)
     n_steps = integer("n_steps", n_steps, 16, 2**53)
     kw = dict(kwargs)
     kind = "given"
+    t0 = time.perf_counter()
     if floor is None:
         if hasattr(m, "impact_zone_floor"):
             floor_kw = {k: kw[k] for k in ("n_threads", "progress") if k in kw}
@@ -196,6 +225,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
             floor, kind = Curve.constant(m.valid_band()[0]), "band"
     elif not isinstance(floor, Curve):
         floor = Curve.constant(real_number("floor", floor))
+    searched = ceiling is None
     if ceiling is None:
         ceiling = _ceiling(m, floor, n_steps, kw)
     elif not isinstance(ceiling, Curve):
@@ -207,6 +237,10 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         # e.g. K = -0.261 against a band from -0.257 at eps = -0.1); raising it would replace an
         # invariant curve by a level orbits cross. A given floor is only a level.
         floor, raised = _inside_band(m, floor, ceiling)
+    _log.info(
+        "impact_zone: floor %s, ceiling %s, %.1f s", kind,
+        f"searched ({n_steps} steps per tested orbit)" if searched else "given", time.perf_counter() - t0,
+    )  # fmt: skip
     return ImpactZone(ceiling=ceiling, floor=floor, floor_kind=kind, raised=raised)
 
 
@@ -254,7 +288,7 @@ def _ceiling(m, floor: Curve, n_steps: int, kw: dict) -> Curve:
     # or on a non-impacting curve just above it, not on the ceiling.
     gap = max(1e-3 * width, 10 * _error(floor), 2 * float(kw.get("tol", 1e-6)))
     a_floor = max(K_f + gap, lo + 1e-9 * max(1.0, abs(lo)))
-    grid = kw.get("grid", 64)
+    grid = kw.get("n_grid", kw.get("grid", 64))  # grid=: the old name, which critical_curve warns about
     grid = int(grid) if isinstance(grid, (int, np.integer)) and grid >= 2 else 64  # critical_curve checks it
 
     def search(K_range):

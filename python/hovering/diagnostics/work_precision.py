@@ -31,7 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import integer, is_choice, real_number
+from .._checks import integer, is_choice, random_seed, real_number
+from .._deprecated import renamed_keywords
 from ..analysis.hovering import hovering_area
 from ..analysis.rotation import rotation_number
 from ..flow.section import STEPPERS, Section
@@ -589,7 +590,7 @@ def _hovering(m, tolerances, n_points, repeat, seed, n_threads, progress):
     runs = []
     for samples, n in settings:
         sec, a = _best_time(
-            lambda: hovering_area(m, n_steps=int(n), samples=int(samples), seed=seed, n_threads=n_threads), repeat
+            lambda: hovering_area(m, n_steps=int(n), n_samples=int(samples), rng=seed, n_threads=n_threads), repeat
         )
         runs.append((samples, n, sec, a))
     ref = runs[-1][3]
@@ -621,6 +622,7 @@ def _hovering(m, tolerances, n_points, repeat, seed, n_threads, progress):
 # ------------------------------------------------------------------------------------------------
 
 
+@renamed_keywords(seed="rng")
 def work_precision(
     target,
     tolerances: Sequence | None = None,
@@ -631,7 +633,7 @@ def work_precision(
     returns: Sequence[int] = (1, 100, 10_000),
     quick: bool = False,
     repeat: int = 2,
-    seed: int = 0,
+    rng: int | np.random.Generator | None = 0,
     n_threads: int = 1,
     external: Sequence[str] = (),
     progress=False,
@@ -645,7 +647,7 @@ def work_precision(
         depend on the map's coordinates).
     tolerances : sequence, optional
         Flow: rtol = atol values (default 1e-6, 1e-8, 1e-10, 1e-12). Rotation: iteration counts
-        (default 1e2, 1e3, 1e4, 1e5). Hovering area: (samples, n_steps) pairs, the largest being
+        (default 1e2, 1e3, 1e4, 1e5). Hovering area: (n_samples, n_steps) pairs, the largest being
         the reference (default (400, 250), (1600, 500), (6400, 1000), (25600, 2000)).
     steppers : sequence, optional
         Flow: steppers (default ``FLOW_STEPPERS_DEFAULT``, those that apply to the system). Rotation: SIMD sin accuracies in ulp
@@ -661,8 +663,10 @@ def work_precision(
         A smaller, faster diagram (fewer tolerances, points and returns).
     repeat : int, optional
         Timed runs per setting (the best is kept: this machine's single runs vary by up to 1.5x).
-    seed : int, optional
-        Seed of the starting points.
+    rng : int, numpy.random.Generator or None, optional
+        The starting points' randomness (SPEC 7): an integer seed in [0, 2**63 - 1] (default 0), a
+        Generator (one seed is drawn from it) or None (fresh OS entropy). Formerly ``seed=``
+        (deprecated, still accepted with a DeprecationWarning; giving both is a TypeError).
     n_threads : int, optional
         Threads of the timed runs (default 1, so times are per core).
     external : sequence of str, optional
@@ -682,6 +686,8 @@ def work_precision(
 
     Raises
     ------
+    TypeError
+        For an ``rng`` that is not None, an int or a Generator, or both ``rng`` and ``seed``.
     ValueError
         For an unknown target or quantity, or bad settings (named, with the allowed range).
     """
@@ -690,6 +696,7 @@ def work_precision(
         raise ValueError(f"quantity must be 'auto', 'return', 'rotation' or 'hovering_area', got {quantity!r}")
     quick = bool(quick)
     repeat = integer("repeat", repeat, 1, 100)
+    seed = random_seed(rng)
     n_threads = integer("n_threads", n_threads, 0, 1024)
     if progress is not False and progress is not None and not callable(progress):
         raise ValueError(f"progress must be a callable progress(done, total) or False, got {progress!r}")
@@ -701,10 +708,10 @@ def work_precision(
                 if quick
                 else [(400, 250), (1600, 500), (6400, 1000), (25600, 2000)]
             )
-        tolerances = [(integer("samples", s, 16, 10**9), integer("n_steps", n, 1, 10**9)) for s, n in tolerances]
+        tolerances = [(integer("n_samples", s, 16, 10**9), integer("n_steps", n, 1, 10**9)) for s, n in tolerances]
         if len(tolerances) < 2:
             raise ValueError(
-                "hovering_area needs at least two (samples, n_steps) settings (the largest is the reference)"
+                "hovering_area needs at least two (n_samples, n_steps) settings (the largest is the reference)"
             )
         return _hovering(target, tolerances, None, repeat, seed, n_threads, progress)
     if is_flow:

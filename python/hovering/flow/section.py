@@ -121,6 +121,19 @@ class ReturnMapResult(Summarized, Saveable):
     trajectory, trajectory_index, trajectory_kind, trajectory_truncated : ndarray or None
         With ``trajectory_dt``: each return's flow, rows ``(t, q1, p1, q2, p2)`` (its clock
         starts at 0), as in :class:`hovering.IterateResult`; see :meth:`trajectory_of`.
+
+    Examples
+    --------
+    >>> import hovering
+    >>> sec = hovering.Section(hovering.paper.system(eps=-0.05), h=1.0)
+    >>> res = sec.return_map([0.0, 1.0], [0.3, 0.3], trajectory_dt=0.1)
+    >>> res
+    <ReturnMapResult n=2, status={OK: 2}>
+    >>> res.z.shape, res.region.tolist()      # image states; Region.ABOVE for both
+    ((2, 4), [1, 1])
+    >>> rows = res.trajectory_of(0)           # the flow of the first return: (t, q1, p1, q2, p2)
+    >>> rows.shape[1], bool(rows[0, 0] == 0.0)
+    (5, True)
     """
 
     theta: np.ndarray
@@ -168,7 +181,7 @@ class ReturnMapResult(Summarized, Saveable):
         Raises
         ------
         ImportError
-            Without xarray, naming ``pip install 'hovering[xarray]'``.
+            Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
         from .._interop import return_map_dataset
 
@@ -189,6 +202,17 @@ class Section:
     ------
     ValueError
         If sys is not a StepSystem or h is not a finite number.
+
+    Examples
+    --------
+    >>> import hovering
+    >>> sec = hovering.Section(hovering.paper.system(eps=-0.05), h=1.0)
+    >>> z = sec.point(0.5, 0.3)             # the state (q1, 0, q2, p2) at section coordinates (0.5, 0.3)
+    >>> z.shape, sec.coordinates(z).round(6).tolist()
+    ((1, 4), [[0.5, 0.3]])
+    >>> res = sec.return_map([0.0, 2.0], [0.3, 0.45])   # one return of each point (see return_map)
+    >>> res.itinerary
+    ['0', 'u']
     """
 
     def __init__(self, sys: StepSystem, h: float):
@@ -369,6 +393,23 @@ class Section:
         KeyboardInterrupt
             On Ctrl-C: its ``partial`` attribute holds the ReturnMapResult with every finished
             return and status INTERRUPTED for the rest.
+
+        Examples
+        --------
+        >>> import numpy as np, hovering
+        >>> sec = hovering.Section(hovering.paper.system(eps=-0.05), h=1.0)
+        >>> res = sec.return_map([0.0, 1.0, 2.0], [0.3, 0.3, 0.45])
+        >>> res.count("OK"), res.itinerary     # no impact: two pass above the step, one beside it
+        (3, ['0', '0', 'u'])
+        >>> print(np.round(res.theta, 3), np.round(res.I, 3))
+        [-2.948 -1.924 -0.435] [0.226 0.267 0.488]
+        >>> bool(res.energy_error.max() < 1e-8)
+        True
+
+        A point with no point of Sigma_h is an outcome of its own, not an error:
+
+        >>> sec.return_map([0.0], [0.8]).count("OFF_SECTION")
+        1
         """
         opts = flow_options(rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)
         opts.validate_for(self.sys.core)

@@ -227,6 +227,20 @@ class StepSystem:
     ------
     ValueError
         Naming the bad value and its allowed range.
+
+    Examples
+    --------
+    The README's system: V1 harmonic, V2 a Tan well, coupled by ``eps q1 q2``:
+
+    >>> import hovering
+    >>> system = hovering.StepSystem(hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7), hovering.Bilinear(), eps=-0.05)
+    >>> round(system.step_energy, 4)     # above this energy orbits can reach the corner
+    0.7665
+    >>> p = hovering.onset_parameters(system, h=1.0)   # the truncated model's parameters at h = 1
+    >>> round(p.Omega0, 4), round(p.theta_w, 4)
+    (9.8347, 2.4445)
+    >>> system.replace(eps=0.0).eps     # a validated copy with a field changed
+    0.0
     """
 
     V1: Potential

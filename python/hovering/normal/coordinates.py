@@ -18,6 +18,7 @@ import numpy as np
 
 from .._checks import MAX_MODES, check_points, integer, real_array, require_angles, require_finite, require_type
 from .._core import normal as _core_normal
+from .._deprecated import renamed_keywords
 from .._enums import wrap
 from .._pickle import reduce_record
 from .._serial import Saveable
@@ -319,7 +320,8 @@ def _wall_section(sec: Section) -> Section:
     return Section(sec.sys.replace(geometry="wall"), sec.h)
 
 
-def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, iterations: int = 55) -> np.ndarray:
+@renamed_keywords(iterations="bisections")
+def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, bisections: int = 55) -> np.ndarray:
     """The tangential curve ``I_tan^eps(theta)`` (Def:sing_curve) point by point, by bisection in I.
 
     For each theta, the action at which the orbit from (theta, I) touches the line q1 = qw1
@@ -341,8 +343,9 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
         Integration tolerance of each return.
     bracket : float, optional
         Relative half-width of the initial bracket around I_tan(h), in (0, 1); default automatic.
-    iterations : int, optional
-        Bisection steps in [1, 200] (55 reach ~1e-16 relative).
+    bisections : int, optional
+        Bisection steps in [1, 200] (55 reach ~1e-16 relative), as :func:`hovering.corner_curves`' own.
+        Formerly ``iterations=`` (deprecated, still accepted with a DeprecationWarning).
 
     Returns
     -------
@@ -352,15 +355,15 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
     Raises
     ------
     ValueError
-        For an empty theta, a bracket outside (0, 1) or bad iterations, or if no bracket up to
+        For an empty theta, a bracket outside (0, 1) or bad bisections, or if no bracket up to
         I_tan (1 -+ 0.95) contains the tangency for every theta.
     """
     _section("sec", sec)
     shape = np.shape(theta) if np.ndim(theta) else (1,)
     th = np.atleast_1d(real_array("theta", theta)).ravel()
     require_angles("theta", th)
-    if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 200:
-        raise ValueError(f"iterations must be an integer in [1, 200], got {iterations!r}")
+    if isinstance(bisections, bool) or not isinstance(bisections, (int, np.integer)) or not 1 <= bisections <= 200:
+        raise ValueError(f"bisections must be an integer in [1, 200], got {bisections!r}")
     if bracket is not None and not (isinstance(bracket, (int, float)) and 0 < bracket < 1):
         raise ValueError(f"bracket must lie in (0, 1), got {bracket!r}")
     if th.size == 0:
@@ -383,7 +386,7 @@ def tangential_curve(sec: Section, theta, rtol: float = 1e-12, bracket=None, ite
                 "the curve may not be a graph: see hovering.TangentialCurve"
             )
         rel = min(0.95, 2 * rel)
-    for _ in range(int(iterations)):
+    for _ in range(int(bisections)):
         mid = 0.5 * (lo + hi)
         c = crosses(mid)
         lo = np.where(c, mid, lo)

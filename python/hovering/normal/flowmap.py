@@ -77,6 +77,18 @@ class FlowSteps(Saveable):
         Accepted integrator steps.
     z : ndarray
         The image states (q1, p1, q2, p2), shape (n, 4).
+
+    Examples
+    --------
+    >>> import hovering
+    >>> fm = hovering.paper.flow_map(eps=-0.05)
+    >>> st = fm.returns([0.3, 0.3], [-0.02, -0.2])      # one return of two points
+    >>> st.status.tolist(), st.region.tolist(), st.itinerary
+    ([0, 0], [1, 1], ['0', '0'])
+    >>> print(f"{st.phi[0]:.3f} {st.K[0]:.4f}")
+    -2.487 -0.0026
+    >>> st.z.shape
+    (2, 4)
     """
 
     phi: np.ndarray
@@ -151,6 +163,25 @@ class FlowMap(MapAnalyses):
     A FlowMap pickles and saves (:func:`hovering.save`) as its constructor arguments and its
     tangential curve's measured samples: it is rebuilt through the constructor with that curve (no
     trace of the flow, no measurement) and steps bit for bit as the original.
+
+    Examples
+    --------
+    The README's system: a harmonic and a Tan oscillator, bilinear coupling, the step at
+    (qw1, qw2) = (-1, -0.5), on the section at energy h = 1:
+
+    >>> import hovering
+    >>> system = hovering.StepSystem(hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7), hovering.Bilinear(), eps=-0.05)
+    >>> fm = hovering.FlowMap(system, h=1.0)
+    >>> print(repr(fm).split("# ")[1])      # what its truncated model will see
+    effective eps = eps b1 = -0.0282 (b1 = 0.5639), band K in [-0.2966, 0.2638]
+    >>> fm.region(0.3, -0.02)               # J_0: this return passes above the step
+    <Region.ABOVE: 1>
+    >>> th = fm.theory()                    # leading order, from the onset parameters and measured forcing
+    >>> th.hovers, round(th.area, 4)
+    (True, 0.0745)
+    >>> model = fm.truncated()              # its truncated model (every measured forcing mode)
+    >>> type(model).__name__
+    'TruncatedFamily'
     """
 
     #: Unit of work of this map's progress reports (one return of the flow).
@@ -368,6 +399,17 @@ class FlowMap(MapAnalyses):
         ------
         KeyboardInterrupt
             On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
+
+        Examples
+        --------
+        >>> import hovering
+        >>> fm = hovering.paper.flow_map(eps=-0.05)
+        >>> st = fm.returns([0.3, 0.3], [-0.02, -0.2])
+        >>> st.itinerary, st.status.tolist()          # both pass above the step: returns OK
+        (['0', '0'], [0, 0])
+        >>> back = fm.returns(st.phi, st.K, inverse=True)   # one step back, by time reversal
+        >>> bool(abs(back.phi[0] - 0.3) < 1e-6 and abs(back.K[0] + 0.02) < 1e-6)
+        True
         """
         p, k, _ = point_pair(phi, K, "returns")
         d = self._core.steps(
@@ -532,6 +574,19 @@ class FlowMap(MapAnalyses):
             bounds or a bad ``progress``.
         KeyboardInterrupt
             On Ctrl-C (honoured within ~0.1 s): ``.partial`` holds every orbit up to where it was.
+
+        Examples
+        --------
+        Two orbits from the line L1, 100 returns each, with the itinerary of every return:
+
+        >>> import numpy as np, hovering
+        >>> fm = hovering.paper.flow_map(eps=-0.05)
+        >>> K0 = np.array([-0.04, 0.0])
+        >>> res = fm.iterate(fm.L1(K0), K0, 100, record=("orbit", "regions", "itinerary"))
+        >>> res.phi.shape, res.count(hovering.Status.OK)
+        ((2, 101), 2)
+        >>> res.itinerary[0][:4], res.itinerary[1][:4]   # impacts on the right wall; beside the step
+        (['0', 'R', '0', 'R'], ['u', 'u', 'u', 'u'])
         """
         record, n_steps, mask = iterate_arguments(record, FLOW_RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         every, stop_side, stop_curve = transport_arguments(every, stop)
@@ -845,7 +900,7 @@ class FlowMap(MapAnalyses):
             Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, clipped to the
             band (from 0.95 of its lower edge) and below ``K = -1e-3``).
         **kwargs
-            ``grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
+            ``n_grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
 
         Returns
         -------

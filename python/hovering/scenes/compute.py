@@ -10,6 +10,7 @@ eps = 0 no coupling, no "regions" no crossing bookkeeping, no "trajectory" no de
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -98,6 +99,32 @@ __all__ = [
     "scaled",
     "scene_map",
 ]
+
+_log = logging.getLogger(__name__)
+
+
+class _Stages:
+    """The stages of one scene's computation: each timed into ``meta["timings"]`` and logged at INFO
+    (what ``hovering -v`` shows) when it starts, with what it computes and how much, and when it
+    ends, with its time: ``scene impact-zone: stage 2/3 flow: barrier scan 480 orbits x 10000
+    returns, transits 2 x 64 orbits x 10000 returns`` ... ``scene impact-zone: stage 2/3 flow done,
+    12.3 s``. The library only logs; the command line decides what is shown."""
+
+    def __init__(self, meta: dict, total: int):
+        self.meta, self.total, self.number = meta, total, 0
+        self.name, self.t = "", 0.0
+
+    def start(self, name: str, what: str = "") -> None:
+        self.number, self.name, self.t = self.number + 1, name, time.perf_counter()
+        _log.info(
+            "scene %s: stage %d/%d %s%s", self.meta["name"], self.number, self.total, name, f": {what}" if what else ""
+        )
+
+    def end(self) -> float:
+        dt = time.perf_counter() - self.t
+        self.meta["timings"][self.name] = dt
+        _log.info("scene %s: stage %d/%d %s done, %.1f s", self.meta["name"], self.number, self.total, self.name, dt)
+        return dt
 
 
 def scaled(n: int, quick: bool, floor: int = 100) -> int:
@@ -451,11 +478,13 @@ def _orbit_scene(scene: OrbitScene, quick: bool, progress, meta: dict) -> OrbitS
     n_steps = scaled(scene.n_steps, quick)
     meta["n_steps"] = n_steps
     done, maps = {}, {}
+    stages = _Stages(meta, sum(p.zoom is None for p in scene.panels))
     for p in scene.panels:
         if p.zoom is None:
-            t = time.perf_counter()
+            n = p.n_orbits if scene.kind == "portrait" else len(p.special) + len(p.orbits)
+            stages.start(f"panel {p.id}", f"{n} orbits x {n_steps} steps" + (", critical curve" if p.critical else ""))
             done[p.id], maps[p.id] = _orbit_panel(scene, p, n_steps, quick, progress)
-            meta["timings"][f"panel {p.id}"] = time.perf_counter() - t
+            stages.end()
     panels = []
     for p in scene.panels:
         if p.zoom is None:
@@ -520,7 +549,7 @@ def run_point(kind: str, point: dict, n_threads: int = 0) -> dict:
     # A row holds the estimate, not its split: the split's orbit classes and the flow's floor search
     # would cost a sweep point up to 1.5 s for nothing it shows.
     kw = dict(
-        n_steps=point["n_steps"], samples=point["samples"], seed=point["seed"], n_threads=n_threads, components=False
+        n_steps=point["n_steps"], n_samples=point["samples"], rng=point["seed"], n_threads=n_threads, components=False
     )
     if kind == "hovering_area":
         h = TruncatedMap(**point["map"]).hovering_area(K_low=point["K_low"], **kw)
@@ -594,22 +623,53 @@ def _row_check(kind: str, point: dict) -> Callable:
     return check
 
 
-def _sweep(kind: str, points: list, ckpt, bar, where: Executor | None) -> tuple:
+def _sweep_size(points: list, where) -> str:
+    """What a sweep computes, for its log line: points, samples x steps per point, where."""
+    p = points[0]
+    models = f" + {len(p['models'])} model(s)" if p.get("models") else ""
+    if where is None:
+        place = "in this process"
+    elif where.scheduler is not None:
+        place = f"on the Dask scheduler at {where.scheduler}"
+    elif where.client is not None:
+        place = "on a Dask client"
+    elif where.pool is not None:
+        place = "on the caller's pool"
+    else:
+        place = f"{where.workers} at a time on {'a Dask LocalCluster' if where.dask else 'threads'}"
+    return f"{len(points)} points of {p['samples']} samples x {p['n_steps']} steps{models}, {place}"
+
+
+def _point_label(point: dict) -> str:
+    eps = point["map"]["eps"] if "map" in point else point["system"]["eps"]
+    return f"eps = {eps:g}"
+
+
+def _sweep(kind: str, points: list, ckpt, bar, where: Executor | None, name: str = "") -> tuple:
     """Rows of a plan's points in order: from the checkpoint (each row checked first: the file is
     untrusted), or computed (here, or as pieces on the executor ``where``) and
     checkpointed as each arrives (a point another process wrote meanwhile is not written again).
-    Returns (rows, reused: one bool per point, True where the checkpoint had it)."""
+    Returns (rows, reused: one bool per point, True where the checkpoint had it). Each point is
+    logged at INFO as it arrives (``name``: the scene's, for the line)."""
     keys = [point_key(kind, p) for p in points]
     rows = [ckpt.get(k, _row_check(kind, p)) for k, p in zip(keys, points)]
     reused = [r is not None for r in rows]
     bar.advance(sum(reused))
     todo = [i for i, r in enumerate(rows) if r is None]
+    _log.info(
+        "scene %s: %d of %d points from the checkpoint %s, %d to compute", name, sum(reused), len(points),
+        ckpt.path, len(todo),
+    )  # fmt: skip
 
     def done(j, row):
         i = todo[j]
         ckpt.put(keys[i], row)
         rows[i] = ckpt.get(keys[i]) if keys[i] in ckpt else row  # another process's row, if it was first
         bar.advance(1)
+        _log.info(
+            "scene %s: point %d/%d (%s) area %.4g +- %.2g, %.1f s", name, i + 1, len(points),
+            _point_label(points[i]), rows[i]["area"], rows[i]["error"], rows[i]["seconds"],
+        )  # fmt: skip
 
     if where is not None:
         with open_executor(**where.where()) as ex:
@@ -644,8 +704,11 @@ def _hovering_scene(
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
     eps_all = np.array(scene.eps)
+    stages = _Stages(meta, 1)
+    stages.start("sweep", _sweep_size(points, where))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="point") as bar:
-        all_rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where)
+        all_rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where, scene.name)
+    stages.end()
     drawn = set()
     out = []
     ne = len(scene.eps)
@@ -696,33 +759,34 @@ def _work(res) -> dict:
 def _flow_portrait(scene: FlowPortraitScene, quick: bool, progress, meta: dict) -> FlowPortraitResult:
     n = scaled(scene.n_steps, quick, floor=50)
     meta["n_steps"] = n
-    t = time.perf_counter()
+    stages = _Stages(meta, 5)
+    stages.start("setup", f"flow map (tangential curve, forcing) and its {scene.model} model")
     fm = _flowmap(scene)
     tm = fm.truncated(forcing=scene.model)
-    meta["timings"]["setup"] = time.perf_counter() - t
+    stages.end()
     K0 = np.linspace(scene.K0_range[0], scene.K0_range[1], scene.n_orbits)
     phi0 = np.asarray(fm.L1(K0), dtype=float)
     regions = "regions" in scene.outputs.record
     record = ("orbit", "regions") if regions else ("orbit",)
     labels = [f"K0={k:.4g}" for k in K0]
     colors = [orbit_color(i) for i in range(scene.n_orbits)]
-    t = time.perf_counter()
+    stages.start("flow", f"{scene.n_orbits} orbits x {n} returns")
     fres = fm.iterate(phi0, K0, n, record=record, **_progress_kw(progress))
-    meta["timings"]["flow"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start("reversal check", f"2 orbits x {min(n, 1000)} returns back")
     meta["accuracy"] = _reversal_check(fm, fres, min(n, 1000))
-    meta["timings"]["reversal check"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start("model", f"{scene.n_orbits} orbits x {n} steps")
     mres = tm.iterate(phi0, K0, n, record=record)
-    meta["timings"]["model"] = time.perf_counter() - t
+    stages.end()
     flow = OrbitSet.of(fres, labels, colors, ["fan"] * len(labels))
     model = OrbitSet.of(mres, labels, colors, ["fan"] * len(labels))
     floor = max(fm.valid_band()[0], tm.valid_band()[0])
     lo = min(_auto_ylim(flow.K, floor)[0], _auto_ylim(model.K, floor)[0])
     hi = max(_auto_ylim(flow.K, floor)[1], _auto_ylim(model.K, floor)[1])
-    t = time.perf_counter()
+    stages.start("corner curves", f"{scene.corner_K} circles")
     fg = flow_geometry(fm, (lo, hi), scene.corner_K, fm.integrator_options.get("rtol", 1e-10))
-    meta["timings"]["corner curves"] = time.perf_counter() - t
+    stages.end()
     mg = map_geometry(tm, (lo, hi), corner_curves=scene.corner_K > 0)
     p = fm.onset
     onset = dict(Omega0=p.Omega0, theta_w=p.theta_w, tau0=p.tau0, tau1=p.tau1, lam=p.lam)
@@ -768,8 +832,11 @@ def _flow_hovering(
     meta.update(n_steps=points[0]["n_steps"], samples=points[0]["samples"])
     ckpt = Checkpoint(checkpoint)
     meta["checkpoint"] = str(ckpt.path)
+    stages = _Stages(meta, 1)
+    stages.start("sweep", _sweep_size(points, where))
     with progress_bar(progress, total=len(points), desc=scene.name, unit="eps") as bar:
-        rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where)
+        rows, from_ckpt = _sweep(scene.kind, points, ckpt, bar, where, scene.name)
+    stages.end()
     reused = sum(from_ckpt)
     col = lambda c: np.array([r[c] for r in rows], dtype=float)  # noqa: E731
     models = {
@@ -809,7 +876,9 @@ def _tangent_tori(scene: TangentToriScene, quick: bool, progress, meta: dict) ->
     h1w, h2w = float(sys.V1.V(sys.qw1)), float(sys.V2.V(sys.qw2))
     fm = _flowmap(scene, coordinates="section")
     tori = []
+    stages = _Stages(meta, 2)
     for name, h1, color in (("right", h1w, "C0"), ("upper", h - h2w, "C3")):
+        stages.start(f"torus {name}", f"1 orbit x {scene.n_returns} returns with its trajectory")
         h2 = h - h1
         q1, p1 = _circle(sys.V1, h1, scene.n_points)
         q2, p2 = _circle(sys.V2, h2, scene.n_points)
@@ -826,6 +895,7 @@ def _tangent_tori(scene: TangentToriScene, quick: bool, progress, meta: dict) ->
         )
         meta.setdefault("status", {})[name] = Status(int(res.status[0])).name
         meta.setdefault("work", {})[name] = _work(res)
+        stages.end()
         tori.append(
             TorusResult(
                 name=name,
@@ -850,11 +920,12 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
     meta["grid"] = [nphi, nK]
     lo = max(scene.K_range[0], 0.95 * fm.valid_band()[0])
     P, KK = np.meshgrid(-np.pi + 2 * np.pi * (np.arange(nphi) + 0.5) / nphi, np.linspace(lo, scene.K_range[1], nK))
-    t = time.perf_counter()
+    stages = _Stages(meta, 2)
+    stages.start("returns", f"{nphi} x {nK} points, 1 return each")
     res = fm.iterate(
         P.ravel(), KK.ravel(), 1, record=("orbit", "regions", "section", "states"), **_progress_kw(progress)
     )
-    meta["timings"]["returns"] = time.perf_counter() - t
+    stages.end()
     ok = np.isfinite(res.theta[:, 0])  # points with a point of Sigma_h
     z = res.z
     # The tangency circle K = 0 and its image (K = eps f(phi) to leading order).
@@ -873,11 +944,11 @@ def _sigma_structure(scene: SigmaStructureScene, quick: bool, progress, meta: di
         q21=tg.z[:, 1, 2],
         p21=tg.z[:, 1, 3],
     )
-    t = time.perf_counter()
+    stages.start("corner curves", f"{10 if quick else 24} circles")
     corners = flow_geometry(
         fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10)
     )
-    meta["timings"]["corner curves"] = time.perf_counter() - t
+    stages.end()
     return SigmaStructureResult(
         scene=scene,
         meta=meta,
@@ -918,18 +989,19 @@ def _samples_through(T: float, dt_max: float) -> float:
 
 
 def _corner_directions(scene: CornerDirectionsScene, quick: bool, progress, meta: dict) -> CornerDirectionsResult:
-    t = time.perf_counter()
+    stages = _Stages(meta, 3)
+    stages.start("setup", "flow map (tangential curve)")
     fm = _flowmap(scene)  # its tangential curve gives the normal coordinates of the curves
     flow = _wall_flow(scene, fm)
     sys, h = flow.sys, scene.h
     sec = Section(sys, h)
-    meta["timings"]["setup"] = time.perf_counter() - t
+    stages.end()
     p1max = corner_speed(sys, h)
     n = max(scene.n_curve // 4, 8) if quick else scene.n_curve
     meta["n_curve"] = n
     # p1w spaced evenly in p1w^2 (K is about linear in it near the tangency, eq:cornersingbordrho).
     p1w = p1max * np.sqrt((np.arange(n) + 0.5) / n)
-    t = time.perf_counter()
+    stages.start("curves", f"3 directions x {n} corner states, traced back and forth")
     curves = {}
     for ab in DIRECTIONS:
         z0, T, ok = flow.preimage(corner_states(sys, h, ab, p1w))
@@ -944,8 +1016,8 @@ def _corner_directions(scene: CornerDirectionsScene, quick: bool, progress, meta
         phi, K = np.full(n, np.nan), np.full(n, np.nan)
         phi[ok], K[ok] = fm.curve.to_normal(th[ok], I[ok])
         curves[ab] = dict(p1w=p1w.copy(), theta=th, I=I, phi=phi, K=K, reached=reached, error=err)
-    meta["timings"]["curves"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start("trajectories", f"3 directions x {len(scene.p1w_fractions)} trajectories")
     trajectories = []
     for ab in DIRECTIONS:
         pw = p1max * np.asarray(scene.p1w_fractions)
@@ -973,7 +1045,7 @@ def _corner_directions(scene: CornerDirectionsScene, quick: bool, progress, meta
                     arrival=tr[k, 1:].copy(),
                 )
             )
-    meta["timings"]["trajectories"] = time.perf_counter() - t
+    stages.end()
     meta["work"] = flow.work
     return CornerDirectionsResult(
         scene=scene,
@@ -1003,7 +1075,8 @@ def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) 
     thetas = wrap(
         np.array([t_1R - up / 4, t_1R, t_1R + low / 4, t_1R + low / 2, t_1R + 3 * low / 4, t_R0, t_R0 + up / 4])
     )
-    t = time.perf_counter()
+    stages = _Stages(meta, 2)
+    stages.start("points", f"{thetas.size} wall points and their trajectories")
     # Each point's segment starts where the tangential curve (traced back from the wall by the core)
     # puts it on Sigma_h; the smooth flow draws it (it only touches the walls), the step system says
     # what the touch is: grazing the right wall, hitting the corner, or passing above it.
@@ -1024,17 +1097,17 @@ def _wall_tangency(scene: WallTangencyScene, quick: bool, progress, meta: dict) 
         )
         for i, (q2, p2) in enumerate(sys.V2.point_at(float(x), E2) for x in thetas)
     ]
-    meta["timings"]["points"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
     n_th, n_rho = scene.grid
     if quick:
         n_th, n_rho = max(n_th // 4, 24), max(n_rho // 4, 6)
+    stages.start("regions", f"{n_th} x {n_rho} wall states labelled")
     meta["grid"] = [n_th, n_rho]
     It = tangent_action(sys, h)
     TH, RHO = np.meshgrid(-np.pi + 2 * np.pi * (np.arange(n_th) + 0.5) / n_th, It * (np.arange(n_rho) + 0.5) / n_rho)
     zw = wall_states(sys, h, TH.ravel(), RHO.ravel(), I_tan=It)
     _, region, _ = flow.labels(zw)
-    meta["timings"]["regions"] = time.perf_counter() - t
+    stages.end()
     meta["work"] = flow.work
     return WallTangencyResult(
         scene=scene,
@@ -1102,20 +1175,23 @@ def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) ->
     n_theta = max(scene.n_theta // 4, 90) if quick else scene.n_theta
     n_circles = max(scene.n_circles // 2, 4) if quick else scene.n_circles
     meta.update(n_theta=n_theta, n_circles=n_circles)
-    t = time.perf_counter()
+    stages = _Stages(meta, 3)
+    stages.start("circle", f"{n_theta} angles labelled")
     th = -np.pi + 2 * np.pi * (np.arange(n_theta) + 0.5) / n_theta
     It = wall_tangency_action(sys, h, th)
     tangency = wall_states(sys, h, th, 0.0, I_tan=It)  # p1 = 0: the tangency line rho_w = 0
     zc = wall_states(sys, h, th, rho, I_tan=It)
     _, region, _ = flow.labels(zc)
-    meta["timings"]["circle"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start(
+        "corner curves", f"{n_circles + 1} circles x {max(n_theta // 4, 64)} angles, {scene.bisections} bisections"
+    )
     # The circle's own boundaries and the curves' circles, bisected together (rho^2 spacing: the
     # curve sigma_01 goes as sqrt(rho_w) near the tangency line, Lemma lemma:border).
     rhos = np.concatenate([[rho], rmax * ((np.arange(n_circles) + 1.0) / n_circles) ** 2])
     found, other = _circle_boundaries(flow, h, rhos, max(n_theta // 4, 64), scene.bisections)
     meta["other_changes"] = [int(x) for x in other]
-    meta["timings"]["corner curves"] = time.perf_counter() - t
+    stages.end()
     boundaries = {ab: float(found[ab][0]) for ab in DIRECTIONS}
     curves = {"rho_w": rhos[1:]}
     for ab in DIRECTIONS:
@@ -1124,7 +1200,7 @@ def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) ->
         z[bad] = np.nan
         curves[f"theta_{ab}"] = found[ab][1:]
         curves[f"q2_{ab}"], curves[f"p2_{ab}"] = z[:, 2], z[:, 3]
-    t = time.perf_counter()
+    stages.start("segments", f"up to {3 * scene.segments + 3} trajectory segments")
     # Segments: `segments` per arc, evenly inside it, and one at each of the circle's boundaries.
     picks = []
     for a, (lo_ab, hi_ab) in (("R", ("1R", "R0")), ("0", ("R0", "01")), ("1", ("01", "1R"))):
@@ -1151,7 +1227,7 @@ def _wall_section(scene: WallSectionScene, quick: bool, progress, meta: dict) ->
                     itinerary=r["itinerary"][j],
                 )
             )
-    meta["timings"]["segments"] = time.perf_counter() - t
+    stages.end()
     meta["work"] = flow.work
     return WallSectionResult(
         scene=scene,
@@ -1193,25 +1269,35 @@ def _zone_study(name, m, zone, scene: ImpactZoneScene, n_scan: int, n_transit: i
     return ZoneStudy(name=name, zone=zone, scan=scan, up=up, down=down, seconds=sec)
 
 
+def _study_size(scene: ImpactZoneScene, n_scan: int, n_transit: int, unit: str) -> str:
+    return (
+        f"barrier scan {scene.n_starts} orbits x {n_scan} {unit}, "
+        f"transits 2 x {scene.transit_orbits} orbits x {n_transit} {unit}"
+    )
+
+
 def _impact_zone(scene: ImpactZoneScene, quick: bool, progress, meta: dict) -> ImpactZoneResult:
     n_scan, n_transit = scaled(scene.n_steps, quick, floor=1000), scaled(scene.transit_steps, quick, floor=200)
     n_crit = scaled(scene.critical_steps, quick, floor=2000)
     f = scene.model_factor
     meta.update(n_steps=n_scan, transit_steps=n_transit, critical_steps=n_crit)
-    t = time.perf_counter()
+    stages = _Stages(meta, 3)
+    stages.start(
+        "zones", f"flow map, its {scene.model} model, their ceilings and floors ({n_crit} steps per tested orbit)"
+    )
     fm = _flowmap(scene)
     tm = fm.truncated(forcing=scene.model)
     fzone = impact_zone(fm, n_steps=n_crit)
     # The model has no floor of its own: it is measured in the flow's zone coordinate, between its
     # own critical curve and the flow's floor (the torus tangent to the upper wall).
     mzone = impact_zone(tm, n_steps=n_crit, floor=fzone.floor)
-    meta["timings"]["zones"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start("flow", _study_size(scene, n_scan, n_transit, "returns"))
     flow = _zone_study("flow", fm, fzone, scene, n_scan, n_transit, progress)
-    meta["timings"]["flow"] = time.perf_counter() - t
-    t = time.perf_counter()
+    stages.end()
+    stages.start("model", _study_size(scene, n_scan * f, n_transit * f, "steps"))
     model = _zone_study(scene.model, tm, mzone, scene, n_scan * f, n_transit * f, progress)
-    meta["timings"]["model"] = time.perf_counter() - t
+    stages.end()
     p = fm.onset
     return ImpactZoneResult(
         scene=scene,
@@ -1303,6 +1389,7 @@ def compute(
     progress = check_progress(progress)
     meta = dict(version=__version__, quick=bool(quick), kind=scene.kind, name=scene.name, timings={})
     t0 = time.perf_counter()
+    _log.info("scene %s: %s%s", scene.name, scene.kind, f" (quick: counts / {QUICK_FACTOR})" if quick else "")
     ck = checkpoint if checkpoint is not None else scene.output.with_suffix(".sweep.jsonl")
     where = from_old_arguments(
         "compute",
@@ -1338,4 +1425,5 @@ def compute(
     else:
         raise ValueError(f"no computation for scene kind {scene.kind!r}")
     meta["timings"]["total"] = time.perf_counter() - t0
+    _log.info("scene %s: computed in %.1f s", scene.name, meta["timings"]["total"])
     return out

@@ -538,7 +538,7 @@ class HoveringAreaResult(SceneResult):
         Raises
         ------
         ImportError
-            Without pandas, naming ``pip install 'hovering[pandas]'``.
+            Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
         from .._interop import series_frame
 
@@ -556,7 +556,7 @@ class HoveringAreaResult(SceneResult):
         Raises
         ------
         ImportError
-            Without xarray, naming ``pip install 'hovering[xarray]'``.
+            Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
         from .._interop import series_dataset
 
@@ -649,7 +649,7 @@ class FlowHoveringResult(SceneResult):
         Raises
         ------
         ImportError
-            Without pandas, naming ``pip install 'hovering[pandas]'``.
+            Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
         from .._interop import flow_sweep_frame
 
@@ -667,7 +667,7 @@ class FlowHoveringResult(SceneResult):
         Raises
         ------
         ImportError
-            Without xarray, naming ``pip install 'hovering[xarray]'``.
+            Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
         from .._interop import flow_sweep_dataset
 

@@ -293,6 +293,28 @@ class _MapAPI(MapAnalyses):
         rotations (huge K) is ``ESCAPED`` too, never an ``OK`` orbit with a meaningless phi.
         Both kernels compute phi and the region of every step as :meth:`step` does, bit for bit;
         K differs only through the sin implementation (SLEEF vs libm, ~1 ulp).
+
+        Examples
+        --------
+        Four orbits started on the line L1 (where the invariant curves have their minima),
+        1000 steps each:
+
+        >>> import numpy as np, hovering
+        >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+        >>> K0 = np.array([-0.2, -0.1, 0.0, 0.1])
+        >>> res = m.iterate(m.L1(K0), K0, 1000)
+        >>> res.phi.shape, res.count(hovering.Status.OK)
+        ((4, 1001), 4)
+        >>> print(np.round(res.rotation, 3))     # rho, the mean rotation per step
+        [3.852 3.954 4.056 4.154]
+
+        Stop each orbit when it first reaches K >= 0.05 (only the state is kept, no orbit):
+
+        >>> up = m.iterate(m.L1(K0), K0, 1000, record=(), stop=hovering.Above(0.05))
+        >>> up.stop_step.tolist()                # the start counts: the last one starts above
+        [1, 1, 1, 0]
+        >>> up.count(hovering.Status.STOPPED)
+        4
         """
         record, n_steps, mask = iterate_arguments(record, _RECORD_KEYS, n_steps, exit_regions, stop_on_exit)
         every, stop_side, stop_curve = transport_arguments(every, stop)
@@ -370,6 +392,21 @@ class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     ValueError
         Naming the parameter and its allowed range, for non-finite values, |Omega0| > 1e6,
         theta_w outside (0, pi), lam <= 0 or K_max <= 0.
+
+    Examples
+    --------
+    The map of the paper's figures at eps = 0.3 (the sign that hovers):
+
+    >>> import numpy as np, hovering
+    >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+    >>> m.region(0.3, -0.2)                  # J_0: passes above the step, no impact
+    <Region.ABOVE: 1>
+    >>> phi1, K1 = m.step(0.3, -0.2)
+    >>> print(f"{phi1:.4f} {K1:.4f}")
+    -2.3000 -0.4237
+    >>> th = m.theory()                      # leading order: eq:hovsetsize, eq:kcrit, eq:rhocrit
+    >>> th.hovers, round(th.area, 4), round(th.K_crit, 4), round(th.rho_crit, 4)
+    (True, 0.7639, -0.2747, 3.7694)
     """
 
     def __init__(self, eps, Omega0, theta_w, tau0=1.0, tau1=0.5, lam=0.5, K_max=math.inf):

@@ -447,6 +447,18 @@ class Theory(Saveable):
         The tolerance below which a coefficient was taken as 0 (see :func:`theory`).
     geometry : str
         ``"step"`` (the paper's), ``"wall"`` or ``"none"`` (see :func:`theory`).
+
+    Examples
+    --------
+    Every map has its theory (``m.theory()``); the two signs of eps of the paper's figure:
+
+    >>> import numpy as np, hovering
+    >>> th = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4).theory()
+    >>> th.hovers, round(th.area, 4), round(th.K_crit, 4), round(th.rho_crit, 4)
+    (True, 0.7639, -0.2747, 3.7694)
+    >>> th = hovering.TruncatedMap(eps=-0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4).theory()
+    >>> th.hovers, th.area, th.note.split(":")[0]
+    (False, 0.0, 'impacting case')
     """
 
     eps: float
@@ -639,6 +651,15 @@ def theory(
     ValueError
         For non-finite parameters, an empty forcing, ``n_grid < 101``, an unknown geometry or a
         negative ``forcing_tol``.
+
+    Examples
+    --------
+    >>> import math, hovering
+    >>> th = hovering.theory(0.3, hovering.OMEGA_G, 3 * math.pi / 4)   # eps, Omega0, theta_w
+    >>> th.hovers, round(th.area, 4)
+    (True, 0.7639)
+    >>> hovering.theory(0.3, hovering.OMEGA_G, 3 * math.pi / 4, geometry="wall").area   # no corner: nothing hovers
+    0.0
     """
     eps, theta_w, tau0 = (real_number(n, v) for n, v in (("eps", eps), ("theta_w", theta_w), ("tau0", tau0)))
     Omega0 = _omega0(real_number("Omega0", Omega0))

@@ -56,10 +56,10 @@ struct HoveringAreaOptions {
 /// Per-sample outcomes of the two iterations: the Status under F_0 and under F_eps, the steps
 /// F_eps took before it stopped, and the regions its orbit visited (bit r: Region r).
 struct HoveringOutcomes {
-    std::vector<std::int8_t> status_F0, status;
-    std::vector<std::int64_t> steps_done;
-    std::vector<std::int8_t> visited;
-    bool interrupted = false;  ///< cancelled: the outcomes are not a result
+    std::vector<std::int8_t> status_F0, status;  ///< per sample: its Status under F_0, under F_eps
+    std::vector<std::int64_t> steps_done;        ///< per sample: steps F_eps took before it stopped
+    std::vector<std::int8_t> visited;            ///< per sample: bit r set when its orbit reached Region r
+    bool interrupted = false;                    ///< cancelled: the outcomes are not a result
 };
 
 /// The measured area; the fields of Python's HoveringArea that do not need the theory.

@@ -84,9 +84,11 @@ public:
     double parameter_of(double theta) const;
     /// Largest deviation of the interpolant from direct traces at off-grid points: (in theta, in I).
     std::pair<double, double> interpolation_error() const { return {err_theta_, err_I_}; }
-    /// The measured samples: wall angles s_k, angles theta_k and actions I_k on Sigma_h.
+    /// The measured wall angles s_k = -pi + 2 pi k / n.
     const std::vector<double>& s() const { return s_; }
+    /// The measured angles theta_k = theta(s_k) on Sigma_h.
     const std::vector<double>& theta() const { return theta_; }
+    /// The measured actions I_k = I(s_k) on Sigma_h.
     const std::vector<double>& I() const { return I_; }
     /// The unperturbed tangent action I_tan(h) = H2^{-1}(h - V1(qw1)) (eq:Itan).
     double I_tan0() const { return I0_; }
