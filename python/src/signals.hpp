@@ -6,8 +6,16 @@
 // computed, and the Python wrapper raises KeyboardInterrupt with that partial result attached.
 // The same waiting thread reports progress to a Python callable (ProgressReport) when asked to.
 // Every GIL acquisition here goes through the gate of gil.hpp (none once the interpreter exits).
+//
+// The runner is a new thread per call. When the process can start no thread (ulimit -u, a pids
+// limit, or an address space too full for another stack: a long-lived process under load), the
+// work used to run on the calling thread, where nothing polls for signals: Ctrl-C and kill -INT
+// were ignored and progress went silent until the call ended (minutes to hours), in that process
+// only. The runner is then the reserve thread (ReserveRunner), started by an earlier call while
+// threads could still be started and kept for the life of the process.
 
 #include <Python.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -16,6 +24,7 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <system_error>
 #include <thread>
 
@@ -23,6 +32,85 @@
 #include "pybind.hpp"
 
 namespace hovering_py {
+
+/// One thread kept for the life of the process, which runs a watched call's work when no new
+/// thread can be started (see the top of this file). It is started by the first watched call (and
+/// again by the first one in a child of os.fork, where the parent's threads do not exist); it never
+/// touches Python while idle, and is neither joined nor destroyed (nothing waits for it at exit).
+/// One call at a time uses it; a second one that finds no thread runs on its calling thread.
+class ReserveRunner {
+public:
+    /// This process's reserve (null only if not even the object could be allocated); its thread
+    /// may not be running yet (start()).
+    static ReserveRunner* get() noexcept {
+        static std::atomic<ReserveRunner*> current{nullptr};
+        const pid_t pid = getpid();
+        ReserveRunner* r = current.load();
+        while (r == nullptr || r->pid_ != pid) {  // none yet, or the parent's (gone with os.fork)
+            ReserveRunner* fresh = new (std::nothrow) ReserveRunner(pid);
+            if (fresh == nullptr) return nullptr;
+            if (current.compare_exchange_strong(r, fresh)) return fresh;  // the parent's is leaked
+            delete fresh;  // another thread made it first: r is now theirs
+        }
+        return r;
+    }
+
+    /// Start the thread if it is not running yet; whether it runs. A refused start is tried again
+    /// by the next call.
+    bool start() noexcept {
+        try {
+            std::call_once(started_once_, [this] {
+                std::thread([this] { loop(); }).detach();
+                started_ = true;
+            });
+        } catch (...) {  // std::system_error: no thread to spare now
+        }
+        return started_;
+    }
+
+    /// Run fn(arg) on the reserve thread if it runs and is idle (true); else false and nothing runs.
+    bool try_run(void (*fn)(void*), void* arg) noexcept {
+        if (!start()) return false;
+        std::lock_guard<std::mutex> lock(mu_);
+        if (busy_) return false;
+        busy_ = true;
+        fn_ = fn;
+        arg_ = arg;
+        cv_.notify_all();
+        return true;
+    }
+
+    /// Wait until what try_run started has returned (and no longer touches anything of the caller's).
+    void wait() noexcept {
+        std::unique_lock<std::mutex> lock(mu_);
+        cv_.wait(lock, [this] { return !busy_; });
+    }
+
+private:
+    explicit ReserveRunner(pid_t pid) : pid_(pid) {}
+    void loop() noexcept {
+        std::unique_lock<std::mutex> lock(mu_);
+        for (;;) {
+            cv_.wait(lock, [this] { return fn_ != nullptr; });
+            void (*fn)(void*) = fn_;
+            void* arg = arg_;
+            fn_ = nullptr;
+            lock.unlock();
+            fn(arg);  // catches everything itself (run_watched's runner)
+            lock.lock();
+            busy_ = false;
+            cv_.notify_all();
+        }
+    }
+    const pid_t pid_;
+    std::once_flag started_once_;
+    bool started_ = false;  // written once, inside call_once (which orders it before later reads)
+    std::mutex mu_;
+    std::condition_variable cv_;
+    bool busy_ = false;
+    void (*fn_)(void*) = nullptr;
+    void* arg_ = nullptr;
+};
 
 /// Whether the calling thread (GIL held) is Python's main thread. It runs Python code (threading's),
 /// which may hand the GIL to another thread and take it back: through the gate, as every GIL
@@ -82,23 +170,30 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const Progr
             std::mutex mu;
             std::condition_variable cv;
             bool done = false;
+            auto run = [&] {
+                try {
+                    work();
+                } catch (...) {
+                    err = std::current_exception();
+                }
+                std::lock_guard<std::mutex> lock(mu);
+                done = true;
+                cv.notify_one();
+            };
+            // Started now, while threads can be: it is what runs the work once none can.
+            ReserveRunner* const reserve = ReserveRunner::get();
+            if (reserve != nullptr) reserve->start();
             std::thread runner;
-            bool threaded = true;
+            bool threaded = true, on_reserve = false;
             try {
-                runner = std::thread([&] {
-                    try {
-                        work();
-                    } catch (...) {
-                        err = std::current_exception();
-                    }
-                    std::lock_guard<std::mutex> lock(mu);
-                    done = true;
-                    cv.notify_one();
-                });
+                runner = std::thread(run);
             } catch (const std::system_error&) {
-                // No thread to spare (ulimit -u, a container's pids limit): compute here; only
-                // Ctrl-C's promptness and the intermediate progress reports are lost, not the result.
-                threaded = false;
+                // No new thread (see the top of this file): the reserve runs the work; if it is
+                // busy with another call too, compute here, where only Ctrl-C's promptness and the
+                // intermediate progress reports are lost, not the result.
+                on_reserve = reserve != nullptr &&
+                             reserve->try_run([](void* r) { (*static_cast<decltype(run)*>(r))(); }, &run);
+                threaded = on_reserve;
             }
             if (!threaded) {
                 work();
@@ -122,7 +217,10 @@ bool run_watched(Work&& work, std::atomic<bool>& cancel, bool watch, const Progr
                     lock.lock();
                 }
                 lock.unlock();
-                runner.join();
+                if (on_reserve)
+                    reserve->wait();
+                else
+                    runner.join();
                 if (err) std::rethrow_exception(err);
             }
         }

@@ -153,14 +153,24 @@ def test_an_executor_and_any_thread_count_give_the_one_process_answer():
         assert np.array_equal(getattr(one, f), getattr(threads, f), equal_nan=f in ("margin",)), f
 
 
+#: Classification options of the Ctrl-C scans: island chains up to period 2 only. The orbits cut
+#: short are never classified; were the interrupt lost, the full classification of 4 x 2e6 points
+#: (~18 s, mostly the island tests of periods up to 64) would be what the test waits for.
+_SHORT = dict(max_period=2)
+
+
 def test_ctrl_c_keeps_the_orbits_so_far():
     m = paper.truncated_map(0.3)
     zone = hovering.impact_zone(m, n_steps=5000)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt) as info:
         # starts that stay in the band, so that the press lands inside a long orbit (an orbit that
-        # leaves the band early still returns its 1e7-wide padded record, which takes seconds)
-        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, s_range=(0.5, 1.0), progress=press)
+        # leaves the band early still returns its padded record). 2e6 steps: one start per piece,
+        # ~0.5 s each, the press at the first one's first report (~0.1 s); were it lost, the scan
+        # would end within seconds (its classification kept short by max_period) and fail here.
+        hovering.barrier_scan(
+            m, zone, n_starts=4, n_steps=2 * 10**6, s_range=(0.5, 1.0), classify=_SHORT, progress=press
+        )
     assert time.perf_counter() - press.fired_at < PROMPT
     part = info.value.partial
     assert not part.complete and len(part) == 4
@@ -173,8 +183,10 @@ def test_an_orbit_that_ends_on_its_own_keeps_its_verdict_when_the_rest_is_interr
     m = paper.truncated_map(0.3)
     zone = hovering.impact_zone(m, n_steps=5000)
     with pytest.raises(KeyboardInterrupt) as info:
-        # the lowest start leaves the band after 1160 steps; the second one is cut short
-        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**6, progress=CtrlCOnceStarted(after=1))
+        # the lowest start leaves the band after 1160 steps; the second one is cut short. Three
+        # starts share the first piece (the most that fit 1.3e6 steps), ~0.35 s of work, Ctrl-C at
+        # its first report (~0.1 s); the whole scan takes seconds, so a lost interrupt fails here.
+        hovering.barrier_scan(m, zone, n_starts=4, n_steps=1_300_000, progress=CtrlCOnceStarted(after=1))
     part = info.value.partial
     cut_short = part.status == hovering.Status.INTERRUPTED
     assert part.status[0] == hovering.Status.ESCAPED and part.decided_by[0] != "interrupted"
@@ -266,8 +278,10 @@ def test_interrupted_orbits_are_not_classified(monkeypatch):
     m = paper.truncated_map(0.3)
     zone = hovering.impact_zone(m, n_steps=5000)
     press = CtrlCOnceStarted()
-    with pytest.raises(KeyboardInterrupt) as info:
-        hovering.barrier_scan(m, zone, n_starts=4, n_steps=10**7, s_range=(0.5, 1.0), progress=press)
+    with pytest.raises(KeyboardInterrupt) as info:  # bounded as in test_ctrl_c_keeps_the_orbits_so_far
+        hovering.barrier_scan(
+            m, zone, n_starts=4, n_steps=2 * 10**6, s_range=(0.5, 1.0), classify=_SHORT, progress=press
+        )
     part = info.value.partial
     assert np.all(part.status == hovering.Status.INTERRUPTED) and np.all(part.decided_by == "interrupted")
     assert rows and all(n == 0 for n in rows)

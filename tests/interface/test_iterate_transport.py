@@ -90,16 +90,16 @@ def test_every_k_is_a_slice_of_the_full_record(m, starts, kernel, k):
 
 
 def test_every_k_thins_what_the_memory_check_counts(m):
-    # 1e12 steps of one orbit: every state would need 16 TB and is refused before any work; every
-    # 1e11-th state is 11 states, so that run starts (Ctrl-C, pressed once work is under way,
-    # ends it: the partial result has the thinned shape).
+    # 1e12 steps of one orbit: every state would need 16 TB and is refused before any work. A run
+    # of 3e6 steps thinned to every 3e5-th state (11 states; ~1 s, the family's ~7 s) starts, and
+    # Ctrl-C, pressed once work is under way, ends it: the partial result has the thinned shape.
     with pytest.raises(ValueError, match=r"for 1 orbits x 1000000000000 steps needs .* GiB, more than half"):
         m.iterate([0.1], [0.1], 10**12, record=("orbit",))
     with pytest.raises(ValueError, match=r"for 1 orbits x 1000000000000 steps \(every 2\) needs .* GiB"):
         m.iterate([0.1], [0.1], 10**12, record=("orbit",), every=2)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt) as info:
-        m.iterate([0.1], [0.1], 10**12, record=("orbit",), every=10**11, progress=press)
+        m.iterate([0.1], [0.1], 3 * 10**6, record=("orbit",), every=3 * 10**5, progress=press)
     assert time.perf_counter() - press.fired_at < PROMPT
     part = info.value.partial
     assert part.phi.shape == (1, 11) and part.status[0] == Status.INTERRUPTED and part.phi[0, 0] == 0.1
@@ -316,11 +316,11 @@ def test_interrupt_keeps_the_transport_records(kernel):
     n = 20_000
     phi0, K0 = band_sample(m, n, np.random.default_rng(5), K_hi=0.8, margin=0.5)
     press = CtrlCOnceStarted()
-    with pytest.raises(KeyboardInterrupt) as info:
+    with pytest.raises(KeyboardInterrupt) as info:  # ~1 s (simd), ~6 s (scalar) of work; Ctrl-C at ~0.1 s
         m.iterate(
             phi0,
             K0,
-            100_000,
+            20_000,
             record=("extrema", "residence"),
             n_threads=2,
             kernel=kernel,
@@ -485,8 +485,8 @@ def test_flow_interrupt_keeps_the_transport_records(fm):
     phi, K = rng.uniform(-np.pi, np.pi, 100), rng.uniform(-0.06, 0.05, 100)
     press = CtrlCOnceStarted()
     kw = dict(record=("extrema", "residence"), stop=Above(0.045))
-    with pytest.raises(KeyboardInterrupt) as info:
-        fm.iterate(phi, K, 100_000, n_threads=2, progress=press, **kw)
+    with pytest.raises(KeyboardInterrupt) as info:  # ~2 s of work on 2 idle cores; Ctrl-C at ~0.1 s
+        fm.iterate(phi, K, 2000, n_threads=2, progress=press, **kw)
     assert time.perf_counter() - press.fired_at < PROMPT
     res = info.value.partial
     assert np.any(res.status == Status.INTERRUPTED)

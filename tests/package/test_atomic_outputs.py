@@ -126,7 +126,9 @@ action, variant, block, d = sys.argv[1:5]
 
 def stop_here():
     print("ready", flush=True)
-    time.sleep(600)
+    # Where the signal arrives. Were a SIGINT not honoured, the writer would go on after this and
+    # write its file (the test then fails on it) rather than keep the test waiting.
+    time.sleep(30)
 
 
 if block != "-":

@@ -178,8 +178,9 @@ def test_ctrl_c_with_a_bar_keeps_the_partial_result_and_closes_the_bar(tm, capsy
 
     rng = np.random.default_rng(5)
     phi0, K0 = rng.uniform(-np.pi, np.pi, 20_000), rng.uniform(-0.5, 0.5, 20_000)
-    # ~2e9 steps: minutes of work. Ctrl-C is pressed once the work has begun (whatever the load):
-    # by the bar's own first update (progress=True), or by the callable (progress=rec).
+    # 2e9 steps, ~4 s on 2 idle cores (a lost interrupt fails in seconds). Ctrl-C is pressed once
+    # the work has begun (whatever the load): by the bar's own first update (progress=True), or by
+    # the callable (progress=rec).
     press = CtrlCOnceStarted()
     update = tqdm_std.tqdm.update
 

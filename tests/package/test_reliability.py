@@ -25,7 +25,9 @@ SIGINT_IN_ITERATE = textwrap.dedent(
             print("ready", flush=True)
     t0 = time.perf_counter()
     try:
-        m.iterate(np.zeros(20000), np.full(20000, 0.1), 10**7, record=(), progress=ready)  # ~minutes
+        # 2e9 steps, ~4 s on 2 idle cores: a SIGINT that is not honoured ends in "returned", not a hang
+        m.iterate(np.zeros(20000), np.full(20000, 0.1), 10**5, record=(), progress=ready)
+        print("returned", time.perf_counter() - t0, flush=True)
     except KeyboardInterrupt as e:
         r = e.partial
         print("interrupted", time.perf_counter() - t0, int((r.status == hv.Status.INTERRUPTED).sum()),
@@ -43,10 +45,13 @@ def test_sigint_to_the_process_stops_iterate_and_keeps_the_partial_result():
     p = subprocess.Popen(
         [sys.executable, "-c", SIGINT_IN_ITERATE], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
-    assert p.stdout.readline().strip() == "ready"
-    sent = time.perf_counter()
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=60)
+    try:
+        assert p.stdout.readline().strip() == "ready"
+        sent = time.perf_counter()
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        p.kill()  # a no-op once it has exited; else nothing is left running behind the test
     waited = time.perf_counter() - sent
     assert p.returncode == 0, err[-500:]
     words = out.split()
@@ -54,8 +59,8 @@ def test_sigint_to_the_process_stops_iterate_and_keeps_the_partial_result():
     n_interrupted, steps = int(words[2]), int(words[3])
     # Every orbit is accounted for, and work was done before the signal (nothing thrown away).
     assert n_interrupted > 0 and steps > 0
-    # The full run takes minutes (2e11 steps); stopping must not wait for it. 10 s is generous
-    # against a loaded machine (the watcher polls every 0.1 s).
+    # Stopping must not wait for the full run; 10 s is generous against a loaded machine (the
+    # watcher polls every 0.1 s).
     assert waited < 10, waited
 
 

@@ -9,7 +9,7 @@ of one sample stream), and Ctrl-C must stop the pieces running on other threads.
 
 from __future__ import annotations
 
-import _thread
+import importlib
 import subprocess
 import sys
 import textwrap
@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import hovering
+from conftest import CtrlCOnceStarted
 from hovering import paper
 from hovering.analysis.hovering import hovering_area
 from hovering.parallel import Executor
@@ -76,19 +77,31 @@ def test_local_workers_start_no_process_and_give_the_one_process_answer():
     assert many.area == one.area and many.areas == one.areas and many.unresolved == one.unresolved
 
 
-def test_ctrl_c_stops_the_pieces_running_on_other_threads():
-    # Each piece would take hours; Ctrl-C reaches only the main thread, which must stop the pieces
-    # on the pool's threads (the run's stop event, polled by the core every ~0.1 s) and return.
-    # The bound is 30 s: generous against a loaded 2-core machine, hours below the full run.
+def test_ctrl_c_stops_the_pieces_running_on_other_threads(monkeypatch):
+    # Ctrl-C reaches only the main thread, which must stop the pieces on the pool's threads (the
+    # run's stop event, polled by the core every ~0.1 s) and return. It is pressed (interrupt_main)
+    # when the first piece is reported done, so it lands mid-run under any load: the piece that
+    # took the freed worker has just started. The pieces take ~1 s each (~3 s in all on 2 idle
+    # cores): a stop that never reached them ends the call in seconds, not hours, and fails below.
+    area = importlib.import_module("hovering.analysis.hovering")
+    real_piece, outcomes = area._piece, []
+
+    def piece(*args):
+        try:
+            res = real_piece(*args)
+        except KeyboardInterrupt:
+            outcomes.append("stopped")
+            raise
+        outcomes.append("finished")
+        return res
+
+    monkeypatch.setattr(area, "_piece", piece)
     m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=2.0)
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    t0 = time.perf_counter()
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            m.hovering_area(n_steps=10**7, n_samples=10**6, executor=Executor(workers=2, pieces=4))
-    finally:
-        timer.cancel()
-    assert time.perf_counter() - t0 - 0.5 < 30
+    press = CtrlCOnceStarted()
+    with pytest.raises(KeyboardInterrupt):
+        m.hovering_area(n_steps=10**5, n_samples=10**5, executor=Executor(workers=2, pieces=4), progress=press)
+    # The bound is 30 s: generous against a loaded 2-core machine, the pieces' seconds below a lost stop.
+    assert time.perf_counter() - press.fired_at < 30
+    assert "stopped" in outcomes, outcomes  # a piece under way was stopped, not waited for
     # No piece is left computing once the call has returned: the pool's threads have ended.
     assert not [t for t in threading.enumerate() if t.name.startswith("hovering-piece")]

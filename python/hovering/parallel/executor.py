@@ -477,17 +477,22 @@ def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Callable | 
         After cancelling every piece not yet finished (the finished ones were yielded).
     """
     futures = {}
-    for i, args in enumerate(pieces):
-        futures[ex.submit(fn, *args)] = i
-    n = len(futures)
-    _log.info(
-        "%d pieces of %s on %s (%d workers)",
-        n,
-        getattr(fn, "__qualname__", fn),
-        getattr(ex, "name", type(ex).__name__),
-        ex.workers,
-    )
+    n = 0
     try:
+        # Submitting is inside the try: a Ctrl-C that lands while the pieces are handed out must
+        # stop the ones already running too. Else they never saw the stop event and the executor's
+        # close() waited for each to finish in full (hours for a long run: the interrupt "never
+        # landed").
+        for i, args in enumerate(pieces):
+            futures[ex.submit(fn, *args)] = i
+        n = len(futures)
+        _log.info(
+            "%d pieces of %s on %s (%d workers)",
+            n,
+            getattr(fn, "__qualname__", fn),
+            getattr(ex, "name", type(ex).__name__),
+            ex.workers,
+        )
         for f in ex.as_completed(list(futures)):
             i = futures.pop(f)
             res = f.result()
@@ -497,6 +502,7 @@ def run_pieces(ex, fn: Callable, pieces: Iterable[tuple], on_result: Callable | 
             yield i, res
     except BaseException as e:
         if futures:
+            n = n or len(futures)
             _log.info("%s: %d of %d pieces not finished, cancelled", type(e).__name__, len(futures), n)
         ex.cancel(list(futures))
         raise
