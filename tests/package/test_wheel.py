@@ -138,7 +138,8 @@ def namespace_wrapper():
     files = system_copies()
     binds = " && ".join(f"mount --bind /dev/null {f}" for f in files) or "true"
     for flags in (["-m"], ["-r", "-m"]):
-        probe = subprocess.run([unshare, *flags, "sh", "-c", "true"], capture_output=True, timeout=60)
+        # The probe makes the very bind mounts the run will need (a namespace may allow no mounts).
+        probe = subprocess.run([unshare, *flags, "sh", "-c", binds], capture_output=True, timeout=60)
         if probe.returncode == 0:
             return [unshare, *flags, "sh", "-c", binds + ' && exec "$0" "$@"'], files
     return None
