@@ -78,6 +78,7 @@ _WHY = {
     Status.IMPACT_LIMIT: "too many impacts in one return",
     Status.OFF_SECTION: "left Sigma_h",
     Status.OUTSIDE_WELL: "reached the edge of a bounded well",
+    Status.IMPRECISE: "a return's error could not be verified within rtol",
 }
 _WHY_AT_START = {
     Status.ESCAPED: "the point lies outside the band where the map is defined",

@@ -32,6 +32,7 @@ void register_enums(py::module_& m) {
         .value("OFF_SECTION", Status::OffSection, "flow: the point is not on Sigma_h at this energy")
         .value("OUTSIDE_WELL", Status::OutsideWell, "flow: no accepted step keeps the state inside a bounded well")
         .value("STOPPED", Status::Stopped, "the orbit reached the set of its stop condition (hovering.Above / Below)")
+        .value("IMPRECISE", Status::Imprecise, "flow: a return's verified error stayed above its band (FlowOptions.verify_steps)")
         .finalize();
     py::native_enum<FlowStatus>(m, "FlowStatus", "enum.IntEnum", "Outcome of one return of the flow.")
         .value("OK", FlowStatus::Ok, "returned to Sigma_h")
@@ -43,6 +44,7 @@ void register_enums(py::module_& m) {
         .value("OFF_SECTION", FlowStatus::OffSection, "the starting point is not on Sigma_h at this energy")
         .value("INTERRUPTED", FlowStatus::Interrupted, "the batch was interrupted before this return ended")
         .value("OUTSIDE_WELL", FlowStatus::OutsideWell, "no accepted step keeps the state inside a bounded well")
+        .value("IMPRECISE", FlowStatus::Imprecise, "a verified return's error stayed above its band at rtol / 10^4")
         .finalize();
     py::native_enum<TrajectoryPoint>(m, "TrajectoryPoint", "enum.IntEnum", "What a recorded trajectory point is.")
         .value("SAMPLE", TrajectoryPoint::Sample, "uniform sample at t = k dt of the orbit's clock")

@@ -61,7 +61,7 @@ void register_flow(py::module_& m) {
 
     py::class_<FlowOptions>(m, "FlowOptions", "Integrator settings of the return map (validated on use).")
         .def(py::init([](std::string stepper, double rtol, double atol, double event_tol, std::int64_t max_steps,
-                         int max_impacts, double grazing_tol, double corner_tol) {
+                         int max_impacts, double grazing_tol, double corner_tol, std::int64_t verify_steps) {
                  FlowOptions o;
                  o.stepper = std::move(stepper);
                  o.rtol = rtol;
@@ -71,6 +71,7 @@ void register_flow(py::module_& m) {
                  o.max_impacts = max_impacts;
                  o.grazing_tol = grazing_tol;
                  o.corner_tol = corner_tol;
+                 o.verify_steps = verify_steps;
                  o.validate();
                  return o;
              }),
@@ -78,7 +79,8 @@ void register_flow(py::module_& m) {
              py::arg("stepper") = FlowOptions{}.stepper, py::arg("rtol") = FlowOptions{}.rtol,
              py::arg("atol") = FlowOptions{}.atol, py::arg("event_tol") = FlowOptions{}.event_tol,
              py::arg("max_steps") = FlowOptions{}.max_steps, py::arg("max_impacts") = FlowOptions{}.max_impacts,
-             py::arg("grazing_tol") = FlowOptions{}.grazing_tol, py::arg("corner_tol") = FlowOptions{}.corner_tol)
+             py::arg("grazing_tol") = FlowOptions{}.grazing_tol, py::arg("corner_tol") = FlowOptions{}.corner_tol,
+             py::arg("verify_steps") = FlowOptions{}.verify_steps)
         .def_readonly("stepper", &FlowOptions::stepper)
         .def_readonly("rtol", &FlowOptions::rtol)
         .def_readonly("atol", &FlowOptions::atol)
@@ -87,6 +89,7 @@ void register_flow(py::module_& m) {
         .def_readonly("max_impacts", &FlowOptions::max_impacts)
         .def_readonly("grazing_tol", &FlowOptions::grazing_tol)
         .def_readonly("corner_tol", &FlowOptions::corner_tol)
+        .def_readonly("verify_steps", &FlowOptions::verify_steps)
         .def(
             "validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
             "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");

@@ -109,12 +109,14 @@ void register_pickles(py::module_& core) {
     fo.def(py::pickle(
         [](const FlowOptions& o) -> py::object {
             return py::make_tuple(o.stepper, o.rtol, o.atol, o.event_tol, o.max_steps, o.max_impacts, o.grazing_tol,
-                                  o.corner_tol);
+                                  o.corner_tol, o.verify_steps);
         },
         [](const py::object& state) {
-            const py::tuple t =
-                state_of(state, 8, "FlowOptions",
-                         "(stepper, rtol, atol, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)");
+            // Pickles from before verify_steps hold 8 entries: they get its default.
+            const bool old = py::isinstance<py::tuple>(state) && py::len(state) == 8;
+            const py::tuple t = state_of(
+                state, old ? 8 : 9, "FlowOptions",
+                "(stepper, rtol, atol, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)");
             FlowOptions o;
             try {
                 o.stepper = t[0].cast<std::string>();
@@ -125,6 +127,7 @@ void register_pickles(py::module_& core) {
                 o.max_impacts = t[5].cast<int>();
                 o.grazing_tol = t[6].cast<double>();
                 o.corner_tol = t[7].cast<double>();
+                if (!old) o.verify_steps = t[8].cast<std::int64_t>();
             } catch (const py::cast_error&) {
                 throw py::value_error("FlowOptions.__setstate__: wrong entry types in " + short_repr(state, 200));
             }

@@ -42,6 +42,20 @@ def _one(sec, theta, I, **kw):
 DEPTHS = [1e-4, 1e-6, 1e-8, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14]
 
 
+def _unverifiable(r, d, stepper):
+    """Whether a shallow impact's return was reported IMPRECISE, where that is the honest answer.
+
+    The return is verified (its impact amplifies errors ~1/sqrt(d)); at rtol 1e-12 the tighter
+    traces stop at the rounding floor: rk8pd's 1e-14 allows one trace 100x tighter, whose error
+    amplified by 1/sqrt(d) >= 100 at d <= 1e-4 (measured 0.24 rtol / sqrt(d) at rtol 1e-12) stays
+    above the band; taylor's 1e-15 allows two, enough down to d ~ 1e-6. IMPRECISE says so.
+    """
+    if r.status[0] != FlowStatus.IMPRECISE:
+        return False
+    assert d <= (1e-4 if stepper == "rk8pd" else 1e-8), (d, r.status[0])
+    return True
+
+
 @pytest.mark.parametrize("stepper", ["rk8pd", "taylor"])
 @pytest.mark.parametrize("d", DEPTHS)
 def test_grazing_the_right_wall_at_depth(sec, d, stepper):
@@ -51,6 +65,8 @@ def test_grazing_the_right_wall_at_depth(sec, d, stepper):
     I, W = V2.action(H2), V2.frequency(H2)
     th0 = float(wrap(np.pi - W * np.pi))
     r = _one(sec, th0, I, stepper=stepper)
+    if d >= 1e-11 and _unverifiable(r, d, stepper):
+        return
     if d >= 1e-11:  # deeper than grazing_tol = 1e-12: a reflection, with the exact return
         assert r.status[0] == FlowStatus.OK and r.itinerary[0] == "R"
         t1 = np.arccos(QW1 / np.sqrt(2 * h1))
@@ -59,8 +75,8 @@ def test_grazing_the_right_wall_at_depth(sec, d, stepper):
     elif d <= 1e-13:  # within grazing_tol: a tangential touch, reported as such
         assert r.status[0] == FlowStatus.GRAZING
         assert abs(r.z[0, 0] - QW1) <= 2e-12 and abs(r.z[0, 1]) <= 1e-5  # at the wall, p1 ~ sqrt(d)
-    else:  # d == grazing_tol: the boundary itself; either answer, never another one
-        assert r.status[0] in (FlowStatus.OK, FlowStatus.GRAZING)
+    else:  # d == grazing_tol: the boundary itself; either answer (or IMPRECISE), never another one
+        assert r.status[0] in (FlowStatus.OK, FlowStatus.GRAZING, FlowStatus.IMPRECISE)
 
 
 @pytest.mark.parametrize("stepper", ["rk8pd", "taylor"])
@@ -71,6 +87,8 @@ def test_grazing_the_upper_wall_at_depth(sec, d, stepper):
     I, W = V2.action(H2), V2.frequency(H2)
     th0 = float(wrap(np.pi - W * np.pi))
     r = _one(sec, th0, I, stepper=stepper)
+    if d >= 1e-11 and _unverifiable(r, d, stepper):
+        return
     if d >= 1e-11:
         assert r.status[0] == FlowStatus.OK and r.itinerary[0] == "1"
         # the reflection maps theta_w2 to -theta_w2: the angle jumps by -2 theta_w2
@@ -81,7 +99,7 @@ def test_grazing_the_upper_wall_at_depth(sec, d, stepper):
         assert r.status[0] == FlowStatus.GRAZING
         assert abs(r.z[0, 2] - QW2) <= 2e-12
     else:
-        assert r.status[0] in (FlowStatus.OK, FlowStatus.GRAZING)
+        assert r.status[0] in (FlowStatus.OK, FlowStatus.GRAZING, FlowStatus.IMPRECISE)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -163,6 +181,12 @@ def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
         # rtol 1e-2 leaves energy errors up to ~11 on h = 1000 near the chart's edge (H2 -> h):
         # a return whose (theta, I) then names no point, or another one, says so
         FlowStatus.OFF_SECTION,
+        # and a verified return (long, or a shallow impact) whose error stays far above rtol 1e-2
+        # at 1e-4 and 1e-6 says so
+        FlowStatus.IMPRECISE,
+        # rkf45's loose steps next to the singularity can gain energy without bound (8e11 on
+        # h = 1000, measured): a runaway, stopped once its kinetic energy passes 1e8 (1 + h)
+        FlowStatus.NON_FINITE,
     }
     stopped = r.status != FlowStatus.OK
     assert np.all(r.time[stopped] > 0)  # where it stopped, in time
@@ -197,18 +221,23 @@ def test_step_limit_reports_the_time_and_state_reached(sec, max_steps):
 
 
 def test_non_finite_reports_the_time_and_state_reached():
-    # A runaway (an indefinite coupled potential): NON_FINITE once the state overflows, with the
-    # last finite state (~1e307) and its time (~1040, not 0); its own coordinates are NaN.
+    # A runaway (an indefinite coupled potential): NON_FINITE once its kinetic energy passes
+    # 1e8 (1 + |h|), with that last state and its time: the unstable mode grows as e^(0.68 t)
+    # (0.68 = sqrt(0.5 - 0.04)), ~1.7e4 after t ~ 14. H is kept to the end (rounding of terms of
+    # size ~1e8); the state's own coordinates are NaN (it is not on Sigma_h).
     s = Section(
         StepSystem(
             V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
         ),
         0.3,
     )
-    r = s.return_map([np.linspace(-np.pi, np.pi, 41)[12]], [0.5])
-    assert r.status[0] == FlowStatus.NON_FINITE
-    assert np.isfinite(r.z[0]).all() and np.max(np.abs(r.z[0])) > 1e300
-    assert 1000 < r.time[0] < 1100 and r.steps[0] > 100 and np.isnan([r.theta[0], r.I[0]]).all()
+    for stepper in ("rk8pd", "taylor"):
+        r = s.return_map([np.linspace(-np.pi, np.pi, 41)[12]], [0.5], stepper=stepper)
+        assert r.status[0] == FlowStatus.NON_FINITE
+        kinetic = 0.5 * (r.z[0, 1] ** 2 + r.z[0, 3] ** 2)
+        assert np.isfinite(r.z[0]).all() and 1e8 * 1.3 < kinetic < 1e10
+        assert 8 < r.time[0] < 20 and np.isnan([r.theta[0], r.I[0]]).all()
+        assert r.energy_error[0] < 1e-14 * kinetic
 
 
 # ------------------------------------------------------------------------------------------------
@@ -224,7 +253,8 @@ def test_implicit_gauss_steppers_converge(stepper, order):
     ex = s0.return_map(th, I, stepper="exact")
     errs = []
     for tol in (1e-6, 1e-9):
-        r = s0.return_map(th, I, rtol=tol, atol=tol, stepper=stepper)
+        # the method's own convergence: unverified (a verified return is a tighter trace's)
+        r = s0.return_map(th, I, rtol=tol, atol=tol, stepper=stepper, verify_steps=0)
         ok = (r.status == 0) & (ex.status == 0)
         assert ok.sum() >= 14 and list(np.array(r.itinerary)[ok]) == list(np.array(ex.itinerary)[ok])
         errs.append(np.max(np.abs(wrap(r.theta[ok] - ex.theta[ok]))))
@@ -233,7 +263,7 @@ def test_implicit_gauss_steppers_converge(stepper, order):
     assert errs[1] < errs[0] / 10 and errs[1] < 1e-4
     # coupled (the Jacobian's coupling terms): agrees with rk8pd to the implicit stepper's accuracy
     s1 = Section(sys0.replace(eps=0.05), H)
-    a = s1.return_map(th, I, rtol=1e-10, atol=1e-10, stepper=stepper)
+    a = s1.return_map(th, I, rtol=1e-10, atol=1e-10, stepper=stepper, verify_steps=0)
     b = s1.return_map(th, I, rtol=1e-12, atol=1e-12)
     ok = (a.status == 0) & (b.status == 0)
     assert np.max(np.abs(wrap(a.theta[ok] - b.theta[ok]))) < (1e-6 if order == 4 else 1e-3)

@@ -19,7 +19,8 @@ import hovering as hv
 from hovering import FlowStatus, Status
 
 #: An indefinite quadratic potential (eps = -0.5 > the oscillators' 0.04): orbits that do not
-#: reflect off the wall quickly run away (t ~ 1040, the state ~1e307, NON_FINITE).
+#: reflect off the wall quickly run away (NON_FINITE once the kinetic energy passes 1e8 (1 + h),
+#: t ~ 12).
 RUNAWAY = hv.StepSystem(
     V1=hv.Harmonic(0.2), V2=hv.Harmonic(0.2), coupling=hv.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
 )
@@ -49,15 +50,20 @@ def test_return_map_keeps_the_good_returns_beside_a_runaway(sec):
             assert same(getattr(alone, f)[0], getattr(r, f)[i]), (i, f)
         assert alone.itinerary[0] == r.itinerary[i]
         assert same(alone.trajectory_of(0), r.trajectory_of(i))
-    # The runaway: its last state and time (finite, huge), no image coordinates.
-    assert np.isnan(r.theta[BAD]) and np.isnan(r.I[BAD]) and np.isnan(r.energy_error[BAD])
-    assert np.isfinite(r.z[BAD]).all() and np.max(np.abs(r.z[BAD])) > 1e300 and r.time[BAD] > 100
+    # The runaway: its last state and time (finite, kinetic energy past 1e8 (1 + h)), no image
+    # coordinates, H kept to rounding.
+    assert np.isnan(r.theta[BAD]) and np.isnan(r.I[BAD])
+    kinetic = 0.5 * (r.z[BAD, 1] ** 2 + r.z[BAD, 3] ** 2)
+    assert np.isfinite(r.z[BAD]).all() and kinetic > 1e8 * (1 + H) and r.time[BAD] > 8
+    assert r.energy_error[BAD] < 1e-14 * kinetic
     assert r.count(FlowStatus.NON_FINITE) == 1
 
 
 def test_section_coordinates_of_a_runaway_state_are_nan(sec):
-    # Its H2 overflows: no action in double precision, as for a state with a non-finite entry.
+    # A state whose H2 overflows (where a runaway would end without the kinetic-energy stop) has
+    # no action in double precision, as a state with a non-finite entry.
     r = sec.return_map(THETA, I0)
+    r.z[BAD] = [1e300, 1e300, 1e300, 1e300]
     c = sec.coordinates(r.z)
     assert np.isnan(c[BAD]).all()
     ok = r.status == FlowStatus.OK

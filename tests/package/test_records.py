@@ -91,6 +91,15 @@ def test_files_written_before_load_and_step_as_they_did(name, suffix):
     m = _unpickle(path.read_bytes()) if suffix == ".pkl" else hv.load(path)
     phi, K = expected["phi"], expected[f"{name}.K"]
     p1, K1 = m.step(phi, K)
+    if isinstance(m, hv.FlowMap):
+        # Since verified returns (0.3.0) a long or shallow-impact return is a tighter trace's: the
+        # loaded map steps within its rtol of what it did, and unverified bit for bit as it did.
+        rtol = m.integrator_options["rtol"]
+        assert np.allclose(p1, expected[f"{name}.phi1"], rtol=0, atol=100 * rtol, equal_nan=True)
+        assert np.allclose(K1, expected[f"{name}.K1"], rtol=0, atol=100 * rtol, equal_nan=True)
+        record = m._to_record()
+        m = type(m)._from_record({**record, "options": {**record["options"], "verify_steps": 0}})
+        p1, K1 = m.step(phi, K)
     # Bit for bit: the same doubles through the same constructors (NaN where no return).
     assert np.array_equal(p1, expected[f"{name}.phi1"], equal_nan=True)
     assert np.array_equal(K1, expected[f"{name}.K1"], equal_nan=True)

@@ -33,6 +33,7 @@ enum class Status : std::int8_t {
     OffSection = 9,    ///< flow: the point is not on Sigma_h at this energy
     OutsideWell = 10,  ///< flow: no accepted step keeps the state inside a bounded well (e.g. Tan)
     Stopped = 11,      ///< the orbit reached the set of the stop condition (above / below a curve)
+    Imprecise = 12,    ///< flow: a return's verified error stayed above its band (chaotic amplification)
 };
 
 /// States recorded per orbit with every = e: x_0, x_e, ..., x_{e floor(n_steps / e)}.

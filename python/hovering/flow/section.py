@@ -34,6 +34,7 @@ _OPTION_CHECKS = dict(
     max_impacts=lambda v: integer("max_impacts", v, 1, 1_000_000),
     grazing_tol=lambda v: real_number("grazing_tol", v, 0, False),
     corner_tol=lambda v: real_number("corner_tol", v, 0, False),
+    verify_steps=lambda v: integer("verify_steps", v, -1, 2**62),
 )
 
 
@@ -46,16 +47,17 @@ def flow_options(
     max_impacts: int | None = None,
     grazing_tol: float | None = None,
     corner_tol: float | None = None,
+    verify_steps: int | None = None,
 ) -> _core_flow.FlowOptions:
     """Integrator settings of the flow, validated with errors that name the value and its range.
 
     Parameters
     ----------
-    rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol
+    rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps
         See :meth:`Section.return_map` (``"exact"`` ignores rtol and atol; whether it applies
         depends on the system: ``FlowOptions.validate_for(system)``). None: the core's default
         (``hovering._core.flow.FlowOptions()``: rk8pd, rtol 1e-10, atol 1e-12, event_tol 1e-15,
-        max_steps 1e6, max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10).
+        max_steps 1e6, max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10, verify_steps -1).
 
     Returns
     -------
@@ -77,6 +79,7 @@ def flow_options(
         ("max_impacts", max_impacts),
         ("grazing_tol", grazing_tol),
         ("corner_tol", corner_tol),
+        ("verify_steps", verify_steps),
     )
     kw.update({k: _OPTION_CHECKS[k](v) for k, v in given if v is not None})
     return _core_flow.FlowOptions(**kw)
@@ -110,12 +113,13 @@ class ReturnMapResult(Summarized, Saveable):
         Per-orbit :class:`FlowStatus`: OK, or why this orbit alone stopped (CORNER, GRAZING,
         STEP_LIMIT, NON_FINITE, IMPACT_LIMIT, OFF_SECTION for a start with no point of Sigma_h,
         INTERRUPTED, OUTSIDE_WELL where no accepted step keeps the state inside a bounded well such
-        as Tan's); the others are computed regardless. ``z`` and ``time`` of a stopped orbit are
+        as Tan's, IMPRECISE where a verified return's error stayed above its band: see
+        ``verify_steps``); the others are computed regardless. ``z`` and ``time`` of a stopped orbit are
         the last state reached (always inside the wells) and its time.
     energy_error : ndarray
         ``|H(image) - H(start)|``.
     steps : ndarray of int64
-        Accepted integrator steps.
+        Accepted integrator steps (of every trace of a verified return).
     work : dict or None
         What the integration did, summed over the call (see :attr:`hovering.IterateResult.work`).
     trajectory, trajectory_index, trajectory_kind, trajectory_truncated : ndarray or None
@@ -313,6 +317,7 @@ class Section:
         max_impacts: int | None = None,
         grazing_tol: float | None = None,
         corner_tol: float | None = None,
+        verify_steps: int | None = None,
         n_threads: int = 0,
         trajectory_dt: float | None = None,
         max_trajectory_points: int = MAX_TRAJECTORY_POINTS,
@@ -362,6 +367,17 @@ class Section:
             dips deeper than this are impacts however short.
         corner_tol : float, optional
             An impact this close to the corner is a corner hit (status CORNER).
+        verify_steps : int, optional
+            Which returns are verified. rtol bounds each step's error, not a return's: errors add
+            up over long returns and a chaotic return or a shallow impact amplifies them. A
+            verified return is traced again at rtol / 100 (and rtol / 10^4 if needed); the
+            tighter result is kept once its estimated error is within the band (return time
+            within ``rtol * max(1, t)``, each state component within ``rtol * |z| + atol``),
+            else the return gets status IMPRECISE. -1 (default): returns of 128 or more steps
+            with ``"taylor"``, of ``64 (1e-8 / rtol)^(1/p)`` (at least 16) with a GSL stepper of
+            order p (rk8pd: 64 at rtol 1e-8, 114 at 1e-10), and every return with a shallow impact (error amplification 2 |a| / (|v| w) >= 20); never with ``"exact"``. 0: no
+            verification. N >= 1: returns of N or more steps (and shallow impacts). ``steps``
+            counts the steps of every trace of a return.
         n_threads : int, optional
             Worker threads (0 = all cores, or 1 when a potential is defined in Python: its calls
             serialise on the GIL).
@@ -411,7 +427,9 @@ class Section:
         >>> sec.return_map([0.0], [0.8]).count("OFF_SECTION")
         1
         """
-        opts = flow_options(rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol)
+        opts = flow_options(
+            rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps
+        )
         opts.validate_for(self.sys.core)
         threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)

@@ -149,8 +149,8 @@ class FlowMap(MapAnalyses):
         Number of returns the ``accuracy`` target is for (default 1; errors grow as m^2 with the
         number m of returns, so a 1e4-return portrait needs a much tighter setting).
     **options
-        ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol`` (see
-        :meth:`hovering.Section.return_map`).
+        ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol``,
+        ``verify_steps`` (see :meth:`hovering.Section.return_map`).
 
     Raises
     ------
@@ -210,11 +210,11 @@ class FlowMap(MapAnalyses):
             raise ValueError(f"coordinates must be 'normal' or 'section', got {coordinates!r}")
         self.section = Section(sys, h)
         self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
-        unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
+        unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol", "verify_steps"}
         if unknown:
             raise ValueError(
                 f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
-                "grazing_tol, corner_tol"
+                "grazing_tol, corner_tol, verify_steps"
             )
         #: What an ``accuracy`` target chose (None without one): the row of the measurement.
         self.accuracy_choice = None
@@ -336,7 +336,7 @@ class FlowMap(MapAnalyses):
     #: The integrator options a saved FlowMap holds (:attr:`integrator_options`): a file's options
     #: are these or nothing, never an ``accuracy`` target (that would measure, i.e. compute, on load).
     _RECORD_OPTIONS = frozenset(
-        {"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol"}
+        {"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol", "verify_steps"}
     )
 
     @classmethod

@@ -22,11 +22,12 @@ enum class FlowStatus : std::int8_t {
     Corner = 1,       ///< hit the corner (orbit stops)
     Grazing = 2,      ///< touched a wall tangentially
     StepLimit = 3,    ///< max_steps reached before returning
-    NonFinite = 4,    ///< the state became non-finite
+    NonFinite = 4,    ///< the state became non-finite, or ran away (kinetic energy > kRunawayKinetic (1 + |h|))
     ImpactLimit = 5,  ///< more impacts than max_impacts in one return (chattering)
     OffSection = 6,   ///< the starting point is not on Sigma_h at this energy (nothing integrated)
     Interrupted = 7,  ///< the caller cancelled the batch before or during this return
     OutsideWell = 8,  ///< no step that the tolerances accept keeps the state inside a bounded well
+    Imprecise = 9,    ///< a verified return whose error stayed above its band at rtol / 10^4 (FlowOptions::verify_steps)
 };
 
 /// The orbit outcome (Status) of a return that ended with this FlowStatus.
@@ -35,6 +36,20 @@ Status orbit_status(FlowStatus s);
 /// The names FlowOptions::stepper takes, its default first (bound as hovering.flow.STEPPERS).
 inline constexpr std::array<const char*, 10> kSteppers = {"rk8pd",  "rkck",   "rkf45",  "rk4",    "rk2",
                                                           "msadams", "rk4imp", "rk2imp", "taylor", "exact"};
+
+/// Kinetic energy, relative to 1 + |h|, beyond which an orbit is a runaway (status NonFinite): a
+/// coupling unbounded below lets it grow without bound; bounded motion keeps it below h - min V.
+inline constexpr double kRunawayKinetic = 1e8;
+
+/// Steps from which a "taylor" return is verified by default (FlowOptions::verify_steps = -1).
+inline constexpr std::int64_t kVerifySteps = 128;
+/// Steps from which a return of a GSL stepper of order p is verified by default, at rtol 1e-8:
+/// kVerifyStepsGsl (1e-8 / rtol)^(1/p), at least 16 (about what an ordinary return needs times 3).
+inline constexpr std::int64_t kVerifyStepsGsl = 64;
+
+/// Error amplification of an impact (2 |a| / (|v| w): a shallow impact's saltation) from which a
+/// return is verified whenever verify_steps is not 0.
+inline constexpr double kVerifyAmplification = 20;
 
 /// Integrator settings.
 /// Stepper "exact" is the flow in closed form where the system has one (eps = 0 with Harmonic or
@@ -50,6 +65,11 @@ struct FlowOptions {
     int max_impacts = 100;             ///< per return; more ends the orbit with ImpactLimit
     double grazing_tol = 1e-12;        ///< |min distance to a wall| below which an orbit touches it tangentially
     double corner_tol = 1e-10;         ///< distance to the corner below which an impact is a corner hit
+    /// Returns of at least this many steps, or with a shallow impact (kVerifyAmplification), are verified: traced again at rtol / 100 (and / 10^4 if
+    /// needed) and the tighter result kept once its estimated error is within the band (time within
+    /// rtol max(1, t), each state component within rtol |z| + atol); -1 (default): kVerifySteps
+    /// for "taylor", kVerifyStepsGsl scaled by the tolerance for the GSL steppers, never for "exact"; 0: never.
+    std::int64_t verify_steps = -1;
     /// Validate (throws std::invalid_argument naming the bad value and the allowed range).
     void validate() const;
     /// validate(), and that the stepper applies to s ("exact" needs a closed-form flow; the message

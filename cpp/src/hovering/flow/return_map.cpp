@@ -35,6 +35,8 @@ Status orbit_status(FlowStatus s) {
             return Status::Interrupted;
         case FlowStatus::OutsideWell:
             return Status::OutsideWell;
+        case FlowStatus::Imprecise:
+            return Status::Imprecise;
     }
     return Status::NonFinite;
 }

@@ -29,6 +29,8 @@ void FlowOptions::validate() const {
         bad("grazing_tol must be finite and >= 0, got " + fmt(grazing_tol));
     if (!(corner_tol >= 0 && std::isfinite(corner_tol)))
         bad("corner_tol must be finite and >= 0, got " + fmt(corner_tol));
+    if (verify_steps < -1)
+        bad("verify_steps must be -1 (automatic), 0 (never) or >= 1, got " + std::to_string(verify_steps));
 }
 
 void FlowOptions::validate(const FlowSystem& s) const {

@@ -101,6 +101,8 @@ FlowWork Tracer::work() const {
     FlowWork w = work_;
     w.field_evaluations = in_.field().evaluations();
     w.coupling_evaluations = in_.field().coupling_evaluations;
+    for (const auto& v : verifier_)
+        if (v) w += v->work();
     return w;
 }
 
@@ -162,6 +164,15 @@ void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing) {
     R.dt = R.hmax * std::pow(std::max(o_.rtol, 1e-16), 1.0 / in_.order());
     in_.field()(y, R.dy);
     R.armed = first_crossing;
+    R.z0 = z0;
+    R.first_crossing = first_crossing;
+    if (dense_) {
+        R.dense_points = dense_->points->size();
+        R.dense_kinds = dense_->kinds->size();
+        R.dense_next = dense_->next;
+        R.dense_room = dense_->room;
+        R.dense_truncated = dense_->truncated;
+    }
 }
 
 bool Tracer::step(const std::atomic<bool>* cancel) {
@@ -197,6 +208,13 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
             return R.over = true;
         }
         t = t0 + h;
+        // A runaway (a coupling unbounded below): the kinetic energy grows without bound while H
+        // is kept, each step shorter than the last (toward a Tan well's edge it took 1e6 steps
+        // to overflow). Bounded motion keeps it below h - min V; 1e8 (1 + |h|) is far beyond.
+        if (0.5 * (y[1] * y[1] + y[3] * y[3]) > kRunawayKinetic * (1 + std::fabs(R.H0))) {
+            r.status = FlowStatus::NonFinite;
+            return R.over = true;
+        }
         const double* d1 = dy;
         // Lower bounds of q1 and q2 over the step, computed when an event candidate needs them.
         double lb[2] = {kNaN, kNaN};
@@ -360,6 +378,14 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
                 dense->push(dense->offset + t, y, TrajectoryPoint::ImpactOut);
             }
             field(y, dy);
+            {
+                // A shallow impact amplifies the state's error: its time moves by dq / v and the
+                // reflected velocity by 2 a dq / v (the saltation term), a factor 2 |a| / (|v| w)
+                // against the oscillation's own scale w (8 hmax is the shorter period).
+                const int pi = is_right ? 1 : 3;
+                const double w = kTwoPi / (8 * R.hmax);
+                R.amplification = std::max(R.amplification, 2 * std::fabs(dy[pi]) / (std::fabs(y[pi]) * w));
+            }
             in_.restart();
             reflected = true;
             break;
@@ -380,7 +406,99 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
 ReturnResult Tracer::end() {
     Ret& R = ret_;
     finish(R.r, R.y, R.t, R.done, R.crossed, R.H0);
+    const std::int64_t from = verify_from();
+    if (from > 0 && R.r.status == FlowStatus::Ok && (R.r.steps >= from || R.amplification >= kVerifyAmplification))
+        return verify(std::move(R.r));
     return std::move(R.r);
+}
+
+std::int64_t Tracer::verify_from() const {
+    if (o_.verify_steps >= 0) return o_.verify_steps;
+    // Measured on random systems (tests/flow/test_differential.py): below these step counts, and
+    // without a shallow impact, a return's error stayed within its band. A taylor step errs far
+    // below rtol, whatever the tolerance; a GSL step errs by about rtol, so its errors add up
+    // sooner, and an ordinary return takes rtol^(-1/order) more steps at tighter tolerances
+    // (rk8pd on slow oscillators: 85-107 steps, 3-10x the band at rtol 1e-8). The closed form
+    // has no step error to verify.
+    if (in_.exact_kind() != ExactKind::None) return 0;
+    if (o_.stepper == "taylor") return kVerifySteps;
+    const double n = double(kVerifyStepsGsl) * std::pow(1e-8 / o_.rtol, 1.0 / in_.order());
+    return std::int64_t(std::clamp(n, 16.0, 1e15));
+}
+
+ReturnResult Tracer::verify(ReturnResult r0) {
+    // A long return's error is not bounded by its steps' tolerance: local errors add up over
+    // hundreds of steps, and a chaotic return (strong coupling, near a tangency) or a shallow
+    // impact amplifies them (~3e-5 in time at rtol 1e-8 measured). Tracing it again at rtol / 100
+    // measures the error of the first trace. The tighter trace's own error is taken as a tenth
+    // of that difference: measured 30-300x smaller, but only ~3x where rk8pd's steps sit at the
+    // step bound and its error hardly follows the tolerance (slow oscillators at rtol 1e-6), so
+    // a tenth is kept only if the difference is within 10 bands; else one level tighter.
+    // The floor: below it a tighter tolerance stops reducing the error (rounding): ~1e-15 for
+    // taylor; GSL's steppers, whose error estimates are differences of stages, stall sooner.
+    const bool taylor = o_.stepper == "taylor";
+    const double floor = taylor ? 1e-15 : 1e-14;
+    ReturnResult prev = std::move(r0);
+    double prev_tol = o_.rtol;
+    const std::int64_t steps0 = prev.steps;
+    std::int64_t steps = prev.steps;
+    for (int level = 0; level < 2; ++level) {
+        const double factor = level == 0 ? 1e-2 : 1e-4;
+        const double tol = std::max(o_.rtol * factor, floor);
+        if (!(tol < 0.5 * prev_tol)) break;  // nothing tighter to compare with
+        if (!verifier_[level]) {
+            FlowOptions v = o_;
+            v.rtol = tol;
+            v.atol = std::max(o_.atol * factor, 1e-300);
+            v.verify_steps = 0;
+            v.max_steps = std::max<std::int64_t>(o_.max_steps, 1);
+            verifier_[level] = std::make_unique<Tracer>(s_, v);
+            verifier_[level]->set_event_driven(event_driven_);
+        }
+        Tracer& V = *verifier_[level];
+        V.set_labels(labels_);
+        // A budget of steps: the tighter trace needs about (prev_tol / tol)^(1/order) times the
+        // steps; ten times that means it cannot meet its tolerance (rounding), so no verdict.
+        const double growth = std::pow(prev_tol / tol, 1.0 / std::max(1, in_.order()));
+        V.o_.max_steps = std::min<std::int64_t>(o_.max_steps, std::int64_t(10 * growth * double(prev.steps)) + 1000);
+        if (dense_) {  // the trajectory shows the return that is kept: the tighter one's points
+            dense_->points->resize(ret_.dense_points);
+            dense_->kinds->resize(ret_.dense_kinds);
+            dense_->next = ret_.dense_next;
+            dense_->room = ret_.dense_room;
+            dense_->truncated = ret_.dense_truncated;
+        }
+        V.set_dense(dense_);
+        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, nullptr);
+        V.set_dense(nullptr);
+        steps += r.steps;
+        if (r.status == FlowStatus::StepLimit || r.status == FlowStatus::NonFinite ||
+            r.status == FlowStatus::OutsideWell) {
+            prev.steps = steps;  // the tighter trace could not be completed: not verified
+            prev.status = FlowStatus::Imprecise;
+            return prev;
+        }
+        if (r.status != FlowStatus::Ok) {  // the tighter trace decides (a graze, a corner, ...)
+            r.steps = steps;
+            return r;
+        }
+        // The difference in units of the band (time: rtol max(1, t); state: rtol |z| + atol), and
+        // the tighter trace's error estimated from it.
+        double d = std::fabs(prev.time - r.time) / (o_.rtol * std::max(1.0, std::fabs(r.time)));
+        for (int i = 0; i < 4; ++i) {
+            const double zi = r.z[std::size_t(i)];
+            d = std::max(d, std::fabs(prev.z[std::size_t(i)] - zi) / (o_.rtol * std::fabs(zi) + o_.atol));
+        }
+        if (prev.itinerary != r.itinerary) d = kInf;
+        const double estimate = 0.1 * d;
+        r.steps = steps;
+        prev = std::move(r);
+        prev_tol = tol;
+        if (estimate <= 1) return prev;
+    }
+    if (prev.steps == steps0) return prev;  // no tighter trace was possible (rtol at the floor)
+    prev.status = FlowStatus::Imprecise;
+    return prev;
 }
 
 bool Tracer::halted(ReturnResult& r, const std::atomic<bool>* cancel) const {

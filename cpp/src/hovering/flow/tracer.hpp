@@ -100,6 +100,13 @@ private:
         bool seen_negative = false, armed = false, crossed = false;
         bool done = false;  // the return found its end event (section, corner, graze, limit)
         bool over = false;  // step() will take no more steps
+        double amplification = 0;    // largest error amplification of an impact (verify_from)
+        std::array<double, 4> z0{};  // where the return started (verification traces it again)
+        bool first_crossing = false;
+        // The dense output's state when the return began: a verified return replaces its points.
+        std::size_t dense_points = 0, dense_kinds = 0;
+        std::int64_t dense_next = 0, dense_room = 0;
+        bool dense_truncated = false;
     };
     Ret ret_;
     struct Candidate {
@@ -119,6 +126,11 @@ private:
     /// stopped (state y at time t), the "0" / "u" label of an Ok return without impact, the energy
     /// error against H0, and the step count.
     void finish(ReturnResult& r, const double* y, double t, bool done, bool crossed, double H0);
+    // The steps from which a return is verified (0: never), from FlowOptions::verify_steps.
+    std::int64_t verify_from() const;
+    // A finished Ok return r0 of verify_from() steps or more, traced again at rtol / 100 (and
+    // / 10^4): the first tighter result whose estimated error is within the band, else Imprecise.
+    ReturnResult verify(ReturnResult r0);
     // Whether the return's end z is the point of Sigma_h (energy h) that its section coordinates
     // name (see finish()).
     bool on_chart(const std::array<double, 4>& z, double h) const;
@@ -132,6 +144,7 @@ private:
     bool labels_ = true;
     bool event_driven_ = true;
     DenseRecorder* dense_ = nullptr;
+    std::unique_ptr<Tracer> verifier_[2];  // at rtol / 100 and / 10^4, built on first use
 };
 
 /// Several returns traced side by side by one worker. With stepper "taylor" eight lanes: every
