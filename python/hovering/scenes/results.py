@@ -24,7 +24,9 @@ from .._provenance import provenance
 from ..analysis.barriers import BarrierScan
 from ..analysis.transit import TransitResult
 from ..analysis.zone import ImpactZone
-from .schema import MAX_TEXT, _color, _str
+from .values import MAX_TEXT
+from .values import color as _color
+from .values import text as _str
 from .spec import SceneSpec
 
 #: The ``format`` of a scene result's sidecar JSON.
@@ -93,8 +95,6 @@ def jsonable(x):
 
 
 def _texts(where: str, values, n: int | None = None, color: bool = False) -> None:
-    from .schema import _color, _str
-
     if not isinstance(values, list) or (n is not None and len(values) != n):
         raise ValueError(
             f"{where} must be a list of {n if n is not None else 'some'} strings, got "

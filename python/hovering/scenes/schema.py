@@ -9,10 +9,8 @@ second, not after its simulation.
 
 from __future__ import annotations
 
-import ast
 import dataclasses
 import math
-import operator
 import os
 import re
 import tomllib
@@ -21,7 +19,7 @@ from pathlib import Path
 from .._output import output_path
 from ..flow.section import STEPPERS
 from ..interface import register
-from ..truncated.theory import OMEGA_G, golden_family
+from ..truncated.theory import golden_family
 from .spec import (
     FLOW_KINDS,
     KINDS,
@@ -49,6 +47,30 @@ from .spec import (
     ZoomSpec,
     figure_inches,
 )
+from .values import (  # noqa: F401 (re-exported: the limits and checks were defined here)
+    _MAX_INT_BITS,
+    MAX_CANVAS_PIXELS,
+    MAX_KEY_PARTS,
+    MAX_PANELS,
+    MAX_PATH_CHARS,
+    MAX_SCENE_BYTES,
+    MAX_SCENE_DEPTH,
+    MAX_SCENE_STRING,
+    MAX_SERIES_POINTS,
+    MAX_TEXT,
+    boolean,
+    check_keys,
+    color,
+    distinct_reals,
+    evaluate,
+    integer,
+    pair,
+    real,
+    size,
+    table,
+    tables,
+    text,
+)
 from .wall import corner_energy, wall_tangency_action
 
 __all__ = [
@@ -71,202 +93,21 @@ _MAP_KEYS = ("Omega0", "theta_w", "tau0", "tau1", "lam")
 _MAP_DEFAULTS = {"tau0": 1.0, "tau1": 0.5, "lam": 0.5}
 _COMMON_KEYS = ("kind", "title", "output", "dpi", "figsize")
 
-# Value checking: every failure is a ValueError naming the key, the value and what is allowed
-
-
-_NAMES = {"pi": math.pi, "OMEGA_G": OMEGA_G}
-_BINOPS = {
-    ast.Add: operator.add,
-    ast.Sub: operator.sub,
-    ast.Mult: operator.mul,
-    ast.Div: operator.truediv,
-    ast.Pow: operator.pow,
-}
-_UNOPS = {ast.USub: operator.neg, ast.UAdd: operator.pos}
-_FUNCS = {"sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "acos": math.acos}
-
-
-def _eval_expr(node):
-    if isinstance(node, ast.Expression):
-        return _eval_expr(node.body)
-    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
-        return float(node.value)
-    if isinstance(node, ast.Name) and node.id in _NAMES:
-        return _NAMES[node.id]
-    if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
-        return _BINOPS[type(node.op)](_eval_expr(node.left), _eval_expr(node.right))
-    if isinstance(node, ast.UnaryOp) and type(node.op) in _UNOPS:
-        return _UNOPS[type(node.op)](_eval_expr(node.operand))
-    if (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id in _FUNCS
-        and len(node.args) == 1
-        and not node.keywords
-    ):
-        return _FUNCS[node.func.id](_eval_expr(node.args[0]))
-    raise ValueError("unsupported expression")
-
-
-#: Most panels (or hovering-area series) in one figure: a scene is a figure, not a sweep; 200
-#: panels took 4 minutes and 300 MB.
-MAX_PANELS = 36
-#: Most eps values of one hovering-area scene.
-MAX_SERIES_POINTS = 200
-#: Largest scene file read (a scene is a few hundred bytes; /dev/zero must not be read forever).
-MAX_SCENE_BYTES = 1 << 20
-
-#: Longest expression string accepted: a parameter is a formula like "2 * pi * (sqrt(5) - 1) / 2",
-#: never a program; a 50,000-deep one exhausted the parser's memory.
-_MAX_EXPR = 200
-#: Longest text drawn on a figure or naming something in it (title, panel id, orbit and series
-#: labels, colour names), in characters: the paper's longest title has ~60; savefig took 0.4 s with
-#: a 200-character title and two minutes with a 500,000-character one.
-MAX_TEXT = 200
-#: Longest path (``output``): Linux's PATH_MAX.
-MAX_PATH_CHARS = 4096
-#: Longest string or key anywhere in a scene file, checked before any field: a backstop so that no
-#: message prints more (each field's own limit is smaller: MAX_TEXT, MAX_PATH_CHARS, 200 for an
-#: expression).
-MAX_SCENE_STRING = 1 << 16
-#: Deepest nesting of tables and arrays in a scene file: its deepest is 4 (``[[panels]]``, ``zoom``,
-#: ``xlim``); Python's TOML reader recurses once per level and fails near 500.
-MAX_SCENE_DEPTH = 16
-#: Most parts of one dotted key (``a.b.c = 1``; a scene's have at most 3): Python's TOML reader takes
-#: time and memory quadratic in them (100,000 parts: 8 GB).
-MAX_KEY_PARTS = 16
-#: Largest figure canvas, in pixels (dpi^2 x width x height in inches): Agg holds 4 bytes per pixel,
-#: so 150 million is 600 MB and ~10 s of savefig. The largest example figure has 3.9 million; the
-#: limit allows 600 dpi at 19 x 12 inches, or 1200 dpi at 10 x 12.
-MAX_CANVAS_PIXELS = 150_000_000
-#: Integers beyond a double (TOML's are 64-bit; Python's reader takes any) are refused before any
-#: field sees them: a field's own range check names its range, but no message should print a
-#: 10,000-digit number (Python refuses to, beyond 4300 digits).
-_MAX_INT_BITS = 1024
-
-
-def _real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
-    """A finite real number (or an expression string of numbers, pi, OMEGA_G) inside a range."""
-    if isinstance(value, bool):
-        raise ValueError(f"{where} must be a number, got {value!r}")
-    if isinstance(value, str):
-        if len(value) > _MAX_EXPR:
-            raise ValueError(f"{where}: expression of {len(value)} characters; allowed: at most {_MAX_EXPR}")
-        try:
-            v = float(_eval_expr(ast.parse(value, mode="eval")))
-        except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError, RecursionError, MemoryError):
-            raise ValueError(
-                f"{where}: cannot evaluate {value!r}; allowed: a number or an expression of numbers, "
-                f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos"
-            ) from None
-    elif isinstance(value, (int, float)):
-        try:
-            v = float(value)
-        except OverflowError:
-            raise ValueError(
-                f"{where} is an integer of {value.bit_length()} bits, beyond the range of a double; "
-                f"allowed: a finite number"
-            ) from None
-    else:
-        raise ValueError(f"{where} must be a number, got {value!r}")
-    if not math.isfinite(v):
-        raise ValueError(f"{where} must be finite, got {value!r}")
-    bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
-    bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
-    if bad_lo or bad_hi:
-        left = "(" if lo_open or lo is None else "["
-        right = ")" if hi_open or hi is None else "]"
-        rng = f"{left}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{right}"
-        raise ValueError(f"{where} = {value!r} is out of range; allowed: {rng}")
-    return v
-
-
-def _int(where: str, value, lo=None, hi=None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"{where} must be an integer, got {value!r}")
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise ValueError(f"{where} = {value!r} is out of range; allowed: [{lo}, {'inf' if hi is None else hi}]")
-    return int(value)
-
-
-def _bool(where: str, value) -> bool:
-    if not isinstance(value, bool):
-        raise ValueError(f"{where} must be true or false, got {value!r}")
-    return value
-
-
-def _str(where: str, value, choices=None, limit: int = MAX_TEXT) -> str:
-    if not isinstance(value, str) or not value.strip():
-        raise ValueError(f"{where} must be a non-empty string, got {value!r}")
-    if len(value) > limit:
-        raise ValueError(f"{where}: a string of {len(value)} characters; allowed: at most {limit}")
-    if not value.isascii():  # a file from elsewhere (a result) may hold what no TOML file can
-        try:
-            value.encode("utf-8")
-        except UnicodeEncodeError as e:
-            raise ValueError(f"{where}: a lone surrogate at character {e.start}; allowed: Unicode text") from None
-    if choices is not None and value not in choices:
-        raise ValueError(f"{where} = {value!r} is not allowed; allowed: {', '.join(repr(c) for c in choices)}")
-    return value
-
-
-def _color(where: str, value) -> str:
-    """A colour matplotlib understands, checked when the scene is read (not at savefig time)."""
-    from matplotlib.colors import is_color_like
-
-    v = _str(where, value)
-    if not is_color_like(v):
-        raise ValueError(
-            f"{where} = {value!r} is not a matplotlib colour; allowed: a name ('red'), 'C0'..'C9', or hex '#rrggbb'"
-        )
-    return v
-
-
-def _pair(where: str, value, increasing=True) -> tuple:
-    if not isinstance(value, list) or len(value) != 2:
-        raise ValueError(f"{where} must be a list of two numbers [low, high], got {value!r}")
-    a, b = _real(f"{where}[0]", value[0]), _real(f"{where}[1]", value[1])
-    if increasing and not a < b:
-        raise ValueError(f"{where} = {value!r} must be increasing (low < high)")
-    return (a, b)
-
-
-def _table(where: str, value) -> dict:
-    if not isinstance(value, dict):
-        raise ValueError(f"{where} must be a table, got {value!r}")
-    return value
-
-
-def _tables(where: str, value, what: str) -> list:
-    """A non-empty array of tables ([[what]]) of at most MAX_PANELS entries (one figure)."""
-    if not isinstance(value, list) or not value:
-        raise ValueError(f"{where} must be a non-empty array of tables ([[{what}]]), got {value!r}")
-    if len(value) > MAX_PANELS:
-        raise ValueError(f"{where}: {len(value)} {what}; allowed: at most {MAX_PANELS} (one figure)")
-    return value
-
-
-def _eps_list(where: str, value, **bounds) -> tuple:
-    """A non-empty list of distinct eps values, at most MAX_SERIES_POINTS of them."""
-    if not isinstance(value, list) or not value:
-        raise ValueError(f"{where} must be a non-empty list of numbers, got {value!r}")
-    if len(value) > MAX_SERIES_POINTS:
-        raise ValueError(f"{where}: {len(value)} values; allowed: at most {MAX_SERIES_POINTS} (use a sweep for more)")
-    eps = tuple(_real(f"{where}[{i}]", e, **bounds) for i, e in enumerate(value))
-    if len(set(eps)) != len(eps):
-        raise ValueError(f"{where} = {value!r} lists a value twice")
-    return eps
-
-
-def _check_keys(where: str, table: dict, allowed, required=()) -> None:
-    unknown = [k for k in table if k not in allowed]
-    if unknown:
-        raise ValueError(
-            f"{where}: unknown key(s) {', '.join(repr(k) for k in unknown)}; allowed keys: {', '.join(allowed)}"
-        )
-    for k in required:
-        if k not in table:
-            raise ValueError(f"{where}: missing required key {k!r}; allowed keys: {', '.join(allowed)}")
+# One value's checks live in .values (the kinds call them too); the old private names stay here.
+_eval_expr, _real, _int, _bool, _str, _color, _pair, _table, _tables, _eps_list, _check_keys, _size = (
+    evaluate,
+    real,
+    integer,
+    boolean,
+    text,
+    color,
+    pair,
+    table,
+    tables,
+    distinct_reals,
+    check_keys,
+    size,
+)
 
 
 def _map_params(where: str, table: dict) -> dict:
@@ -559,12 +400,6 @@ def _parse_scene(data, p: Path | None, where: str, check_output: bool) -> SceneS
     if kind == "hovering_area":
         return _parse_hovering_area(where, data, scene_map, common)
     return _parse_orbit_scene(where, kind, data, scene_map, common)
-
-
-def _size(where: str, value) -> tuple:
-    if not isinstance(value, list) or len(value) != 2:
-        raise ValueError(f"{where} must be [width, height] in inches, got {value!r}")
-    return tuple(_real(f"{where}[{i}]", v, lo=0.5, hi=60.0) for i, v in enumerate(value))
 
 
 def _parse_orbit_scene(where: str, kind: str, data: dict, scene_map: dict, common: dict) -> SceneSpec:
