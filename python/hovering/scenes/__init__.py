@@ -34,6 +34,7 @@ from importlib import resources
 from pathlib import Path
 
 from .._deprecated import moved_module
+from . import registry
 from .compute import compute
 from .report import format_summary
 from .results import SceneResult, load_result, summarize
@@ -54,8 +55,8 @@ from .spec import (
     ZoomSpec,
 )
 
-#: The kinds that checkpoint their points (``<output>.sweep.jsonl``).
-SWEEP_KINDS = ("hovering_area", "flow_hovering_area")
+#: The kinds that checkpoint their points (``<output>.sweep.jsonl``): those with a sweep plan.
+SWEEP_KINDS = tuple(k for k in KINDS if registry.get(k).sweep)
 
 __all__ = [
     "KINDS",
