@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import _serial
 from .._display import Summarized
-from .._enums import Region, Status
+from .._enums import FlowStatus, Region, Status
 from .._output import output_path, write_text
 from .._provenance import provenance
 from .._serial import saved_as
@@ -319,8 +319,6 @@ def check_status(where: str, value) -> None:
     ValueError
         For another value, naming the statuses.
     """
-    from .._enums import FlowStatus
-
     _text(where, value, tuple(s.name for s in FlowStatus))
 
 

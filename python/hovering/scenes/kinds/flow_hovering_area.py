@@ -109,7 +109,7 @@ class FlowHoveringResult(SceneResult):
         ImportError
             Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
-        from .._interop import flow_sweep_frame
+        from ..._interop import flow_sweep_frame
 
         return flow_sweep_frame(self)
 
@@ -127,7 +127,7 @@ class FlowHoveringResult(SceneResult):
         ImportError
             Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
-        from .._interop import flow_sweep_dataset
+        from ..._interop import flow_sweep_dataset
 
         return flow_sweep_dataset(self)
 

@@ -253,7 +253,7 @@ class HoveringAreaResult(SceneResult):
         ImportError
             Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
-        from .._interop import series_frame
+        from ..._interop import series_frame
 
         return series_frame(self)
 
@@ -271,7 +271,7 @@ class HoveringAreaResult(SceneResult):
         ImportError
             Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
-        from .._interop import series_dataset
+        from ..._interop import series_dataset
 
         return series_dataset(self)
 
