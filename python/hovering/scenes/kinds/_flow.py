@@ -327,17 +327,16 @@ class FlowScene(SceneSpec):
     outputs: OutputsSpec = table(OutputsSpec)
 
 
-def needs_step(where: str, values: dict, kind: str) -> None:
-    """A kind that draws the regions of the step needs the step's two walls.
+def needs_step(where: str, values: dict) -> None:
+    """A kind that draws the regions of the step needs the step's two walls (a kind's
+    :attr:`~hovering.scenes.registry.Kind.check`).
 
     Parameters
     ----------
     where : str
         The scene, for the message.
     values : dict
-        The fields read so far (``system``).
-    kind : str
-        The kind, for the message.
+        The fields read so far (``kind``, ``system``).
 
     Raises
     ------
@@ -347,7 +346,7 @@ def needs_step(where: str, values: dict, kind: str) -> None:
     system = values["system"]
     if system.geometry != "step":
         raise ValueError(
-            f"{where}.system.geometry = {system.geometry!r}: a {kind} scene draws the regions of "
+            f"{where}.system.geometry = {system.geometry!r}: a {values['kind']} scene draws the regions of "
             f"the step; allowed: 'step'"
         )
 

@@ -43,7 +43,7 @@ def _fractions(where: str, value, reading) -> tuple:
 
 
 def _check(where: str, values: dict) -> None:
-    needs_step(where, values, "corner_directions")
+    needs_step(where, values)
     above_corner(where, values)
 
 

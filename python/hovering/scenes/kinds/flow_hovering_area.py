@@ -346,7 +346,7 @@ KIND = register(
         doc="|HOV| against eps for the flow, its truncated models and eq:hovsetsize",
         figsize=(13.0, 5.2),
         records=(("regions",), ("regions",)),
-        check=lambda where, values: needs_step(where, values, "flow_hovering_area"),
+        check=needs_step,
         scene_map=lambda scene: flowmap(scene, eps=scene.eps[0]),
         plan=plan,
         quick_floor=(50, 100),

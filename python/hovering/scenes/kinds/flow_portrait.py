@@ -227,7 +227,7 @@ KIND = register(
         doc="the flow's return map beside its truncated model, from the same starts",
         figsize=(13.0, 5.6),
         records=(("regions",), ()),
-        check=lambda where, values: needs_step(where, values, "flow_portrait"),
+        check=needs_step,
         scene_map=flowmap,
     )
 )

@@ -24,7 +24,7 @@ __all__ = ["ImpactZoneScene", "ZoneStudy", "ImpactZoneResult", "compute", "summa
 
 
 def _check(where: str, values: dict) -> None:
-    needs_step(where, values, "impact_zone")
+    needs_step(where, values)
     if values["system"].eps == 0:
         raise ValueError(
             f"{where}.system.eps = 0: at eps = 0 every level K is invariant and the zone has no critical "

@@ -189,7 +189,7 @@ KIND = register(
         doc="fig:structure_Sigma from the flow: regions J_R, J_0, J_1 and their images",
         figsize=(12.0, 12.0),
         records=(("regions", "section", "states"), ("regions", "section", "states")),
-        check=lambda where, values: needs_step(where, values, "sigma_structure"),
+        check=needs_step,
         scene_map=flowmap,
     )
 )

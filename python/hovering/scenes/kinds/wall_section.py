@@ -24,7 +24,7 @@ __all__ = ["WallSectionScene", "WallSegment", "WallSectionResult", "compute", "s
 
 
 def _check(where: str, values: dict) -> None:
-    needs_step(where, values, "wall_section")
+    needs_step(where, values)
     above_corner(where, values)
     # The wall coordinates need the tangency line I_tan^{eps,-}(theta) near the unperturbed one.
     system = values["system"]

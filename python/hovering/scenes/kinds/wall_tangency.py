@@ -25,7 +25,7 @@ __all__ = ["WallTangencyScene", "WallPoint", "WallTangencyResult", "compute", "s
 
 
 def _check(where: str, values: dict) -> None:
-    needs_step(where, values, "wall_tangency")
+    needs_step(where, values)
     above_corner(where, values)
     system = values["system"]
     if system.eps != 0:
