@@ -5,6 +5,7 @@ series' map (the golden family of thm:hoveringc included) and the lines drawn un
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import MISSING, dataclass
 
@@ -14,7 +15,7 @@ from ..._serial import saved_as
 from ...truncated.maps import TruncatedMap
 from ...truncated.theory import golden_family
 from ..base import Geometry, SceneSpec
-from ..fields import custom, declared, integer, real
+from ..fields import PARAM, custom, declared, integer, real
 from ..values import check_keys
 from ..values import real as real_value
 from ..values import table as table_value
@@ -25,6 +26,7 @@ __all__ = [
     "MAP_DEFAULTS",
     "TruncatedScene",
     "map_params",
+    "map_key",
     "golden",
     "resolve_map",
     "check_band",
@@ -88,6 +90,32 @@ MAP_KEYS = tuple(d.name for d in declared(MapSpec) if d.name != "eps")
 #: Their defaults (MapSpec's, read from its fields).
 MAP_DEFAULTS = {d.name: d.default for d in declared(MapSpec) if d.default is not MISSING}
 _MAP_PARAMS = {d.name: d.param for d in declared(MapSpec)}
+
+
+def map_key(name: str):
+    """A map parameter of a table under a scene with a ``[map]`` (a series): MapSpec's declaration
+    (its range), and when absent the scene's ``[map]`` value, else MapSpec's default.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`MAP_KEYS`.
+
+    Returns
+    -------
+    dataclasses.Field
+        Without a default where MapSpec has none (``Omega0``, ``theta_w``: required of the table
+        or the ``[map]``, unless something else sets them).
+    """
+    default = MAP_DEFAULTS.get(name, MISSING)
+
+    def from_map(where, reading):
+        return reading.get("map", {}).get(name, default)
+
+    param = dataclasses.replace(_MAP_PARAMS[name], required=False, default_from=from_map)
+    if default is MISSING:
+        return dataclasses.field(metadata={PARAM: param})
+    return dataclasses.field(default=default, metadata={PARAM: param})
 
 
 def map_params(where: str, table: dict) -> dict:

@@ -15,16 +15,14 @@ from ...analysis.hovering import default_depth
 from ...parallel.checkpoint import Checkpoint
 from ...truncated.theory import golden_family, hovering_area_theory
 from ..base import SceneResult, check_array, fmt
-from ..fields import custom, distinct_reals, integer
+from ..fields import Reading, color, custom, distinct_reals, integer, read_values, real, text, write
 from ..plan import sweep_counts
 from ..registry import Kind, register
-from ..values import check_keys, tables
 from ..values import color as color_value
-from ..values import real as real_value
-from ..values import table as table_value
+from ..values import tables
 from ..values import text as text_value
 from ._sweep import sweep, sweep_size
-from ._truncated import MAP_DEFAULTS, MAP_KEYS, MapSpec, TruncatedScene, map_params
+from ._truncated import MapSpec, TruncatedScene, map_key
 
 __all__ = [
     "SeriesSpec",
@@ -60,15 +58,15 @@ class SeriesSpec:
         the band floor to measure HOV by its definition over the whole band.
     """
 
-    label: str
-    Omega0: float | None
-    theta_w: float | None
-    tau0: float = MAP_DEFAULTS["tau0"]
-    tau1: float = MAP_DEFAULTS["tau1"]
-    lam: float = MAP_DEFAULTS["lam"]
-    golden_c: float | None = None
-    color: str | None = None
-    K_low: float | None = None
+    label: str = text()
+    Omega0: float | None = map_key("Omega0")
+    theta_w: float | None = map_key("theta_w")
+    tau0: float = map_key("tau0")
+    tau1: float = map_key("tau1")
+    lam: float = map_key("lam")
+    golden_c: float | None = real(None)
+    color: str | None = color()
+    K_low: float | None = real(None, hi=0.0, hi_open=True)
 
     def map_at(self, eps: float) -> MapSpec:
         """The map of this series at one eps.
@@ -88,26 +86,18 @@ class SeriesSpec:
         return MapSpec(eps, self.Omega0, self.theta_w, self.tau0, self.tau1, self.lam)
 
 
-_SERIES_KEYS = ("label", "golden_c", "color", "K_low") + MAP_KEYS
-
-
 def _read_series(where: str, value, reading) -> tuple:
     """The curves: each a map family (fixed, or the golden family) checked at every eps of the scene."""
     eps = reading.values["eps"]
-    scene_map = reading.get("map")
     series = []
     for i, st in enumerate(tables(where, value, "series")):
         sw = f"{where}[{i}]"
-        st = table_value(sw, st)
-        check_keys(sw, st, _SERIES_KEYS, ("label",))
-        vals = {**MAP_DEFAULTS, **scene_map, **map_params(sw, st)}
-        c = None
-        if "golden_c" in st:
+        vals = read_values(SeriesSpec, sw, st, Reading(sw, {}, parent=reading))
+        if vals["golden_c"] is not None:
             for k in ("Omega0", "theta_w"):
                 if k in st:
                     raise ValueError(f"{sw}: give either 'golden_c' or {k!r}, not both")
-            c = real_value(f"{sw}.golden_c", st["golden_c"])
-            if not abs(c) < abs(vals["tau0"]):
+            if not abs(vals["golden_c"]) < abs(vals["tau0"]):
                 raise ValueError(
                     f"{sw}.golden_c = {st['golden_c']!r} is out of range; allowed: |c| < |tau0| = {abs(vals['tau0'])}"
                 )
@@ -116,13 +106,7 @@ def _read_series(where: str, value, reading) -> tuple:
             for k in ("Omega0", "theta_w"):
                 if k not in vals:
                     raise ValueError(f"{sw}: missing required key {k!r} (in [map] or the series), or 'golden_c'")
-        s = SeriesSpec(
-            label=text_value(f"{sw}.label", st["label"]),
-            golden_c=c,
-            color=color_value(f"{sw}.color", st["color"]) if "color" in st else None,
-            K_low=real_value(f"{sw}.K_low", st["K_low"], hi=0.0, hi_open=True) if "K_low" in st else None,
-            **{k: vals[k] for k in MAP_KEYS},
-        )
+        s = SeriesSpec(**vals)
         for e in eps:
             try:
                 m = s.map_at(e).build()
@@ -138,8 +122,7 @@ def _read_series(where: str, value, reading) -> tuple:
 
 
 def _series_value(series: tuple, kind) -> list:
-    keys = ("label", "tau0", "tau1", "lam", "golden_c", "Omega0", "theta_w", "color", "K_low")
-    return [{k: getattr(s, k) for k in keys if getattr(s, k) is not None} for s in series]
+    return [write(s, kind) for s in series]
 
 
 @saved_as("hovering.scenes.spec:HoveringAreaScene")

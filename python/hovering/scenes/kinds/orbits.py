@@ -207,8 +207,10 @@ def _portrait_panel(pw: str, pt: dict, reading) -> PanelSpec:
     check_keys(pw, pt, _PORTRAIT_PANEL_KEYS, ("id", "eps"))
     m = resolve_map(pw, reading.get("map"), pt)
     keys = OrbitScene._keys  # the scene's n_orbits and K0_range are the panels' defaults: one range each
-    kr = keys["K0_range"].metadata[PARAM].read(f"{pw}.K0_range", pt["K0_range"], reading) if "K0_range" in pt else None
-    kr = kr if kr is not None else reading.get("K0_range")
+    if "K0_range" in pt:
+        kr = keys["K0_range"].metadata[PARAM].read(f"{pw}.K0_range", pt["K0_range"], reading)
+    else:
+        kr = reading.get("K0_range")
     if kr is None:
         raise ValueError(f"{pw}: missing required key 'K0_range' (in the scene or the panel)")
     check_band(f"{pw}.K0_range", m, kr)
