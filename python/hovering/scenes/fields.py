@@ -462,19 +462,18 @@ def choice_list(default=MISSING, choices=(), **opts):
     return _field(default, Param(read, f"a list from {list(choices)}", **_required(default, opts)))
 
 
-def table(cls, default=MISSING, **opts):
+def table(cls, **opts):
     """A nested table read by the generic reader into ``cls`` (whose fields are declared too).
 
-    An absent table is read as an empty one, so that its fields' rules for defaults apply.
+    An absent table is read as an empty one, so that its fields' rules for defaults apply; a spec
+    built in code gets ``cls()``.
 
     Parameters
     ----------
     cls : type
         The table's dataclass.
-    default : object, optional
-        Ignored when reading (absent means empty); ``cls()`` for a spec built in code.
     **opts
-        Further :class:`Param` attributes.
+        Further :class:`Param` attributes (``required=True``: the table must be given).
 
     Returns
     -------
@@ -681,8 +680,7 @@ def read(cls, where: str, value, parent: Reading | None = None, **known):
     object
         ``cls(**values)``.
     """
-    r = Reading(where, {}, known, parent=parent)
-    return cls(**{k: x for k, x in read_values(cls, where, value, r).items()})
+    return cls(**read_values(cls, where, value, Reading(where, {}, known, parent=parent)))
 
 
 def write(obj, kind=None) -> dict:
