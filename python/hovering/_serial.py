@@ -43,13 +43,39 @@ from ._provenance import provenance
 from ._untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
 from ._version import __version__
 
-__all__ = ["FORMAT", "Saveable", "from_tree", "load", "record_key", "save", "to_tree"]
+__all__ = ["FORMAT", "Saveable", "from_tree", "load", "record_key", "save", "saved_as", "to_tree"]
 
 _MAX_INT_BITS = _untrusted.MAX_INT_BITS
 
 
+def saved_as(name: str):
+    """Class decorator: the name files give a class that moved after files were written naming it.
+
+    A file names each class ``module:QualName``; a class that moved keeps the name it was written
+    under (its old module re-exports it), so files written before and after the move are the same
+    and each version reads the other's. Only the class itself carries the name (a subclass is
+    written under its own).
+
+    Parameters
+    ----------
+    name : str
+        ``"hovering.module:QualName"``, where the class can still be imported from.
+
+    Returns
+    -------
+    callable
+        The decorator (returns the class unchanged but for the name).
+    """
+
+    def mark(cls):
+        cls._saved_as = name
+        return cls
+
+    return mark
+
+
 def _type_name(cls) -> str:
-    return f"{cls.__module__}:{cls.__qualname__}"
+    return cls.__dict__.get("_saved_as") or f"{cls.__module__}:{cls.__qualname__}"
 
 
 def _resolve(name, kind: str = "any"):
@@ -71,9 +97,9 @@ def _resolve(name, kind: str = "any"):
             obj = getattr(obj, part)
     except (ImportError, AttributeError):
         raise ValueError(f"cannot rebuild type {name!r}: this version of hovering has no such class") from None
-    # The name must lead to a class defined where the name says (not, e.g., to a function that a
-    # hovering module imported from elsewhere).
-    if not (isinstance(obj, type) and obj.__module__ == module and obj.__qualname__ == qual):
+    # The name must lead to a class defined where the name says, or to one that says it was written
+    # under this name (saved_as), not, e.g., to a function that a hovering module imported from elsewhere.
+    if not (isinstance(obj, type) and _type_name(obj) == name):
         raise ValueError(f"refusing to rebuild type {name!r}: it does not name a class defined in hovering")
     ok = {
         "enum": lambda c: issubclass(c, enum.Enum),

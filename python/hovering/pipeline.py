@@ -18,7 +18,7 @@ from ._output import is_ours, output_path, refuse_foreign, savefig, write_bytes,
 from .plot.figures import render
 from .plot.primitives import draw_geometry as draw_geometry_lines
 from .plot.primitives import plot_orbits
-from .scenes import SWEEP_KINDS, compute
+from .scenes import compute, registry
 from .scenes.compute import map_geometry
 from .scenes.results import Geometry, load_result
 from .scenes.schema import output_dirs
@@ -87,7 +87,7 @@ def run_scene(
         else output_path("output", scene.output, within=output_dirs(scene.path))
     )
     npz, side, ckpt = png.with_suffix(".npz"), png.with_suffix(".json"), png.with_suffix(".sweep.jsonl")
-    sweep = scene.kind in SWEEP_KINDS
+    sweep = registry.get(scene.kind).sweep
     refuse_foreign([png, npz, side] + ([ckpt] if sweep else []), force)
     try:
         png.parent.mkdir(parents=True, exist_ok=True)

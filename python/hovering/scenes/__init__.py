@@ -6,21 +6,13 @@
          --save--> NPZ + JSON (scene, parameters, version, timings)
          --render--> Figure (pure function of the result)  /  --summarize--> text report
 
-A scene names its effects; nothing else is simulated. The kinds:
-
-``portrait``, ``critical_orbits``, ``hovering_area``
-    The truncated map (sec:truncatedmapnum): orbits from L1, the paper's special orbits with
-    critical curves and zooms, |HOV| against eps.
-``flow_portrait``
-    The full return map and its truncated model side by side, same starts, coloured by region,
-    with the measured corner-singularity curves and K = 0.
-``flow_hovering_area``
-    |HOV| against eps for the flow, its truncated models (onset arcs; arcs measured on the flow)
-    and eq:hovsetsize, both signs of eps, with error bars.
-``tangent_tori``
-    fig:two-tang computed: the two tangent tori of the unperturbed system with trajectories.
-``sigma_structure``
-    fig:structure_Sigma computed from the flow: regions J_R, J_0, J_1 and their images.
+A scene names its effects; nothing else is simulated. Each kind is one declaration,
+``hovering/scenes/kinds/<kind>.py`` (its keys with their defaults, ranges and choices, its
+computation, result, summary and report) with its figure in ``hovering/plot/kinds/<kind>.py``;
+:data:`KINDS` lists them and ``registry.get(kind).doc`` says what each draws (the truncated map's
+orbits, critical curves and |HOV|; the flow's return map beside its model, |HOV| of the flow and
+its models, the paper's figures of the tangent tori, of Sigma_h, of the corner and the wall
+section; the impact zone).
 
 Flow scenes carry ``[system]`` (potentials ``harmonic`` / ``tan``, ``coupling`` = ``"bilinear"``,
 ``"none"`` or terms ``[[c, i, j], ...]``, ``eps``, ``qw1``, ``qw2``, ``geometry`` none / wall /
@@ -34,6 +26,7 @@ from importlib import resources
 from pathlib import Path
 
 from .._deprecated import moved_module
+from . import registry
 from .compute import compute
 from .report import format_summary
 from .results import SceneResult, load_result, summarize
@@ -54,8 +47,8 @@ from .spec import (
     ZoomSpec,
 )
 
-#: The kinds that checkpoint their points (``<output>.sweep.jsonl``).
-SWEEP_KINDS = ("hovering_area", "flow_hovering_area")
+#: The kinds that checkpoint their points (``<output>.sweep.jsonl``): those with a sweep plan.
+SWEEP_KINDS = tuple(k for k in KINDS if registry.get(k).sweep)
 
 __all__ = [
     "KINDS",

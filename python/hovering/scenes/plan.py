@@ -17,24 +17,28 @@ point's fields except ``label``, ``theory`` and ``b1`` (carried into the row), w
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from pathlib import Path
 
-import numpy as np
-
 from .._output import write_text
 from .._version import __version__
-from ..analysis.hovering import default_depth
 from ..flow import Harmonic, Tan
 from ..flow.system import Polynomial, StepSystem
-from ..normal.compare import truncated_from_flow
-from ..normal.corners import corner_curves
-from ..normal.flowmap import FlowMap
-from .spec import QUICK_FACTOR, FlowHoveringScene, HoveringAreaScene, SceneSpec
+from . import registry
+from .base import QUICK_FACTOR, SceneSpec
 
-__all__ = ["FORMAT", "VERSION", "plan_points", "point_key", "plan_text", "write_plan", "sweep_counts"]
+__all__ = [
+    "FORMAT",
+    "VERSION",
+    "plan_points",
+    "point_key",
+    "plan_text",
+    "write_plan",
+    "sweep_counts",
+    "system_record",
+    "build_system",
+]
 
 #: The plan's ``format`` and ``version`` (hovering_sweep refuses another version).
 FORMAT = "hovering-sweep-plan"
@@ -47,8 +51,9 @@ _CARRIED = ("label", "theory", "b1")
 def sweep_counts(scene: SceneSpec, quick: bool = False) -> tuple:
     """``(n_steps, samples)`` of each point of a sweep scene: the scene's, or a ``--quick`` run's.
 
-    A quick run divides both by :data:`~hovering.scenes.spec.QUICK_FACTOR`, keeping at least
-    100 steps and 400 samples (truncated map) or 50 returns and 100 samples (flow).
+    A quick run divides both by :data:`~hovering.scenes.spec.QUICK_FACTOR`, keeping at least its
+    kind's :attr:`~hovering.scenes.registry.Kind.quick_floor` (100 steps and 400 samples for the
+    truncated map, 50 returns and 100 samples for the flow).
 
     Parameters
     ----------
@@ -61,42 +66,30 @@ def sweep_counts(scene: SceneSpec, quick: bool = False) -> tuple:
     -------
     tuple of int
     """
-    flow = isinstance(scene, FlowHoveringScene)
-    floor, min_samples = (50, 100) if flow else (100, 400)
+    floor, min_samples = registry.get(scene.kind).quick_floor
     n = scene.n_steps
     if not quick:
         return n, scene.samples
     return max(n // QUICK_FACTOR, min(floor, n)), max(scene.samples // QUICK_FACTOR, min_samples)
 
 
-def _truncated_points(scene: HoveringAreaScene, quick: bool) -> list:
-    n_steps, samples = sweep_counts(scene, quick)
-    out = []
-    for s in scene.series:
-        for e in scene.eps:
-            ms = s.map_at(e)
-            m = ms.build()
-            if s.K_low is not None:
-                K_low = float(s.K_low)
-            else:  # the default box of hovering_area: the critical band, cut to the map's band
-                depth = default_depth(m) if e != 0 else 0.1
-                K_low = max(-depth, m.valid_band()[0] * (1 - 1e-9))
-            mp = {k: float(getattr(ms, k)) for k in ("eps", "Omega0", "theta_w", "tau0", "tau1", "lam")}
-            out.append(
-                {
-                    "label": s.label,
-                    "n_steps": int(n_steps),
-                    "samples": int(samples),
-                    "seed": int(scene.seed),
-                    "K_low": float(K_low),
-                    "theory": float(m.theory().area),
-                    "map": mp,
-                }
-            )
-    return out
+def system_record(spec, eps: float) -> dict:
+    """A flow scene's system as a plan point's ``system`` table, at one eps.
 
+    Parameters
+    ----------
+    spec : SystemSpec
+        The scene's system.
+    eps : float
+        The point's eps.
 
-def _system(spec, eps: float) -> dict:
+    Returns
+    -------
+    dict
+        ``V1``, ``V2`` (``kind``, ``omega``, ``alpha`` of a tan), ``coupling`` terms, ``eps``,
+        ``qw1``, ``qw2``, ``geometry``: plain numbers and strings.
+    """
+
     def pot(p):
         d = {"kind": p.kind, "omega": float(p.omega)}
         if p.kind == "tan":
@@ -144,72 +137,6 @@ def build_system(system: dict):
     )
 
 
-def _model(name: str, tm, K_low: float) -> dict:
-    rec = tm._to_record()
-    out = {"name": name, "K_low": float(K_low), "eps": float(rec["eps"])}
-    for k in ("K", "Omega", "JR", "J1", "forcing"):
-        out[k] = [float(x) for x in np.asarray(rec[k], dtype=float)]
-    out["K_max"] = float(rec["K_max"])
-    return out
-
-
-def _measured_model(fm, K_low: float):
-    """The truncated family with arcs measured on the flow's corner curves (and measured forcing).
-
-    Circles below the flow's impact zone (eps > 0: under the deformed torus tangent to the upper
-    wall, ``FlowMap.impact_zone_floor``) hold no J_1 / J_R arcs: the family then stops at the
-    lowest circle that has them, and its band is shallower than the box asked for.
-    """
-    depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
-    s = np.linspace(math.sqrt(depth), 0.0, 17)[:-1]
-    K = np.concatenate([-(s**2), [0.01, 0.03, 0.05]])
-    cc = corner_curves(fm.section, K, fm.curve, n_phi=256, bisections=30, rtol=1e-12)
-    ok = (K > 0) | (np.isfinite(cc.JR) & np.isfinite(cc.J1) & np.isfinite(cc.Omega))
-    first = int(np.argmax(np.cumprod(ok[::-1])[::-1])) if not ok.all() else 0
-    keep = np.zeros(K.size, bool)
-    keep[first:] = True
-    keep &= ok
-    if not keep.all():
-        cc = dataclasses.replace(
-            cc,
-            **{
-                f: getattr(cc, f)[keep]
-                for f in ("K", "phi_R0", "phi_01", "phi_1R", "JR", "J0", "J1", "Omega", "Omega_spread", "other")
-            },
-        )
-    return truncated_from_flow(cc, fm.eps, forcing=tuple(fm.forcing_coefficients()))
-
-
-def _flow_point(scene: FlowHoveringScene, e: float, n_steps: int, samples: int) -> dict:
-    system = _system(scene.system, e)
-    fm = FlowMap(build_system(system), h=scene.h, **scene.integrator.options())
-    o = fm.integrator_options  # what an accuracy target chose, or the scene's setting
-    integrator = {"stepper": o["stepper"], "rtol": float(o["rtol"]), "atol": float(o["atol"])}
-    # One box for flow and models, so the same points are classified by each: the default depth
-    # (the critical band of eq:hovsetsize), cut to the band every model is defined on.
-    depth = default_depth(fm) if e != 0 else 0.1
-    tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
-    K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
-    if "onset" in tms:
-        K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
-    # A model whose band is shallower than the box (measured arcs stop at the impact zone's floor)
-    # samples its own box: its points are not the flow's.
-    models = [_model(name, tm, max(K_low, tm.valid_band()[0] * (1 - 1e-9))) for name, tm in tms.items()]
-    th = fm.theory()
-    return {
-        "n_steps": int(n_steps),
-        "samples": int(samples),
-        "seed": int(scene.seed),
-        "K_low": float(K_low),
-        "theory": float(th.area),
-        "b1": float(th.forcing[0]),
-        "h": float(scene.h),
-        "system": system,
-        "integrator": integrator,
-        "models": models,
-    }
-
-
 def plan_points(scene: SceneSpec, quick: bool = False) -> list:
     """The resolved points of a sweep scene, in order (series-major for ``hovering_area``).
 
@@ -230,15 +157,14 @@ def plan_points(scene: SceneSpec, quick: bool = False) -> list:
     ValueError
         For a scene of another kind.
     """
-    if isinstance(scene, HoveringAreaScene):
-        return _truncated_points(scene, quick)
-    if isinstance(scene, FlowHoveringScene):
-        n_steps, samples = sweep_counts(scene, quick)
-        return [_flow_point(scene, e, n_steps, samples) for e in scene.eps]
-    raise ValueError(
-        f"scene {scene.name!r} is of kind {scene.kind!r}; a plan is made of the sweep kinds "
-        "'hovering_area' and 'flow_hovering_area'"
-    )
+    kind = registry.get(scene.kind)
+    if kind.plan is None:
+        sweeps = [k for k in registry.names() if registry.get(k).sweep]
+        raise ValueError(
+            f"scene {scene.name!r} is of kind {scene.kind!r}; a plan is made of the sweep kinds "
+            + " and ".join(repr(k) for k in sweeps)
+        )
+    return kind.plan(scene, quick)
 
 
 def point_key(kind: str, point: dict) -> dict:
