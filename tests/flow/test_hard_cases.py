@@ -185,7 +185,7 @@ def test_states_outside_the_tan_well_are_never_reported(gap, stepper):
         # at 1e-4 and 1e-6 says so
         FlowStatus.IMPRECISE,
         # rkf45's loose steps next to the singularity can gain energy without bound (8e11 on
-        # h = 1000, measured): a runaway, stopped once its kinetic energy passes 1e8 (1 + h)
+        # h = 1000, measured): a runaway, stopped once its kinetic energy passes 1e4 (1 + h)
         FlowStatus.NON_FINITE,
     }
     stopped = r.status != FlowStatus.OK
@@ -222,9 +222,9 @@ def test_step_limit_reports_the_time_and_state_reached(sec, max_steps):
 
 def test_non_finite_reports_the_time_and_state_reached():
     # A runaway (an indefinite coupled potential): NON_FINITE once its kinetic energy passes
-    # 1e8 (1 + |h|), with that last state and its time: the unstable mode grows as e^(0.68 t)
-    # (0.68 = sqrt(0.5 - 0.04)), ~1.7e4 after t ~ 14. H is kept to the end (rounding of terms of
-    # size ~1e8); the state's own coordinates are NaN (it is not on Sigma_h).
+    # 1e4 (1 + |h|), with that last state and its time: the unstable mode grows as e^(0.68 t)
+    # (0.68 = sqrt(0.5 - 0.04)), kinetic energy ~1e4 after t ~ 6. H is kept to the end (to the
+    # integrator's accuracy relative to terms of size ~1e4); the state's own coordinates are NaN (it is not on Sigma_h).
     s = Section(
         StepSystem(
             V1=Harmonic(0.2), V2=Harmonic(0.2), coupling=hovering.Bilinear(), eps=-0.5, qw1=-1, qw2=-2, geometry="wall"
@@ -235,9 +235,9 @@ def test_non_finite_reports_the_time_and_state_reached():
         r = s.return_map([np.linspace(-np.pi, np.pi, 41)[12]], [0.5], stepper=stepper)
         assert r.status[0] == FlowStatus.NON_FINITE
         kinetic = 0.5 * (r.z[0, 1] ** 2 + r.z[0, 3] ** 2)
-        assert np.isfinite(r.z[0]).all() and 1e8 * 1.3 < kinetic < 1e10
-        assert 8 < r.time[0] < 20 and np.isnan([r.theta[0], r.I[0]]).all()
-        assert r.energy_error[0] < 1e-14 * kinetic
+        assert np.isfinite(r.z[0]).all() and 1e4 * 1.3 < kinetic < 1e6
+        assert 4 < r.time[0] < 10 and np.isnan([r.theta[0], r.I[0]]).all()
+        assert r.energy_error[0] < 1e-12 * kinetic  # measured 8e-14 (rk8pd, rtol 1e-10), 1e-16 (taylor)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -369,15 +369,17 @@ class Section:
             An impact this close to the corner is a corner hit (status CORNER).
         verify_steps : int, optional
             Which returns are verified. rtol bounds each step's error, not a return's: errors add
-            up over long returns and a chaotic return or a shallow impact amplifies them. A
-            verified return is traced again at rtol / 100 (and rtol / 10^4 if needed); the
-            tighter result is kept once its estimated error is within the band (return time
-            within ``rtol * max(1, t)``, each state component within ``rtol * |z| + atol``),
-            else the return gets status IMPRECISE. -1 (default): returns of 128 or more steps
-            with ``"taylor"``, of ``64 (1e-8 / rtol)^(1/p)`` (at least 16) with a GSL stepper of
-            order p (rk8pd: 64 at rtol 1e-8, 114 at 1e-10), and every return with a shallow impact (error amplification 2 |a| / (|v| w) >= 20); never with ``"exact"``. 0: no
-            verification. N >= 1: returns of N or more steps (and shallow impacts). ``steps``
-            counts the steps of every trace of a return.
+            up over long returns, and chaos or impacts amplify them. A verified return is traced
+            again at rtol / 100 (and rtol / 10^4 if needed); the tighter trace is kept once a
+            tenth of the difference is within the band (return time within ``rtol * max(1, t)``,
+            each state component within ``rtol * |z| + atol``), else the return gets status
+            IMPRECISE. A return is verified when its steps times its impacts' error
+            amplification (the product over impacts of ``2 |a| / (|v| w)``, at least 1 each:
+            a shallow impact's saltation) reach N. -1 (default): N = 128 with ``"taylor"``,
+            ``40 (1e-8 / rtol)^(1/p)`` (at least 16) with a GSL stepper of order p (rk8pd: 40 at
+            rtol 1e-8, 71 at 1e-10), never with ``"exact"``; 0: no verification; N >= 1: that N.
+            ``steps`` counts the steps of every trace. Cost on the README system: 1-2% more steps
+            with taylor, 13-28% with rk8pd (docs: Accuracy, "Verified returns").
         n_threads : int, optional
             Worker threads (0 = all cores, or 1 when a potential is defined in Python: its calls
             serialise on the GIL).

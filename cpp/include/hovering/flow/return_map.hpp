@@ -38,18 +38,16 @@ inline constexpr std::array<const char*, 10> kSteppers = {"rk8pd",  "rkck",   "r
                                                           "msadams", "rk4imp", "rk2imp", "taylor", "exact"};
 
 /// Kinetic energy, relative to 1 + |h|, beyond which an orbit is a runaway (status NonFinite): a
-/// coupling unbounded below lets it grow without bound; bounded motion keeps it below h - min V.
-inline constexpr double kRunawayKinetic = 1e8;
+/// coupling unbounded below lets it grow without bound; bounded motion keeps it below h - min V,
+/// so only a potential whose minimum lies below -1e4 (1 + |h|) could be stopped wrongly.
+inline constexpr double kRunawayKinetic = 1e4;
 
-/// Steps from which a "taylor" return is verified by default (FlowOptions::verify_steps = -1).
+/// Steps (times the impacts' amplification) from which a "taylor" return is verified by default
+/// (FlowOptions::verify_steps = -1).
 inline constexpr std::int64_t kVerifySteps = 128;
-/// Steps from which a return of a GSL stepper of order p is verified by default, at rtol 1e-8:
-/// kVerifyStepsGsl (1e-8 / rtol)^(1/p), at least 16 (about what an ordinary return needs times 3).
-inline constexpr std::int64_t kVerifyStepsGsl = 64;
-
-/// Error amplification of an impact (2 |a| / (|v| w): a shallow impact's saltation) from which a
-/// return is verified whenever verify_steps is not 0.
-inline constexpr double kVerifyAmplification = 20;
+/// The same for a GSL stepper of order p at rtol 1e-8; kVerifyStepsGsl (1e-8 / rtol)^(1/p) at
+/// another rtol (at least 16): its steps grow so as the tolerance tightens.
+inline constexpr std::int64_t kVerifyStepsGsl = 40;
 
 /// Integrator settings.
 /// Stepper "exact" is the flow in closed form where the system has one (eps = 0 with Harmonic or
@@ -65,10 +63,12 @@ struct FlowOptions {
     int max_impacts = 100;             ///< per return; more ends the orbit with ImpactLimit
     double grazing_tol = 1e-12;        ///< |min distance to a wall| below which an orbit touches it tangentially
     double corner_tol = 1e-10;         ///< distance to the corner below which an impact is a corner hit
-    /// Returns of at least this many steps, or with a shallow impact (kVerifyAmplification), are verified: traced again at rtol / 100 (and / 10^4 if
-    /// needed) and the tighter result kept once its estimated error is within the band (time within
-    /// rtol max(1, t), each state component within rtol |z| + atol); -1 (default): kVerifySteps
-    /// for "taylor", kVerifyStepsGsl scaled by the tolerance for the GSL steppers, never for "exact"; 0: never.
+    /// A return whose steps times its impacts' error amplification (the product of each impact's
+    /// 2 |a| / (|v| w), at least 1: a shallow impact's saltation term) reach this is verified:
+    /// traced again at rtol / 100 (and / 10^4 if needed) and the tighter result kept once its
+    /// estimated error is within the band (time within rtol max(1, t), each state component within
+    /// rtol |z| + atol), else Imprecise. -1 (default): kVerifySteps for "taylor", kVerifyStepsGsl
+    /// scaled by the tolerance for the GSL steppers, never for "exact"; 0: never.
     std::int64_t verify_steps = -1;
     /// Validate (throws std::invalid_argument naming the bad value and the allowed range).
     void validate() const;

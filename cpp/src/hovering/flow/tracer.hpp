@@ -100,7 +100,7 @@ private:
         bool seen_negative = false, armed = false, crossed = false;
         bool done = false;  // the return found its end event (section, corner, graze, limit)
         bool over = false;  // step() will take no more steps
-        double amplification = 0;    // largest error amplification of an impact (verify_from)
+        double amplification = 1;    // product of the impacts' error amplifications (verify_from)
         std::array<double, 4> z0{};  // where the return started (verification traces it again)
         bool first_crossing = false;
         // The dense output's state when the return began: a verified return replaces its points.
