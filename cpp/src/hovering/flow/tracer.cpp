@@ -183,6 +183,7 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
     const bool labels = labels_;
     DenseRecorder* const dense = dense_;
     Ret& R = ret_;
+    R.cancel = cancel;
     ReturnResult& r = R.r;
     double* const y = R.y;
     double* const dy = R.dy;
@@ -472,7 +473,7 @@ ReturnResult Tracer::verify(ReturnResult r0) {
             dense_->truncated = ret_.dense_truncated;
         }
         V.set_dense(dense_);
-        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, nullptr);
+        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, ret_.cancel);
         V.set_dense(nullptr);
         steps += r.steps;
         if (r.status == FlowStatus::StepLimit || r.status == FlowStatus::NonFinite ||

@@ -103,6 +103,7 @@ private:
         double amplification = 1;    // product of the impacts' error amplifications (verify_from)
         std::array<double, 4> z0{};  // where the return started (verification traces it again)
         bool first_crossing = false;
+        const std::atomic<bool>* cancel = nullptr;  // the last step()'s, polled by verification too
         // The dense output's state when the return began: a verified return replaces its points.
         std::size_t dense_points = 0, dense_kinds = 0;
         std::int64_t dense_next = 0, dense_room = 0;
