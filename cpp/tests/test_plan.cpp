@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "hovering/flow/potential.hpp"
 #include "hovering/sweep/plan.hpp"
 #include "hovering/sweep/run.hpp"
 #include "testing.hpp"
@@ -178,8 +179,10 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1.4",
          "points[0].system.V2.alpha is missing");
     // The kinds and their parameters' ranges are the core's registry (potential_kinds()).
-    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"quartic\", omega = 1.4, alpha = 0.7",
-         "points[0].system.V2.kind = 'quartic': allowed: one of 'harmonic' 'tan'");
+    std::string kinds;
+    for (const hovering::PotentialKind& k : hovering::potential_kinds()) kinds += " '" + k.kind + "'";
+    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"cubic\", omega = 1.4, alpha = 0.7",
+         "points[0].system.V2.kind = 'cubic': allowed: one of" + kinds);
     flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1e200, alpha = 0.7",
          "points[0].system.V2.omega = 1e+200: allowed:");
     flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"harmonic\", omega = 1.4, alpha = 0.7",

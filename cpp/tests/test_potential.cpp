@@ -156,8 +156,11 @@ TEST_CASE("every compiled kind: the registry builds it, and its closed forms mat
     // The registry (CompiledPotentials) is what scene files, plans and the bindings read: each kind
     // builds through make_potential with its parameters in order, refuses a wrong count and an
     // out-of-range value, and, like the classes above, agrees with the generic quadrature path.
-    CHECK(!potential_kinds().empty());
-    CHECK_INVALID(potential_kind("no-such-kind"), "potential kind must be one of 'harmonic', 'tan'");
+    CHECK(potential_kinds().size() >= 2);
+    std::string kinds;
+    for (const PotentialKind& k : potential_kinds()) kinds += std::string(kinds.empty() ? "'" : ", '") + k.kind + "'";
+    CHECK(kinds.rfind("'harmonic', 'tan'", 0) == 0);
+    CHECK_INVALID(potential_kind("no-such-kind"), "potential kind must be one of " + kinds + ", got 'no-such-kind'");
     for (const PotentialKind& k : potential_kinds()) {
         CHECK(&potential_kind(k.kind) == &k);
         CHECK_INVALID(make_potential(k.kind, std::vector<double>(k.params.size() + 1, 1.0)), "parameter(s)");
