@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 import hovering  # noqa: E402
 from hovering import paper  # noqa: E402
-from hovering._output import savefig  # noqa: E402  (atomic: a killed run leaves the old docs PNG)
+from hovering._io.output import savefig  # noqa: E402  (atomic: a killed run leaves the old docs PNG)
 from hovering.diagnostics import exact_available  # noqa: E402
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"

@@ -169,7 +169,7 @@ def main(argv=None) -> None:
 
     samples, steps = (500, 500) if args.quick else (2000, 2000)
     t0 = time.perf_counter()
-    area = fm.hovering_area(n_steps=steps, n_samples=samples)
+    area = hv.hovering_area(fm, n_steps=steps, n_samples=samples)
     print(
         f"hovering_area of the flow, {samples} points x {steps} returns (2 threads): {time.perf_counter() - t0:.1f} s "
         f"(|HOV| = {area.area:.4f} +- {area.error:.4f}, theory {area.theory:.4f})"

@@ -62,7 +62,7 @@ def main(argv=None):
     K_low = -2 * args.eps / math.sin(p["Omega0"] / 2)
 
     t0 = time.perf_counter()
-    hv = m.hovering_area(n_steps=args.steps, n_samples=args.samples, K_low=K_low)
+    hv = hovering.hovering_area(m, n_steps=args.steps, n_samples=args.samples, K_low=K_low)
     t_ours = time.perf_counter() - t0
 
     rng = np.random.default_rng(0)

@@ -108,7 +108,7 @@ API_GROUPS = (
     (
         "Transport across the impact zone",
         "The zone between its floor and ceiling, transits across it, barriers, and the curves that stop an orbit.",
-        ("impact_zone", "transit", "barrier_scan", "Curve", "Above", "Below"),
+        ("impact_zone", "impact_zone_floor", "transit", "barrier_scan", "Curve", "Above", "Below"),
     ),
     (
         "Results",
@@ -142,8 +142,17 @@ API_GROUPS = (
     ),
     (
         "Utilities",
-        "Accuracy with its cost, files, provenance, the SIMD kernel, the interactive explorer.",
-        ("work_precision", "save", "load", "show_versions", "explore", "simd_width", "simd_is_avx2"),
+        "Accuracy with its cost and accuracy targets, files, provenance, the SIMD kernel, the interactive explorer.",
+        (
+            "work_precision",
+            "accurate_flow_map",
+            "save",
+            "load",
+            "show_versions",
+            "explore",
+            "simd_width",
+            "simd_is_avx2",
+        ),
     ),
 )
 

@@ -30,9 +30,9 @@ def compare(eps: float, samples: int, steps: int, rtol: float = 1e-10) -> dict:
     fm = hv.FlowMap(system(eps), h=1.0, rtol=rtol)
     tm = fm.truncated()
     t = time.perf_counter()
-    flow = fm.hovering_area(n_steps=steps, n_samples=samples, keep_points=True)
+    flow = hv.hovering_area(fm, n_steps=steps, n_samples=samples, keep_points=True)
     t_flow = time.perf_counter() - t
-    model = tm.hovering_area(n_steps=steps, n_samples=samples, K_low=flow.box[2], keep_points=True)
+    model = hv.hovering_area(tm, n_steps=steps, n_samples=samples, K_low=flow.box[2], keep_points=True)
     th = fm.theory()
     return dict(
         eps=eps,

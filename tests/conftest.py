@@ -202,8 +202,17 @@ def sweep_exe():
     if not (build / "CMakeCache.txt").exists():
         gen = ["-G", "Ninja"] if shutil.which("ninja") else []
         subprocess.run(
-            [cmake, "-S", str(root), "-B", str(build), *gen, "-DCMAKE_BUILD_TYPE=Release", "-DHOVERING_BUILD_TESTS=ON",
-             "-DHOVERING_BUILD_APPS=ON"],
+            [
+                cmake,
+                "-S",
+                str(root),
+                "-B",
+                str(build),
+                *gen,
+                "-DCMAKE_BUILD_TYPE=Release",
+                "-DHOVERING_BUILD_TESTS=ON",
+                "-DHOVERING_BUILD_APPS=ON",
+            ],
             check=True,
             capture_output=True,
             timeout=600,

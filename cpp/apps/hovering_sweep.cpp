@@ -20,7 +20,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
@@ -60,12 +59,6 @@ std::string printable(const std::string& s) {
         if (u < 0x20 || u == 0x7f) c = '?';
     }
     return out;
-}
-
-std::string num(double x) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, x);
-    return std::string(buf, r.ptr);
 }
 
 /// Reports a running point's progress on a terminal about once a second (nothing when stderr is
@@ -203,7 +196,7 @@ int main(int argc, char** argv) {
             if (ckpt.done(p.key)) continue;  // finished (by another run, meanwhile)
             std::string what = "[" + std::to_string(i + 1) + "/" + std::to_string(plan.points.size()) + "]";
             if (!p.label.empty()) what += " " + printable(p.label) + ",";
-            what += " eps = " + num(plan.kind == "hovering_area" ? p.map.eps : p.system.eps);
+            what += " eps = " + format_number(plan.kind == "hovering_area" ? p.map.eps : p.system.eps);
             std::atomic<std::int64_t> done{0};
             PointRow row;
             {

@@ -22,7 +22,7 @@ FlowSystem make(std::shared_ptr<const Potential> V1, std::shared_ptr<const Poten
 
 TEST_CASE("exact: event-driven angle flow = step loop on the closed form; first crossings", "[exact]") {
     FlowOptions o;
-    o.stepper = "exact";
+    o.stepper = Stepper::Exact;
     for (int g = 0; g < 3; ++g) {
         const FlowSystem s = make(std::make_shared<Harmonic>(1.0), std::make_shared<Tan>(1.4, 0.7), Geometry(g), 0.0);
         detail::Tracer ev(s, o), st(s, o);
@@ -70,7 +70,7 @@ TEST_CASE("exact: linear flow against a Taylor series of exp(A t), eigenvalues >
         const FlowSystem s =
             make(std::make_shared<Harmonic>(1.0), std::make_shared<Harmonic>(1.3), Geometry::Wall, eps);
         FlowOptions o;
-        o.stepper = "exact";
+        o.stepper = Stepper::Exact;
         CHECK(detail::exact_kind(s, o) == detail::ExactKind::Linear);
         const detail::LinearFlow L(s);
         const double K[2][2] = {{1.0, eps}, {eps, 1.69}};
@@ -100,7 +100,7 @@ TEST_CASE("exact: linear flow against a Taylor series of exp(A t), eigenvalues >
 
 TEST_CASE("exact: systems without a closed-form flow are refused before any work", "[exact]") {
     FlowOptions o;
-    o.stepper = "exact";
+    o.stepper = Stepper::Exact;
     FlowSystem s = make(std::make_shared<Tan>(1.4, 0.7), std::make_shared<Harmonic>(1.0), Geometry::Step, 0.1);
     const std::array<double, 4> z{1.0, 0.0, 0.1, 0.1};
     CHECK_INVALID(return_map(s, z, o), "stepper 'exact' needs a flow in closed form");
@@ -115,9 +115,7 @@ TEST_CASE("exact: systems without a closed-form flow are refused before any work
     s.V1 = std::make_shared<Harmonic>(1.0);
     s.eps = 0.3;
     CHECK(detail::exact_kind(s, o) == detail::ExactKind::Angles);
-    FlowOptions bad;
-    bad.stepper = "exakt";
-    CHECK_INVALID(bad.validate(), "or exact (closed-form flow");
+    CHECK_INVALID(parse_stepper("exakt"), "or exact (closed-form flow");
 }
 
 TEST_CASE("every stepper finds the first return where p1 changes sign twice within a long step", "[exact][events]") {
@@ -165,7 +163,7 @@ TEST_CASE("every stepper finds the first return where p1 changes sign twice with
             for (const char* st : {"taylor", "rk8pd", "exact"}) {
                 for (double tol : {1e-6, 1e-10, 1e-14}) {
                     FlowOptions o;
-                    o.stepper = st;
+                    o.stepper = parse_stepper(st);
                     o.rtol = o.atol = tol;
                     const ReturnResult r = return_map(s, z0, o);
                     INFO(hovering_test::msg("eps %g, %s at %g: t = %.12g, reference %.12g", eps, st, tol, r.time, t_ref));

@@ -67,9 +67,10 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     CHECK_INVALID(section_point(s, h, 0.3, 5.0), "no point of Sigma_h");
     CHECK_INVALID(section_point(s, h, 4.0, 0.3), "theta must lie in [-pi, pi]");
     FlowOptions bad = o;
-    bad.stepper = "euler";
-    CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "stepper must be one of");
-    bad = o;
+    CHECK_INVALID(parse_stepper("euler"), "stepper must be one of");
+    CHECK(parse_stepper("rk8pd") == Stepper::Rk8pd);
+    CHECK(std::string(stepper_name(Stepper::Exact)) == "exact");
+    for (const char* name : kSteppers) CHECK(std::string(stepper_name(parse_stepper(name))) == name);
     bad.rtol = 0;
     CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
     bad = o;
@@ -151,7 +152,7 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     // events located on an rk8pd extension of each step. Adams' global error runs ~400x its local
     // tolerance here (measured max 3.8e-10 over 200 returns at rtol = atol = 1e-12), hence 5e-9.
     FlowOptions ms = o;
-    ms.stepper = "msadams";
+    ms.stepper = Stepper::Msadams;
     ms.atol = 1e-12;
     // Its own traces: verified, that ~400x error at 1e-12 is IMPRECISE (its floor, 1e-14, is too
     // close to bring it within rtol).
@@ -235,7 +236,7 @@ TEST_CASE("stepper taylor: the series of the exact solution, and exact eps = 0 r
     s.qw2 = -0.5;
     s.geometry = Geometry::Step;
     FlowOptions o;
-    o.stepper = "taylor";
+    o.stepper = Stepper::Taylor;
     o.rtol = o.atol = 1e-13;
     o.validate(s);
 
@@ -264,7 +265,7 @@ TEST_CASE("stepper taylor: the series of the exact solution, and exact eps = 0 r
     // wall included (q1's amplitude exceeds |qw1| for I < ~0.1): 5e-12.
     s.geometry = Geometry::Wall;
     FlowOptions ex;
-    ex.stepper = "exact";
+    ex.stepper = Stepper::Exact;
     const double h = 1.0;
     int impacts = 0;
     for (double I : {0.02, 0.06, 0.3}) {

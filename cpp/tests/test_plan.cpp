@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "hovering/flow/potential.hpp"
 #include "hovering/sweep/plan.hpp"
 #include "hovering/sweep/run.hpp"
 #include "testing.hpp"
@@ -177,6 +178,15 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 1], [2.0, 1, 1]]", "each (i, j) once");
     flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1.4",
          "points[0].system.V2.alpha is missing");
+    // The kinds and their parameters' ranges are the core's registry (potential_kinds()).
+    std::string kinds;
+    for (const hovering::PotentialKind& k : hovering::potential_kinds()) kinds += " '" + k.kind + "'";
+    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"cubic\", omega = 1.4, alpha = 0.7",
+         "points[0].system.V2.kind = 'cubic': allowed: one of" + kinds);
+    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1e200, alpha = 0.7",
+         "points[0].system.V2.omega = 1e+200: allowed:");
+    flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"harmonic\", omega = 1.4, alpha = 0.7",
+         "points[0].system.V2.alpha is not a key of this table");
     flow("qw2 = -0.5", "qw2 = 0.5", "points[0].system.qw2 = 0.5: allowed: a finite number < 0");
     flow("geometry = \"step\"", "geometry = \"box\"", "geometry = 'box': allowed: one of 'none' 'wall' 'step'");
     flow("integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n",

@@ -1,7 +1,10 @@
 // Potentials and onset parameters: closed forms vs GSL quadrature, definitions vs the appendix.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "hovering/flow/system.hpp"
@@ -147,6 +150,41 @@ TEST_CASE("potentials: closed forms vs quadrature; onset parameters three ways",
         std::string name() const override { return "Plateau"; }
     } plateau;
     CHECK_INVALID(plateau.period(0.5), "Plateau.period: the quadrature over the level h = 0.5 did not converge");
+}
+
+TEST_CASE("every compiled kind: the registry builds it, and its closed forms match quadrature", "[flow][potential]") {
+    // The registry (CompiledPotentials) is what scene files, plans and the bindings read: each kind
+    // builds through make_potential with its parameters in order, refuses a wrong count and an
+    // out-of-range value, and, like the classes above, agrees with the generic quadrature path.
+    CHECK(potential_kinds().size() >= 2);
+    std::string kinds;
+    for (const PotentialKind& k : potential_kinds()) kinds += std::string(kinds.empty() ? "'" : ", '") + k.kind + "'";
+    CHECK(kinds.rfind("'harmonic', 'tan'", 0) == 0);
+    CHECK_INVALID(potential_kind("no-such-kind"), "potential kind must be one of " + kinds + ", got 'no-such-kind'");
+    for (const PotentialKind& k : potential_kinds()) {
+        CHECK(&potential_kind(k.kind) == &k);
+        CHECK_INVALID(make_potential(k.kind, std::vector<double>(k.params.size() + 1, 1.0)), "parameter(s)");
+        std::vector<double> bad(k.params.size(), 1.0);
+        bad[0] = k.params[0].hi * 2;
+        CHECK_INVALID(make_potential(k.kind, bad), std::string(k.cls) + ": " + k.params[0].name + " must lie in [");
+        // Two wells per kind: each parameter 1, or alternately 0.8 and 1.9 (clamped into its range).
+        for (const std::array<double, 2>& pattern :
+             {std::array<double, 2>{1.0, 1.0}, std::array<double, 2>{0.8, 1.9}}) {
+            std::vector<double> params;
+            for (std::size_t i = 0; i < k.params.size(); ++i)
+                params.push_back(std::clamp(pattern[i % 2], k.params[i].lo, k.params[i].hi));
+            const std::shared_ptr<const Potential> base = make_potential(k.kind, params);
+            CHECKF(base->name().rfind(k.cls + "(", 0) == 0, "%s named %s", k.kind.c_str(), base->name().c_str());
+            const Numerical num(base);
+            for (double h : {0.05, 0.7, 2.5}) {
+                CHECKF(rel(base->period(h), num.period(h)) < 1e-10, "%s period at h=%g", base->name().c_str(), h);
+                CHECKF(rel(base->action(h), num.action(h)) < 1e-10, "%s action at h=%g", base->name().c_str(), h);
+                const double qm = base->turning_points(h).second;
+                CHECKF(std::fabs(base->angle_of(0.5 * qm, h) - num.angle_of(0.5 * qm, h)) < 1e-10, "%s angle at h=%g",
+                       base->name().c_str(), h);
+            }
+        }
+    }
 }
 
 TEST_CASE("generic turning points at every level", "[flow][potential]") {

@@ -25,11 +25,13 @@ import sys as _sys
 import types as _types
 from typing import TYPE_CHECKING
 
-from ._version import __version__
+from ._deprecated import install as _install_old_paths
+from ._version import __version__ as __version__
 
-# ruff: noqa: F405  (__all__ names what _api holds: star-imported for type checkers, loaded at first use)
-if TYPE_CHECKING:  # what type checkers and editors see; at run time the first use loads it (__getattr__)
+if TYPE_CHECKING:  # what type checkers and editors see; at run time each name loads at its first use (__getattr__)
     from ._api import *  # noqa: F403
+
+_install_old_paths()  # the old module paths (hovering.geometry, ...): a table in _deprecated, no files
 
 # A library's logger: records go where the application sends them (the command line's -v), and
 # nowhere by default (no "No handlers" fallback printing warnings on stderr).
@@ -55,150 +57,66 @@ def simd_width() -> int:
     return truncated.simd_width()
 
 
-__all__ = [
-    "__version__",
-    "paper",
-    "diagnostics",
-    "pipeline",
-    "WorkPrecision",
-    "work_precision",
-    "TruncatedMap",
-    "TruncatedFamily",
-    "IterateResult",
-    "FlowMap",
-    "FlowSteps",
-    "ReturnMap",
-    "Curve",
-    "Above",
-    "Below",
-    "Region",
-    "Status",
-    "FlowStatus",
-    "Geometry",
-    "TrajectoryPoint",
-    "region_mask",
-    "truncated",
-    "flow",
-    "normal",
-    "analysis",
-    "geometry",
-    "rotation_number",
-    "birkhoff_average",
-    "regularity",
-    "hovering_area",
-    "critical_curve",
-    "HoveringArea",
-    "HoveringComponents",
-    "compare_hovering",
-    "HoveringComparison",
-    "ModelVerdicts",
-    "CriticalCurve",
-    "Theory",
-    "theory",
-    "OMEGA_G",
-    "L1",
-    "L2",
-    "k_eps1",
-    "k_eps2",
-    "rho1",
-    "rho2",
-    "K_crit",
-    "rho_crit",
-    "hovering_area_theory",
-    "golden_family",
-    "wrap",
-    "simd_is_avx2",
-    "simd_width",
-    "Potential",
-    "Harmonic",
-    "Tan",
-    "Numerical",
-    "CustomPotential",
-    "check_potential",
-    "Bilinear",
-    "StepSystem",
-    "OnsetParameters",
-    "onset_parameters",
-    "Polynomial",
-    "Section",
-    "ReturnMapResult",
-    "tangential_curve",
-    "TangentialCurve",
-    "CornerCurves",
-    "MapComparison",
-    "corner_curves",
-    "truncated_from_flow",
-    "compare_maps",
-    "forcing_function",
-    "forcing_coefficients",
-    "to_normal",
-    "from_normal",
-    "explore",
-    "save",
-    "load",
-    "show_versions",
-    "OrbitClasses",
-    "classify_orbits",
-    "ConeCrossing",
-    "cone_crossing",
-    "converse_kam",
-    "ImpactZone",
-    "impact_zone",
-    "transit",
-    "BarrierScan",
-    "barrier_scan",
-]
+# The public names: every name python/hovering/_api.py imports (the one list; type checkers read
+# it through the TYPE_CHECKING import above), plus these defined or kept here.
+_OWN = ("__version__", "simd_width", "geometry")
 
-# Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene
-# pipeline): the public API (hovering._api, at the first use of any of its names), the scene
-# pipeline, the figures and the module that joins them; and the old module paths
-# (hovering.geometry, hovering.fullmap, ...), which warn on use (hovering._deprecated).
-_LAZY_MODULES = ("pipeline", "scenes", "plot")
-_OLD_MODULES = (
-    "accuracy",
-    "references",
-    "fullmap",
-    "geometry",
-    "maps",
-    "potentials",
-    "system",
-    "plotting",
-    "figures",
-    "distribute",
-    "sweeps",
-)
+#: {public name: (module, attribute)}, read from _api.py's imports at the first use of a name.
+_PUBLIC: dict | None = None
 
 
-def _load_api() -> None:
-    """Import the public API (:mod:`hovering._api`: the core, numpy, the models and analyses) and
-    keep its names here, so that only the first use pays (later lookups never reach __getattr__)."""
+def _public() -> dict:
+    """The public API's table, from the imports of :mod:`hovering._api` (parsed, not run: each name
+    loads its own module at its first use, and nothing else)."""
+    global _PUBLIC
+    if _PUBLIC is None:
+        import ast
+        import os
+
+        path = os.path.join(os.path.dirname(__file__), "_api.py")
+        with open(path, encoding="utf-8") as f:
+            tree = ast.parse(f.read(), path)
+        table = {}
+        for node in tree.body:
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                module = f"{__name__}.{node.module}" if node.module else __name__
+                for a in node.names:
+                    table[a.asname or a.name] = (module, a.name)
+        _PUBLIC = table
+    return _PUBLIC
+
+
+def _resolve(module: str, attr: str):
+    """``module.attr``, importing only what holds it (a submodule of the package is itself the value)."""
     import importlib
 
-    api = importlib.import_module(f"{__name__}._api")
-    g = globals()
-    for n in __all__:
-        # The API's value wins over a submodule of the same name, as the eager ``from .explore
-        # import explore`` did (importing hovering.explore set the package's attribute first).
-        if hasattr(api, n):
-            g[n] = getattr(api, n)
+    if module == __name__:
+        return importlib.import_module(f"{__name__}.{attr}")
+    try:
+        mod = importlib.import_module(module)
+    except ModuleNotFoundError:  # a submodule of the compiled core (hovering._core.truncated)
+        parent, _, child = module.rpartition(".")
+        mod = getattr(importlib.import_module(parent), child)
+    return getattr(mod, attr)
 
 
 def __getattr__(name: str):
     import importlib
 
-    if name in _LAZY_MODULES or name in _OLD_MODULES:
-        return importlib.import_module(f"{__name__}.{name}")
+    if name == "__all__":
+        value = [*_OWN[:2], *_public(), *_OWN[2:]]
+        globals()["__all__"] = value
+        return value
     if name.startswith("__") and name.endswith("__"):  # Python's probes, not names of ours
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    if name in __all__:
-        # Asked again, half-loaded, while _api itself imports (``from . import analysis``): the
-        # name is not there yet, the AttributeError lets the import system import the submodule.
-        _load_api()
-        if name in globals():
-            return globals()[name]
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    # Any other submodule is imported alone: the package's own modules ask for theirs this way
-    # (``from . import _untrusted`` looks here first), also while the API is half imported.
+    if name in _public():
+        # Only the module that holds the name (and what it imports): hovering.TruncatedMap loads
+        # the truncated map, not the analyses or the diagnostics.
+        value = _resolve(*_public()[name])
+        globals()[name] = value
+        return value
+    # Any other submodule is imported alone (scenes, plot, pipeline; an old path, which
+    # hovering._deprecated's finder serves): the package's own modules ask for theirs this way too.
     import importlib.util
 
     if name.isidentifier() and importlib.util.find_spec(f"{__name__}.{name}") is not None:
@@ -207,7 +125,7 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list:
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(__getattr__("__all__")))
 
 
 #: Public functions named as the submodule that holds them: the name is the function.

@@ -1,18 +1,21 @@
-"""The public API of :mod:`hovering`, loaded on first use.
+"""The public API of :mod:`hovering`: the one list of its names, as the imports that define them.
 
-``import hovering`` itself imports neither the compiled core nor numpy (``hovering --version``
-answers in milliseconds); the package's ``__getattr__`` imports this module the first time any of
-its names is used, and from then on the package holds them all, as an eager import would. Importing
-it also registers the hooks the models' convenience methods call (:func:`hovering.interface.hook`).
+It is read, not run: ``import hovering`` imports neither the compiled core nor numpy
+(``hovering --version`` answers in milliseconds), and the package's ``__getattr__`` parses these
+imports to load, at the first use of a name, the module that holds it and nothing else
+(``hovering.TruncatedMap`` loads the truncated map, not the analyses or the diagnostics; SPEC 1's
+lazy loading from a stub). Type checkers and editors see them through the package's
+``TYPE_CHECKING`` import. Importing this module loads the whole API at once.
 """
 
 from __future__ import annotations
 
 # ruff: noqa: F401  (every name here is re-exported by the package's __getattr__)
-from . import _core, analysis, flow, normal, paper, truncated
+from . import analysis, diagnostics, flow, normal, paper, pipeline, truncated
+from ._core.truncated import simd_is_avx2
 from ._enums import FlowStatus, Geometry, Region, Status, region_mask, wrap
-from ._provenance import show_versions
-from ._serial import load, save
+from ._io.provenance import show_versions
+from ._io.serial import load, save
 from .analysis import (
     BarrierScan,
     ConeCrossing,
@@ -32,12 +35,13 @@ from .analysis import (
     critical_curve,
     hovering_area,
     impact_zone,
+    impact_zone_floor,
     regularity,
     rotation_number,
     transit,
 )
 from .curve import Above, Below, Curve
-from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
+from .diagnostics import WorkPrecision, accurate_flow_map, work_precision
 from .explore import explore
 from .flow import (
     Bilinear,
@@ -89,5 +93,3 @@ from .truncated import (
     rho_crit,
 )
 from .truncated.theory import theory
-
-simd_is_avx2 = _core.truncated.simd_is_avx2

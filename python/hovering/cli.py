@@ -135,7 +135,7 @@ def _scene(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._output import output_path
+    from ._io.output import output_path
     from .scenes import load_scene
 
     try:
@@ -163,7 +163,7 @@ def _demo(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._output import output_path
+    from ._io.output import output_path
     from .scenes import packaged_scene, parse_scene
 
     path = packaged_scene("demo")
@@ -185,7 +185,7 @@ def _demo(args) -> int:
 def _plan(args) -> int:
     from pathlib import Path
 
-    from ._output import refuse_foreign
+    from ._io.output import refuse_foreign
     from .scenes import load_scene
     from .scenes.plan import write_plan
 
@@ -213,7 +213,7 @@ def _redraw(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._output import output_path
+    from ._io.output import output_path
     from .pipeline import redraw
 
     try:
@@ -235,8 +235,8 @@ def _accuracy(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ._output import output_path, refuse_foreign, savefig, write_text
-    from ._provenance import provenance
+    from ._io.output import output_path, refuse_foreign, savefig, write_text
+    from ._io.provenance import provenance
     from .diagnostics import work_precision
     from .flow.section import Section
     from .scenes import load_scene

@@ -40,6 +40,7 @@ from ._enums import Region, Status, wrap
 from ._style import REGION_COLORS
 from .interface import require_map
 from .normal.flowmap import FlowMap
+from .plot.primitives import break_seam
 
 __all__ = [
     "explore",
@@ -60,10 +61,9 @@ DEFAULT_N_STEPS = {"truncated": 2000, "flow": 500}
 #: Most steps per orbit :func:`explore` accepts (one orbit of the flow at 1e7 returns is ~100 s).
 MAX_N_STEPS = 10**7
 
-#: Colour of the points of each region: :data:`hovering.plot.style.REGION_COLORS`, plus one for the
-#: flow's Region.MULTI (two or more impacts in one return), which the truncated maps never produce
-#: (if the plotting module gains its own, that one wins).
-COLORS = {Region.MULTI: "#8172b3", **REGION_COLORS}
+#: Colour of the points of each region (the flow's Region.MULTI included): the package's one table,
+#: :data:`hovering._style.REGION_COLORS`, under the name this module has always exported.
+COLORS = REGION_COLORS
 _NO_REGION_COLOR = "0.5"
 
 # Status names are terse; the title says what they mean for a clicked orbit.
@@ -522,7 +522,7 @@ class Explorer:
                 phi = wrap(getattr(self.map, fn)(K))
             except (ValueError, AttributeError):  # no onset parameters: no lines
                 return
-            self.ax.plot(_break(phi), K, color="0.6", lw=0.8, ls=ls, zorder=1)
+            self.ax.plot(break_seam(phi), K, color="0.6", lw=0.8, ls=ls, zorder=1)
             self.ax.annotate(
                 fn,
                 (phi[-1], K[-1]),
@@ -535,7 +535,7 @@ class Explorer:
         Kn = K[K < 0]
         if hasattr(self.map, "corner_curves") and Kn.size:
             for phi in self.map.corner_curves(Kn).values():
-                self.ax.plot(_break(phi), Kn, color="k", lw=0.6, ls=":", zorder=2)
+                self.ax.plot(break_seam(phi), Kn, color="k", lw=0.6, ls=":", zorder=2)
 
     def _update_legend(self) -> None:
         from matplotlib.lines import Line2D
@@ -546,13 +546,6 @@ class Explorer:
         if len(stopped) > _LEGEND_STOPPED:
             handles.append(Line2D([], [], ls="none", label=f"... {len(stopped) - _LEGEND_STOPPED} more stopped"))
         self.ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
-
-
-def _break(phi) -> np.ndarray:
-    """NaN where a wrapped curve jumps across phi = +-pi, so no line is drawn across the plot."""
-    phi = np.array(phi, dtype=float)
-    phi[1:][np.abs(np.diff(phi)) > np.pi] = np.nan
-    return phi
 
 
 def _K_range(value) -> tuple:

@@ -6,19 +6,18 @@ never each other.
 
 from __future__ import annotations
 
-import importlib
 import operator
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, fields
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from ._checks import _short, check_memory, integer, is_choice, real_number
-from ._deprecated import renamed_keywords
+from ._deprecated import moved_method
 from ._display import Summarized, status_counts
 from ._enums import Status, region_mask, status_code
-from ._serial import Saveable
+from ._io.serial import Saveable
 from .curve import StopCondition
 
 __all__ = [
@@ -32,58 +31,7 @@ __all__ = [
     "trajectory_rows",
     "require_map",
     "MAX_TRAJECTORY_POINTS",
-    "register",
-    "hook",
 ]
-
-#: Functions of the layers above the models that the models' convenience methods call
-#: (``m.hovering_area()``, ``FlowMap(accuracy=...)``): each higher module registers its own when
-#: it is imported (:mod:`hovering._api` imports all of them; :func:`hook` loads it on a miss), so
-#: the arrows still point down.
-_HOOKS: dict = {}
-
-
-def register(name: str, fn: Callable | None = None) -> Callable:
-    """Make ``fn`` the implementation of the hook ``name`` (called by the module that owns it);
-    without ``fn``, a decorator that does so.
-
-    Parameters
-    ----------
-    name : str
-        The hook's name (``"hovering_area"``, ``"critical_curve"``, ``"choose_setting"``,
-        ``"check_spec"``).
-    fn : callable, optional
-        Its implementation.
-
-    Returns
-    -------
-    callable
-        ``fn`` (or the decorator).
-    """
-    if fn is None:
-        return lambda f: register(name, f)
-    _HOOKS[name] = fn
-    return fn
-
-
-def hook(name: str) -> Callable:
-    """The implementation registered for ``name``.
-
-    Raises
-    ------
-    RuntimeError
-        If no module registers it (an unknown hook name).
-    """
-    if name not in _HOOKS:
-        # The owners are loaded with the public API (hovering._api), which ``import hovering``
-        # defers to the first use of a name: a model used straight from its module
-        # (``from hovering.normal import FlowMap``) can call a hook before anything loaded them.
-        # By name, as _deprecated resolves moved paths: this layer imports nothing above it.
-        importlib.import_module("hovering._api")
-    try:
-        return _HOOKS[name]
-    except KeyError:
-        raise RuntimeError(f"{name} is provided by no part of hovering (known hooks: {sorted(_HOOKS)})") from None
 
 
 @runtime_checkable
@@ -134,46 +82,16 @@ class ReturnMap(Protocol):
 
 
 class MapAnalyses:
-    """The analyses as methods, for every map (mixed into TruncatedMap, TruncatedFamily, FlowMap)."""
+    """What every map has beside its interface (mixed into TruncatedMap, TruncatedFamily, FlowMap).
 
-    @renamed_keywords(samples="n_samples")
-    def hovering_area(self, n_steps: int = 10_000, n_samples: int = 100_000, **kwargs):
-        """Area of the hovering set HOV(eps), with error estimate and theory; see :func:`hovering.hovering_area`.
+    The analyses are free functions of a map, written once in :mod:`hovering.analysis`
+    (``hovering.hovering_area(m)``, ``hovering.critical_curve(m)``), never methods: a model sits
+    below the analyses and never calls up to them. The methods of those names are deprecated
+    (:func:`hovering._deprecated.moved_method`).
+    """
 
-        Parameters
-        ----------
-        n_steps : int, optional
-            Iterates that count as "never impacts".
-        n_samples : int, optional
-            Sample points (stratified over the box below K = 0); formerly ``samples=`` (deprecated).
-        **kwargs
-            ``K_low``, ``rng``, ``n_threads``, ``keep_points``, ``progress`` (True: a tqdm bar on
-            stderr; a callable ``progress(done, total)``), ``components``, ``deepen``, ``executor``.
-
-        Returns
-        -------
-        HoveringArea
-            ``.area``, ``.error``, ``.theory`` and diagnostics.
-        """
-        return hook("hovering_area")(self, n_steps=n_steps, n_samples=n_samples, **kwargs)
-
-    def critical_curve(self, n_steps: int = 20_000, **kwargs):
-        """Lowest invariant curve in the no-impact regions; see :func:`hovering.critical_curve`.
-
-        Parameters
-        ----------
-        n_steps : int, optional
-            Iterates per tested orbit.
-        **kwargs
-            ``K_range``, ``regions``, ``line``, ``n_grid``, ``digits``, ``tol``, ``n_threads``,
-            ``search``, ``progress`` (True: a tqdm bar on stderr; a callable ``progress(done, total)``).
-
-        Returns
-        -------
-        CriticalCurve
-            ``.K_min``, ``.rotation``, ``.K_pred``, ``.rotation_pred``, ``.hovers``, ``.note``, ...
-        """
-        return hook("critical_curve")(self, n_steps=n_steps, **kwargs)
+    hovering_area = moved_method("hovering_area", "hovering.analysis.hovering_area")
+    critical_curve = moved_method("critical_curve", "hovering.analysis.critical_curve")
 
     def hovers(self) -> bool:
         """Whether the leading-order theory predicts a hovering set for this map (see :meth:`theory`)."""
@@ -431,7 +349,7 @@ class IterateResult(Summarized, Saveable):
         ImportError
             Without xarray, naming ``pip install 'hovering[xarray]'``.
         """
-        from ._interop import iterate_dataset
+        from ._io.interop import iterate_dataset
 
         return iterate_dataset(self)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ._output import is_ours, output_path, refuse_foreign, savefig, write_bytes, write_error
+from ._io.output import is_ours, output_path, refuse_foreign, savefig, write_bytes, write_error
 from .plot.figures import render
 from .plot.primitives import draw_geometry as draw_geometry_lines
 from .plot.primitives import plot_orbits
@@ -43,7 +43,7 @@ def run_scene(
 
     Where it writes: ``out`` if given, else the scene's ``output``, which must lie under the scene
     file's folder or the working directory. It replaces only files hovering wrote (results,
-    sidecars, checkpoints, and figures beside them; see :mod:`hovering._output`): any other file
+    sidecars, checkpoints, and figures beside them; see :mod:`hovering._io.output`): any other file
     in the way is refused before anything is computed, unless ``force``. Every file is written
     atomically (a kill or a full disk leaves the previous ones intact); the figure is written last.
 
@@ -78,7 +78,7 @@ def run_scene(
     ------
     ValueError
         For an output path outside the allowed folders, a file in the way that hovering did not
-        write, or a failed write (:class:`hovering._output.WriteError`, e.g. ``no space left``).
+        write, or a failed write (:class:`hovering._io.output.WriteError`, e.g. ``no space left``).
     """
     t0 = time.perf_counter()
     png = (

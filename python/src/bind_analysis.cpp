@@ -165,6 +165,10 @@ void register_analysis(py::module_& m) {
         "(area, sampling_error) of the part of hovering_area's box holding count of its n samples.");
     m.def("default_depth", &default_depth, py::arg("eps"), py::arg("Omega0"), py::arg("forcing"),
           "Depth of hovering_area's default box below K = 0 (inf when not finite and positive).");
+    m.def("box_floor", &box_floor, py::arg("band_lo"),
+          "The deepest box bottom inside a band whose lower end is band_lo: band_lo (1 - 1e-9).");
+    m.def("default_K_low", &default_K_low, py::arg("eps"), py::arg("Omega0"), py::arg("forcing"), py::arg("band_lo"),
+          "Bottom of hovering_area's default box: -default_depth (0.1 at eps = 0), raised to box_floor(band_lo).");
     m.def(
         "first_order_shape",
         [](const std::vector<double>& b, double Omega0, const darray& psi) {

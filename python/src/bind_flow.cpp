@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,14 +59,17 @@ void register_flow(py::module_& m) {
     py::tuple steppers(kSteppers.size());
     for (std::size_t i = 0; i < kSteppers.size(); ++i) steppers[i] = kSteppers[i];
     m.attr("STEPPERS") = steppers;  // the names FlowOptions.stepper takes, its default first
+    m.def("default_atol", &FlowOptions::default_atol, py::arg("rtol"),
+          "The absolute tolerance wherever none is given (FlowOptions.default_atol: rtol's).");
 
     py::class_<FlowOptions>(m, "FlowOptions", "Integrator settings of the return map (validated on use).")
-        .def(py::init([](std::string stepper, double rtol, double atol, double event_tol, std::int64_t max_steps,
-                         int max_impacts, double grazing_tol, double corner_tol, std::int64_t verify_steps) {
+        .def(py::init([](const std::string& stepper, double rtol, std::optional<double> atol, double event_tol,
+                         std::int64_t max_steps, int max_impacts, double grazing_tol, double corner_tol,
+                         std::int64_t verify_steps) {
                  FlowOptions o;
-                 o.stepper = std::move(stepper);
+                 o.stepper = parse_stepper(stepper);  // the one place a name becomes a Stepper
                  o.rtol = rtol;
-                 o.atol = atol;
+                 o.atol = atol ? *atol : FlowOptions::default_atol(rtol);
                  o.event_tol = event_tol;
                  o.max_steps = max_steps;
                  o.max_impacts = max_impacts;
@@ -75,13 +79,17 @@ void register_flow(py::module_& m) {
                  o.validate();
                  return o;
              }),
-             // The core's defaults (FlowOptions{}), the one place they are written.
-             py::arg("stepper") = FlowOptions{}.stepper, py::arg("rtol") = FlowOptions{}.rtol,
-             py::arg("atol") = FlowOptions{}.atol, py::arg("event_tol") = FlowOptions{}.event_tol,
+             // The core's defaults (FlowOptions{}), the one place they are written; atol None:
+             // FlowOptions::default_atol(rtol), the one policy.
+             py::arg("stepper") = std::string(stepper_name(FlowOptions{}.stepper)),
+             py::arg("rtol") = FlowOptions{}.rtol,
+             py::arg("atol") = py::none(), py::arg("event_tol") = FlowOptions{}.event_tol,
              py::arg("max_steps") = FlowOptions{}.max_steps, py::arg("max_impacts") = FlowOptions{}.max_impacts,
              py::arg("grazing_tol") = FlowOptions{}.grazing_tol, py::arg("corner_tol") = FlowOptions{}.corner_tol,
              py::arg("verify_steps") = FlowOptions{}.verify_steps)
-        .def_readonly("stepper", &FlowOptions::stepper)
+        .def_property_readonly(
+            "stepper", [](const FlowOptions& o) { return std::string(stepper_name(o.stepper)); },
+            "The stepper's name (an entry of STEPPERS).")
         .def_readonly("rtol", &FlowOptions::rtol)
         .def_readonly("atol", &FlowOptions::atol)
         .def_readonly("event_tol", &FlowOptions::event_tol)

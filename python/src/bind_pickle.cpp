@@ -108,8 +108,8 @@ void register_pickles(py::module_& core) {
     py::class_<FlowOptions> fo(flow.attr("FlowOptions"));
     fo.def(py::pickle(
         [](const FlowOptions& o) -> py::object {
-            return py::make_tuple(o.stepper, o.rtol, o.atol, o.event_tol, o.max_steps, o.max_impacts, o.grazing_tol,
-                                  o.corner_tol, o.verify_steps);
+            return py::make_tuple(std::string(stepper_name(o.stepper)), o.rtol, o.atol, o.event_tol, o.max_steps,
+                                  o.max_impacts, o.grazing_tol, o.corner_tol, o.verify_steps);
         },
         [](const py::object& state) {
             // Pickles from before verify_steps hold 8 entries: they get its default.
@@ -119,7 +119,7 @@ void register_pickles(py::module_& core) {
                 "(stepper, rtol, atol, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)");
             FlowOptions o;
             try {
-                o.stepper = t[0].cast<std::string>();
+                o.stepper = parse_stepper(t[0].cast<std::string>());
                 o.rtol = t[1].cast<double>();
                 o.atol = t[2].cast<double>();
                 o.event_tol = t[3].cast<double>();

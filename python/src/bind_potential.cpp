@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "gil.hpp"
 #include "hovering/flow/system.hpp"
@@ -256,6 +257,57 @@ py::tuple state_tuple(const py::handle& state, std::size_t n, const char* cls, c
     return py::reinterpret_borrow<py::tuple>(state);
 }
 
+/// Bind one compiled potential P from its kInfo: constructor (each argument through real_arg, named
+/// in a wrong type's message), a read-only property per parameter, and pickling by the parameters
+/// (the state is what the constructor takes: unpickling runs its checks again).
+template <class P, std::size_t... I>
+void bind_kind(py::module_& m, std::index_sequence<I...>) {
+    constexpr std::size_t n = sizeof...(I);
+    const std::string doc = std::string(P::kInfo.formula) + " (closed-form action-angle).";
+    py::class_<P, Potential, std::shared_ptr<P>> c(m, P::kInfo.cls, doc.c_str());
+    c.def(py::init([](decltype((void)I, py::handle())... a) {
+              return std::make_shared<P>(real_arg(a, P::kInfo.cls, P::kInfo.params[I].name)...);
+          }),
+          py::arg(P::kInfo.params[I].name)...);
+    (c.def_property_readonly(P::kInfo.params[I].name, [](const P& p) { return p.parameters()[I]; }), ...);
+    std::string fields = "(";
+    for (const PotentialParam& q : P::kInfo.params) fields += std::string(q.name) + ", ";
+    fields = fields.substr(0, fields.size() - 2) + (n == 1 ? ",)" : ")");
+    c.def(py::pickle(
+        [](const P& p) {
+            const auto v = p.parameters();
+            return py::object(py::make_tuple(v[I]...));
+        },
+        [fields](const py::object& state) {
+            const py::tuple t = state_tuple(state, n, P::kInfo.cls, fields.c_str());
+            return std::make_shared<P>(real_arg(t[I], P::kInfo.cls, P::kInfo.params[I].name)...);
+        }));
+}
+
+/// Bind every compiled potential (the core's registry, CompiledPotentials) and its list of kinds.
+template <class... P>
+void bind_compiled(py::module_& m, PotentialList<P...>) {
+    (bind_kind<P>(m, std::make_index_sequence<P::kInfo.params.size()>{}), ...);
+    py::class_<PotentialParam>(m, "PotentialParam", "A parameter of a compiled potential: its name and range.")
+        .def_property_readonly("name", [](const PotentialParam& p) { return std::string(p.name); })
+        .def_readonly("lo", &PotentialParam::lo)
+        .def_readonly("hi", &PotentialParam::hi)
+        .def("__repr__", [](const PotentialParam& p) {
+            return "PotentialParam(" + std::string(p.name) + " in [" + fmt(p.lo) + ", " + fmt(p.hi) + "])";
+        });
+    py::class_<PotentialKind>(m, "PotentialKind",
+                              "A compiled potential kind: its name in scene files and plans, its class, its "
+                              "formula and its parameters in the constructor's order.")
+        .def_readonly("kind", &PotentialKind::kind)
+        .def_readonly("cls", &PotentialKind::cls)
+        .def_readonly("formula", &PotentialKind::formula)
+        .def_readonly("params", &PotentialKind::params)
+        .def("__repr__", [](const PotentialKind& k) { return "PotentialKind(" + k.kind + ": " + k.cls + ")"; });
+    py::tuple kinds(potential_kinds().size());
+    for (std::size_t i = 0; i < potential_kinds().size(); ++i) kinds[i] = py::cast(potential_kinds()[i]);
+    m.attr("POTENTIAL_KINDS") = kinds;  // the core's registry, in its order
+}
+
 /// Pickling of the potentials and the onset parameters (protocol 2+, copy, deepcopy): the state is
 /// what the constructor takes, and unpickling runs the constructor's checks again. A Python subclass
 /// of Potential keeps its instance dict (its class must be importable, as for any pickled class);
@@ -268,18 +320,6 @@ void register_potential_pickles(py::module_& m) {
                                throw py::value_error("Potential.__setstate__: expected the instance dict, got " +
                                                      short_repr(state));
                            return std::make_pair(new PyPotential(), py::reinterpret_borrow<py::dict>(state));
-                       }));
-    py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>> harmonic(m.attr("Harmonic"));
-    harmonic.def(py::pickle([](const Harmonic& p) { return py::object(py::make_tuple(p.omega())); },
-                            [](const py::object& state) {
-                                const py::tuple t = state_tuple(state, 1, "Harmonic", "(omega,)");
-                                return std::make_shared<Harmonic>(real_arg(t[0], "Harmonic", "omega"));
-                            }));
-    py::class_<Tan, Potential, std::shared_ptr<Tan>> tan(m.attr("Tan"));
-    tan.def(py::pickle([](const Tan& p) { return py::object(py::make_tuple(p.omega(), p.alpha())); },
-                       [](const py::object& state) {
-                           const py::tuple t = state_tuple(state, 2, "Tan", "(omega, alpha)");
-                           return std::make_shared<Tan>(real_arg(t[0], "Tan", "omega"), real_arg(t[1], "Tan", "alpha"));
                        }));
     py::class_<Numerical, Potential, std::shared_ptr<Numerical>> numerical(m.attr("Numerical"));
     numerical.def(py::pickle(
@@ -370,20 +410,7 @@ void register_potential(py::module_& m) {
                      "of the wrong kind: a ValueError, and the TypeError V and V' raised for it before."));
     pot.attr("ReturnError") = err;
     potential_return_error = err.release().ptr();
-    py::class_<Harmonic, Potential, std::shared_ptr<Harmonic>>(m, "Harmonic",
-                                                               "V = omega^2 q^2 / 2 (closed-form action-angle).")
-        .def(
-            py::init([](py::handle omega) { return std::make_shared<Harmonic>(real_arg(omega, "Harmonic", "omega")); }),
-            py::arg("omega"))
-        .def_property_readonly("omega", &Harmonic::omega);
-    py::class_<Tan, Potential, std::shared_ptr<Tan>>(
-        m, "Tan", "V = omega^2 / (2 alpha^2) tan^2(alpha q) (closed-form action-angle).")
-        .def(py::init([](py::handle omega, py::handle alpha) {
-                 return std::make_shared<Tan>(real_arg(omega, "Tan", "omega"), real_arg(alpha, "Tan", "alpha"));
-             }),
-             py::arg("omega"), py::arg("alpha"))
-        .def_property_readonly("omega", &Tan::omega)
-        .def_property_readonly("alpha", &Tan::alpha);
+    bind_compiled(m, CompiledPotentials{});
     py::class_<Numerical, Potential, std::shared_ptr<Numerical>>(
         m, "Numerical", "Answers every energy question of another potential by GSL quadrature and root finding.")
         .def(py::init([](const py::object& base) { return std::make_shared<Numerical>(keep_python_alive(base)); }),

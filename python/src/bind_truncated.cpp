@@ -234,8 +234,11 @@ void register_truncated(py::module_& mod) {
     mod.def("simd_is_avx2", &simd_is_avx2, "Whether the selected SIMD lane kernel uses AVX2 or wider vectors.");
     mod.def("simd_width", &simd_width,
             "Doubles per SIMD packet of the selected lane kernel (8 AVX-512, 4 AVX2, 2 SSE2).");
-    mod.def("simd_level", &simd_level, "Instruction set of the selected lane kernel: 'sse2', 'avx2', 'avx512'.");
+    mod.def("simd_level", &simd_level,
+            "Instruction set of the selected SIMD kernels (the truncated map's lanes, the flow's Taylor "
+            "expansion): 'sse2', 'avx2', 'avx512'.");
     mod.def("simd_levels", &simd_levels, "The lane kernels of this build that this CPU runs, narrowest first.");
     mod.def("set_simd_level", &set_simd_level, py::arg("level"),
-            "Select the lane kernel by name ('auto': the widest this CPU runs); ValueError names the allowed ones.");
+            "Select the SIMD kernels' level by name ('auto': the widest this CPU runs); ValueError names the "
+            "allowed ones.");
 }

@@ -131,7 +131,7 @@ def test_hovering_area_matches_brute_force_and_theory(eps):
     m = paper_map(eps)
     p = dict(PAPER, eps=eps)
     K_low = -2 * eps / math.sin(PAPER["Omega0"] / 2)
-    hv = m.hovering_area(n_steps=2000, n_samples=40_000, K_low=K_low, rng=1)
+    hv = hovering.hovering_area(m, n_steps=2000, n_samples=40_000, K_low=K_low, rng=1)
     bf, bf_sigma = brute_force_area(p, 2000, 160, 40, K_low)
     # Two independent estimates of one area (different point sets, different implementations):
     # they differ by sampling noise only; 3 combined standard deviations + both iteration errors.
@@ -146,13 +146,13 @@ def test_hovering_area_matches_brute_force_and_theory(eps):
 
 @pytest.mark.parametrize("eps", [-0.1, -0.2])
 def test_hovering_set_is_empty_for_negative_eps(eps):
-    hv = paper_map(eps).hovering_area(n_steps=4000, n_samples=40_000)
+    hv = hovering.hovering_area(paper_map(eps), n_steps=4000, n_samples=40_000)
     assert hv.area == 0.0 and hv.theory == 0.0
 
 
 def test_hovering_area_grows_monotonically_in_eps():
     eps = [0.05, 0.1, 0.15, 0.2, 0.25, 0.3]
-    hv = [paper_map(e).hovering_area(n_steps=4000, n_samples=40_000, K_low=-0.7) for e in eps]
+    hv = [hovering.hovering_area(paper_map(e), n_steps=4000, n_samples=40_000, K_low=-0.7) for e in eps]
     areas = np.array([h.area for h in hv])
     errs = np.array([h.error for h in hv])
     # Each increment exceeds the combined errors of its two ends (increments ~0.12 vs errors ~0.02).
@@ -161,15 +161,15 @@ def test_hovering_area_grows_monotonically_in_eps():
 
 def test_hovering_area_reports_errors_and_validates():
     m = paper_map(0.2)
-    hv = m.hovering_area(n_steps=400, n_samples=2000, keep_points=True)
+    hv = hovering.hovering_area(m, n_steps=400, n_samples=2000, keep_points=True)
     n4, n2, n1 = sorted(hv.areas)
     assert hv.areas[n4] >= hv.areas[n2] >= hv.areas[n1] == hv.area  # estimates only fall with N
     assert hv.error == pytest.approx(2 * hv.sampling_error + hv.iteration_error)
     assert hv.hovering.sum() / hv.n_samples * 2 * np.pi * -hv.box[2] == pytest.approx(hv.area)
     with pytest.raises(ValueError, match="K_low must lie in the band below 0"):
-        m.hovering_area(K_low=0.1)
+        hovering.hovering_area(m, K_low=0.1)
     with pytest.raises(ValueError, match=r"n_steps must be an integer in \[4, "):
-        m.hovering_area(n_steps=2)
+        hovering.hovering_area(m, n_steps=2)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -180,7 +180,7 @@ def test_critical_curve_at_paper_parameters():
     # eq:rhocrit predicts rho_c = 3.7694 at eps = 0.3; the paper measures 3.79 for the orbit
     # started at K~_c. The issue asks for agreement to 0.03.
     m = paper_map(0.3)
-    cc = m.critical_curve(n_steps=20_000)
+    cc = hovering.critical_curve(m, n_steps=20_000)
     assert abs(cc.rotation - cc.rotation_pred) < 0.03
     assert abs(cc.rotation_pred - 3.7694) < 1e-4
     # Its lowest point is near K~_c (eq:kcrit, O(eps^2) = 0.09 away at most) and on L1 (the start).
@@ -199,9 +199,9 @@ def test_golden_family_critical_rotation_and_monotone_area():
     for eps in (0.15, 0.3):
         for c in (-0.9, 0.0, 0.9):
             m = hovering.TruncatedMap(eps, *hovering.golden_family(eps, c))
-            devs[eps, c] = abs(m.critical_curve(n_steps=20_000).rotation - hovering.OMEGA_G)
+            devs[eps, c] = abs(hovering.critical_curve(m, n_steps=20_000).rotation - hovering.OMEGA_G)
             if eps == 0.3:
-                areas[c] = m.hovering_area(n_steps=3000, n_samples=30_000).area
+                areas[c] = hovering.hovering_area(m, n_steps=3000, n_samples=30_000).area
     # Measured deviations <= 0.0024 at eps 0.15 and <= 0.0098 at 0.3; bound 0.15 eps^2.
     for (eps, c), d in devs.items():
         assert d < 0.15 * eps**2, (eps, c, d)
@@ -212,12 +212,12 @@ def test_lowest_curve_above_the_step_for_both_signs():
     # k^{u0}: the lowest curve in K >= 0. For eps > 0 its minimum is near L1, for eps < 0 near L2,
     # and F_eps(phi, K) = F_{-eps}(phi + pi, K) above the step makes the two mirror images:
     # equal rotation numbers (paper, before thm:hoveringc).
-    up = paper_map(0.3).critical_curve(n_steps=20_000, regions=("0u",), K_range=(1e-6, 0.5), line="L1")
-    dn = paper_map(-0.3).critical_curve(n_steps=20_000, regions=("0u",), K_range=(1e-6, 0.5), line="L2")
+    up = hovering.critical_curve(paper_map(0.3), n_steps=20_000, regions=("0u",), K_range=(1e-6, 0.5), line="L1")
+    dn = hovering.critical_curve(paper_map(-0.3), n_steps=20_000, regions=("0u",), K_range=(1e-6, 0.5), line="L2")
     assert up.K_min >= 0 and dn.K_min >= 0
     assert abs(up.rotation - dn.rotation) < 1e-3
     with pytest.raises(RuntimeError, match="no invariant curve"):
-        paper_map(0.3).critical_curve(n_steps=2000, K_range=(-0.6, -0.5), n_grid=4)
+        hovering.critical_curve(paper_map(0.3), n_steps=2000, K_range=(-0.6, -0.5), n_grid=4)
 
 
 def test_critical_curve_is_a_rotational_curve_not_an_island():
@@ -228,7 +228,7 @@ def test_critical_curve_is_a_rotational_curve_not_an_island():
 
     m = hovering.TruncatedMap(0.92, *hovering.golden_family(0.92, -0.9))
     lo = m.valid_band()[0]
-    cc = m.critical_curve(n_steps=20_000, K_range=(lo * 0.999, 0.5))
+    cc = hovering.critical_curve(m, n_steps=20_000, K_range=(lo * 0.999, 0.5))
     assert cc.K_min > -1.5
     assert max_angular_gap(cc.phi) < 20 * 2 * np.pi / 20_000
     island = m.iterate([m.L1(-2.73)], [-2.73], 6000, record=("orbit",))

@@ -297,7 +297,7 @@ def test_a_flow_zone_keeps_its_floor_torus_below_the_band_and_scans_from_it():
     zone = hovering.impact_zone(fm, n_steps=1000)
     lo = fm.valid_band()[0]
     assert zone.floor_kind == "flow" and not zone.raised and zone.floor.K.min() < lo
-    assert zone.floor == fm.impact_zone_floor(n_steps=1000).curve
+    assert zone.floor == hovering.impact_zone_floor(fm, n_steps=1000).curve
     phi_low = float(zone.floor.phi[np.argmin(zone.floor.K)])
     r = hovering.barrier_scan(fm, zone, n_starts=4, n_steps=300, line=phi_low, s_range=(0.0, 0.02))
     assert r.K0[0] < lo and np.all(r.status == hovering.Status.OK)

@@ -302,7 +302,7 @@ def test_critical_curve_is_the_lowest_circle_on_L1():
     regions) puts the lowest no-impact circle at K_min on L1. Starts at and above it are circles;
     starts up to 0.02 below it are not (within the 0.004 spacing of the starts)."""
     m = hovering.paper.truncated_map(0.3)
-    K_min = m.critical_curve(n_steps=20_000).K_min
+    K_min = hovering.critical_curve(m, n_steps=20_000).K_min
     K0 = K_min + 0.004 * np.arange(-5, 6)
     c = hovering.classify_orbits(m.iterate(m.L1(K0), K0, 20_000, record=("orbit",)))
     assert np.all(c.kind[5:] == "circle"), c.kind

@@ -179,7 +179,7 @@ def test_demo_old_flags_still_work_with_a_deprecation_line(tmp_path, capsys):
 
 # Where the package may print: the command line (cli.py, the explorer's own command line) and
 # show_versions, whose job is printing the record; everything else logs.
-ALLOWED = {("cli.py", None), ("explore.py", "main"), ("_provenance.py", "show_versions")}
+ALLOWED = {("cli.py", None), ("explore.py", "main"), ("_io/provenance.py", "show_versions")}
 
 
 def _prints(tree) -> list:

@@ -7,6 +7,7 @@ they moved to the core)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -132,9 +133,17 @@ def test_integrator_defaults_and_steppers_are_the_cores():
     assert hv.flow.STEPPERS == tuple(_core.flow.STEPPERS) and hv.flow.STEPPERS[0] == d.stepper
     o = hv.flow.flow_options()
     assert (o.stepper, o.rtol, o.atol, o.max_steps) == (d.stepper, d.rtol, d.atol, d.max_steps)
-    assert hv.flow.flow_options(rtol=1e-8).rtol == 1e-8 and hv.flow.flow_options(rtol=1e-8).atol == d.atol
+    # One atol policy, the core's: where none is given atol is rtol's (FlowOptions::default_atol),
+    # for the core's own defaults, for flow_options (Section.return_map), FlowMap and the scenes.
+    assert d.atol == d.rtol == _core.flow.default_atol(d.rtol)
+    assert hv.flow.flow_options(rtol=1e-8).rtol == 1e-8 and hv.flow.flow_options(rtol=1e-8).atol == 1e-8
+    assert hv.flow.flow_options(rtol=1e-8, atol=1e-13).atol == 1e-13
     fm = paper.flow_map(0.05, coordinates="section")
-    # A FlowMap's atol defaults to its rtol (the map's documented rule), the rest is the core's.
     assert fm.integrator_options == dict(rtol=d.rtol, atol=d.rtol, stepper=d.stepper)
-    with pytest.raises(ValueError, match=r"stepper must be one of \('rk8pd', 'rkck'"):
+    spec = hv.scenes.load_scene(Path(hv.scenes.__file__).parent / "data" / "demo.toml", check_output=False)
+    assert (spec.integrator.stepper, spec.integrator.rtol, spec.integrator.atol) == (d.stepper, 1e-10, 1e-10)
+    # The stepper is parsed once, by the core: its message names the value and every stepper.
+    with pytest.raises(
+        ValueError, match=r"stepper must be one of rk8pd, rkck, .*GSL's bsimp and msbdf are not offered.*got 'euler'"
+    ):
         hv.flow.flow_options(stepper="euler")

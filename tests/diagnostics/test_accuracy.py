@@ -19,7 +19,7 @@ import pytest
 
 import hovering
 from hovering import FlowMap, Section, paper
-from hovering.diagnostics import choose_setting
+from hovering.diagnostics import accurate_flow_map, choose_setting
 from hovering.diagnostics.work_precision import _reference_run
 from hovering.paper import V2, system
 
@@ -103,7 +103,7 @@ def test_plot_has_one_curve_per_method_and_the_long_orbit_panel(wp_step):
 @pytest.mark.parametrize("accuracy", [1e-6, 1e-9, 1e-12])
 def test_accuracy_target_holds_on_fresh_points(accuracy):
     sec = Section(system(0.05), 1.0)
-    fm = FlowMap(system(0.05), 1.0, coordinates="section", accuracy=accuracy)
+    fm = accurate_flow_map(system(0.05), 1.0, accuracy, coordinates="section")
     opts = fm.integrator_options
     assert fm.accuracy_choice["error"] <= accuracy and fm.accuracy_choice["seconds"] > 0
     # the choice, run on 200 points it was not measured on, against the rk8pd 1e-14 reference;
@@ -126,9 +126,21 @@ def test_looser_targets_never_cost_more():
 def test_unreachable_target_names_the_best_reachable():
     # The best error measured and its setting (method and tolerance).
     with pytest.raises(ValueError, match=r"not reached.*best measured is [\d.e+-]+ \(\w+ at [\d.e+-]+;"):
-        FlowMap(system(0.05), 1.0, coordinates="section", accuracy=1e-17)
+        accurate_flow_map(system(0.05), 1.0, 1e-17, coordinates="section")
     with pytest.raises(ValueError, match="accuracy"):
-        FlowMap(system(0.05), 1.0, coordinates="section", accuracy=2.0)
+        accurate_flow_map(system(0.05), 1.0, 2.0, coordinates="section")
+    with pytest.raises(ValueError, match=r"accuracy picks the stepper and tolerances itself; remove \['rtol'\]"):
+        accurate_flow_map(system(0.05), 1.0, 1e-9, rtol=1e-8)
+
+
+def test_the_old_form_warns_and_gives_the_builders_map():
+    # FlowMap(accuracy=) is deprecated: the target is resolved above the models, by the builder;
+    # the old form still measures the same setting (found by name through hovering._deprecated).
+    new = accurate_flow_map(system(0.0), 1.0, 1e-9, coordinates="section")
+    with pytest.warns(DeprecationWarning, match=r"FlowMap\(accuracy=\.\.\.\) is deprecated .*accurate_flow_map"):
+        old = FlowMap(system(0.0), 1.0, coordinates="section", accuracy=1e-9)
+    assert old.integrator_options == new.integrator_options and old.accuracy_choice["method"] == "exact"
+    np.testing.assert_array_equal(old.step(0.3, 0.2), new.step(0.3, 0.2))
 
 
 def test_scene_accuracy_key(tmp_path):

@@ -30,7 +30,7 @@ def test_every_analysis_runs_on_every_map(maps, kind):
     hov = hv.hovering_area(m, n_steps=400, n_samples=400)
     assert hov.area > 0 and abs(hov.area - th.area) < hov.error + 0.25 * th.area
     assert hov.area_both_sides == pytest.approx(hov.area)  # near the tangency all of HOV is hovering proper
-    cc = m.critical_curve(n_steps=600, n_grid=16, tol=1e-3)
+    cc = hv.critical_curve(m, n_steps=600, n_grid=16, tol=1e-3)
     # eq:kcrit: within O(eps^2) (and the flow's forcing b_1 eps) of the prediction, rotation to O(eps^2)
     assert cc.hovers and abs(cc.K_min - th.K_crit) < 0.5 * abs(th.K_crit)
     assert abs(cc.rotation - th.rho_crit) < 0.05

@@ -68,10 +68,10 @@ def test_a_coupling_even_in_q2_has_no_first_order_forcing_but_hovers_through_hig
     assert th.hovers and th.hovering_sign == 1 and th.area == pytest.approx(0.002447, rel=1e-3)
     # The flow agrees: it hovers for eps > 0 (1000 stratified samples, 400 returns; the estimate
     # 0.0022 +- 0.0004 against the theory's 0.00245, within 2 error bars) and not for eps < 0.
-    ha = fm.hovering_area(n_steps=400, n_samples=1000)
+    ha = hv.hovering_area(fm, n_steps=400, n_samples=1000)
     assert ha.area > 0 and abs(ha.area - th.area) < 2 * ha.error
     neg = fm.with_eps(-0.05)
-    assert not neg.theory().hovers and neg.hovering_area(n_steps=400, n_samples=1000).area == 0.0
+    assert not neg.theory().hovers and hv.hovering_area(neg, n_steps=400, n_samples=1000).area == 0.0
     # Its model carries the same forcing, b_1 = 0: the first-mode model is F_0.
     assert fm.truncated().theory().forcing[0] == 0.0 and fm.truncated(forcing="first_mode").eps == 0.0
 

@@ -107,9 +107,9 @@ def test_critical_curve_on_a_vertical_line_at_the_seam(truncated_maps):
     # finds the same curve (continuity; the grid and bisection are the same).
     m = truncated_maps["TruncatedMap"]
     kw = dict(n_steps=512, n_grid=8, K_range=(-0.6, 0.4), tol=1e-3, n_threads=1)
-    a = m.critical_curve(line=-PI, **kw)
-    assert m.critical_curve(line=PI, **kw).K0 == a.K0
-    assert abs(m.critical_curve(line=HIGH[0], **kw).K0 - a.K0) <= 2e-3
+    a = hv.critical_curve(m, line=-PI, **kw)
+    assert hv.critical_curve(m, line=PI, **kw).K0 == a.K0
+    assert abs(hv.critical_curve(m, line=HIGH[0], **kw).K0 - a.K0) <= 2e-3
 
 
 # ------------------------------------------------------------------ the flow

@@ -39,8 +39,8 @@ import pytest  # noqa: E402
 
 import hovering  # noqa: E402
 from hovering import _core, pipeline, scenes  # noqa: E402
-from hovering._output import WriteError  # noqa: E402
-from hovering._provenance import provenance  # noqa: E402
+from hovering._io.output import WriteError  # noqa: E402
+from hovering._io.provenance import provenance  # noqa: E402
 from hovering.parallel.checkpoint import Checkpoint  # noqa: E402
 
 # Processes killed mid-write, concurrent writers, a full tmpfs: end to end (CI and scripts/test.sh run them).
@@ -310,7 +310,7 @@ def test_full_disk_in_the_api_is_a_write_error_and_keeps_the_files(tmp_path):
 
 def test_a_full_device_is_no_space_left():
     # /dev/full answers every write with ENOSPC (no privileges needed).
-    from hovering._output import append_line
+    from hovering._io.output import append_line
 
     with pytest.raises(WriteError, match="cannot write /dev/full: no space left on device"):
         append_line("/dev/full", '{"key": 1}')
@@ -815,7 +815,7 @@ def meta_doc(path) -> dict:
 
 def test_saved_results_checkpoints_and_sidecars_record_provenance(tmp_path):
     m = hovering.TruncatedMap(eps=0.2, Omega0=2.1, theta_w=2.0)
-    hovering.save(m.hovering_area(n_steps=100, n_samples=400, rng=3), tmp_path / "h.npz")
+    hovering.save(hovering.hovering_area(m, n_steps=100, n_samples=400, rng=3), tmp_path / "h.npz")
     rec = meta_doc(tmp_path / "h.npz")["provenance"]
     assert list(rec) == KEYS and rec == provenance(seed=3)  # the result's own seed (HoveringArea.seed)
     (tmp_path / "s.toml").write_text(sweep_scene())
@@ -849,7 +849,7 @@ def test_files_written_before_provenance_still_load(tmp_path):
         Checkpoint(tmp_path / "c.jsonl")
     assert (tmp_path / "c.jsonl").read_text() == '{"key": {"eps": 0.1}, "row": {"area": 0.5}}\n'
     # an old scene result is still recognised as hovering's, so a rerun may replace it
-    from hovering._output import is_ours
+    from hovering._io.output import is_ours
 
     assert is_ours(tmp_path / "old.npz") and is_ours(tmp_path / "c.jsonl")
     old_sidecar = {"scene": {"__dataclass__": "hovering.scenes.spec:OrbitScene"}}

@@ -26,40 +26,49 @@ NAN = float("nan")
 
 BAD = {
     # hangs and silent skips
-    "critical tol=0": (lambda: M.critical_curve(tol=0), r"tol must be finite and >= 1e-14 .* got 0"),
-    "critical tol=1e-18": (lambda: M.critical_curve(tol=1e-18), r"tol must be finite and >= 1e-14"),
-    "critical tol=-1": (lambda: M.critical_curve(tol=-1), r"tol must be finite and >= 1e-14 .* got -1"),
-    "critical tol=nan": (lambda: M.critical_curve(tol=NAN), r"tol must be finite .* got nan"),
+    "critical tol=0": (lambda: hv.critical_curve(M, tol=0), r"tol must be finite and >= 1e-14 .* got 0"),
+    "critical tol=1e-18": (lambda: hv.critical_curve(M, tol=1e-18), r"tol must be finite and >= 1e-14"),
+    "critical tol=-1": (lambda: hv.critical_curve(M, tol=-1), r"tol must be finite and >= 1e-14 .* got -1"),
+    "critical tol=nan": (lambda: hv.critical_curve(M, tol=NAN), r"tol must be finite .* got nan"),
     # unclear errors
-    "critical n_grid=0": (lambda: M.critical_curve(n_grid=0), r"n_grid must be an integer in \[2, 1000000\], got 0"),
+    "critical n_grid=0": (
+        lambda: hv.critical_curve(M, n_grid=0),
+        r"n_grid must be an integer in \[2, 1000000\], got 0",
+    ),
     "critical n_grid=2**63": (
-        lambda: M.critical_curve(n_grid=2**63),
+        lambda: hv.critical_curve(M, n_grid=2**63),
         r"n_grid must be an integer in \[2, 1000000\]",
     ),
-    "critical n_steps=0": (lambda: M.critical_curve(n_steps=0), r"n_steps must be an integer in \[16, \d+\], got 0"),
-    "critical digits=nan": (lambda: M.critical_curve(digits=NAN), r"digits must be a number in \(0, 16\], got nan"),
+    "critical n_steps=0": (
+        lambda: hv.critical_curve(M, n_steps=0),
+        r"n_steps must be an integer in \[16, \d+\], got 0",
+    ),
+    "critical digits=nan": (lambda: hv.critical_curve(M, digits=NAN), r"digits must be a number in \(0, 16\], got nan"),
     "critical K_range 3": (
-        lambda: M.critical_curve(K_range=(-0.3, -0.2, 0.1)),
+        lambda: hv.critical_curve(M, K_range=(-0.3, -0.2, 0.1)),
         r"K_range must be a pair \(K_lo, K_hi\)",
     ),
     "area n_samples=nan": (
-        lambda: M.hovering_area(n_samples=NAN),
+        lambda: hv.hovering_area(M, n_samples=NAN),
         r"n_samples must be an integer in \[1, \d+\], got nan",
     ),
     "area n_samples=inf": (
-        lambda: M.hovering_area(n_samples=math.inf),
+        lambda: hv.hovering_area(M, n_samples=math.inf),
         r"n_samples must be an integer in \[1, \d+\], got inf",
     ),
     "area n_samples=2.5": (
-        lambda: M.hovering_area(n_samples=2.5),
+        lambda: hv.hovering_area(M, n_samples=2.5),
         r"n_samples must be an integer in \[1, \d+\], got 2.5",
     ),
-    "area rng=-1": (lambda: M.hovering_area(rng=-1), r"rng must be an integer seed in \[0, \d+\].*got -1"),
+    "area rng=-1": (lambda: hv.hovering_area(M, rng=-1), r"rng must be an integer seed in \[0, \d+\].*got -1"),
     "area n_steps='100'": (
-        lambda: M.hovering_area(n_steps="100"),
+        lambda: hv.hovering_area(M, n_steps="100"),
         r"n_steps must be an integer in \[4, \d+\], got '100'",
     ),
-    "return_map stepper=3": (lambda: SEC.return_map([0.1], [0.3], stepper=3), r"stepper must be one of \('rk8pd'"),
+    "return_map stepper=3": (
+        lambda: SEC.return_map([0.1], [0.3], stepper=3),
+        r"stepper must be one of rk8pd, .*got '3'",
+    ),
     "return_map max_steps=2**70": (
         lambda: SEC.return_map([0.1], [0.3], max_steps=2**70),
         r"max_steps must be an integer in \[1, 4611686018427387904\], got 1180591620717411303424",
@@ -420,7 +429,7 @@ def test_scene_cli_refuses_a_bad_out_path(tmp_path, capsys):
 
 def test_output_path_names_the_file_savefig_writes(tmp_path):
     # savefig("out/x") writes out/x.png: the summary used to name "out/x".
-    from hovering._output import output_path
+    from hovering._io.output import output_path
 
     assert output_path("out", tmp_path / "sub" / "x") == tmp_path / "sub" / "x.png"
     assert output_path("out", tmp_path / "x.pdf") == tmp_path / "x.pdf"
@@ -451,7 +460,7 @@ def test_scene_cli_reports_values_only_the_run_can_check_in_one_line(tmp_path, c
 
 
 def test_output_path_refuses_what_savefig_would_fail_on(tmp_path):
-    from hovering._output import output_path
+    from hovering._io.output import output_path
 
     with pytest.raises(ValueError, match="no NUL byte"):
         output_path("out", str(tmp_path / "a\0b.png"))

@@ -63,11 +63,11 @@ MANY_CALLS = textwrap.dedent(
         "return_map": lambda p: sec.return_map(np.linspace(-3, 3, 400), np.full(400, 0.33), progress=p),
         "python_potential": lambda p: py_sec.return_map(np.linspace(-3, 3, 64), np.full(64, 0.3), n_threads=2,
                                                         progress=p),
-        "hovering_area": lambda p: m.hovering_area(n_steps=5_000, n_samples=2_000, progress=p),
-        "hovering_area_threads": lambda p: m.hovering_area(n_steps=5_000, n_samples=2_000, progress=p,
+        "hovering_area": lambda p: hv.hovering_area(m, n_steps=5_000, n_samples=2_000, progress=p),
+        "hovering_area_threads": lambda p: hv.hovering_area(m, n_steps=5_000, n_samples=2_000, progress=p,
                                                            executor=hv.parallel.Executor(workers=2, pieces=4)),
-        "hovering_area_pool": lambda p: m.hovering_area(n_steps=5_000, n_samples=2_000, progress=p, executor=pool),
-        "critical_curve": lambda p: m.critical_curve(n_steps=2_000, n_grid=16, progress=p),
+        "hovering_area_pool": lambda p: hv.hovering_area(m, n_steps=5_000, n_samples=2_000, progress=p, executor=pool),
+        "critical_curve": lambda p: hv.critical_curve(m, n_steps=2_000, n_grid=16, progress=p),
         "transit": lambda p: hv.transit(m, zone, "up", n_orbits=4, n_steps=50_000, start_s=0.5, target_s=1.0,
                                         progress=p),
         "transit_threads": lambda p: hv.transit(m, zone, "up", n_orbits=8, n_steps=50_000, start_s=0.5,
@@ -221,7 +221,7 @@ def test_ctrl_c_while_the_pieces_are_handed_out_stops_the_running_ones(monkeypat
 
     monkeypatch.setattr(executor_module._Local, "submit", submit)
     with pytest.raises(KeyboardInterrupt):
-        m.hovering_area(n_steps=10**5, n_samples=4 * 10**4, executor=Executor(workers=2, pieces=8))
+        hovering.hovering_area(m, n_steps=10**5, n_samples=4 * 10**4, executor=Executor(workers=2, pieces=8))
     (run,) = runs
     assert len(run.submitted) == 2 and all(f.done() for f in run.submitted)
     assert all(isinstance(f.exception(), KeyboardInterrupt) for f in run.submitted)  # stopped, not finished

@@ -60,7 +60,7 @@ REQUIRED = (
 FLAGS = doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS
 
 # Old module paths that warn when used (hovering._deprecated): no documentation of their own.
-_SKIP_MODULES = set(getattr(hovering, "_OLD_MODULES", ()))
+_SKIP_MODULES = {m.rpartition(".")[2] for m in hovering._deprecated.OLD_MODULES}
 
 
 def _own(obj) -> bool:
@@ -119,7 +119,11 @@ def _docstrings() -> dict:
             path, line = name, 0
         out[name] = (inspect.cleandoc(doc), path, line)
 
-    for name, obj in _public().items():
+    # The names a user calls first before the others: a method two classes share (TruncatedMap's and
+    # TruncatedFamily's iterate) is collected once, under the first name, whatever __all__'s order.
+    public = _public()
+    order = sorted(public, key=lambda n: (n not in REQUIRED, REQUIRED.index(n) if n in REQUIRED else 0))
+    for name, obj in ((n, public[n]) for n in order):
         if isinstance(obj, types.ModuleType):
             add(name, obj)
         elif inspect.isclass(obj):

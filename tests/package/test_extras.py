@@ -58,7 +58,10 @@ def _missing(monkeypatch, *modules):
 )
 def test_a_dask_run_without_dask_names_the_distributed_extra(monkeypatch, make):
     _missing(monkeypatch, "distributed")
-    with pytest.raises(ImportError, match=r"needs distributed, .* pip install distributed \(hovering's extra 'distributed': pip install '\.\[distributed\]'"):
+    with pytest.raises(
+        ImportError,
+        match=r"needs distributed, .* pip install distributed \(hovering's extra 'distributed': pip install '\.\[distributed\]'",
+    ):
         make()
 
 

@@ -73,25 +73,78 @@ def test_import_hovering_is_light():
     assert not pipeline, sorted(pipeline)
 
 
-def test_import_hovering_loads_no_core_and_the_first_use_loads_the_api():
-    # `import hovering` (and `hovering --version`) load neither numpy nor the compiled core; the
-    # first use of a public name loads the API, as the eager import did; a model used straight from
-    # its module finds the analyses its methods call (hooks registered on demand); hovering.explore
-    # stays the function whichever of it and its module is imported first.
+def _run(code: str) -> str:
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    return r.stdout
+
+
+def test_import_hovering_loads_no_core_and_each_name_only_its_own_module():
+    # `import hovering` (and `hovering --version`) load neither numpy nor any layer (the core only
+    # when the version must come from it: a source tree beside another install); the first use
+    # of a public name loads the module that holds it and what that imports, nothing else.
     code = (
-        "import sys, hovering\n"
-        "light = [m for m in ('numpy', 'hovering._core', 'hovering.analysis') if m in sys.modules]\n"
+        "import sys, json, os\n"
+        "from importlib import metadata\n"
+        "import hovering\n"
+        "d = metadata.distribution('hovering')\n"
+        "own = os.path.realpath(str(d.locate_file('hovering/_version.py'))) == os.path.realpath(hovering._version.__file__)\n"
+        "def loaded(): return sorted(m for m in sys.modules if m.startswith(('hovering', 'numpy')))\n"
+        "first = loaded()\n"
         "m = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=2.0)\n"
-        "loaded = all(m in sys.modules for m in ('numpy', 'hovering._core', 'hovering.diagnostics'))\n"
-        "print(light, loaded, callable(hovering.explore), 'hovering_area' in dir(hovering))\n"
+        "second = loaded()\n"
+        "hovering.hovering_area\n"
+        "third = loaded()\n"
+        "print(json.dumps([own, first, second, third, callable(hovering.explore), 'hovering_area' in dir(hovering)]))\n"
     )
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0 and r.stdout.split() == ["[]", "True", "True", "True"], r.stdout + r.stderr
+    own, first, second, third, explore_is_function, listed = json.loads(_run(code))
+    # the version's source (and numpy, which the core imports) only when the metadata is not this copy's
+    assert ("hovering._core" in first) == (not own) and ("numpy" in first) == (not own)
+    assert not [
+        m
+        for m in first
+        if m.startswith("hovering.")
+        and not m.startswith(("hovering._core", "hovering._version", "hovering._deprecated"))
+    ]
+    layers = ("hovering.analysis", "hovering.diagnostics", "hovering.normal", "hovering.scenes", "hovering.explore")
+    assert "numpy" in second and "hovering.truncated.maps" in second and not [m for m in second if m.startswith(layers)]
+    above = ("hovering.diagnostics", "hovering.scenes", "hovering.explore", "hovering.plot", "hovering.pipeline")
+    assert "hovering.analysis" in third and not [m for m in third if m.startswith(above)]
+    assert explore_is_function and listed
+
+
+def test_every_public_name_is_the_one_api_py_imports():
+    # The package's table is read from _api.py's imports: the same objects an eager import gives,
+    # and hovering.explore stays the function whichever of it and its module is imported first.
     code = (
+        "import json, types, warnings\n"
         "import hovering.explore, hovering\n"
-        "from hovering.truncated import TruncatedMap\n"
-        "m = TruncatedMap(eps=0.2, Omega0=2.1, theta_w=2.0)\n"
-        "print(callable(hovering.explore), m.hovering_area(n_steps=40, n_samples=50).n_samples > 0)\n"
+        "from hovering import _api\n"
+        "warnings.simplefilter('error')\n"
+        "odd = [n for n in hovering.__all__ if n not in ('__version__', 'simd_width', 'geometry') and getattr(hovering, n) is not getattr(_api, n)]\n"
+        "print(json.dumps([odd, len(hovering.__all__), callable(hovering.explore), sorted(set(hovering.__all__) - set(dir(_api)))]))\n"
     )
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0 and r.stdout.split() == ["True", "True"], r.stdout + r.stderr
+    odd, n, explore_is_function, own = json.loads(_run(code))
+    assert odd == [] and n > 80 and explore_is_function
+    assert own == ["__version__", "geometry", "simd_width"]
+
+
+def test_the_old_module_paths_are_no_files_and_still_import():
+    # The root holds the package's topics: the old paths are a table (hovering._deprecated), served
+    # to the import system; each still imports, and its names warn as they are used.
+    assert not [p.name for p in PACKAGE.glob("*.py") if p.stem in ("geometry", "maps", "fullmap", "sweeps")]
+    code = (
+        "import json, warnings\n"
+        "import hovering.geometry as g\n"
+        "from hovering.maps import TruncatedMap\n"
+        "import hovering._pickle, hovering._io.records\n"
+        "with warnings.catch_warnings(record=True) as w:\n"
+        "    warnings.simplefilter('always')\n"
+        "    g.K_crit\n"
+        "print(json.dumps([str(w[0].message), hovering._pickle is hovering._io.records]))\n"
+    )
+    message, same = json.loads(_run(code))
+    assert (
+        message.startswith("hovering.geometry.K_crit is deprecated") and "hovering.truncated.theory.K_crit" in message
+    )
+    assert same

@@ -46,7 +46,7 @@ M = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 
 
 def _public_callables():
     """(qualified name, callable) of every public function, class and method of ``hovering.__all__``
-    (methods inherited from mixins included: ``TruncatedMap.hovering_area`` is MapAnalyses')."""
+    (methods inherited from mixins included: ``TruncatedMap.hovers`` is MapAnalyses')."""
     out = []
     for name in hovering.__all__:
         obj = getattr(hovering, name)
@@ -93,8 +93,8 @@ def test_no_public_signature_takes_an_old_name_of_a_concept():
 def test_the_scan_sees_the_signatures_and_would_catch_a_twin():
     seen = dict(_public_callables())
     # the renamed functions and the inherited methods are scanned under their new names...
+    assert "TruncatedMap.hovers" in seen
     assert {"n_samples", "rng"} <= set(_parameters(seen["hovering_area"]))
-    assert "n_samples" in _parameters(seen["TruncatedMap.hovering_area"])
     assert "n_grid" in _parameters(seen["critical_curve"]) and "bisections" in _parameters(seen["tangential_curve"])
     assert "rng" in _parameters(seen["transit"]) and "rng" in _parameters(seen["work_precision"])
 
@@ -140,17 +140,23 @@ def test_hovering_area_old_names_warn_and_give_the_same_area():
     assert all(w.filename == __file__ for w in rec)  # the user's line, not the package's
 
 
-def test_the_method_and_positional_calls_keep_working():
+def test_the_old_keyword_the_deprecated_method_and_positional_calls_keep_working():
     with pytest.warns(DeprecationWarning, match=r"hovering_area\(samples=\.\.\.\).*n_samples"):
-        old = M.hovering_area(n_steps=200, samples=500)
-    assert old.area == M.hovering_area(200, 500).area == hovering.hovering_area(M, 200, 500).area
+        old = hovering.hovering_area(M, n_steps=200, samples=500)
+    # The method is the function now (analyses are free functions of a map): it warns and calls it.
+    with pytest.warns(
+        DeprecationWarning,
+        match=r"TruncatedMap\.hovering_area\(\) is deprecated .*use hovering\.hovering_area\(m, \.\.\.\)",
+    ):
+        method = M.hovering_area(200, 500)
+    assert old.area == hovering.hovering_area(M, 200, 500).area == method.area
 
 
 def test_both_names_at_once_are_a_type_error():
     for call in (
         lambda: hovering.hovering_area(M, n_steps=200, samples=500, n_samples=500),
         lambda: hovering.hovering_area(M, n_steps=200, seed=1, rng=1),
-        lambda: M.hovering_area(n_steps=200, samples=500, n_samples=500),
+        lambda: hovering.hovering_area(M, n_steps=200, samples=500, n_samples=500),
         lambda: hovering.critical_curve(M, grid=8, n_grid=8),
     ):
         with pytest.raises(
@@ -162,8 +168,8 @@ def test_both_names_at_once_are_a_type_error():
 def test_critical_curve_grid_is_n_grid():
     kw = dict(n_steps=600, tol=1e-3)
     with pytest.warns(DeprecationWarning, match=r"critical_curve\(grid=\.\.\.\).*critical_curve\(n_grid=\.\.\.\)"):
-        old = M.critical_curve(grid=8, **kw)
-    assert old.K0 == M.critical_curve(n_grid=8, **kw).K0
+        old = hovering.critical_curve(M, grid=8, **kw)
+    assert old.K0 == hovering.critical_curve(M, n_grid=8, **kw).K0
     # impact_zone passes its keywords on: the old name still reaches critical_curve (and warns)
     with pytest.warns(DeprecationWarning, match=r"n_grid"):
         z_old = hovering.impact_zone(M, n_steps=600, floor=-0.3, grid=8, tol=1e-3)

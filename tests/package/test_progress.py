@@ -104,13 +104,13 @@ def test_analyses_report_one_bar_for_the_whole_call(tm, fm):
     rec.check(2 * area.n_samples * 400)
     assert area.area == hv.hovering_area(tm, n_steps=400, n_samples=500).area
     rec = Recorder()
-    cc = tm.critical_curve(n_steps=600, n_grid=16, tol=1e-3, progress=rec)
+    cc = hv.critical_curve(tm, n_steps=600, n_grid=16, tol=1e-3, progress=rec)
     done = rec.calls[-1][0]
     assert rec.calls[-1] == (done, done) and done % 600 == 0 and done >= 17 * 600
     assert [d for d, _ in rec.calls] == sorted(d for d, _ in rec.calls)
-    assert cc.K0 == tm.critical_curve(n_steps=600, n_grid=16, tol=1e-3).K0
+    assert cc.K0 == hv.critical_curve(tm, n_steps=600, n_grid=16, tol=1e-3).K0
     rec = Recorder()
-    flow_area = fm.hovering_area(n_steps=20, n_samples=30, progress=rec)
+    flow_area = hv.hovering_area(fm, n_steps=20, n_samples=30, progress=rec)
     rec.check(2 * flow_area.n_samples * 20)
 
 

@@ -113,7 +113,7 @@ def _interrupted(call):
 def test_ctrl_c_stops_hovering_area():
     m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=2.0)
     # ~4 s on 2 idle cores
-    assert _interrupted(lambda p: m.hovering_area(n_steps=10**5, n_samples=10**5, n_threads=2, progress=p)) < 30
+    assert _interrupted(lambda p: hv.hovering_area(m, n_steps=10**5, n_samples=10**5, n_threads=2, progress=p)) < 30
 
 
 def test_ctrl_c_stops_critical_curve():
@@ -128,7 +128,7 @@ def test_ctrl_c_stops_critical_curve():
         geometry="step",
     )
     fm = hv.FlowMap(s, 1.0)
-    assert _interrupted(lambda p: fm.critical_curve(n_steps=5000, n_grid=64, n_threads=2, progress=p)) < 30
+    assert _interrupted(lambda p: hv.critical_curve(fm, n_steps=5000, n_grid=64, n_threads=2, progress=p)) < 30
 
 
 def test_ctrl_c_stops_a_scene(tmp_path):

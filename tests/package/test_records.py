@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import _pickle, _serial, paper
+from hovering import paper
+from hovering._io import records as _pickle
+from hovering._io import serial as _serial
 from hovering.parallel.checkpoint import canonical
 
 LEGACY = Path(__file__).resolve().parents[1] / "data" / "legacy"

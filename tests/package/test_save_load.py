@@ -165,7 +165,7 @@ def test_foreign_types_are_refused(tmp_path):
         # A hovering module imports os: the name must lead to a class defined in hovering, not
         # through the module's attributes to os.system.
         "enum through a hovering module": {"__enum__": "hovering._checks:os.system", "value": f"touch {marker}"},
-        "dataclass through a hovering module": {"__dataclass__": "hovering._serial:json.JSONDecoder", "fields": {}},
+        "dataclass through a hovering module": {"__dataclass__": "hovering._io.serial:json.JSONDecoder", "fields": {}},
         "dunder": {"__record__": "hovering:__builtins__.eval", "data": {"__dict__": {}}},
         "not a dataclass": {"__dataclass__": "hovering.truncated.maps:TruncatedMap", "fields": {}},
         "not an enum": {"__enum__": "hovering.truncated.maps:TruncatedMap", "value": 1},

@@ -27,7 +27,9 @@ import numpy as np
 import pytest
 
 import hovering as hv
-from hovering import _serial, _untrusted, paper, scenes
+from hovering import paper, scenes
+from hovering._io import serial as _serial
+from hovering._io import untrusted as _untrusted
 from hovering.cli import main
 from hovering.parallel.checkpoint import Checkpoint
 from hovering.pipeline import redraw, run_scene
@@ -206,11 +208,11 @@ def test_pickled_object_arrays_are_refused_from_their_header(tmp_path):
 
 
 def test_flowmap_record_asking_for_an_accuracy_target_is_refused_without_measuring(genuine, tmp_path, monkeypatch):
-    import hovering.diagnostics.tolerance
+    import hovering.diagnostics.tolerance as tolerance
 
     calls = []
-    real = hovering.interface.hook("choose_setting")
-    monkeypatch.setitem(hovering.interface._HOOKS, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
+    real = tolerance.choose_setting
+    monkeypatch.setattr(tolerance, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
     assert hv.load(genuine["flowmap"]).integrator_options["stepper"] == "rk8pd" and calls == []
     # Before: this 3 KB record ran a work-precision measurement for more than 300 s (it was killed).
     path = _craft(

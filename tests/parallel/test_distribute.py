@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+import hovering
 from hovering import paper
 from hovering.analysis.hovering import hovering_area
 from hovering.parallel import Executor
@@ -184,7 +185,7 @@ def test_the_six_old_arguments_still_work_and_warn_naming_executor_and_the_relea
     assert {x.filename for x in w} == {__file__}
     # through the map's method (one more frame of ours between): still attributed to this file
     with pytest.warns(DeprecationWarning) as w:
-        same(single, M.hovering_area(**KW, workers=2))
+        same(single, hovering.hovering_area(M, **KW, workers=2))
     assert [x.filename for x in w] == [__file__]
     with pytest.raises(ValueError, match="not both"):
         hovering_area(M, **KW, executor=2, workers=2)

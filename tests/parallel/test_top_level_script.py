@@ -99,7 +99,9 @@ def test_ctrl_c_stops_the_pieces_running_on_other_threads(monkeypatch):
     m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=2.0)
     press = CtrlCOnceStarted()
     with pytest.raises(KeyboardInterrupt):
-        m.hovering_area(n_steps=10**5, n_samples=10**5, executor=Executor(workers=2, pieces=4), progress=press)
+        hovering.hovering_area(
+            m, n_steps=10**5, n_samples=10**5, executor=Executor(workers=2, pieces=4), progress=press
+        )
     # The bound is 30 s: generous against a loaded 2-core machine, the pieces' seconds below a lost stop.
     assert time.perf_counter() - press.fired_at < 30
     assert "stopped" in outcomes, outcomes  # a piece under way was stopped, not waited for

@@ -28,7 +28,8 @@ import numpy as np
 import pytest
 
 import hovering
-from hovering import _serial, scenes
+from hovering import scenes
+from hovering._io import serial as _serial
 from hovering.plot import common, render
 from hovering.plot.style import QUICK_MARK
 from hovering.scenes import compute, format_summary, load_scene, parse_scene, registry

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+import hovering
 from hovering.parallel.checkpoint import Checkpoint, canonical
 from hovering.scenes import load_scene
 from hovering.scenes.compute import compute, run_point
@@ -142,10 +143,9 @@ def test_the_hand_written_plan_of_the_docs_runs(sweep_exe, tmp_path):
     data = tomllib.loads(toml)
     r = run_exe(sweep_exe, plan, tmp_path / "hand.jsonl")
     assert "2 points, 0 already in" in r.stderr
-    import hovering
 
     m = hovering.TruncatedMap(**data["points"][0]["map"])
-    assert -m.hovering_area(n_steps=4, n_samples=1).box[2] == -data["points"][0]["K_low"]
+    assert -hovering.hovering_area(m, n_steps=4, n_samples=1).box[2] == -data["points"][0]["K_low"]
     exe = rows_by_key(tmp_path / "hand.jsonl")
     for p in data["points"]:
         p = {**p, "theory": p.get("theory", math.nan)}

@@ -27,7 +27,7 @@ def test_hovering_sign_and_area_for_every_omega(Omega0, eps):
     hovers = eps * math.sin(Omega0 / 2) > 0
     assert th.hovers == hovers and m.hovers() == hovers
     assert th.hovering_sign == (1 if math.sin(Omega0 / 2) > 0 else -1)
-    hv_area = m.hovering_area(n_steps=4000, n_samples=20_000)
+    hv_area = hv.hovering_area(m, n_steps=4000, n_samples=20_000)
     assert hv_area.theory == th.area
     if hovers:
         # eq:hovsetsize: 0.2546 for eps = 0.1 at the paper's parameters; measured 0.2519 +- 0.0033
@@ -60,12 +60,12 @@ def test_symmetry_behind_it():
 
 def test_critical_curve_on_the_sign_that_does_not_hover_says_so():
     m = paper.truncated_map(-0.3)
-    cc = m.critical_curve(n_steps=4000)
+    cc = hv.critical_curve(m, n_steps=4000)
     # The lowest curve avoiding the impacts is k^{u0}: minimum ~0 on L2 (thm:minmaxinvriantcurves).
     assert not cc.hovers and cc.line == "L2" and "no hovering set" in cc.note
     assert -0.02 < cc.K_min < 0.02 and cc.K0 > -0.02
     with pytest.raises(RuntimeError, match="impacting case"):
-        m.critical_curve(n_steps=4000, line="L1", K_range=(-0.3, -0.05))
+        hv.critical_curve(m, n_steps=4000, line="L1", K_range=(-0.3, -0.05))
 
 
 def test_multimode_theory_reduces_to_the_closed_forms():
@@ -87,7 +87,7 @@ def test_multimode_theory_reduces_to_the_closed_forms():
     )
     th = fam.theory()
     assert th.hovers and th.forcing == (0.8, 0.15)
-    meas = fam.hovering_area(n_steps=4000, n_samples=20_000)
+    meas = hv.hovering_area(fam, n_steps=4000, n_samples=20_000)
     assert abs(meas.area - th.area) < meas.error + 0.3 * 0.1**2
 
 

@@ -5,6 +5,8 @@
 //   flow/       the oscillators-step flow (sec:setup) and its return map to Sigma_h
 //   normal/     normal coordinates (phi, K) of the flow's section, and the flow as a map on them
 
+#include "hovering/batch.hpp"
+#include "hovering/simd.hpp"
 #include "hovering/types.hpp"
 
 #include "hovering/truncated/arcs.hpp"

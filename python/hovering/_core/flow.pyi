@@ -103,20 +103,44 @@ class FlowSystem:
 
 STEPPERS: tuple[str, ...]
 
+def default_atol(rtol: float) -> float: ...
+
+class PotentialParam:
+    @property
+    def name(self) -> str: ...
+    @property
+    def lo(self) -> float: ...
+    @property
+    def hi(self) -> float: ...
+
+class PotentialKind:
+    @property
+    def kind(self) -> str: ...
+    @property
+    def cls(self) -> str: ...
+    @property
+    def formula(self) -> str: ...
+    @property
+    def params(self) -> list[PotentialParam]: ...
+
+# The core's registry of compiled potentials (CompiledPotentials), in its order.
+POTENTIAL_KINDS: tuple[PotentialKind, ...]
+
 class FlowOptions:
     def __init__(
         self,
         stepper: str = ...,
         rtol: float = ...,
-        atol: float = ...,
+        atol: float | None = ...,
         event_tol: float = ...,
         max_steps: int = ...,
         max_impacts: int = ...,
         grazing_tol: float = ...,
         corner_tol: float = ...,
+        verify_steps: int = ...,
     ) -> None: ...
-    def __getstate__(self) -> tuple[str, float, float, float, int, int, float, float]: ...
-    def __setstate__(self, state: tuple[str, float, float, float, int, int, float, float]) -> None: ...
+    def __getstate__(self) -> tuple[str, float, float, float, int, int, float, float, int]: ...
+    def __setstate__(self, state: tuple[str, float, float, float, int, int, float, float, int]) -> None: ...
     def validate_for(self, system: FlowSystem) -> None: ...
     stepper: str
     rtol: float

@@ -2,7 +2,6 @@
 and regularity, the hovering set HOV(eps), the critical invariant curve, orbit classes, the
 impact zone, transport across it and its barriers."""
 
-from ..interface import register
 from .barriers import BarrierScan, Layer, barrier_scan
 from .critical import CriticalCurve, critical_curve, max_angular_gap
 from .hovering import HoveringArea, HoveringComponents, hovering_area
@@ -18,7 +17,7 @@ from .orbits import (
 )
 from .rotation import birkhoff_average, birkhoff_weights, regularity, rotation_number
 from .transit import TransitResult, transit
-from .zone import ImpactZone, impact_zone
+from .zone import ImpactZone, impact_zone, impact_zone_floor
 
 __all__ = [
     "birkhoff_weights",
@@ -43,14 +42,10 @@ __all__ = [
     "converse_kam",
     "ImpactZone",
     "impact_zone",
+    "impact_zone_floor",
     "TransitResult",
     "transit",
     "BarrierScan",
     "Layer",
     "barrier_scan",
 ]
-
-# The models' convenience methods (m.hovering_area(), m.critical_curve()) call these through the
-# interface's hooks: the models sit below the analyses and never import them.
-register("hovering_area", hovering_area)
-register("critical_curve", critical_curve)

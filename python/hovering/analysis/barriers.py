@@ -31,7 +31,7 @@ from .._arrays import unique
 from .._checks import integer, is_choice, real_number
 from .._display import Summarized, status_counts
 from .._enums import Region, Status
-from .._serial import Saveable
+from .._io.serial import Saveable
 from ..interface import require_map
 from ..parallel.executor import as_executor, run_pieces
 from ..parallel.executor import executor as open_executor
@@ -247,7 +247,7 @@ class BarrierScan(Summarized, Saveable):
         ImportError
             Without pandas, naming ``pip install 'hovering[pandas]'``.
         """
-        from .._interop import barrier_frame
+        from .._io.interop import barrier_frame
 
         return barrier_frame(self)
 
@@ -548,7 +548,7 @@ def barrier_scan(
     # A truncated map is undefined outside its band. A flow's band is a conservative rectangle of
     # its section: its floor torus (an orbit, on the section) may dip below it, and so may starts
     # just above that floor; a start truly off the section ends with its own status.
-    exact_band = not hasattr(m, "impact_zone_floor")
+    exact_band = not hasattr(m, "upper_tangent_K")  # a truncated map (a FlowMap's band is conservative)
     if exact_band and np.any((K0 <= lo_band) | (K0 >= hi_band)):
         j = int(np.argmax((K0 <= lo_band) | (K0 >= hi_band)))
         raise ValueError(

@@ -15,8 +15,8 @@ from .._checks import is_choice, real_array
 from .._deprecated import renamed_keywords
 from .._display import Summarized
 from .._enums import REGION_LABELS, Region, Status, region_mask
+from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar
-from .._serial import Saveable
 from ..curve import Curve
 from ..interface import require_map
 from .rotation import regularity, rotation_number
@@ -82,7 +82,7 @@ class CriticalCurve(Summarized, Saveable):
 
     >>> import numpy as np, hovering
     >>> m = hovering.TruncatedMap(eps=-0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
-    >>> cc = m.critical_curve(n_steps=2000)
+    >>> cc = hovering.critical_curve(m, n_steps=2000)
     >>> cc.hovers, cc.line, cc.note.split(":")[0]
     (False, 'L2', 'impacting case')
     >>> bool(cc.K_min >= 0), cc.phi.shape      # k^{u0} lies in K >= 0; the orbit: n_steps + 1 points
@@ -147,7 +147,7 @@ class CriticalCurve(Summarized, Saveable):
         ImportError
             Without xarray, naming ``pip install 'hovering[xarray]'``.
         """
-        from .._interop import critical_curve_dataset
+        from .._io.interop import critical_curve_dataset
 
         return critical_curve_dataset(self)
 

@@ -22,15 +22,16 @@ from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
 from .._deprecated import renamed_keywords
 from .._display import Summarized
+from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar, stop_hook
-from .._serial import Saveable
 from ..interface import require_map
 from ..parallel.checkpoint import Checkpoint
 from ..parallel.executor import Executor, from_old_arguments, run_pieces
 from ..parallel.executor import executor as open_executor
 from .orbits import classify_orbits
+from .zone import impact_zone_floor
 
-__all__ = ["HoveringArea", "HoveringComponents", "hovering_area"]
+__all__ = ["HoveringArea", "HoveringComponents", "hovering_area", "default_K_low", "default_depth"]
 
 _log = logging.getLogger(__name__)
 
@@ -63,7 +64,7 @@ class HoveringComponents:
         zone's floor: island chains, which the definition counts and eq:hovsetsize does not.
     under_floor, under_floor_error : float
         Hovering points below the zone's floor (for a FlowMap its own floor curve,
-        :meth:`hovering.FlowMap.impact_zone_floor`: orbits that pass above the step every return
+        :func:`hovering.impact_zone_floor`: orbits that pass above the step every return
         there). The truncated maps have no floor (their zone reaches down to the band's edge, see
         :func:`hovering.impact_zone`): 0 there.
     periods : dict
@@ -90,7 +91,7 @@ class HoveringComponents:
 
     >>> import numpy as np, hovering
     >>> m = hovering.TruncatedMap(eps=-0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
-    >>> hv = m.hovering_area(1000, 2000)          # N = 1000 steps, 2000 samples
+    >>> hv = hovering.hovering_area(m, 1000, 2000)   # N = 1000 steps, 2000 samples
     >>> c = hv.components
     >>> hv.theory, c.counts["band"], sorted(c.periods), c.floor
     (0.0, 0, [2], 'none')
@@ -201,7 +202,7 @@ class HoveringArea(Summarized, Saveable):
     --------
     >>> import numpy as np, hovering
     >>> m = hovering.TruncatedMap(eps=0.2, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
-    >>> hv = m.hovering_area(2000, 4000)          # N = 2000 steps, 4000 samples
+    >>> hv = hovering.hovering_area(m, 2000, 4000)   # N = 2000 steps, 4000 samples
     >>> sorted(hv.areas)                         # the estimates at N/4, N/2 and N
     [500, 1000, 2000]
     >>> print("box: phi in [%.4f, %.4f), K in [%.4f, %.1f)" % hv.box)
@@ -266,7 +267,7 @@ class HoveringArea(Summarized, Saveable):
         ImportError
             Without xarray, naming ``pip install 'hovering[xarray]'``.
         """
-        from .._interop import hovering_area_dataset
+        from .._io.interop import hovering_area_dataset
 
         return hovering_area_dataset(self)
 
@@ -292,6 +293,32 @@ def default_depth(m) -> float:
     """
     th = m.theory()
     return float(_core_analysis.default_depth(float(m.eps), float(th.Omega0), [float(b) for b in th.forcing]))
+
+
+def default_K_low(m, band_lo: float | None = None) -> float:
+    """Bottom of the default box of :func:`hovering_area`: ``-default_depth(m)`` (0.1 at eps = 0,
+    which has no critical band), raised to just inside the band.
+
+    The core's one rule (``hovering._core.analysis.default_K_low``), which :func:`hovering_area`
+    and the sweep plans' writers call alike.
+
+    Parameters
+    ----------
+    m : ReturnMap
+        The map.
+    band_lo : float, optional
+        Lower end of the band the box must lie in (default: the map's, ``m.valid_band()[0]``;
+        ``-inf``: the default box uncut).
+
+    Returns
+    -------
+    float
+    """
+    lo = m.valid_band()[0] if band_lo is None else float(band_lo)
+    if m.eps == 0:  # no critical band: the core's fixed depth, and no theory to compute
+        return float(_core_analysis.default_K_low(0.0, 0.0, [], lo))
+    th = m.theory()
+    return float(_core_analysis.default_K_low(float(m.eps), float(th.Omega0), [float(b) for b in th.forcing], lo))
 
 
 def _outcomes(m, phi, K, n_steps: int, n_threads: int, progress=False) -> tuple:
@@ -321,10 +348,10 @@ def _piece(m, samples, K_low, seed, lo, hi, n_steps: int, n_threads: int):
 
 
 def _map_key(m):
-    """The map's record as a checkpoint keys it (:func:`hovering._serial.record_key`), or a
+    """The map's record as a checkpoint keys it (:func:`hovering._io.serial.record_key`), or a
     ValueError, before any work, for a map that has none: a potential defined in Python
     (CustomPotential, a Potential subclass) is code, which no record holds."""
-    from .._serial import record_key
+    from .._io.serial import record_key
 
     try:
         return record_key(m)
@@ -481,12 +508,12 @@ def _split(m, phi, K, hovering, both_sides, samples: int, K_low: float, n_steps:
     code[hovering & both_sides] = COMPONENTS.index("band")
     one = hovering & ~both_sides
     floor = "none"
-    if hasattr(m, "impact_zone_floor"):  # a FlowMap: the zone has a floor of its own
+    if hasattr(m, "upper_tangent_K"):  # a FlowMap: the zone has a floor of its own
         floor = "unneeded"
         if one.any():
             try:
                 # Orbits of the search no longer than the measurement's own "never" (as impact_zone).
-                curve = m.impact_zone_floor(n_steps=min(n_steps, 2000), n_threads=n_threads).curve
+                curve = impact_zone_floor(m, n_steps=min(n_steps, 2000), n_threads=n_threads).curve
             except (ValueError, RuntimeError) as e:  # no curve found: say why, keep the points in `islands`
                 floor = f"not found: {e}"
             else:
@@ -596,7 +623,7 @@ def hovering_area(
     components : bool, optional
         Split the area into its parts (:class:`HoveringComponents`: the non-resonant band, island
         chains by period, the region under the zone's floor). Only hovering samples whose orbit
-        stays on one side cost extra: a FlowMap's floor search (:meth:`FlowMap.impact_zone_floor`)
+        stays on one side cost extra: a FlowMap's floor search (:func:`hovering.impact_zone_floor`)
         and a recorded orbit of 2048 points for up to 3 samples per connected cluster of them.
         ``False``: ``components`` is None.
     deepen : int, optional
@@ -643,8 +670,6 @@ def hovering_area(
     0.5093
     >>> bool(abs(hv.area - hv.theory) < hv.error), bool(hv.error < 0.05)
     (True, True)
-
-    The same measurement is a method of every map: ``m.hovering_area(2000, 4000)``.
     """
     require_map("m", m)
     n_steps = integer("n_steps", n_steps, 4, 2**53)
@@ -661,11 +686,10 @@ def hovering_area(
         raise ValueError(
             f"this map's band has no part below K = 0 (lower end {lo}): no point impacts under F_0, nothing can hover"
         )
-    bottom = lo * (1 - 1e-9)  # the deepest box inside the band
+    bottom = _core_analysis.box_floor(lo)  # the deepest box inside the band
     default_box = K_low is None
     if default_box:
-        depth = default_depth(m) if m.eps != 0 else 0.1
-        K_low = max(-depth, bottom)
+        K_low = default_K_low(m, lo)
     K_low = real_number("K_low", K_low)
     if not (lo < K_low < 0):
         raise ValueError(f"K_low must lie in the band below 0, ({lo}, 0), got {K_low}")

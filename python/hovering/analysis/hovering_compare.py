@@ -15,8 +15,8 @@ import numpy as np
 from .._checks import flag, integer, is_choice, random_seed, thread_count
 from .._core import analysis as _core_analysis
 from .._deprecated import renamed_keywords
+from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar
-from .._serial import Saveable
 from ..normal import FlowMap
 from .hovering import HoveringArea, _outcomes, hovering_area
 

@@ -29,7 +29,7 @@ from .._checks import MAX_SEED, integer, is_choice, random_seed, real_number
 from .._deprecated import renamed_keywords
 from .._display import Summarized, status_counts
 from .._enums import Status
-from .._serial import Saveable
+from .._io.serial import Saveable
 from ..curve import Above, Below, Curve
 from ..interface import require_map
 from ..parallel.executor import as_executor, run_pieces
@@ -171,7 +171,7 @@ class TransitResult(Summarized, Saveable):
         ImportError
             Without pandas, naming ``pip install 'hovering[pandas]'``.
         """
-        from .._interop import transit_frame
+        from .._io.interop import transit_frame
 
         return transit_frame(self)
 

@@ -3,7 +3,7 @@
 Its ceiling is the critical invariant curve (the lowest invariant curve that never impacts,
 :func:`hovering.critical_curve`); its floor, for the flow, the deformed torus tangent to the upper
 wall (the highest invariant curve below the zone that stays above the step,
-:meth:`hovering.FlowMap.impact_zone_floor`). The truncated map has no floor of its own: its zone
+:func:`impact_zone_floor`). The truncated map has no floor of its own: its zone
 reaches down to the lower edge of the map's band, or to a floor the user gives. The zone coordinate
 ``s = (K - floor(phi)) / (ceiling(phi) - floor(phi))`` is 0 on the floor and 1 on the ceiling, so
 orbits of different maps (the flow and its models) compare on one scale (sec:discussion, the
@@ -26,11 +26,12 @@ import numpy as np
 
 from .._checks import integer, real_array, real_number
 from .._enums import Region, region_mask
-from .._serial import Saveable
+from .._io.serial import Saveable
 from ..curve import Curve
 from ..interface import require_map
+from .critical import critical_curve
 
-__all__ = ["ImpactZone", "impact_zone"]
+__all__ = ["ImpactZone", "impact_zone", "impact_zone_floor"]
 
 _log = logging.getLogger(__name__)
 
@@ -147,7 +148,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
     """The impact zone of a map: its ceiling and floor as :class:`hovering.Curve` objects.
 
     The floor is settled first, then the ceiling is searched above it: the lowest invariant curve
-    that never impacts (``m.critical_curve``, regions J_0u and J_0) among the starts on the search
+    that never impacts (``critical_curve(m)``, regions J_0u and J_0) among the starts on the search
     line that lie *above the floor*. Below a flow's floor the orbits pass above the step every
     return, so the invariant curves there never impact either; a search that reached below the
     floor could return one of them (it did, at the sign of eps that does not hover) and the zone
@@ -158,7 +159,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
     m : TruncatedMap, TruncatedFamily or FlowMap
         The map.
     ceiling : Curve or float, optional
-        The upper boundary; default: the critical invariant curve ``m.critical_curve(n_steps,
+        The upper boundary; default: the critical invariant curve ``critical_curve(m, n_steps,
         **kwargs).curve``, searched on the line ``critical_curve`` picks (L1 where the map hovers,
         L2 where it does not) between the floor and the band's top. Without ``K_range`` the search
         starts in the range the leading-order theory predicts, clipped to the band and to above
@@ -166,7 +167,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         holds no curve or its lowest start already passes.
     floor : Curve or float, optional
         The lower boundary; default: for a :class:`hovering.FlowMap` its own floor
-        (``m.impact_zone_floor().curve``, an invariant curve of the flow, used as it is); for the
+        (``impact_zone_floor(m).curve``, an invariant curve of the flow, used as it is); for the
         truncated maps, which have none, the lower edge of the band (``m.valid_band()[0]``). A
         given floor that dips within 1% of the zone's height (from the band's lower edge to the
         top of the ceiling, or to the band's top if lower) of the band's lower edge, or below it,
@@ -176,7 +177,7 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         Iterates per tested orbit of the ceiling search; the flow's floor search uses
         ``min(n_steps, 2000)``.
     **kwargs
-        Passed to :meth:`critical_curve` (``K_range``, ``line``, ``regions``, ``n_grid``, ``digits``,
+        Passed to :func:`critical_curve` (``K_range``, ``line``, ``regions``, ``n_grid``, ``digits``,
         ``tol``, ``n_threads``, ``progress``, ...); ``n_threads`` and ``progress`` also to the
         flow's floor search.
 
@@ -218,9 +219,9 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
     kind = "given"
     t0 = time.perf_counter()
     if floor is None:
-        if hasattr(m, "impact_zone_floor"):
+        if hasattr(m, "upper_tangent_K"):  # a FlowMap: the zone has a floor of its own
             floor_kw = {k: kw[k] for k in ("n_threads", "progress") if k in kw}
-            floor, kind = m.impact_zone_floor(n_steps=min(n_steps, 2000), **floor_kw).curve, "flow"
+            floor, kind = impact_zone_floor(m, n_steps=min(n_steps, 2000), **floor_kw).curve, "flow"
         else:
             floor, kind = Curve.constant(m.valid_band()[0]), "band"
     elif not isinstance(floor, Curve):
@@ -242,6 +243,85 @@ def impact_zone(m, ceiling=None, floor=None, n_steps: int = 20_000, **kwargs) ->
         f"searched ({n_steps} steps per tested orbit)" if searched else "given", time.perf_counter() - t0,
     )  # fmt: skip
     return ImpactZone(ceiling=ceiling, floor=floor, floor_kind=kind, raised=raised)
+
+
+def impact_zone_floor(m, n_steps: int = 2000, phi: float = 0.0, K_range=None, **kwargs):
+    """The lower boundary of the impact zone: the highest invariant curve below it (sec:discussion).
+
+    Searched on the vertical line ``phi``: the highest start whose orbit never leaves J_0 (passes
+    above the step every return, no impact) and is a regular rotational curve; the deformed
+    torus tangent to the upper wall at eps = 0 (:meth:`FlowMap.upper_tangent_K`). It is an orbit of
+    the flow, so every point of it lies on the section, also where it leaves the rectangle
+    :meth:`FlowMap.valid_band` (which is conservative: e.g. K = -0.261 against a band from -0.257 on
+    the README system at eps = -0.1).
+
+    Parameters
+    ----------
+    m : FlowMap
+        The flow's map, in normal coordinates.
+    n_steps : int, optional
+        Returns per tested orbit.
+    phi : float, optional
+        The search line's angle.
+    K_range : (float, float), optional
+        Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, clipped to the
+        band (from 0.95 of its lower edge) and below ``K = -1e-3``).
+    **kwargs
+        ``n_grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
+
+    Returns
+    -------
+    CriticalCurve
+        ``K0`` (height on the line), ``K_min``, ``K_max`` (the curve's extent), rotation.
+
+    Raises
+    ------
+    ValueError
+        Outside normal coordinates; where the default range is empty (the eps = 0 torus and
+        its eps-neighbourhood all outside the band); and where no curve is found (the message
+        starts "no invariant curve", says why that happens - the tori below the zone destroyed
+        at this eps (README system, eps = -0.15, -0.2), or lying below the band (eps = -0.3) -
+        and what to pass: ``K_range``, more ``n_steps``, or to :func:`hovering.impact_zone` a
+        ``floor=``).
+    """
+    require_map("m", m)
+    if not hasattr(m, "upper_tangent_K"):
+        raise ValueError(
+            f"the impact zone floor is the flow's (the deformed torus tangent to the upper wall): m must be a "
+            f"hovering.FlowMap, got a {type(m).__name__} (a truncated map's zone reaches down to its band)"
+        )
+    if m.coordinates != "normal":
+        raise ValueError("the impact zone floor is searched in normal coordinates: use coordinates='normal'")
+    Ku = m.upper_tangent_K()
+    lo, hi = m.valid_band()
+    if K_range is None:
+        d = 0.05 + 2 * abs(m.eps)
+        K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3, hi))
+        if not K_range[0] < K_range[1]:
+            raise ValueError(
+                f"no invariant curve can be searched below the impact zone: the torus tangent to the upper wall "
+                f"(K = {Ku:.6g} at eps = 0) and its eps-neighbourhood lie outside the band ({lo:.6g}, {hi:.6g}) "
+                f"where this section's normal coordinates hold (eps = {m.eps:g}); pass impact_zone a floor= "
+                f"(a hovering.Curve or a height, e.g. floor={0.95 * lo:.4g})"
+            )
+    try:
+        return critical_curve(
+            m, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi), search="highest", **kwargs
+        )
+    except RuntimeError as e:
+        below = Ku < lo
+        raise ValueError(
+            f"{e}. Below the impact zone (around the eps = 0 torus tangent to the upper wall, K = {Ku:.6g}) no "
+            f"orbit in {tuple(float(k) for k in K_range)} stayed above the step for {n_steps} returns as a "
+            "regular rotational curve: "
+            + (
+                f"that torus lies below the band ({lo:.6g}, {hi:.6g}) where the normal coordinates hold"
+                if below
+                else "at this eps the tori there are destroyed or impact (or need more returns to show regular)"
+            )
+            + "; pass K_range=(K_lo, K_hi), more n_steps, or impact_zone a floor= (a hovering.Curve or a "
+            f"height, e.g. floor={0.95 * lo:.4g}, just inside the band's lower edge)"
+        ) from None
 
 
 def _error(curve: Curve) -> float:
@@ -292,7 +372,7 @@ def _ceiling(m, floor: Curve, n_steps: int, kw: dict) -> Curve:
     grid = int(grid) if isinstance(grid, (int, np.integer)) and grid >= 2 else 64  # critical_curve checks it
 
     def search(K_range):
-        return m.critical_curve(n_steps, K_range=K_range, line=line, **kw)
+        return critical_curve(m, n_steps, K_range=K_range, line=line, **kw)
 
     def why(e, K_range):
         return ValueError(
@@ -350,7 +430,7 @@ def _checked(cc, floor: Curve, line, K_f: float, a_floor: float) -> Curve:
             "above the step, or the critical curve itself), so no impacting orbit separates the floor from it. This "
             "happens where a flow's floor torus reaches up to K = 0 (the README system at eps = +0.2, +0.3, the sign "
             "that does not hover) and where a given floor lies just under such a torus or reaches the critical curve; pass a "
-            "floor= at or above the highest curve that never impacts below the zone (FlowMap.impact_zone_floor with "
+            "floor= at or above the highest curve that never impacts below the zone (impact_zone_floor with "
             "a K_range), or both ceiling= and floor="
         )
     c = cc.curve

@@ -1,8 +1,8 @@
 """Accuracy targets: the fastest integrator setting measured to reach a requested error.
 
-``FlowMap(sys, h, accuracy=1e-9)`` is resolved here, above the models: the map's constructor calls
-the ``choose_setting`` hook this module registers (:mod:`hovering.interface`), so the model never
-imports the measuring harness.
+An accuracy target is resolved here, above the models: :func:`accurate_flow_map` measures
+(:func:`choose_setting`), then builds the :class:`~hovering.FlowMap` with the setting chosen. The
+model takes a stepper and tolerances and never imports the measuring harness.
 """
 
 from __future__ import annotations
@@ -13,13 +13,17 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._checks import integer, real_number
-from ..interface import register
+from ..normal.flowmap import FlowMap
 from .work_precision import _EXACT_ERROR, _best_time, _default_actions, _flow, exact_available, stepper_applies
 
-__all__ = ["choose_setting"]
+__all__ = ["choose_setting", "accurate_flow_map"]
 
 
-@register("choose_setting")
+def _target(accuracy, returns) -> tuple:
+    """The target and its number of returns, checked (before anything is measured)."""
+    return real_number("accuracy", accuracy, 0, True, 1, True), integer("returns", returns, 1, 100_000)
+
+
 def choose_setting(
     section,
     accuracy: float,
@@ -61,8 +65,7 @@ def choose_setting(
     ValueError
         For a bad target, or if no candidate reaches it (naming the best error measured).
     """
-    accuracy = real_number("accuracy", accuracy, 0, True, 1, True)
-    returns = integer("accuracy_returns", returns, 1, 100_000)
+    accuracy, returns = _target(accuracy, returns)
     if exact_available(section) and accuracy >= _EXACT_ERROR:
         t, _ = _best_time(
             lambda: section.return_map(
@@ -115,3 +118,68 @@ def choose_setting(
     out["options"] = {"stepper": best["method"], "rtol": best["tolerance"], "atol": best["tolerance"]}
     out["reference"] = wp.reference["method"]
     return out
+
+
+def accurate_flow_map(
+    sys, h: float = 1.0, accuracy: float = 1e-9, returns: int = 1, coordinates: str = "normal", curve=None, **options
+) -> FlowMap:
+    """The flow's return map at the fastest integrator setting measured to reach an accuracy target.
+
+    The setting is chosen by :func:`choose_setting` on this system and energy (the closed-form flow
+    where it applies, else a work-precision ladder); the map is then built with it, as
+    ``FlowMap(sys, h, stepper=..., rtol=tol, atol=tol)`` (what was chosen, with its measured error
+    and cost per return, is in the map's :attr:`~hovering.FlowMap.accuracy_choice`).
+
+    Parameters
+    ----------
+    sys : StepSystem
+        The system.
+    h : float, optional
+        Energy of the section.
+    accuracy : float, optional
+        Target: the largest section-coordinate error of a return allowed, in (0, 1) (default 1e-9).
+    returns : int, optional
+        After how many returns the target holds (1 .. 1e5; errors grow as m^2 with the number m of
+        returns, so a 1e4-return portrait needs a much tighter setting).
+    coordinates : {"normal", "section"}, optional
+        The map's coordinates (see :class:`~hovering.FlowMap`).
+    curve : TangentialCurve, optional
+        The tangential curve of this section (measured once if not given).
+    **options
+        ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol``,
+        ``verify_steps`` (not ``stepper``, ``rtol``, ``atol``: the target chooses them).
+
+    Returns
+    -------
+    FlowMap
+        With :attr:`~hovering.FlowMap.accuracy_choice` set (``method``, ``tolerance``, ``error``,
+        ``seconds``, ``options``, ``reference``, ``returns``).
+
+    Raises
+    ------
+    ValueError
+        For bad parameters (named, with the allowed range), a stepper or tolerance given with the
+        target, or a target no candidate reaches (naming the best error measured).
+
+    Examples
+    --------
+    >>> import hovering
+    >>> sys = hovering.StepSystem(hovering.Harmonic(1.0), hovering.Tan(1.4, 0.7), hovering.Bilinear(), eps=0.0)
+    >>> fm = hovering.diagnostics.accurate_flow_map(sys, 1.0, accuracy=1e-9, coordinates="section")
+    >>> fm.accuracy_choice["method"]       # eps = 0 with Harmonic and Tan: the closed-form flow
+    'exact'
+    """
+    chosen_by_hand = sorted({"stepper", "rtol", "atol"} & set(options))
+    if chosen_by_hand:
+        raise ValueError(f"accuracy picks the stepper and tolerances itself; remove {chosen_by_hand} or use FlowMap")
+    _target(accuracy, returns)
+    # The map at the core's defaults first: every argument checked, and the tangential curve (which
+    # does not depend on the integrator setting) measured once, before the measurement of settings.
+    plain = FlowMap(sys, h, coordinates=coordinates, curve=curve, **options)
+    choice = choose_setting(plain.section, accuracy, returns)
+    tol = choice["tolerance"]
+    fm = FlowMap(
+        sys, h, coordinates=coordinates, curve=plain.curve, stepper=choice["method"], rtol=tol, atol=tol, **options
+    )
+    fm.accuracy_choice = choice
+    return fm

@@ -1,4 +1,11 @@
-"""Single-well potentials defined in Python: ``CustomPotential(V, dV)`` and the checks it runs.
+"""Every single-well potential's Python face: the compiled kinds of the core's registry
+(:data:`POTENTIAL_KINDS`: :class:`Harmonic`, :class:`Tan`), :class:`Numerical`, and potentials
+defined in Python (``CustomPotential(V, dV)`` and the checks it runs).
+
+The compiled kinds come from the core's one list (``CompiledPotentials`` in
+``cpp/include/hovering/flow/potential.hpp``): the bindings bind each with its parameters, scene files
+and plans name it by its kind, and here each gets equality by value and the record
+:func:`hovering.save` writes, all from the registry's parameter names.
 
 The compiled core answers every energy question (period, action, energy, angles, turning points)
 of any potential from V and V' alone, by GSL quadrature and root finding, so a Python-defined
@@ -29,10 +36,65 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._core.flow import Potential, _CallablePotential
-from .._pickle import pickler_stores_code
+from .._core import flow as _core_flow
+from .._core.flow import Harmonic, Numerical, Potential, Tan, _CallablePotential
+from .._io.records import pickler_stores_code, reduce_record
 
-__all__ = ["CustomPotential", "check_potential"]
+__all__ = [
+    "Potential",
+    "Harmonic",
+    "Tan",
+    "Numerical",
+    "CustomPotential",
+    "check_potential",
+    "POTENTIAL_KINDS",
+    "COMPILED",
+]
+
+#: The core's registry of compiled potentials, in its order: each kind's name in scene files and
+#: plans (``kind``), its class (``cls``), its formula and its parameters (``params``: name, lo, hi)
+#: in the constructor's order.
+POTENTIAL_KINDS = tuple(_core_flow.POTENTIAL_KINDS)
+
+#: The compiled potential classes, in the registry's order.
+COMPILED = tuple(getattr(_core_flow, k.cls) for k in POTENTIAL_KINDS)
+
+
+# ---------------------------------------------------------------- the compiled potentials' values
+# Pickling is the compiled classes' own (bind_potential.cpp: their constructor arguments); these
+# add equality by value and the records :func:`hovering.save` writes (no pickle in the file).
+
+
+def _potential_eq(self, other):
+    """Equal to a potential of the same class with the same parameters (for Numerical: an equal base)."""
+    if not isinstance(other, Potential):
+        return NotImplemented
+    return type(self) is type(other) and self.__getstate__() == other.__getstate__()
+
+
+def _potential_hash(self) -> int:
+    """Hash of the class and the parameters (consistent with ``==``)."""
+    return hash((type(self), self.__getstate__()))
+
+
+def _record_fields(*names):
+    def to_record(self) -> dict:
+        """What :func:`hovering.save` writes: the constructor arguments."""
+        return {name: getattr(self, name) for name in names}
+
+    def from_record(cls, record: dict):
+        """Inverse of ``_to_record`` (the constructor's checks run again)."""
+        return cls(*(record[name] for name in names))
+
+    return to_record, classmethod(from_record)
+
+
+_FIELDS = [(c, tuple(p.name for p in k.params)) for c, k in zip(COMPILED, POTENTIAL_KINDS)]
+for _cls, _names in (*_FIELDS, (Numerical, ("base",))):
+    _cls.__eq__, _cls.__hash__ = _potential_eq, _potential_hash
+    _cls._to_record, _cls._from_record = _record_fields(*_names)
+    # Pickled by the record too (the compiled __setstate__ stays, to read the pickles written before).
+    _cls.__reduce__ = reduce_record
 
 # V(0) must vanish to this absolute accuracy: the core measures energies from the minimum.
 _V0_TOL = 1e-12

@@ -6,13 +6,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import check_points, integer, is_choice, real_array, real_number, thread_count
+from .._checks import check_points, integer, real_array, real_number, thread_count
 from .._core import flow as _core_flow
 from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
-from .._pickle import reduce_record
+from .._io.records import reduce_record
+from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar
-from .._serial import Saveable
 from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .system import StepSystem
 
@@ -56,8 +56,9 @@ def flow_options(
     rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps
         See :meth:`Section.return_map` (``"exact"`` ignores rtol and atol; whether it applies
         depends on the system: ``FlowOptions.validate_for(system)``). None: the core's default
-        (``hovering._core.flow.FlowOptions()``: rk8pd, rtol 1e-10, atol 1e-12, event_tol 1e-15,
-        max_steps 1e6, max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10, verify_steps -1).
+        (``hovering._core.flow.FlowOptions()``: rk8pd, rtol 1e-10, event_tol 1e-15, max_steps 1e6,
+        max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10, verify_steps -1; atol: the core's
+        one policy, ``default_atol(rtol)`` = rtol).
 
     Returns
     -------
@@ -65,12 +66,9 @@ def flow_options(
     """
     kw = {}
     if stepper is not None:
-        if not is_choice(stepper, STEPPERS):
-            raise ValueError(
-                f"stepper must be one of {STEPPERS} (GSL's bsimp and msbdf are not offered: stiff "
-                f"solvers, and this flow is not stiff), got {stepper!r}"
-            )
-        kw["stepper"] = stepper
+        # The core parses the name (its message names the value and every stepper); anything but a
+        # string is named the same way.
+        kw["stepper"] = stepper if isinstance(stepper, str) else repr(stepper)
     given = (
         ("rtol", rtol),
         ("atol", atol),
@@ -187,7 +185,7 @@ class ReturnMapResult(Summarized, Saveable):
         ImportError
             Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
-        from .._interop import return_map_dataset
+        from .._io.interop import return_map_dataset
 
         return return_map_dataset(self)
 
@@ -330,7 +328,8 @@ class Section:
         theta, I : array_like
             Section coordinates of the starting points.
         rtol, atol : float, optional
-            Tolerances of the step-size control (not read by ``"exact"``; default 1e-10, 1e-12).
+            Tolerances of the step-size control (not read by ``"exact"``; default rtol 1e-10, and atol
+            rtol's: the core's one policy, ``FlowOptions::default_atol``, as for :class:`FlowMap`).
             Every integrator setting left None takes the core's default (:func:`flow_options`).
         stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "taylor", "exact"}, optional
             ``"taylor"``: Taylor's method on the field, which is a polynomial in the state once each

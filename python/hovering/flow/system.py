@@ -11,12 +11,13 @@ import numpy as np
 
 from .._checks import is_choice, real_number
 from .._core import flow as _core_flow
-from .._core.flow import Harmonic, Numerical, OnsetParameters, Potential, Tan
+from .._core.flow import OnsetParameters
 from .._enums import Geometry
-from .._pickle import reduce_record
+from .._io.records import reduce_record
+from .potentials import COMPILED, Harmonic, Numerical, Potential, Tan, _potential_hash
 
 __all__ = [
-    "Harmonic",
+    "Harmonic",  # re-exported: the potentials' home is hovering.flow.potentials
     "Tan",
     "Numerical",
     "Potential",
@@ -29,41 +30,6 @@ __all__ = [
 
 _GEOMETRIES = ("none", "wall", "step")
 
-
-# ---------------------------------------------------------------- the compiled potentials' values
-# Pickling is the compiled classes' own (bind_potential.cpp: their constructor arguments); these
-# add equality by value and the records :func:`hovering.save` writes (no pickle in the file).
-
-
-def _potential_eq(self, other):
-    """Equal to a potential of the same class with the same parameters (for Numerical: an equal base)."""
-    if not isinstance(other, Potential):
-        return NotImplemented
-    return type(self) is type(other) and self.__getstate__() == other.__getstate__()
-
-
-def _potential_hash(self) -> int:
-    """Hash of the class and the parameters (consistent with ``==``)."""
-    return hash((type(self), self.__getstate__()))
-
-
-def _record_fields(*names):
-    def to_record(self) -> dict:
-        """What :func:`hovering.save` writes: the constructor arguments."""
-        return {name: getattr(self, name) for name in names}
-
-    def from_record(cls, record: dict):
-        """Inverse of ``_to_record`` (the constructor's checks run again)."""
-        return cls(*(record[name] for name in names))
-
-    return to_record, classmethod(from_record)
-
-
-for _cls, _names in ((Harmonic, ("omega",)), (Tan, ("omega", "alpha")), (Numerical, ("base",))):
-    _cls.__eq__, _cls.__hash__ = _potential_eq, _potential_hash
-    _cls._to_record, _cls._from_record = _record_fields(*_names)
-    # Pickled by the record too (the compiled __setstate__ stays, to read the pickles written before).
-    _cls.__reduce__ = reduce_record
 
 _ONSET_FIELDS = ("Omega0", "tau0", "tau1", "lam", "theta_w", "I_tan")
 
@@ -258,9 +224,9 @@ class StepSystem:
                 raise ValueError(
                     f"{name} must be a hovering potential (Harmonic, Tan, CustomPotential, ...), got {pot!r}"
                 )
-            # The core computes Harmonic and Tan forces from their parameters: a Python override of
-            # V or dV in a subclass of them would be silently ignored by the flow.
-            for base in (Harmonic, Tan):
+            # The core computes a compiled potential's forces from its parameters: a Python override
+            # of V or dV in a subclass of one would be silently ignored by the flow.
+            for base in COMPILED:
                 if isinstance(pot, base) and any(getattr(type(pot), f) is not getattr(base, f) for f in ("V", "dV")):
                     raise ValueError(
                         f"{name}: {type(pot).__name__} overrides V/dV of the compiled {base.__name__}, which the "

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._checks import forcing_array, real_number, require_type
 from .._enums import Region, wrap
-from .._serial import Saveable
+from .._io.serial import Saveable
 from ..flow.section import Section
 from ..truncated.maps import TruncatedFamily, TruncatedMap
 from .coordinates import TangentialCurve, _curve_of, _finite_pair, _section

@@ -20,8 +20,8 @@ from .._checks import MAX_MODES, check_points, integer, real_array, require_angl
 from .._core import normal as _core_normal
 from .._deprecated import renamed_keywords
 from .._enums import wrap
-from .._pickle import reduce_record
-from .._serial import Saveable
+from .._io.records import reduce_record
+from .._io.serial import Saveable
 from ..flow.section import FlowStatus, Section, flow_options
 
 __all__ = [

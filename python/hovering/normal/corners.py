@@ -11,7 +11,7 @@ import numpy as np
 
 from .._checks import integer, physical_memory, real_array, require_finite
 from .._enums import wrap
-from .._serial import Saveable
+from .._io.serial import Saveable
 from ..flow.section import FlowStatus, Section
 from ..flow.system import onset_parameters
 from .coordinates import TangentialCurve, _curve_of, _section

@@ -15,19 +15,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, point_pair
-from .._core import flow as _core_flow
 from .._core import normal as _core_normal
+from .._deprecated import call_moved, moved_argument, moved_method
 from .._enums import Region, wrap
-from .._pickle import reduce_record
+from .._io.records import reduce_record
+from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar
-from .._serial import Saveable
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
 from ..interface import (
     MAX_TRAJECTORY_POINTS,
     IterateResult,
     MapAnalyses,
-    hook,
     iterate_arguments,
     recorded_counts,
     trajectory_arguments,
@@ -130,24 +129,20 @@ class FlowMap(MapAnalyses):
     rtol : float, optional
         Relative tolerance of the integrator (GSL step control; default the core's, 1e-10).
     atol : float, optional
-        Absolute tolerance (default ``rtol``: the flow's variables are O(1) here, and an atol
-        below rtol only tightens the steps where a momentum crosses zero: at rtol 1e-10,
-        atol 1e-12 costs 17% more steps for a 2.5x smaller error per return).
+        Absolute tolerance (default: the core's policy, ``FlowOptions::default_atol``: rtol's; the
+        flow's variables are O(1) here, and an atol below rtol only tightens the steps where a
+        momentum crosses zero: at rtol 1e-10, atol 1e-12 costs 17% more steps for a 2.5x smaller
+        error per return).
     stepper : str, optional
         GSL stepper (default the core's, ``"rk8pd"``), or ``"exact"`` for the closed-form flow (see :data:`hovering.flow.STEPPERS`
         and :meth:`hovering.Section.return_map`; it ignores rtol and atol).
     curve : TangentialCurve, optional
         The tangential curve of this section (measured at rtol 1e-13 if not given, with as many
         wall points as its interpolation error below 1e-12 needs).
-    accuracy : float, optional
-        An accuracy target instead of ``stepper``/``rtol``/``atol``: the fastest setting measured
-        (here, on this system and energy: :func:`hovering.diagnostics.choose_setting`) to keep the
-        section-coordinate error of one return (of ``accuracy_returns`` returns) within it. What
-        was chosen is in :attr:`integrator_options` and :attr:`accuracy_choice` (with its measured
-        error and cost per return). A ValueError names the best reachable error if none reaches it.
-    accuracy_returns : int, optional
-        Number of returns the ``accuracy`` target is for (default 1; errors grow as m^2 with the
-        number m of returns, so a 1e4-return portrait needs a much tighter setting).
+    accuracy, accuracy_returns : float, int, optional
+        Deprecated (removed in 0.4.0): an accuracy target is resolved above the models, by
+        :func:`hovering.diagnostics.accurate_flow_map` ``(sys, h, accuracy, returns)``, which
+        measures the fastest setting that reaches it and builds the map with it.
     **options
         ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol``,
         ``verify_steps`` (see :meth:`hovering.Section.return_map`).
@@ -216,21 +211,23 @@ class FlowMap(MapAnalyses):
                 f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
                 "grazing_tol, corner_tol, verify_steps"
             )
-        #: What an ``accuracy`` target chose (None without one): the row of the measurement.
+        #: What an accuracy target chose (:func:`hovering.diagnostics.accurate_flow_map` sets it;
+        #: None without one): the row of the measurement.
         self.accuracy_choice = None
         if accuracy is not None:
-            # Resolved above the models (hovering.diagnostics.tolerance registers it): measuring
-            # is the harness's business, the map only takes what it chose.
-            self.accuracy_choice = hook("choose_setting")(self.section, accuracy, accuracy_returns)
+            # The old form: measuring is the harness's business, two layers up. It is found by
+            # name through the deprecation module only, as long as the old form lives.
+            moved_argument("FlowMap", "accuracy", "hovering.diagnostics.accurate_flow_map(sys, h, accuracy, returns)")
+            self.accuracy_choice = call_moved(
+                "hovering.diagnostics.tolerance.choose_setting", self.section, accuracy, accuracy_returns
+            )
             stepper, rtol = self.accuracy_choice["method"], self.accuracy_choice["tolerance"]
             atol = rtol
-        default = _core_flow.FlowOptions()  # the core's defaults, for what is not given
-        stepper = default.stepper if stepper is None else stepper
-        rtol = default.rtol if rtol is None else rtol
-        atol = rtol if atol is None else atol
+        # None: the core's default (its FlowOptions{} and default_atol, the one policy).
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
         self._options.validate_for(sys.core)  # before the tangential curve is measured
-        self.integrator_options = dict(rtol=float(rtol), atol=float(atol), stepper=stepper, **options)
+        o = self._options
+        self.integrator_options = dict(rtol=float(o.rtol), atol=float(o.atol), stepper=o.stepper, **options)
         #: Why there are no onset parameters (None when there are): below the step energy, or
         #: too close to it for them to be accurate (onset_parameters raises rather than guess).
         self.onset_error = None
@@ -330,13 +327,23 @@ class FlowMap(MapAnalyses):
         }
 
     #: Entries of the record derived from the others (the forcing fit of the curve): not part of
-    #: the map's identity in a checkpoint key (:func:`hovering._serial.record_key`).
+    #: the map's identity in a checkpoint key (:func:`hovering._io.serial.record_key`).
     _RECORD_CACHE = ("forcing",)
 
     #: The integrator options a saved FlowMap holds (:attr:`integrator_options`): a file's options
     #: are these or nothing, never an ``accuracy`` target (that would measure, i.e. compute, on load).
     _RECORD_OPTIONS = frozenset(
-        {"rtol", "atol", "stepper", "event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol", "verify_steps"}
+        {
+            "rtol",
+            "atol",
+            "stepper",
+            "event_tol",
+            "max_steps",
+            "max_impacts",
+            "grazing_tol",
+            "corner_tol",
+            "verify_steps",
+        }
     )
 
     @classmethod
@@ -880,75 +887,8 @@ class FlowMap(MapAnalyses):
         I_up = self.sys.V2.action(self.sys.V2.V(self.sys.qw2))
         return float(I_up - (self.curve.I_tan0 if self.curve is not None else 0.0))
 
-    def impact_zone_floor(self, n_steps: int = 2000, phi: float = 0.0, K_range=None, **kwargs):
-        """The lower boundary of the impact zone: the highest invariant curve below it (sec:discussion).
-
-        Searched on the vertical line ``phi``: the highest start whose orbit never leaves J_0 (passes
-        above the step every return, no impact) and is a regular rotational curve; the deformed
-        torus tangent to the upper wall at eps = 0 (:meth:`upper_tangent_K`). It is an orbit of
-        the flow, so every point of it lies on the section, also where it leaves the rectangle
-        :meth:`valid_band` (which is conservative: e.g. K = -0.261 against a band from -0.257 on
-        the README system at eps = -0.1).
-
-        Parameters
-        ----------
-        n_steps : int, optional
-            Returns per tested orbit.
-        phi : float, optional
-            The search line's angle.
-        K_range : (float, float), optional
-            Heights searched (default: ``upper_tangent_K() -+ (0.05 + 2 |eps|)``, clipped to the
-            band (from 0.95 of its lower edge) and below ``K = -1e-3``).
-        **kwargs
-            ``n_grid``, ``digits``, ``tol``, ``n_threads``, ``progress`` of :func:`hovering.critical_curve`.
-
-        Returns
-        -------
-        CriticalCurve
-            ``K0`` (height on the line), ``K_min``, ``K_max`` (the curve's extent), rotation.
-
-        Raises
-        ------
-        ValueError
-            Outside normal coordinates; where the default range is empty (the eps = 0 torus and
-            its eps-neighbourhood all outside the band); and where no curve is found (the message
-            starts "no invariant curve", says why that happens - the tori below the zone destroyed
-            at this eps (README system, eps = -0.15, -0.2), or lying below the band (eps = -0.3) -
-            and what to pass: ``K_range``, more ``n_steps``, or to :func:`hovering.impact_zone` a
-            ``floor=``).
-        """
-        if self.coordinates != "normal":
-            raise ValueError("the impact zone floor is searched in normal coordinates: use coordinates='normal'")
-        Ku = self.upper_tangent_K()
-        lo, hi = self.valid_band()
-        if K_range is None:
-            d = 0.05 + 2 * abs(self.eps)
-            K_range = (max(Ku - d, 0.95 * lo), min(Ku + d, -1e-3, hi))
-            if not K_range[0] < K_range[1]:
-                raise ValueError(
-                    f"no invariant curve can be searched below the impact zone: the torus tangent to the upper wall "
-                    f"(K = {Ku:.6g} at eps = 0) and its eps-neighbourhood lie outside the band ({lo:.6g}, {hi:.6g}) "
-                    f"where this section's normal coordinates hold (eps = {self.eps:g}); pass impact_zone a floor= "
-                    f"(a hovering.Curve or a height, e.g. floor={0.95 * lo:.4g})"
-                )
-        try:
-            return hook("critical_curve")(
-                self, n_steps=n_steps, K_range=K_range, regions=("0",), line=float(phi), search="highest", **kwargs
-            )
-        except RuntimeError as e:
-            below = Ku < lo
-            raise ValueError(
-                f"{e}. Below the impact zone (around the eps = 0 torus tangent to the upper wall, K = {Ku:.6g}) no "
-                f"orbit in {tuple(float(k) for k in K_range)} stayed above the step for {n_steps} returns as a "
-                "regular rotational curve: "
-                + (
-                    f"that torus lies below the band ({lo:.6g}, {hi:.6g}) where the normal coordinates hold"
-                    if below
-                    else "at this eps the tori there are destroyed or impact (or need more returns to show regular)"
-                )
-                + "; pass K_range=(K_lo, K_hi), more n_steps, or impact_zone a floor= (a hovering.Curve or a "
-                f"height, e.g. floor={0.95 * lo:.4g}, just inside the band's lower edge)"
-            ) from None
+    #: Deprecated (removed in 0.4.0): the search is an analysis of the map, :func:`hovering.impact_zone_floor`.
+    impact_zone_floor = moved_method("impact_zone_floor", "hovering.analysis.zone.impact_zone_floor")
 
     def step_rotations(self, res: IterateResult, i: int) -> np.ndarray:
         """The rotation of each return of orbit i of ``res``: the angle advance ``phi_{n+1} - phi_n``

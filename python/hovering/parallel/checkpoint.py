@@ -25,7 +25,7 @@ and the line.
 
 A checkpoint is read as untrusted input (docs/threat-model.md): it must be a regular file whose
 parsed size (estimated from its text) fits in half of this machine's memory, a line nested deeper
-than :data:`hovering._untrusted.MAX_TREE_DEPTH` is damaged, and a row is used only after its
+than :data:`hovering._io.untrusted.MAX_TREE_DEPTH` is damaged, and a row is used only after its
 user's check (:meth:`Checkpoint.get`, ``check``) has passed.
 """
 
@@ -40,9 +40,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .. import _untrusted
-from .._output import write_error
-from .._provenance import provenance
+from .._io import untrusted as _untrusted
+from .._io.output import write_error
+from .._io.provenance import provenance
 
 __all__ = ["FORMAT", "VERSION", "Checkpoint", "check_row", "canonical", "encode"]
 
@@ -197,7 +197,7 @@ def _parse_line(raw: bytes) -> Any:
     """The JSON value of one checkpoint line, or a ValueError naming the field and what is wrong.
 
     Refused: bytes that are not UTF-8, nesting deeper than
-    :data:`hovering._untrusted.MAX_TREE_DEPTH`, a syntax error, the tokens ``NaN`` / ``Infinity``,
+    :data:`hovering._io.untrusted.MAX_TREE_DEPTH`, a syntax error, the tokens ``NaN`` / ``Infinity``,
     a number beyond a double, an integer beyond 64 bits (:data:`INT_RANGE`), a name twice in one
     object, a lone UTF-16 surrogate in a string. The same lines ``hovering_sweep`` refuses.
     The parser runs at C speed (hooks only where they cost nothing); the tree is walked only when
@@ -525,7 +525,7 @@ class Checkpoint:
 
         Raises
         ------
-        hovering._output.WriteError
+        hovering._io.output.WriteError
             (a ValueError) When the line cannot be written (e.g. ``no space left``); the file is
             left as it was.
         """

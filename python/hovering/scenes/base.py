@@ -9,6 +9,7 @@ kind's module imports what it needs from here, and the generic front (``schema``
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -19,16 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _serial
 from .._display import Summarized
 from .._enums import FlowStatus, Region, Status
-from .._output import output_path, write_text
-from .._provenance import provenance
-from .._serial import saved_as
-from ..interface import hook
+from .._io import serial as _serial
+from .._io.output import output_path, write_text
+from .._io.provenance import provenance
+from .._io.serial import saved_as
 from . import registry
-from .fields import custom, integer, size, text
-from .values import MAX_PATH_CHARS, MAX_TEXT
+from .fields import PARAM, custom, integer, size, text
+from .values import MAX_CANVAS_PIXELS, MAX_PATH_CHARS, MAX_TEXT
 from .values import color as _color
 from .values import text as _text
 
@@ -43,6 +43,7 @@ __all__ = [
     "Stages",
     "scaled",
     "figure_inches",
+    "check_canvas",
     "output_dirs",
     "summarize",
     "jsonable",
@@ -129,9 +130,16 @@ class SceneSpec:
     figsize: tuple | None = size()
 
     def _validate_loaded(self) -> None:
-        """A spec read from a file (:func:`hovering.load`) gets the checks a scene file gets (the
-        schema, above the spec, registers them as the ``check_spec`` hook)."""
-        hook("check_spec")(self)
+        """A spec read from a file (:func:`hovering.load`): its own bounds, the ones that size what
+        a figure allocates (``dpi``, ``figsize`` as declared here, and the canvas). Every other check
+        a scene file gets (the schema's, a layer above) is run by whoever loads a scene result
+        (:func:`hovering.scenes.load_result`: ``check_spec``)."""
+        where = self.path.name if isinstance(self.path, Path) else "scene"
+        for f in dataclasses.fields(SceneSpec):
+            value = getattr(self, f.name)
+            if f.name in ("dpi", "figsize") and value is not None:
+                f.metadata[PARAM].read(f"{where}.{f.name}", list(value) if f.name == "figsize" else value, None)
+        check_canvas(where, self)
 
 
 def figure_inches(scene, n_panels: int = 1) -> tuple:
@@ -156,6 +164,41 @@ def figure_inches(scene, n_panels: int = 1) -> tuple:
     layout = getattr(scene, "layout", None)
     rows, cols = layout if layout is not None else (n_panels, 1)
     return (6.0 * cols + 1.0, 4.6 * rows + 0.6)
+
+
+def check_canvas(where: str, spec: SceneSpec) -> None:
+    """The figure's canvas (dpi and its size in inches, given or its kind's default) within
+    :data:`~hovering.scenes.values.MAX_CANVAS_PIXELS`: a spec's own bound, checked by the schema
+    for a scene file and by the spec itself for one read back from a saved result.
+
+    Parameters
+    ----------
+    where : str
+        What the spec is, for the message (the file's name).
+    spec : SceneSpec
+        The spec.
+
+    Raises
+    ------
+    ValueError
+        Naming dpi and the size that make the canvas too large, and the limit.
+    """
+
+    w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
+    pixels = (spec.dpi * w) * (spec.dpi * h)
+    if pixels > MAX_CANVAS_PIXELS:
+        given = (
+            "figsize"
+            if spec.figsize is not None
+            else "layout"
+            if getattr(spec, "layout", None) is not None
+            else "the default figure size"
+        )
+        raise ValueError(
+            f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
+            f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
+            f"(lower dpi or figsize)"
+        )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -192,7 +235,7 @@ def jsonable(x):
 
 
 # ------------------------------------------------------------------------------------------------
-# Checks of a result read from a file (hovering._serial calls ``_validate_loaded`` after checking
+# Checks of a result read from a file (hovering._io.serial calls ``_validate_loaded`` after checking
 # each field's declared type): what the figure draws is what a computation could have made. Texts
 # and colours get the scene schema's checks.
 
@@ -458,6 +501,12 @@ class SceneResult(Summarized):
     scene: SceneSpec
     meta: dict
 
+    @staticmethod
+    def _summarize_kind(result) -> dict:
+        """The kind's own numbers: :func:`~hovering.scenes.registry.register` binds the kind's
+        ``summarize`` here, on the kind's result class."""
+        raise ValueError(f"a {type(result).__name__} is the result of no registered scene kind")
+
     def _validate_loaded(self) -> None:
         # What the figure and the summary take from meta (the scene itself was checked as it was read).
 
@@ -508,7 +557,7 @@ class SceneResult(Summarized):
 
         Raises
         ------
-        hovering._output.WriteError
+        hovering._io.output.WriteError
             (a ValueError) When a file cannot be written (e.g. ``no space left``).
         """
 
@@ -539,7 +588,8 @@ def summarize(result) -> dict:
     dict
         ``scene``, ``kind``, ``title``, ``quick``, ``runtime_s``, what ``meta`` recorded of
         ``n_steps``, ``samples``, ``points_reused``, ``checkpoint``, ``grid``, ``accuracy``, then
-        the kind's own numbers (its :attr:`~hovering.scenes.registry.Kind.summarize`: the panels of
+        the kind's own numbers (its :attr:`~hovering.scenes.registry.Kind.summarize`, which
+        :func:`~hovering.scenes.registry.register` binds to the kind's result class: the panels of
         an orbit scene, the points of a sweep, ...).
     """
     sc, meta = result.scene, result.meta
@@ -553,7 +603,7 @@ def summarize(result) -> dict:
     for k in ("n_steps", "samples", "points_reused", "checkpoint", "grid", "accuracy"):
         if k in meta:
             s[k] = meta[k]
-    s.update(registry.get(sc.kind).summarize(result))
+    s.update(type(result)._summarize_kind(result))  # the kind's numbers (bound to its result class by register)
     return jsonable(s)
 
 

@@ -21,9 +21,9 @@ import math
 import os
 from pathlib import Path
 
-from .._output import write_text
+from .._io.output import write_text
 from .._version import __version__
-from ..flow import Harmonic, Tan
+from ..flow.potentials import COMPILED, POTENTIAL_KINDS
 from ..flow.system import Polynomial, StepSystem
 from . import registry
 from .base import QUICK_FACTOR, SceneSpec
@@ -43,6 +43,10 @@ __all__ = [
 #: The plan's ``format`` and ``version`` (hovering_sweep refuses another version).
 FORMAT = "hovering-sweep-plan"
 VERSION = 1
+
+# The core's registry of compiled potentials: a kind's parameters, in its order, and its class.
+_KINDS = {k.kind: k for k in POTENTIAL_KINDS}
+_CLASSES = {k.kind: c for k, c in zip(POTENTIAL_KINDS, COMPILED)}
 
 #: Fields of a point that are not parameters: carried into its row (theory, b1) or shown (label).
 _CARRIED = ("label", "theory", "b1")
@@ -86,15 +90,13 @@ def system_record(spec, eps: float) -> dict:
     Returns
     -------
     dict
-        ``V1``, ``V2`` (``kind``, ``omega``, ``alpha`` of a tan), ``coupling`` terms, ``eps``,
+        ``V1``, ``V2`` (``kind`` and its parameters: ``omega``, ``alpha`` of a tan), ``coupling`` terms, ``eps``,
         ``qw1``, ``qw2``, ``geometry``: plain numbers and strings.
     """
 
     def pot(p):
-        d = {"kind": p.kind, "omega": float(p.omega)}
-        if p.kind == "tan":
-            d["alpha"] = float(p.alpha)
-        return d
+        # The kind and its parameters by the core's registry (the plan reader reads the same names).
+        return {"kind": p.kind, **{q.name: float(getattr(p, q.name)) for q in _KINDS[p.kind].params}}
 
     # Each (i, j) once: the schema (and SystemSpec.build) refuse a repeated power.
     return {
@@ -123,7 +125,7 @@ def build_system(system: dict):
     """
 
     def pot(p):
-        return Harmonic(p["omega"]) if p["kind"] == "harmonic" else Tan(p["omega"], p["alpha"])
+        return _CLASSES[p["kind"]](*(p[q.name] for q in _KINDS[p["kind"]].params))
 
     c = Polynomial({(int(i), int(j)): float(v) for v, i, j in system["coupling"]}) if system["coupling"] else None
     return StepSystem(

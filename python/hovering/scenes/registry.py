@@ -127,6 +127,10 @@ def register(kind: Kind) -> Kind:
     if old is not None and old.spec.__module__ != kind.spec.__module__:
         raise ValueError(f"kind {kind.name!r} is already registered by {old.spec.__module__}")
     _KINDS[kind.name] = kind
+    # The result answers its own summary: code below the kinds (SceneResult.summary and save, in
+    # scenes.base) dispatches on the result's class rather than looking its kind up in this table,
+    # which only the modules above the kinds read (compute, schema, report, plan).
+    kind.result._summarize_kind = staticmethod(kind.summarize)
     return kind
 
 

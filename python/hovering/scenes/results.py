@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import os
 
-from .. import _serial
+from .._io import serial as _serial
 from .base import SIDECAR_FORMAT, Geometry, OrbitSet, SceneResult, jsonable, summarize  # noqa: F401
 from .kinds.corner_directions import CornerDirectionsResult, CornerTrajectory
 from .kinds.flow_hovering_area import FlowHoveringResult
@@ -26,6 +26,7 @@ from .kinds.sigma_structure import SigmaStructureResult
 from .kinds.tangent_tori import TangentToriResult, TorusResult
 from .kinds.wall_section import WallSectionResult, WallSegment
 from .kinds.wall_tangency import WallPoint, WallTangencyResult
+from .schema import check_spec
 
 __all__ = [
     "Geometry",
@@ -69,7 +70,9 @@ def load_result(path: os.PathLike) -> SceneResult:
     Raises
     ------
     ValueError
-        If the file is not a scene result of this package.
+        If the file is not a scene result of this package, or its scene is not one a scene file
+        can give (the schema's checks, :func:`hovering.scenes.schema.check_spec`: naming the
+        file and the field).
     """
     obj = _serial.load(path)
     if not isinstance(obj, SceneResult):
@@ -77,4 +80,10 @@ def load_result(path: os.PathLike) -> SceneResult:
             f"{os.fspath(path)} holds a {type(obj).__name__}, not a scene result "
             "(written by `python -m hovering scene`)"
         )
+    # The loader runs the schema's checks on the scene (the spec, a layer below the schema, checks
+    # only its own bounds as it is rebuilt).
+    try:
+        check_spec(obj.scene)
+    except ValueError as e:
+        raise ValueError(f"{os.fspath(path)}: root.scene: {e}") from None
     return obj

@@ -20,9 +20,8 @@ import re
 import tomllib
 from pathlib import Path
 
-from ..interface import register
 from . import fields, kinds, registry  # noqa: F401 (kinds: every kind of the package registered)
-from .base import SceneSpec, figure_inches, output_dirs
+from .base import SceneSpec, check_canvas, output_dirs
 from .values import (  # noqa: F401 (re-exported: the limits and checks were defined here)
     _MAX_INT_BITS,
     MAX_CANVAS_PIXELS,
@@ -111,7 +110,7 @@ def parse_scene(data: dict, path: os.PathLike | None = None, check_output: bool 
     where = p.name if p is not None else "scene"
     _check_document(where, data)
     spec = _parse_scene(data, p, where, check_output)
-    _check_canvas(where, spec)
+    check_canvas(where, spec)
     return spec
 
 
@@ -139,26 +138,6 @@ def _check_document(where: str, data) -> None:
                 f"{at} = (an integer of {node.bit_length()} bits) is out of range; allowed: integers in "
                 f"[-2**63, 2**63 - 1] (TOML's 64-bit integers)"
             )
-
-
-def _check_canvas(where: str, spec: SceneSpec) -> None:
-    """The figure's canvas (dpi and its size in inches, given or its kind's default) within MAX_CANVAS_PIXELS."""
-
-    w, h = figure_inches(spec, len(getattr(spec, "panels", ())))
-    pixels = (spec.dpi * w) * (spec.dpi * h)
-    if pixels > MAX_CANVAS_PIXELS:
-        given = (
-            "figsize"
-            if spec.figsize is not None
-            else "layout"
-            if getattr(spec, "layout", None) is not None
-            else "the default figure size"
-        )
-        raise ValueError(
-            f"{where}: dpi = {spec.dpi} and {given} make a figure of {w:g} x {h:g} inches, a canvas of "
-            f"{pixels / 1e6:.0f} million pixels; allowed: at most {MAX_CANVAS_PIXELS / 1e6:.0f} million "
-            f"(lower dpi or figsize)"
-        )
 
 
 def _parse_scene(data, p: Path | None, where: str, check_output: bool) -> SceneSpec:
@@ -320,9 +299,9 @@ def _first_difference(a, b, where: str):
     return None if type(a) is type(b) and a == b else (where, a, b)
 
 
-@register("check_spec")
 def check_spec(spec: SceneSpec) -> SceneSpec:
-    """Check a scene spec from elsewhere (a saved result) with the checks a scene file gets.
+    """Check a scene spec from elsewhere (a saved result) with the checks a scene file gets: called
+    by whoever loads one (:func:`hovering.scenes.load_result`, and through it ``redraw``).
 
     The spec is written out as its scene file (:func:`scene_table`) and read by :func:`parse_scene`
     (the output path is not checked: nothing is written to it); the spec read must be ``spec``,

@@ -2,7 +2,7 @@
 
 These are the output of :mod:`hovering.scenes.schema` (TOML -> spec) and the input of
 :mod:`hovering.scenes.compute` (spec -> results). A spec is plain data: it saves with the result
-(:mod:`hovering._serial`) so a figure can be redrawn from the file alone.
+(:mod:`hovering._io.serial`) so a figure can be redrawn from the file alone.
 
 Each kind's spec is declared in its module, :mod:`hovering.scenes.kinds` (``<kind>.py``), its
 fields carrying their defaults, ranges and choices; what several kinds share (the map's

@@ -26,7 +26,7 @@ from .._checks import (
 )
 from .._core import truncated as _core_truncated
 from .._enums import Region, wrap
-from .._pickle import reduce_record
+from .._io.records import reduce_record
 from .._progress import check_progress, progress_bar
 from ..interface import IterateResult, MapAnalyses, iterate_arguments, recorded_counts, transport_arguments
 from . import theory as _geo

@@ -30,7 +30,7 @@ from .._checks import forcing_array, integer, is_choice, real_array, real_number
 from .._core import analysis as _core_analysis
 from .._core import normal as _core_normal
 from .._enums import wrap
-from .._serial import Saveable
+from .._io.serial import Saveable
 
 __all__ = [
     "OMEGA_G",

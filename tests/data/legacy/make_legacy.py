@@ -60,7 +60,7 @@ def main():
         K = rng.uniform(lo, hi, phi.size)
         p1, K1 = objects[name].step(phi, K)
         expected[f"{name}.K"], expected[f"{name}.phi1"], expected[f"{name}.K1"] = K, p1, K1
-    h = m.hovering_area(n_steps=200, n_samples=500, keep_points=True)
+    h = hv.hovering_area(m, n_steps=200, n_samples=500, keep_points=True)
     objects["hovering_area"] = h
     for name, obj in objects.items():
         (OUT / f"{name}.pkl").write_bytes(pickle.dumps(obj, protocol=4))

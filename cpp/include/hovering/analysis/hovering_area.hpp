@@ -121,4 +121,13 @@ double first_order_shape(const std::vector<double>& b, double Omega0, double psi
 /// (2 |eps| / |sin(Omega0 / 2)| for f = sin); +inf when that is not finite and positive (or b is empty).
 double default_depth(double eps, double Omega0, const std::vector<double>& b);
 
+/// The deepest box bottom inside a band whose lower end is band_lo: band_lo (1 - 1e-9), so that
+/// every sample lies strictly inside the band.
+double box_floor(double band_lo);
+
+/// Bottom K_low of hovering_area's default box, the one rule of Python's hovering_area and of the
+/// plan writers: -default_depth(eps, Omega0, b) (-0.1 at eps = 0, which has no critical band),
+/// raised to box_floor(band_lo) (band_lo = -inf: not cut).
+double default_K_low(double eps, double Omega0, const std::vector<double>& b, double band_lo);
+
 }  // namespace hovering

@@ -7,9 +7,12 @@
 // Angle convention of the paper (sec:setup): theta = 0 at the right turning point (q = q_max,
 // p = 0, dp/dt < 0), increasing with time, so on [-pi, pi) sign(theta) = -sign(p).
 
+#include <array>
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace hovering {
 
@@ -17,6 +20,23 @@ namespace hovering {
 struct Estimate {
     double value;  ///< the value
     double error;  ///< estimated absolute error (0: exact)
+};
+
+/// One parameter of a compiled potential: its name and the closed range its constructor accepts.
+struct PotentialParam {
+    const char* name;  ///< "omega", "alpha": the key in scene files and plans, the bound property
+    double lo;         ///< smallest value allowed
+    double hi;         ///< largest value allowed
+};
+
+/// How everything outside the core knows a compiled potential (its class's kInfo): its kind, its
+/// class, its formula and its parameters in the constructor's order.
+template <std::size_t N>
+struct PotentialInfo {
+    const char* kind;                      ///< "harmonic": the `kind` of scene files and plans
+    const char* cls;                       ///< "Harmonic": the class, as bound into Python
+    const char* formula;                   ///< "V = omega^2 q^2 / 2": one line for docs and messages
+    std::array<PotentialParam, N> params;  ///< the constructor's parameters, in order
 };
 
 /// A single-well potential and its energy-dependent quantities.
@@ -79,8 +99,13 @@ protected:
 /// V = omega^2 q^2 / 2.
 class Harmonic final : public Potential {
 public:
-    /// Throws std::invalid_argument unless omega lies in [1e-100, 1e100] (omega^2 stays a normal double).
+    /// Its kind, class and parameter (omega in [1e-100, 1e100]: omega^2 stays a normal double).
+    static constexpr PotentialInfo<1> kInfo{
+        "harmonic", "Harmonic", "V = omega^2 q^2 / 2", {{{"omega", 1e-100, 1e100}}}};
+    /// Throws std::invalid_argument unless omega lies in kInfo's range.
     explicit Harmonic(double omega);
+    /// The constructor's parameters, in kInfo's order.
+    std::array<double, 1> parameters() const { return {omega_}; }
     /// V(q) in closed form.
     double V(double q) const override;
     /// V'(q) in closed form.
@@ -118,8 +143,15 @@ private:
 /// Beyond the wall of the well (|q| >= pi / (2 alpha)) V = +inf and V' = sign(q) inf.
 class Tan final : public Potential {
 public:
-    /// Throws std::invalid_argument unless omega and alpha lie in [1e-100, 1e100].
+    /// Its kind, class and parameters (each in [1e-100, 1e100]: the ratios of V stay normal doubles).
+    static constexpr PotentialInfo<2> kInfo{"tan",
+                                            "Tan",
+                                            "V = omega^2 / (2 alpha^2) tan^2(alpha q)",
+                                            {{{"omega", 1e-100, 1e100}, {"alpha", 1e-100, 1e100}}}};
+    /// Throws std::invalid_argument unless omega and alpha lie in kInfo's ranges.
     Tan(double omega, double alpha);
+    /// The constructor's parameters, in kInfo's order.
+    std::array<double, 2> parameters() const { return {omega_, alpha_}; }
     /// V(q) in closed form.
     double V(double q) const override;
     /// V'(q) in closed form.
@@ -177,5 +209,35 @@ public:
 private:
     std::shared_ptr<const Potential> base_;
 };
+
+// ------------------------------------------------------------------ the registry of compiled kinds
+
+/// A list of potential classes (each with a static kInfo and parameters()).
+template <class... P>
+struct PotentialList {};
+
+/// The compiled potentials: the one list of the classes that scene files and plans name by kind,
+/// that the bindings bind and pickle by their parameters, and that the system checks know. Adding
+/// a class here (with its kInfo, parameters() and a constructor taking them in order) makes it a kind.
+using CompiledPotentials = PotentialList<Harmonic, Tan>;
+
+/// A compiled kind as the run time sees it (potential_kinds()).
+struct PotentialKind {
+    std::string kind;                     ///< PotentialInfo::kind
+    std::string cls;                      ///< PotentialInfo::cls
+    std::string formula;                  ///< PotentialInfo::formula
+    std::vector<PotentialParam> params;   ///< PotentialInfo::params
+};
+
+/// Every compiled kind, in CompiledPotentials' order.
+const std::vector<PotentialKind>& potential_kinds();
+/// The compiled kind named `kind`; throws std::invalid_argument naming the value and the kinds.
+const PotentialKind& potential_kind(const std::string& kind);
+/// A potential of a compiled kind from its parameters, in the kind's order: the one factory of the
+/// plan reader and the sweep. Throws std::invalid_argument for an unknown kind, a wrong number of
+/// parameters (naming them) or a value the class refuses.
+std::shared_ptr<const Potential> make_potential(const std::string& kind, const std::vector<double>& params);
+/// Throw std::invalid_argument ("<cls>: <name> must lie in [lo, hi], got v") unless v is in p's range.
+void check_parameter(const char* cls, const PotentialParam& p, double v);
 
 }  // namespace hovering

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "hovering/batch.hpp"
 #include "hovering/curve.hpp"
 #include "hovering/flow/return_map.hpp"
 #include "hovering/normal/tangential_curve.hpp"
@@ -24,23 +25,13 @@ namespace detail {
 class Tracer;
 }
 
-/// What a flow-map iteration does besides stepping (the flow's counterpart of IterateOptions).
-struct FlowIterateOptions {
-    std::int64_t n_steps = 0;   ///< returns per orbit (>= 0)
-    unsigned exit_mask = 0;     ///< bit r: Region r is in the watched set; 0 disables the watch
-    bool stop_on_exit = false;  ///< stop an orbit (Status::Exited) when it first leaves the set
-    /// Stop an orbit (Status::Stopped) at the first point x_n (x_0 included) in the set, in map coordinates.
-    StopCondition stop;
-    std::int64_t every = 1;                     ///< record every k-th point (and the return from it), k >= 1
-    int n_threads = 0;                          ///< worker threads; 0 = all hardware threads
-    const std::atomic<bool>* cancel = nullptr;  ///< polled between and inside returns
+/// What a flow-map iteration does besides stepping: the shared BatchOptions (counts in returns;
+/// cancel is polled between and inside returns) and whether returns are labelled.
+struct FlowIterateOptions : BatchOptions {
     /// Label returns (itinerary, region; needs the crossings of q1 = qw1 tracked). false: no
     /// label work at all, every region None (then regions, visited, itinerary, rotation and an
     /// exit_mask are refused); the orbit is the same bit for bit.
     bool labels = true;
-    /// Returns accounted for (relaxed increments, one per return; an orbit that stops early adds
-    /// its remaining returns), so it ends at n * n_steps unless cancelled. Null: not counted.
-    std::atomic<std::int64_t>* progress = nullptr;
 };
 
 /// Marks the itinerary of a return an orbit did not take (it had stopped); no return's own

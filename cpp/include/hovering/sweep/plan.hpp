@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "hovering/flow/return_map.hpp"
+
 namespace hovering::sweep {
 
 /// The plan format this reader takes (the file's `version`).
@@ -23,11 +25,11 @@ struct MapParams {
     double eps = 0, Omega0 = 0, theta_w = 0, tau0 = 0, tau1 = 0, lam = 0;
 };
 
-/// A potential of a flow system: kind "harmonic" (omega) or "tan" (omega, alpha).
+/// A potential of a flow system: a compiled kind (hovering::potential_kinds(): "harmonic" with
+/// omega, "tan" with omega and alpha) and its parameters, keys of the plan's table.
 struct PotentialSpec {
-    std::string kind;
-    double omega = 0;
-    double alpha = std::numeric_limits<double>::quiet_NaN();  ///< NaN for "harmonic"
+    std::string kind;            ///< a PotentialKind::kind
+    std::vector<double> params;  ///< the kind's parameters, in its order
 };
 
 /// One term c q1^i q2^j of the coupling.
@@ -46,8 +48,8 @@ struct SystemSpec {
 
 /// The integrator of a flow point (the other FlowOptions keep their defaults).
 struct IntegratorSpec {
-    std::string stepper;
-    double rtol = 0, atol = 0;
+    Stepper stepper = Stepper::Rk8pd;  ///< parsed from the plan's name (kSteppers)
+    double rtol = 0, atol = 0;         ///< both explicit in a plan
 };
 
 /// A truncated model of a flow point: a TruncatedFamily by its tables, and the box it samples.
@@ -87,6 +89,10 @@ struct Plan {
     std::string checkpoint;  ///< default output, relative to the plan's folder ("" if none)
     std::vector<PlanPoint> points;
 };
+
+/// A double as every message of the core, the plan reader and hovering_sweep shows it: the
+/// shortest text that reads back as it ("nan", "inf", "-inf" for the others).
+std::string format_number(double x);
 
 /// Validate a plan given as TOML text; `where` names it in messages.
 Plan parse_plan(const std::string& text, const std::string& where = "plan");

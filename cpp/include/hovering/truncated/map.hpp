@@ -15,7 +15,9 @@
 #include <utility>
 #include <vector>
 
+#include "hovering/batch.hpp"
 #include "hovering/curve.hpp"
+#include "hovering/simd.hpp"  // simd_width, simd_level, ...: declared here before they served every kernel
 #include "hovering/truncated/arcs.hpp"
 #include "hovering/truncated/forcing.hpp"
 #include "hovering/types.hpp"
@@ -50,24 +52,12 @@ struct IterateOutput {
     std::int64_t* stop_step = nullptr;  ///< (n_orbits,) first n with x_n in the stop set, else -1
 };
 
-/// What a batch iteration does besides stepping.
-struct IterateOptions {
-    std::int64_t n_steps = 0;  ///< steps per orbit (>= 0)
-    /// Bit r set: Region r is in the watched set (for exit_step / stop_on_exit); 0 disables the watch.
-    unsigned exit_mask = 0;
-    bool stop_on_exit = false;  ///< stop an orbit (Status::Exited) when it first leaves the set
-    /// Stop an orbit (Status::Stopped) at the first state x_n (x_0 included) in the set; a state
-    /// outside the band is Escaped instead.
-    StopCondition stop;
-    std::int64_t every = 1;        ///< record every k-th state (and the return from it), k >= 1
-    int n_threads = 0;             ///< worker threads; 0 = all hardware threads
+/// What a batch iteration of a truncated map does besides stepping: the shared BatchOptions and
+/// the choice of kernel.
+struct IterateOptions : BatchOptions {
     Kernel kernel = Kernel::Simd;  ///< which step implementation to use
     /// SIMD kernel only: SLEEF's 3.5-ulp sin instead of the 1-ulp one (about 20% faster per step).
     bool fast_sin = false;
-    const std::atomic<bool>* cancel = nullptr;  ///< polled every few steps; set it to stop early
-    /// Orbit-steps accounted for (relaxed increments in chunks; an orbit that stops early adds the
-    /// steps it will not take), so it ends at n * n_steps unless cancelled. Null: not counted.
-    std::atomic<std::int64_t>* progress = nullptr;
 };
 
 /// One member of the truncated family; see the file comment.
@@ -129,17 +119,5 @@ TruncatedMap make_truncated_map(double eps, double Omega0, double theta_w, doubl
 
 /// Wrap an angle to [-pi, pi).
 double wrap_angle(double x);
-
-/// Whether the selected SIMD lane kernel uses 4-wide (AVX2) or wider vectors.
-bool simd_is_avx2();
-/// Doubles per SIMD packet of the selected lane kernel (8 AVX-512, 4 AVX2, 2 SSE2, 1 none).
-int simd_width();
-/// Instruction set of the selected lane kernel: "sse2", "avx2", "avx512" (a native build: its own).
-std::string simd_level();
-/// The lane kernels of this build that this CPU runs, narrowest first (names as simd_level()).
-std::vector<std::string> simd_levels();
-/// Select the lane kernel by name ("" or "auto": the widest this CPU runs); throws
-/// std::invalid_argument naming the allowed levels. Without a call: HOVERING_SIMD, else auto.
-void set_simd_level(const std::string& level);
 
 }  // namespace hovering

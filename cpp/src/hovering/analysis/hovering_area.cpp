@@ -242,4 +242,13 @@ double default_depth(double eps, double Omega0, const std::vector<double>& b) {
     return std::isfinite(d) && d > 0 ? d : detail::kInf;
 }
 
+double box_floor(double band_lo) {
+    return band_lo * (1 - 1e-9);
+}
+
+double default_K_low(double eps, double Omega0, const std::vector<double>& b, double band_lo) {
+    const double depth = eps != 0 ? default_depth(eps, Omega0, b) : 0.1;
+    return std::max(-depth, box_floor(band_lo));
+}
+
 }  // namespace hovering

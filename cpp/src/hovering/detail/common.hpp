@@ -35,9 +35,12 @@ inline double wrap(double x) {
     return y;
 }
 
-/// A double in its shortest round-trip form (1e+200, not 9.9999999999999997e+199), for error
-/// messages that name the offending value exactly as the user typed it.
+/// A double in its shortest round-trip form (1e+200, not 9.9999999999999997e+199; "nan", "inf",
+/// "-inf"): the one formatter of every message of the core, the plan reader and the sweep, which
+/// name the offending value exactly as the user typed it (std::to_string prints six decimals: a
+/// tiny band's edge read "-0.000000").
 inline std::string fmt(double v) {
+    if (std::isnan(v)) return "nan";  // to_chars writes "-nan" for a NaN with its sign bit set
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);
     return std::string(buf, r.ptr);

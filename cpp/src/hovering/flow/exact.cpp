@@ -50,7 +50,7 @@ std::string describe(const FlowSystem& s) {
 }
 
 ExactKind exact_kind(const FlowSystem& s, const FlowOptions& o) {
-    if (o.stepper != "exact") return ExactKind::None;
+    if (o.stepper != Stepper::Exact) return ExactKind::None;
     if (!s.V1 || !s.V2) bad("the system needs two potentials V1 and V2");
     const bool c = coupled(s);
     if (!c && closed_form(s.V1.get()) && closed_form(s.V2.get())) return ExactKind::Angles;

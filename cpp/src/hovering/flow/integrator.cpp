@@ -13,21 +13,20 @@
 
 namespace hovering::detail {
 
-const gsl_odeiv2_step_type* stepper_type(const std::string& name) {
-    if (name == "rk2") return gsl_odeiv2_step_rk2;
-    if (name == "rk4") return gsl_odeiv2_step_rk4;
-    if (name == "rkf45") return gsl_odeiv2_step_rkf45;
-    if (name == "rkck") return gsl_odeiv2_step_rkck;
-    if (name == "rk8pd") return gsl_odeiv2_step_rk8pd;
-    if (name == "msadams") return gsl_odeiv2_step_msadams;
-    if (name == "rk2imp") return gsl_odeiv2_step_rk2imp;
-    if (name == "rk4imp") return gsl_odeiv2_step_rk4imp;
-    if (name == "exact" || name == "taylor") return nullptr;
-    bad("stepper must be one of rk2, rk4, rkf45, rkck, rk8pd (explicit one-step methods), msadams "
-        "(variable-order Adams multistep), rk2imp, rk4imp (implicit Gauss-Legendre, symplectic at a fixed "
-        "step; with the Jacobian), taylor (Taylor's method, order and step from the tolerances; Harmonic and Tan "
-        "potentials) or exact (closed-form flow, where the system has one); got '" +
-        name + "'");
+const gsl_odeiv2_step_type* stepper_type(Stepper s) {
+    switch (s) {
+        case Stepper::Rk8pd: return gsl_odeiv2_step_rk8pd;
+        case Stepper::Rkck: return gsl_odeiv2_step_rkck;
+        case Stepper::Rkf45: return gsl_odeiv2_step_rkf45;
+        case Stepper::Rk4: return gsl_odeiv2_step_rk4;
+        case Stepper::Rk2: return gsl_odeiv2_step_rk2;
+        case Stepper::Msadams: return gsl_odeiv2_step_msadams;
+        case Stepper::Rk4imp: return gsl_odeiv2_step_rk4imp;
+        case Stepper::Rk2imp: return gsl_odeiv2_step_rk2imp;
+        case Stepper::Taylor:
+        case Stepper::Exact: return nullptr;
+    }
+    bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
 }
 
 Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
@@ -36,7 +35,7 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
     sys_ = gsl_odeiv2_system{field_.fn, &Field::jacobian, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
     kind_ = detail::exact_kind(s, o);
-    if (o.stepper == "taylor") {
+    if (o.stepper == Stepper::Taylor) {
         taylor_ = std::make_unique<Taylor>(field_, s, o.rtol, o.atol);
     } else if (kind_ != ExactKind::None) {
         if (kind_ == ExactKind::Linear) linear_ = std::make_unique<LinearFlow>(s);

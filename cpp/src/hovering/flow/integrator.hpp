@@ -15,9 +15,8 @@
 
 namespace hovering::detail {
 
-/// The GSL stepper type of a name (null for "exact" and "taylor": no GSL stepper); throws
-/// std::invalid_argument naming the allowed ones.
-const gsl_odeiv2_step_type* stepper_type(const std::string& name);
+/// The GSL stepper type of a stepper (null for Exact and Taylor: no GSL stepper).
+const gsl_odeiv2_step_type* stepper_type(Stepper s);
 
 /// Shortest step, relative to the step bound, that advance() shortens further for events: two
 /// sign changes of a velocity closer than this are a tangency, below any sign test.

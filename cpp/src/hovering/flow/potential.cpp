@@ -17,6 +17,7 @@
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace hovering {
 
@@ -143,11 +144,6 @@ double brent(const std::function<double(double)>& f, double lo, double hi) {
     return detail::brent(f, lo, hi, 4 * std::numeric_limits<double>::epsilon());
 }
 
-// Parameters whose square (and the ratios omega^2 / alpha^2 of Tan) stay normal doubles: outside,
-// V underflows to 0 or the period to 0 and every answer would be silently wrong.
-void require_scale(double v, const char* name) {
-    if (!(v >= 1e-100 && v <= 1e100)) bad(std::string(name) + " must lie in [1e-100, 1e100], got " + fmt(v));
-}
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -451,7 +447,7 @@ Estimate Potential::angle_slope(double q, double h) const {
 // ------------------------------------------------------------------------------- closed forms
 
 Harmonic::Harmonic(double omega) : omega_(omega) {
-    require_scale(omega, "Harmonic: omega");
+    check_parameter(kInfo.cls, kInfo.params[0], omega);
 }
 double Harmonic::V(double q) const {
     return 0.5 * omega_ * omega_ * q * q;
@@ -518,8 +514,8 @@ Estimate Harmonic::angle_slope(double q, double h) const {
 }
 
 Tan::Tan(double omega, double alpha) : omega_(omega), alpha_(alpha) {
-    require_scale(omega, "Tan: omega");
-    require_scale(alpha, "Tan: alpha");
+    check_parameter(kInfo.cls, kInfo.params[0], omega);
+    check_parameter(kInfo.cls, kInfo.params[1], alpha);
 }
 double Tan::V(double q) const {
     // tan is periodic: without this, a q beyond the wall would land in another copy of the well.
@@ -615,6 +611,81 @@ Estimate Tan::angle_slope(double q, double h) const {
 
 Numerical::Numerical(std::shared_ptr<const Potential> base) : base_(std::move(base)) {
     if (!base_) bad("Numerical: needs a potential");
+}
+
+// ------------------------------------------------------------------ the registry of compiled kinds
+
+namespace {
+
+// A bound as the messages write it: 1e100, not 1e+100.
+std::string bound_text(double x) {
+    std::string t = fmt(x);
+    const auto e = t.find("e+");
+    return e == std::string::npos ? t : t.erase(e + 1, 1);
+}
+
+template <class P, std::size_t... I>
+std::shared_ptr<const Potential> construct(const double* p, std::index_sequence<I...>) {
+    return std::make_shared<P>(p[I]...);
+}
+
+template <class P>
+PotentialKind kind_of() {
+    return {P::kInfo.kind, P::kInfo.cls, P::kInfo.formula,
+            std::vector<PotentialParam>(P::kInfo.params.begin(), P::kInfo.params.end())};
+}
+
+template <class... P>
+std::vector<PotentialKind> kinds_of(PotentialList<P...>) {
+    return {kind_of<P>()...};
+}
+
+// The factory of each kind, in CompiledPotentials' order.
+using Factory = std::shared_ptr<const Potential> (*)(const double*);
+template <class P>
+std::shared_ptr<const Potential> make_of(const double* p) {
+    return construct<P>(p, std::make_index_sequence<P::kInfo.params.size()>{});
+}
+template <class... P>
+std::vector<Factory> factories_of(PotentialList<P...>) {
+    return {&make_of<P>...};
+}
+
+std::string kind_names() {
+    std::string s;
+    for (const PotentialKind& k : potential_kinds()) s += (s.empty() ? "'" : ", '") + k.kind + "'";
+    return s;
+}
+
+}  // namespace
+
+void check_parameter(const char* cls, const PotentialParam& p, double v) {
+    if (!(v >= p.lo && v <= p.hi))
+        bad(std::string(cls) + ": " + p.name + " must lie in [" + bound_text(p.lo) + ", " + bound_text(p.hi) +
+            "], got " + fmt(v));
+}
+
+const std::vector<PotentialKind>& potential_kinds() {
+    static const std::vector<PotentialKind> kinds = kinds_of(CompiledPotentials{});
+    return kinds;
+}
+
+const PotentialKind& potential_kind(const std::string& kind) {
+    for (const PotentialKind& k : potential_kinds())
+        if (k.kind == kind) return k;
+    bad("potential kind must be one of " + kind_names() + ", got '" + kind + "'");
+}
+
+std::shared_ptr<const Potential> make_potential(const std::string& kind, const std::vector<double>& params) {
+    static const std::vector<Factory> make = factories_of(CompiledPotentials{});
+    const PotentialKind& k = potential_kind(kind);
+    if (params.size() != k.params.size()) {
+        std::string names;
+        for (const PotentialParam& p : k.params) names += std::string(names.empty() ? "" : ", ") + p.name;
+        bad("a " + k.kind + " potential takes " + std::to_string(k.params.size()) + " parameter(s) (" + names +
+            "), got " + std::to_string(params.size()));
+    }
+    return make[std::size_t(&k - potential_kinds().data())](params.data());
 }
 
 }  // namespace hovering

@@ -17,8 +17,25 @@ using detail::kInf;
 using detail::kNaN;
 using detail::kPi;
 
+Stepper parse_stepper(const std::string& name) {
+    for (std::size_t i = 0; i < kSteppers.size(); ++i)
+        if (name == kSteppers[i]) return static_cast<Stepper>(i);
+    bad("stepper must be one of rk8pd, rkck, rkf45, rk4, rk2 (explicit one-step methods), msadams "
+        "(variable-order Adams multistep), rk4imp, rk2imp (implicit Gauss-Legendre, symplectic at a fixed "
+        "step; with the Jacobian), taylor (Taylor's method, order and step from the tolerances; Harmonic and Tan "
+        "potentials) or exact (closed-form flow, where the system has one); GSL's bsimp and msbdf are not "
+        "offered (stiff solvers, and this flow is not stiff); got '" +
+        name + "'");
+}
+
+const char* stepper_name(Stepper s) {
+    const auto i = static_cast<std::size_t>(s);
+    if (i >= kSteppers.size()) bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
+    return kSteppers[i];
+}
+
 void FlowOptions::validate() const {
-    detail::stepper_type(stepper);
+    stepper_name(stepper);  // an enum value out of range (a cast from elsewhere)
     if (!(rtol > 0 && rtol < 1)) bad("rtol must lie in (0, 1), got " + fmt(rtol));
     if (!(atol > 0 && std::isfinite(atol))) bad("atol must be finite and > 0, got " + fmt(atol));
     if (!(event_tol > 0 && std::isfinite(event_tol))) bad("event_tol must be finite and > 0, got " + fmt(event_tol));
@@ -36,7 +53,7 @@ void FlowOptions::validate() const {
 void FlowOptions::validate(const FlowSystem& s) const {
     validate();
     detail::exact_kind(s, *this);
-    if (stepper == "taylor") {
+    if (stepper == Stepper::Taylor) {
         const std::string why = detail::taylor_unsupported(s);
         if (!why.empty()) bad(why);
     }

@@ -5,11 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 
 #include "hovering/detail/common.hpp"
-#include "hovering/detail/simd_level.hpp"
+#include "hovering/detail/simd_dispatch.hpp"
 #include "hovering/flow/exact.hpp"
 
 // The builds of taylor_lanes.cpp (see there and CMakeLists.txt).
@@ -30,28 +29,21 @@ const Potential* unwrap(const Potential* v) {
     return v;
 }
 
-// The build of the lane kernel for the SIMD level the core runs (the truncated map's choice:
-// one owner of HOVERING_SIMD and set_simd_level), looked up once per thread and level.
-const TaylorLaneKernels& lane_kernels() {
-    thread_local const char* level = nullptr;
-    thread_local const TaylorLaneKernels* k = &hovering_taylor_base;
-    const char* now = selected_simd_level();
-    if (now != level) {  // the level names are static strings: a pointer compare per call
-        level = now;
-        k = &hovering_taylor_base;
+// The builds of the lane kernel, in the dispatch's order (detail/simd_dispatch.hpp): the level the
+// core runs is the truncated map's too.
+const TaylorLaneKernels* const kTaylorBuilds[kSimdBuilds] = {
+    &hovering_taylor_base,
 #if defined(HOVERING_LANES_DISPATCH)
-        if (std::strcmp(level, hovering_taylor_avx2.level) == 0) k = &hovering_taylor_avx2;
-        if (std::strcmp(level, hovering_taylor_avx512.level) == 0) k = &hovering_taylor_avx512;
+    &hovering_taylor_avx2,
+    &hovering_taylor_avx512,
 #endif
-    }
-    return *k;
+};
+
+const TaylorLaneKernels& lane_kernels() {
+    return selected_build(kTaylorBuilds);
 }
 
 }  // namespace
-
-const char* taylor_lane_level() {
-    return lane_kernels().level;
-}
 
 void Taylor::expand_group(Taylor* const* t, const double* const* y, const double* hmax, TaylorLanes& lanes,
                           int count) {

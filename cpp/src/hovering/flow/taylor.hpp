@@ -49,9 +49,6 @@ inline constexpr int kMaxTaylorGroup = 8;
 /// ln f: a step is the fraction f of the estimated radius of convergence (see the file comment).
 inline constexpr double kLogStepFraction = -1.2;
 
-/// The instruction set expand_group runs on this CPU ("avx512", "avx2" or the build's baseline).
-const char* taylor_lane_level();
-
 /// Coefficients of up to kMaxTaylorGroup expansions, lane-interleaved as the lane kernel writes
 /// them (TaylorLaneKernels), and a count of the kernel calls that wrote them.
 struct alignas(64) TaylorLanes {

@@ -3,7 +3,7 @@
 // baseline). One source, compiled with the core's flags and, in the portable x86-64 build, once more
 // per wider instruction set beside lanes.cpp (CMakeLists.txt), with HOVERING_TAYLOR_NS naming the
 // build's namespace and HOVERING_TAYLOR_TABLE its table; Taylor::expand_group picks the table of
-// the SIMD level the core runs (simd_level(): HOVERING_SIMD, set_simd_level, else the widest).
+// the SIMD level the core runs (detail/simd_dispatch.hpp: one choice for both kernels).
 //
 // The recurrences are latency-bound chains of dependent additions (taylor_kernel.hpp), so four
 // orbits in the lanes of one register cost little more than one: measured 3.3-4.0x per orbit-step
@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "hovering/detail/simd_level.hpp"
 #include "hovering/flow/taylor_kernel.hpp"
 
 #ifndef HOVERING_TAYLOR_NS
@@ -160,24 +161,11 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
     }
 }
 
-constexpr const char* kLevel =
-#if defined(__AVX512F__)
-    "avx512";
-#elif defined(__AVX2__)
-    "avx2";
-#elif defined(__AVX__)
-    "avx";
-#elif defined(__SSE2__)
-    "sse2";
-#else
-    "none";
-#endif
-
 }  // namespace
 
 }  // namespace hovering::HOVERING_TAYLOR_NS
 
 extern "C" const hovering::detail::TaylorLaneKernels HOVERING_TAYLOR_TABLE = {
-    hovering::HOVERING_TAYLOR_NS::kLevel,
+    hovering::detail::kSimdLevel,
     &hovering::HOVERING_TAYLOR_NS::expand<hovering::HOVERING_TAYLOR_NS::V4, 4>,
     &hovering::HOVERING_TAYLOR_NS::expand<hovering::HOVERING_TAYLOR_NS::V8, 8>};

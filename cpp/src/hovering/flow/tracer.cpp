@@ -425,7 +425,7 @@ std::int64_t Tracer::verify_from() const {
     // (rk8pd on slow oscillators: 85-107 steps, 3-10x the band at rtol 1e-8). The closed form
     // has no step error to verify.
     if (in_.exact_kind() != ExactKind::None) return 0;
-    if (o_.stepper == "taylor") return kVerifySteps;
+    if (o_.stepper == Stepper::Taylor) return kVerifySteps;
     const double n = double(kVerifyStepsGsl) * std::pow(1e-8 / o_.rtol, 1.0 / in_.order());
     return std::int64_t(std::clamp(n, 16.0, 1e15));
 }
@@ -440,7 +440,7 @@ ReturnResult Tracer::verify(ReturnResult r0) {
     // a tenth is kept only if the difference is within 10 bands; else one level tighter.
     // The floor: below it a tighter tolerance stops reducing the error (rounding): ~1e-15 for
     // taylor; GSL's steppers, whose error estimates are differences of stages, stall sooner.
-    const bool taylor = o_.stepper == "taylor";
+    const bool taylor = o_.stepper == Stepper::Taylor;
     const double floor = taylor ? 1e-15 : 1e-14;
     ReturnResult prev = std::move(r0);
     double prev_tol = o_.rtol;
@@ -552,7 +552,7 @@ bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
     return std::fabs(p[0] - z[0]) <= 1e-9 * (1 + std::fabs(z[0])) + 4 * e / std::fabs(dz[1]);
 }
 
-TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.stepper == "taylor") {
+TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.stepper == Stepper::Taylor) {
     // Eight lanes (two 4-double vectors) rather than four: measured up to 10% more returns per
     // second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;

@@ -160,18 +160,9 @@ void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inver
 void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const FlowIterateOptions& opt,
                       const FlowIterateOutput& out) const {
     if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
-    if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
-    if (opt.exit_mask >= (1u << kRegionCount))
-        bad("exit_mask must be a set of region codes 0.." + std::to_string(kRegionCount - 1) + ", got " +
-            std::to_string(opt.exit_mask));
-    if (opt.stop_on_exit && opt.exit_mask == 0u) bad("stop_on_exit needs a non-empty set of regions to stay in");
+    opt.validate();
     if (opt.exit_mask && s_.geometry == Geometry::None)
         bad("regions need walls: the smooth flow (geometry none) labels no return, so exit regions cannot be watched");
-    if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
-        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
-            std::to_string(opt.n_threads));
-    if (opt.every < 1) bad("every must be >= 1 (record every k-th point), got " + std::to_string(opt.every));
-    opt.stop.validate();
     if (!opt.labels && (out.regions || out.visited || out.itinerary || out.rotation || out.residence || opt.exit_mask))
         bad("labels = false, but regions, visited, itinerary, rotation, residence or an exit_mask need the returns "
             "labelled");
@@ -246,7 +237,6 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             if (out.itinerary) out.itinerary[at] = kNoItinerary;
         }
     };
-    auto cancelled = [&] { return opt.cancel && opt.cancel->load(std::memory_order_relaxed); };
 
     const int threads = detail::worker_count(opt.n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 4));
@@ -283,7 +273,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         auto next_return = [&](int l) {
             Orbit& o = lane[std::size_t(l)];
             if (!(o.k < ns && o.status == Status::Ok)) return false;
-            if (cancelled()) {
+            if (opt.cancelled()) {
                 o.status = Status::Interrupted;
                 return false;
             }

@@ -3,7 +3,6 @@
 #include "hovering/sweep/plan.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,8 +14,10 @@
 #include <toml++/toml.h>
 #include <nlohmann/json.hpp>
 
+#include "hovering/detail/common.hpp"
 #include "hovering/flow/potential.hpp"
 #include "hovering/flow/return_map.hpp"
+#include "hovering/sweep/json_number.hpp"
 #include "hovering/sweep/plan_build.hpp"
 #include "hovering/truncated/map.hpp"
 
@@ -31,13 +32,7 @@ constexpr std::size_t kMaxPoints = 1000000;
 constexpr std::size_t kMaxTable = 100000;  // entries of a model's table (its key stays a checkpoint line)
 constexpr std::uintmax_t kMaxPlanBytes = std::uintmax_t(256) << 20;
 
-std::string num(double x) {
-    if (std::isnan(x)) return "nan";
-    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, x);
-    return std::string(buf, r.ptr);
-}
+using detail::fmt;  // the core's one formatter of a double in a message
 
 /// A value as the message shows it (TOML's spelling; tables and arrays by their kind).
 std::string show(const toml::node& n) {
@@ -51,7 +46,7 @@ std::string show(const toml::node& n) {
         return "'" + v + "'";
     }
     if (auto i = n.as_integer()) return std::to_string(i->get());
-    if (auto f = n.as_floating_point()) return num(f->get());
+    if (auto f = n.as_floating_point()) return fmt(f->get());
     if (auto b = n.as_boolean()) return b->get() ? "true" : "false";
     if (n.is_table()) return "a table";
     if (n.is_array()) return "an array of " + std::to_string(n.as_array()->size());
@@ -147,7 +142,7 @@ public:
             else
                 fail(key + "[" + std::to_string(i) + "]", " = " + show(a[i]) + ": allowed: a finite number");
             if (!std::isfinite(v))
-                fail(key + "[" + std::to_string(i) + "]", " = " + num(v) + ": allowed: a finite number");
+                fail(key + "[" + std::to_string(i) + "]", " = " + fmt(v) + ": allowed: a finite number");
             out.push_back(v);
         }
         return out;
@@ -168,9 +163,9 @@ private:
                    any_hi = hi == std::numeric_limits<double>::infinity();
         std::string s = finite ? "a finite number" : "a number";
         if (any_lo && any_hi) return s;
-        if (any_lo) return s + (hi_open ? " < " : " <= ") + num(hi);
-        if (any_hi) return s + (lo_open ? " > " : " >= ") + num(lo);
-        return s + " in " + (lo_open ? "(" : "[") + num(lo) + ", " + num(hi) + (hi_open ? ")" : "]");
+        if (any_lo) return s + (hi_open ? " < " : " <= ") + fmt(hi);
+        if (any_hi) return s + (lo_open ? " > " : " >= ") + fmt(lo);
+        return s + " in " + (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
     }
     const toml::table& t_;
     std::string where_;
@@ -192,10 +187,12 @@ MapParams read_map(Table& t) {
 }
 
 PotentialSpec read_potential(Table& t) {
+    // The core's registry of compiled potentials: its kinds, and each kind's parameters and ranges.
+    std::vector<std::string> kinds;
+    for (const PotentialKind& k : potential_kinds()) kinds.push_back(k.kind);
     PotentialSpec p;
-    p.kind = t.string("kind", {"harmonic", "tan"});
-    p.omega = t.real("omega", 0, kInf, true, true);
-    if (p.kind == "tan") p.alpha = t.real("alpha", 0, kInf, true, true);
+    p.kind = t.string("kind", kinds);
+    for (const PotentialParam& q : potential_kind(p.kind).params) p.params.push_back(t.real(q.name, q.lo, q.hi));
     t.done();
     return p;
 }
@@ -236,13 +233,11 @@ SystemSpec read_system(Table& t) {
     return s;
 }
 
-std::vector<std::string> steppers() {
-    return std::vector<std::string>(kSteppers.begin(), kSteppers.end());
-}
-
 IntegratorSpec read_integrator(Table& t) {
     IntegratorSpec it;
-    it.stepper = t.string("stepper", steppers());
+    // The choices are the core's list: the name is checked here (the message names the key) and
+    // parsed once into the core's enum.
+    it.stepper = parse_stepper(t.string("stepper", std::vector<std::string>(kSteppers.begin(), kSteppers.end())));
     it.rtol = t.real("rtol", 0, 1, true, true, true);
     it.atol = t.real("atol", 0, kInf, true, true);
     t.done();
@@ -267,12 +262,6 @@ ModelSpec read_model(Table& t) {
 
 // ------------------------------------------------------------------ the key
 
-/// A double as the key holds it: a JSON number, or the string naming a non-finite one.
-json jnum(double x) {
-    if (std::isnan(x)) return "NaN";
-    if (std::isinf(x)) return x > 0 ? "Infinity" : "-Infinity";
-    return x;
-}
 
 json jreals(const std::vector<double>& v) {
     json a = json::array();
@@ -281,8 +270,9 @@ json jreals(const std::vector<double>& v) {
 }
 
 json potential_key(const PotentialSpec& p) {
-    json j = {{"kind", p.kind}, {"omega", jnum(p.omega)}};
-    if (p.kind == "tan") j["alpha"] = jnum(p.alpha);
+    json j = {{"kind", p.kind}};
+    const std::vector<PotentialParam>& names = potential_kind(p.kind).params;
+    for (std::size_t i = 0; i < names.size(); ++i) j[names[i].name] = jnum(p.params[i]);
     return j;
 }
 
@@ -301,8 +291,9 @@ std::string point_key(const std::string& kind, const PlanPoint& p) {
                        {"eps", jnum(s.eps)},        {"qw1", jnum(s.qw1)},        {"qw2", jnum(s.qw2)},
                        {"geometry", s.geometry}};
         k["h"] = jnum(p.h);
-        k["integrator"] = {
-            {"stepper", p.integrator.stepper}, {"rtol", jnum(p.integrator.rtol)}, {"atol", jnum(p.integrator.atol)}};
+        k["integrator"] = {{"stepper", stepper_name(p.integrator.stepper)},
+                           {"rtol", jnum(p.integrator.rtol)},
+                           {"atol", jnum(p.integrator.atol)}};
         json models = json::array();
         for (const auto& m : p.models)
             models.push_back({{"name", m.name},
@@ -399,6 +390,10 @@ void check_key_parts(const std::string& text, const std::string& where) {
 }
 
 }  // namespace
+
+std::string format_number(double x) {
+    return detail::fmt(x);
+}
 
 Plan parse_plan(const std::string& text, const std::string& where) {
     check_key_parts(text, where);

@@ -1,11 +1,11 @@
 // The core objects of a plan's point; see plan_build.hpp.
 #include "hovering/sweep/plan_build.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "hovering/detail/common.hpp"
 #include "hovering/flow/potential.hpp"
 
 namespace hovering::sweep {
@@ -14,27 +14,10 @@ TruncatedMap build_map(const MapParams& m) {
     return make_truncated_map(m.eps, m.Omega0, m.theta_w, m.tau0, m.tau1, m.lam);
 }
 
-namespace {
-
-/// A double as a message shows it: the shortest text that reads back as it (std::to_string prints
-/// six decimals: a tiny band's edge read "-0.000000", a huge K_low some 300 digits).
-std::string num(double x) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, x);
-    return std::string(buf, r.ptr);
-}
-
-std::shared_ptr<const Potential> potential(const PotentialSpec& p) {
-    if (p.kind == "tan") return std::make_shared<Tan>(p.omega, p.alpha);
-    return std::make_shared<Harmonic>(p.omega);
-}
-
-}  // namespace
-
 FlowSystem build_system(const SystemSpec& sp, double eps) {
     FlowSystem s;
-    s.V1 = potential(sp.V1);
-    s.V2 = potential(sp.V2);
+    s.V1 = make_potential(sp.V1.kind, sp.V1.params);  // the core's one factory of compiled kinds
+    s.V2 = make_potential(sp.V2.kind, sp.V2.params);
     // hovering.StepSystem's core copy: the terms (c, i, j) in order (hovering.Polynomial).
     for (const auto& t : sp.coupling) s.coupling.terms.push_back({t.c, double(t.i), double(t.j)});
     s.eps = eps;
@@ -42,7 +25,8 @@ FlowSystem build_system(const SystemSpec& sp, double eps) {
     s.qw2 = sp.qw2;
     s.geometry = sp.geometry == "step" ? Geometry::Step : sp.geometry == "wall" ? Geometry::Wall : Geometry::None;
     if (eps != 0 && s.coupling.terms.empty())
-        throw std::invalid_argument("system.eps = " + num(eps) + " needs a coupling (system.coupling is empty)");
+        throw std::invalid_argument("system.eps = " + detail::fmt(eps) +
+                                    " needs a coupling (system.coupling is empty)");
     s.validate();
     return s;
 }
@@ -77,8 +61,8 @@ void check_point(const std::string& kind, const PlanPoint& p) {
     if (kind == "hovering_area") {
         const TruncatedMap m = build_map(p.map);
         if (!(m.band().lo < p.K_low))
-            throw std::invalid_argument("K_low = " + num(p.K_low) + " lies below the map's band (lower end " +
-                                        num(m.band().lo) + ")");
+            throw std::invalid_argument("K_low = " + detail::fmt(p.K_low) + " lies below the map's band (lower end " +
+                                        detail::fmt(m.band().lo) + ")");
         return;
     }
     const FlowSystem s = build_system(p.system, p.system.eps);

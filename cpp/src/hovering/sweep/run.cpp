@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hovering/analysis/hovering_area.hpp"
+#include "hovering/sweep/json_number.hpp"
 #include "hovering/sweep/plan_build.hpp"
 
 namespace hovering::sweep {
@@ -27,12 +28,6 @@ namespace {
 
 using json = nlohmann::json;
 
-/// A double as a checkpoint line holds it: a JSON number, or the string naming a non-finite one.
-json jnum(double x) {
-    if (std::isnan(x)) return "NaN";
-    if (std::isinf(x)) return x > 0 ? "Infinity" : "-Infinity";
-    return x;
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();

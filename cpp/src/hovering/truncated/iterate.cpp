@@ -1,17 +1,16 @@
-// Batch iteration of the truncated family: the scalar reference kernel, the choice of the SIMD
-// lane kernel's build (lanes.cpp) for this CPU, and MapCore::iterate on the core's thread pool.
+// Batch iteration of the truncated family: the scalar reference kernel, the SIMD lane kernel's
+// build (lanes.cpp) the dispatch selected (detail/simd_dispatch.hpp), and MapCore::iterate on the
+// core's thread pool.
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
-#include "hovering/detail/simd_level.hpp"
+#include "hovering/detail/simd_dispatch.hpp"
 #include "hovering/truncated/classify.hpp"
 #include "hovering/truncated/lanes.hpp"
 #include "hovering/truncated/map.hpp"
@@ -21,7 +20,6 @@ namespace hovering {
 namespace {
 
 using detail::bad;
-using detail::cancelled;
 using detail::Classified;
 using detail::classify;
 using detail::Finisher;
@@ -62,7 +60,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
             if ((n & 63) == 0) {
                 progress.add(n - counted);  // every 64 steps, off the per-step path
                 counted = n;
-                if (cancelled(opt)) {
+                if (opt.cancelled()) {
                     st = Status::Interrupted;
                     break;
                 }
@@ -110,74 +108,17 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
     }
 }
 
-// The builds of the lane kernel this binary has, narrowest first, each with the test of whether
-// this CPU (and its OS, which must save the wider registers) runs it.
-struct LaneBuild {
-    const LaneKernels* kernels;
-    bool (*runs)();
-    const char* needs;  // the CPU features it needs, for messages
+// The builds of the lane kernel, in the dispatch's order (detail/simd_dispatch.hpp).
+const LaneKernels* const kLaneBuilds[detail::kSimdBuilds] = {
+    &hovering_lanes_base,
+#if defined(HOVERING_LANES_DISPATCH)
+    &hovering_lanes_avx2,
+    &hovering_lanes_avx512,
+#endif
 };
 
-const std::vector<LaneBuild>& lane_builds() {
-#if defined(HOVERING_LANES_DISPATCH)
-    __builtin_cpu_init();  // idempotent; needed if the first call runs before libgcc's constructor
-#endif
-    static const std::vector<LaneBuild> builds = {
-        {&hovering_lanes_base, [] { return true; }, "the baseline of this build"},
-#if defined(HOVERING_LANES_DISPATCH)
-        {&hovering_lanes_avx2, [] { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); },
-         "AVX2 and FMA"},
-        {&hovering_lanes_avx512,
-         [] {
-             return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-                    __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512bw") &&
-                    __builtin_cpu_supports("avx512vl");
-         },
-         "AVX-512 F, CD, BW, DQ and VL"},
-#endif
-    };
-    return builds;
-}
-
-std::string level_names(bool runnable_only) {
-    std::string s;
-    for (const LaneBuild& b : lane_builds())
-        if (!runnable_only || b.runs()) s += std::string(s.empty() ? "" : ", ") + b.kernels->level;
-    return s;
-}
-
-// The build named `level` ("" or "auto": the widest this CPU runs); `what` names the setting in
-// messages (the environment variable or the function).
-const LaneKernels* find_lanes(const std::string& level, const char* what) {
-    const LaneKernels* widest = nullptr;
-    for (const LaneBuild& b : lane_builds()) {
-        if (!b.runs()) continue;
-        widest = b.kernels;
-        if (level == b.kernels->level) return b.kernels;
-    }
-    if (level.empty() || level == "auto") return widest;
-    for (const LaneBuild& b : lane_builds())
-        if (level == b.kernels->level)
-            throw std::invalid_argument(std::string(what) + "='" + level + "' is not available: this CPU lacks " +
-                                        b.needs + " (allowed here: auto, " + level_names(true) + ")");
-    throw std::invalid_argument(std::string(what) + " must be one of auto, " + level_names(true) + " (the " +
-                                "SIMD levels of this build that this CPU runs; this build has " + level_names(false) +
-                                "), got '" + level + "'");
-}
-
-// The selected build: set_simd_level's, else HOVERING_SIMD's (read at first use; a bad value is an
-// error at every use until it is fixed), else the widest this CPU runs.
-std::atomic<const LaneKernels*> g_lanes{nullptr};
-
 const LaneKernels& lanes() {
-    const LaneKernels* k = g_lanes.load(std::memory_order_acquire);
-    if (!k) {
-        const char* env = std::getenv("HOVERING_SIMD");
-        k = find_lanes(env ? env : "", "HOVERING_SIMD");
-        const LaneKernels* expected = nullptr;  // a concurrent set_simd_level wins
-        if (!g_lanes.compare_exchange_strong(expected, k, std::memory_order_acq_rel)) k = expected;
-    }
-    return *k;
+    return detail::selected_build(kLaneBuilds);
 }
 
 template <class A, class F>
@@ -201,39 +142,11 @@ int simd_width() {
     return lanes().width;
 }
 
-std::string simd_level() {
-    return lanes().level;
-}
-
-const char* detail::selected_simd_level() {
-    return lanes().level;
-}
-
-std::vector<std::string> simd_levels() {
-    std::vector<std::string> v;
-    for (const LaneBuild& b : lane_builds())
-        if (b.runs()) v.emplace_back(b.kernels->level);
-    return v;
-}
-
-void set_simd_level(const std::string& level) {
-    g_lanes.store(find_lanes(level, "SIMD level"), std::memory_order_release);
-}
-
 template <class A, class F>
 void MapCore<A, F>::iterate(const double* phi0, const double* K0, std::int64_t n, const IterateOptions& opt,
                             const IterateOutput& out) const {
     if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
-    if (opt.n_steps < 0) bad("n_steps must be >= 0, got " + std::to_string(opt.n_steps));
-    if (opt.exit_mask >= (1u << kRegionCount))
-        bad("exit_mask must be a set of region codes 0.." + std::to_string(kRegionCount - 1) + " (a bit mask < " +
-            std::to_string(1u << kRegionCount) + "), got " + std::to_string(opt.exit_mask));
-    if (opt.stop_on_exit && opt.exit_mask == 0u) bad("stop_on_exit needs a non-empty set of regions to stay in");
-    if (opt.n_threads < 0 || opt.n_threads > detail::kMaxThreads)
-        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
-            std::to_string(opt.n_threads));
-    if (opt.every < 1) bad("every must be >= 1 (record every k-th state), got " + std::to_string(opt.every));
-    opt.stop.validate();
+    opt.validate();
     for (std::int64_t i = 0; i < n; ++i) {
         detail::require_angle(phi0[i], "phi0[" + std::to_string(i) + "]");
         detail::require_finite(K0[i], "K0[" + std::to_string(i) + "]");

@@ -1,8 +1,8 @@
 // The SIMD lane kernel of the truncated family: Eigen packets + SLEEF sin. One source, compiled
 // once with the core's flags and, in the portable x86-64 build, once more per wider instruction
 // set (AVX2, AVX-512) with HOVERING_LANES_NS naming the build's namespace and HOVERING_LANES_TABLE
-// its table; iterate.cpp chooses a table at run time. Compiled with -fno-trapping-math
-// -fno-math-errno (see CMakeLists.txt): without them GCC will not if-convert Eigen's select()
+// its table; iterate.cpp runs the table the dispatch selects (detail/simd_dispatch.hpp). Compiled
+// with -fno-trapping-math -fno-math-errno (see CMakeLists.txt): without them GCC will not if-convert Eigen's select()
 // chains or inline sqrt, and the kernel falls back to scalar code. Neither changes IEEE results.
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
 #include "hovering/detail/simd.hpp"
+#include "hovering/detail/simd_level.hpp"
 #include "hovering/truncated/lanes.hpp"
 #include "hovering/truncated/map.hpp"
 
@@ -26,7 +27,6 @@ namespace hovering::HOVERING_LANES_NS {
 
 namespace {
 
-using detail::cancelled;
 using detail::Finisher;
 using detail::kInvTwoPi;
 using detail::kNaN;
@@ -283,7 +283,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     std::int64_t countdown = next_completion(), record_at = next_record();
 
     while (nlive > 0) {
-        if ((it & 63) == 0 && cancelled(opt)) {
+        if ((it & 63) == 0 && opt.cancelled()) {
             unpack();
             for (int j = 0; j < kLanes; ++j)
                 if (is_live(j)) finish(idx[j], lphi[j], lK[j], it - start[j], Status::Interrupted, tally(j));
@@ -456,30 +456,12 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     }
 }
 
-// The instruction set Eigen vectorises this build for (what the packets and SLEEF's sin use).
-constexpr const char* kLevel =
-#if defined(EIGEN_VECTORIZE_AVX512)
-    "avx512";
-#elif defined(EIGEN_VECTORIZE_AVX) && defined(__AVX2__) && defined(__FMA__)
-    "avx2";
-#elif defined(EIGEN_VECTORIZE_AVX)
-    "avx";
-#elif defined(EIGEN_VECTORIZE_SSE4_1)
-    "sse4.1";
-#elif defined(EIGEN_VECTORIZE_SSE2)
-    "sse2";
-#elif defined(EIGEN_VECTORIZE_NEON)
-    "neon";
-#else
-    "none";
-#endif
-
 }  // namespace
 
 }  // namespace hovering::HOVERING_LANES_NS
 
 extern "C" const hovering::detail::LaneKernels HOVERING_LANES_TABLE = {
-    hovering::HOVERING_LANES_NS::kLevel,
+    hovering::detail::kSimdLevel,  // the instruction set Eigen vectorises this build for
     hovering::detail::kW,
     hovering::HOVERING_LANES_NS::kLanes,
     {&hovering::HOVERING_LANES_NS::run_simd<false, hovering::AnalyticArcs, hovering::SineForcing>,

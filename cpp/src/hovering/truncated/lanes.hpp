@@ -85,10 +85,6 @@ struct Finisher {
     }
 };
 
-inline bool cancelled(const IterateOptions& opt) {
-    return opt.cancel && opt.cancel->load(std::memory_order_relaxed);
-}
-
 /// The lane kernel of one map type: iterates the orbits src hands out.
 template <class A, class F>
 using LaneKernel = void (*)(const MapCore<A, F>&, const double* phi0, const double* K0, WorkCursor& src,

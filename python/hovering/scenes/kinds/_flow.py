@@ -9,13 +9,17 @@ dense output).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..._serial import saved_as
+from ..._core import flow as _core_flow
+from ..._io.serial import saved_as
+from ...diagnostics.tolerance import accurate_flow_map
+from ...flow.potentials import COMPILED, POTENTIAL_KINDS
 from ...flow.section import STEPPERS
-from ...flow.system import Bilinear, Harmonic, Polynomial, StepSystem, Tan
+from ...flow.system import Bilinear, Polynomial, StepSystem
 from ...normal.corners import corner_curves
 from ...normal.flowmap import FlowMap
 from ..base import Geometry, SceneSpec
@@ -39,42 +43,76 @@ __all__ = [
 ]
 
 
-def _alpha_for_tan(where: str, alpha, reading) -> None:
-    """A tan well has a width; a harmonic one has none."""
-    if reading.values["kind"] == "tan":
-        if alpha is None:
-            raise ValueError(f"{reading.where}: missing required key 'alpha' for kind = 'tan'")
-    elif "alpha" in reading.table:
-        raise ValueError(f"{reading.where}: 'alpha' is only used with kind = 'tan', got kind = 'harmonic'")
+# ------------------------------------------------------------------ [system.V1], [system.V2]
+# The kinds, their parameters and ranges are the core's registry of compiled potentials
+# (hovering.flow.potentials.POTENTIAL_KINDS): a kind added there is a kind of scene files, with its
+# parameters as keys, and nothing here changes.
+
+_KINDS = {k.kind: k for k in POTENTIAL_KINDS}
+_CLASSES = {k.kind: c for k, c in zip(POTENTIAL_KINDS, COMPILED)}
+# Each parameter name once, declared with the range of the first kind that has it; a kind whose
+# own range of that name differs is checked against it by _of_kind.
+_PARAMS: dict = {}
+for _k in POTENTIAL_KINDS:
+    for _p in _k.params:
+        _PARAMS.setdefault(_p.name, _p)
 
 
-@saved_as("hovering.scenes.spec:PotentialSpec")
-@dataclass(frozen=True)
-class PotentialSpec:
-    """One oscillator's potential.
+def _of_kind(name: str):
+    """The check of parameter ``name``: required by the kinds that have it, refused by the others."""
+
+    def check(where: str, value, reading) -> None:
+        kind = _KINDS[reading.values["kind"]]
+        own = [p for p in kind.params if p.name == name]
+        if own:
+            if value is None:
+                raise ValueError(f"{reading.where}: missing required key {name!r} for kind = {kind.kind!r}")
+            p = own[0]
+            if not p.lo <= value <= p.hi:
+                raise ValueError(
+                    f"{where} = {value!r} is out of range; allowed: [{p.lo:g}, {p.hi:g}] for kind = {kind.kind!r}"
+                )
+        elif name in reading.table:
+            users = " or ".join(repr(k.kind) for k in POTENTIAL_KINDS if any(p.name == name for p in k.params))
+            raise ValueError(f"{reading.where}: {name!r} is only used with kind = {users}, got kind = {kind.kind!r}")
+
+    return check
+
+
+def _build_potential(self):
+    """The compiled potential: the class of its kind, given its parameters in the kind's order.
+
+    Returns
+    -------
+    hovering.Potential
+        ``hovering.Harmonic``, ``hovering.Tan``, ... (the registry's class of ``kind``).
+    """
+    return _CLASSES[self.kind](*(getattr(self, p.name) for p in _KINDS[self.kind].params))
+
+
+_POTENTIAL_DOC = f"""One oscillator's potential: a compiled kind of the core's registry and its parameters.
 
     Attributes
     ----------
-    kind : {"harmonic", "tan"}
-        ``omega^2 q^2 / 2`` or ``(omega / alpha)^2 tan^2(alpha q) / 2``.
-    omega : float
-        Frequency at the bottom of the well.
-    alpha : float or None
-        Tan only: the well's width parameter (walls at ``|q| = pi / (2 alpha)``).
+    kind : {{{", ".join(repr(k) for k in _KINDS)}}}
+        {"; ".join(f"{k.kind}: {k.formula}" for k in POTENTIAL_KINDS)}.
+    {", ".join(_PARAMS)} : float or None
+        The kind's parameters, in its order ({"; ".join(f"{k.kind}: {', '.join(p.name for p in k.params)}" for k in POTENTIAL_KINDS)}); None where the kind has no parameter of that name.
     """
 
-    kind: str = choice(choices=("harmonic", "tan"))
-    omega: float = real(lo=1e-100, hi=1e100)
-    alpha: float | None = real(None, lo=1e-100, hi=1e100, check=_alpha_for_tan)
-
-    def build(self):
-        """The compiled potential.
-
-        Returns
-        -------
-        hovering.Harmonic or hovering.Tan
-        """
-        return Harmonic(self.omega) if self.kind == "harmonic" else Tan(self.omega, self.alpha)
+#: One oscillator's potential (``[system.V1]``, ``[system.V2]``): its fields are ``kind`` and the
+#: parameters of every compiled kind (the registry's names), built here from the registry.
+PotentialSpec = dataclasses.make_dataclass(
+    "PotentialSpec",
+    [
+        ("kind", str, choice(choices=tuple(_KINDS))),
+        *((name, "float | None", real(None, lo=p.lo, hi=p.hi, check=_of_kind(name))) for name, p in _PARAMS.items()),
+    ],
+    namespace={"build": _build_potential, "__doc__": _POTENTIAL_DOC},
+    frozen=True,
+)
+PotentialSpec.__module__ = __name__
+PotentialSpec = saved_as("hovering.scenes.spec:PotentialSpec")(PotentialSpec)
 
 
 #: The coupling ``"bilinear"``: Vc = q1 q2.
@@ -197,6 +235,15 @@ def _accuracy_alone(where: str, accuracy, reading) -> None:
         )
 
 
+#: The core's integrator defaults (``FlowOptions{}``): the one place they are written.
+_CORE = _core_flow.FlowOptions()
+
+
+def _default_atol(where: str, reading) -> float:
+    """An absent atol: the core's policy for the table's rtol."""
+    return _core_flow.default_atol(reading.get("rtol"))
+
+
 @saved_as("hovering.scenes.spec:IntegratorSpec")
 @dataclass(frozen=True)
 class IntegratorSpec:
@@ -205,31 +252,53 @@ class IntegratorSpec:
     Attributes
     ----------
     stepper : str
-        ``rk8pd`` (default), ``rkck``, ``rkf45``, ``rk4``, ``rk2``, ``msadams`` or ``exact`` (the
+        One of :data:`hovering.flow.STEPPERS` (default the core's, ``rk8pd``), e.g. ``exact`` (the
         closed-form flow: eps = 0 with Harmonic/Tan potentials, or Harmonic ones with a bilinear
         coupling; it ignores the tolerances).
     rtol, atol : float
-        Tolerances of the step control (atol defaults to rtol).
+        Tolerances of the step control (default the core's; atol defaults to the core's policy
+        for the given rtol, ``hovering._core.flow.default_atol``: rtol's).
     accuracy : float or None
-        An accuracy target instead (``accuracy = 1e-9`` in [integrator]): the map picks the
-        fastest setting measured to reach it (:class:`~hovering.FlowMap` ``accuracy``).
+        An accuracy target instead (``accuracy = 1e-9`` in [integrator]): the map is built at the
+        fastest setting measured to reach it (:func:`hovering.diagnostics.accurate_flow_map`).
     """
 
-    stepper: str = choice("rk8pd", STEPPERS)
-    rtol: float = real(1e-10, lo=1e-15, hi=1e-2)
-    atol: float = real(1e-10, lo=1e-15, hi=1e-2, default_from="rtol")
+    stepper: str = choice(_CORE.stepper, STEPPERS)
+    rtol: float = real(_CORE.rtol, lo=1e-15, hi=1e-2)
+    atol: float = real(_CORE.atol, lo=1e-15, hi=1e-2, default_from=_default_atol)
     accuracy: float | None = real(None, lo=1e-13, hi=1e-2, check=_accuracy_alone)
 
     def options(self) -> dict:
-        """Keyword arguments of :class:`~hovering.FlowMap`.
+        """The explicit setting, as keyword arguments of :class:`~hovering.FlowMap` (with an
+        accuracy target, the setting is measured: see :meth:`flow_map`).
 
         Returns
         -------
         dict
+            ``stepper``, ``rtol``, ``atol``.
+        """
+        return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol)
+
+    def flow_map(self, system, h: float, coordinates: str = "normal") -> FlowMap:
+        """The flow's map with this integrator: the explicit setting, or for an accuracy target the
+        fastest setting measured to reach it (:func:`hovering.diagnostics.accurate_flow_map`).
+
+        Parameters
+        ----------
+        system : StepSystem
+            The system.
+        h : float
+            Energy of the section.
+        coordinates : {"normal", "section"}, optional
+            The map's coordinates.
+
+        Returns
+        -------
+        FlowMap
         """
         if self.accuracy is not None:
-            return dict(accuracy=self.accuracy)
-        return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol)
+            return accurate_flow_map(system, h, self.accuracy, coordinates=coordinates)
+        return FlowMap(system, h=h, coordinates=coordinates, **self.options())
 
 
 def _record(where: str, value, reading) -> tuple:
@@ -396,7 +465,7 @@ def flowmap(scene, eps: float | None = None, coordinates: str = "normal") -> Flo
     -------
     FlowMap
     """
-    return FlowMap(scene.system.build(eps=eps), h=scene.h, coordinates=coordinates, **scene.integrator.options())
+    return scene.integrator.flow_map(scene.system.build(eps=eps), scene.h, coordinates)
 
 
 def work(res) -> dict:

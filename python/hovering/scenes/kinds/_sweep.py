@@ -11,6 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ...analysis.hovering import hovering_area
 from ...normal.flowmap import FlowMap
 from ...parallel.checkpoint import check_row
 from ...parallel.executor import Executor, run_pieces
@@ -56,17 +57,17 @@ def run_point(kind: str, point: dict, n_threads: int = 0) -> dict:
         n_steps=point["n_steps"], n_samples=point["samples"], rng=point["seed"], n_threads=n_threads, components=False
     )
     if kind == "hovering_area":
-        h = TruncatedMap(**point["map"]).hovering_area(K_low=point["K_low"], **kw)
+        h = hovering_area(TruncatedMap(**point["map"]), K_low=point["K_low"], **kw)
         row = _area_row(h)
     else:
         fm = FlowMap(build_system(point["system"]), h=point["h"], **point["integrator"])
-        h = fm.hovering_area(K_low=point["K_low"], keep_points=bool(point["models"]), **kw)
+        h = hovering_area(fm, K_low=point["K_low"], keep_points=bool(point["models"]), **kw)
         row = _area_row(h)
         row["b1"] = point["b1"]
         row["models"] = {}
         for m in point["models"]:
             tm = TruncatedFamily._from_record({k: m[k] for k in ("eps", "K", "Omega", "JR", "J1", "forcing", "K_max")})
-            mh = tm.hovering_area(K_low=m["K_low"], keep_points=True, **kw)
+            mh = hovering_area(tm, K_low=m["K_low"], keep_points=True, **kw)
             # A model sampling another box (its band is shallower) classifies other points: no agreement.
             agree = float(np.mean(mh.hovering == h.hovering)) if m["K_low"] == point["K_low"] else float("nan")
             row["models"][m["name"]] = dict(area=mh.area, error=mh.error, agree=agree, K_low=m["K_low"])

@@ -11,7 +11,7 @@ from dataclasses import MISSING, dataclass
 
 import numpy as np
 
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ...truncated.maps import TruncatedMap
 from ...truncated.theory import golden_family
 from ..base import Geometry, SceneSpec

@@ -11,12 +11,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._core.analysis import box_floor
+from ..._io.serial import saved_as
 from ..._progress import progress_bar
-from ..._serial import saved_as
-from ...analysis.hovering import default_depth
+from ...analysis.hovering import default_K_low
 from ...normal.compare import truncated_from_flow
 from ...normal.corners import corner_curves
-from ...normal.flowmap import FlowMap
 from ...parallel.checkpoint import Checkpoint
 from ..base import SceneResult, fmt
 from ..fields import choice_list, distinct_reals, integer
@@ -109,7 +109,7 @@ class FlowHoveringResult(SceneResult):
         ImportError
             Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
-        from ..._interop import flow_sweep_frame
+        from ..._io.interop import flow_sweep_frame
 
         return flow_sweep_frame(self)
 
@@ -127,7 +127,7 @@ class FlowHoveringResult(SceneResult):
         ImportError
             Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
-        from ..._interop import flow_sweep_dataset
+        from ..._io.interop import flow_sweep_dataset
 
         return flow_sweep_dataset(self)
 
@@ -149,7 +149,7 @@ def _measured_model(fm, K_low: float):
     """The truncated family with arcs measured on the flow's corner curves (and measured forcing).
 
     Circles below the flow's impact zone (eps > 0: under the deformed torus tangent to the upper
-    wall, ``FlowMap.impact_zone_floor``) hold no J_1 / J_R arcs: the family then stops at the
+    wall, :func:`hovering.impact_zone_floor`) hold no J_1 / J_R arcs: the family then stops at the
     lowest circle that has them, and its band is shallower than the box asked for.
     """
     depth = min(-1.05 * K_low, -0.95 * fm.valid_band()[0])  # circles with a point of Sigma_h only
@@ -174,19 +174,19 @@ def _measured_model(fm, K_low: float):
 
 def _flow_point(scene: FlowHoveringScene, e: float, n_steps: int, samples: int) -> dict:
     system = system_record(scene.system, e)
-    fm = FlowMap(build_system(system), h=scene.h, **scene.integrator.options())
+    fm = scene.integrator.flow_map(build_system(system), scene.h)
     o = fm.integrator_options  # what an accuracy target chose, or the scene's setting
     integrator = {"stepper": o["stepper"], "rtol": float(o["rtol"]), "atol": float(o["atol"])}
     # One box for flow and models, so the same points are classified by each: the default depth
     # (the critical band of eq:hovsetsize), cut to the band every model is defined on.
-    depth = default_depth(fm) if e != 0 else 0.1
-    tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, -depth)) for name in scene.models}
-    K_low = max(-depth, fm.valid_band()[0] * (1 - 1e-9))
+    deep = default_K_low(fm, -math.inf)  # hovering_area's default box, before a band cuts it
+    tms = {name: (fm.truncated() if name == "onset" else _measured_model(fm, deep)) for name in scene.models}
+    K_low = default_K_low(fm)
     if "onset" in tms:
-        K_low = max(K_low, tms["onset"].valid_band()[0] * (1 - 1e-9))
+        K_low = max(K_low, box_floor(tms["onset"].valid_band()[0]))
     # A model whose band is shallower than the box (measured arcs stop at the impact zone's floor)
     # samples its own box: its points are not the flow's.
-    models = [_model(name, tm, max(K_low, tm.valid_band()[0] * (1 - 1e-9))) for name, tm in tms.items()]
+    models = [_model(name, tm, max(K_low, box_floor(tm.valid_band()[0]))) for name, tm in tms.items()]
     th = fm.theory()
     return {
         "n_steps": int(n_steps),

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._enums import Status
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ..._style import orbit_color
 from ...diagnostics.work_precision import _reverse
 from ..base import Geometry, OrbitSet, SceneResult, fmt, orbit_rows, region_counts

@@ -8,10 +8,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._io.serial import saved_as
 from ..._progress import progress_bar
-from ..._serial import saved_as
 from ..._style import orbit_color
-from ...analysis.hovering import default_depth
+from ...analysis.hovering import default_K_low
 from ...parallel.checkpoint import Checkpoint
 from ...truncated.theory import golden_family, hovering_area_theory
 from ..base import SceneResult, check_array, fmt
@@ -236,7 +236,7 @@ class HoveringAreaResult(SceneResult):
         ImportError
             Without pandas, naming ``pip install pandas`` and the extra ``.[pandas]``.
         """
-        from ..._interop import series_frame
+        from ..._io.interop import series_frame
 
         return series_frame(self)
 
@@ -254,7 +254,7 @@ class HoveringAreaResult(SceneResult):
         ImportError
             Without xarray, naming ``pip install xarray`` and the extra ``.[xarray]``.
         """
-        from ..._interop import series_dataset
+        from ..._io.interop import series_dataset
 
         return series_dataset(self)
 
@@ -291,11 +291,8 @@ def plan(scene: HoveringAreaScene, quick: bool = False) -> list:
         for e in scene.eps:
             ms = s.map_at(e)
             m = ms.build()
-            if s.K_low is not None:
-                K_low = float(s.K_low)
-            else:  # the default box of hovering_area: the critical band, cut to the map's band
-                depth = default_depth(m) if e != 0 else 0.1
-                K_low = max(-depth, m.valid_band()[0] * (1 - 1e-9))
+            # The default box is hovering_area's: the critical band, cut to the map's band.
+            K_low = float(s.K_low) if s.K_low is not None else default_K_low(m)
             mp = {k: float(getattr(ms, k)) for k in ("eps", "Omega0", "theta_w", "tau0", "tau1", "lam")}
             out.append(
                 {

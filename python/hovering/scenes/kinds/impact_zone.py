@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ...analysis.barriers import BarrierScan, barrier_scan
 from ...analysis.transit import TransitResult, transit
 from ...analysis.zone import ImpactZone, impact_zone

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._enums import Region, Status, wrap
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ..._style import SPECIAL_COLORS, orbit_color
-from ...analysis import rotation_number
+from ...analysis import critical_curve, rotation_number
 from ..base import Geometry, OrbitSet, SceneResult, fmt, fmt_pair, orbit_rows
 from ..fields import OMIT, PARAM, choice, color, custom, flag, integer, integers, pair, read, real, text, write
 from ..registry import Kind, register
@@ -688,7 +688,7 @@ def _orbit_panel(scene: OrbitScene, p: PanelSpec, n_steps: int, ctx) -> tuple:
             if p.critical.K_range is not None:
                 kw["K_range"] = p.critical.K_range
             try:
-                c = m.critical_curve(n_steps=ctx.scaled(p.critical.n_steps), **kw, **ctx.progress_kw)
+                c = critical_curve(m, n_steps=ctx.scaled(p.critical.n_steps), **kw, **ctx.progress_kw)
             except RuntimeError as e:
                 critical = dict(found=False, reason=str(e))
             else:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ..base import Geometry, SceneResult, region_counts
 from ..fields import integers, pair, real
 from ..registry import Kind, register

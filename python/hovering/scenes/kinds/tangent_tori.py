@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._enums import Status
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ..base import SceneResult, check_array, fmt
 from ..fields import integer
 from ..registry import Kind, register

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._enums import FlowStatus, wrap
-from ..._serial import saved_as
+from ..._io.serial import saved_as
 from ..base import SceneResult, check_array, check_same_length, check_status, check_trajectory, fmt, region_counts
 from ..fields import integer, real
 from ..registry import Kind, register

@@ -23,8 +23,8 @@ import sys
 
 import numpy as np
 
-from ._core import build_info as _core_build_info
-from ._version import __version__
+from .._core import build_info as _core_build_info
+from .._version import __version__
 
 __all__ = ["provenance", "show_versions"]
 

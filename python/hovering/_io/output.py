@@ -34,7 +34,7 @@ import stat
 from contextlib import contextmanager
 from pathlib import Path
 
-from ._untrusted import is_result_file
+from .untrusted import is_result_file
 
 __all__ = [
     "output_path",

@@ -37,11 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from . import _untrusted
-from ._output import replacing
-from ._provenance import provenance
-from ._untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
-from ._version import __version__
+from .._version import __version__
+from . import untrusted as _untrusted
+from .output import replacing
+from .provenance import provenance
+from .untrusted import _META_KEY, FORMAT, is_result_file  # noqa: F401 (the format's names, re-exported)
 
 __all__ = ["FORMAT", "Saveable", "from_tree", "load", "record_key", "save", "saved_as", "to_tree"]
 

@@ -23,7 +23,7 @@ import zipfile
 
 import numpy as np
 
-from ._checks import physical_memory
+from .._checks import physical_memory
 
 __all__ = [
     "MAX_TREE_CHARS",

@@ -16,9 +16,9 @@ import json
 
 import numpy as np
 
-from ._enums import FlowStatus, Region, Status
-from ._extras import require
-from ._provenance import provenance
+from .._enums import FlowStatus, Region, Status
+from .._extras import require
+from .provenance import provenance
 
 __all__ = [
     "VARIABLES",

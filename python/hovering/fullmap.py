@@ -1,5 +1,0 @@
-"""Old path of :mod:`hovering.normal` (deprecated; removed in 0.4.0)."""
-
-from ._deprecated import moved_module
-
-__getattr__ = moved_module(__name__, "hovering.normal")

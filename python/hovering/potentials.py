@@ -1,5 +1,0 @@
-"""Old path of :mod:`hovering.flow.potentials` (deprecated; removed in 0.4.0)."""
-
-from ._deprecated import moved_module
-
-__getattr__ = moved_module(__name__, "hovering.flow.potentials")
