@@ -195,6 +195,9 @@ TEST_CASE("flow map iteration: labels only when read, dense output, work counter
     const FlowSystem s = issue_system(-0.05);
     FlowOptions o = tight();
     o.rtol = o.atol = 1e-10;
+    // Counting: one section search and one sample per point of each trace, so a single trace per
+    // return (a verified return's extra traces are counted too: test_verified_returns.py).
+    o.verify_steps = 0;
     const FlowMap fm(s, 1.0, o, nullptr);  // section coordinates (theta, I)
     std::vector<double> x = {0.3, -1.0, 2.0, -2.5, 1.1}, y = {0.30, 0.33, 0.31, 0.29, 50.0};  // the last: OffSection
     const std::int64_t n = std::int64_t(x.size()), ns = 5;
