@@ -736,7 +736,9 @@ def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monk
     }[case]
     out = _edited(checkpoint[0], tmp_path, edit)
     computed = []
-    monkeypatch.setattr(hv.TruncatedMap, "hovering_area", lambda *a, **k: computed.append(a))
+    from hovering.scenes.kinds import _sweep  # the function each sweep point calls
+
+    monkeypatch.setattr(_sweep, "hovering_area", lambda *a, **k: computed.append(a))
     _refused(
         run_scene,
         load_scene(HOV_SCENE),
@@ -751,7 +753,9 @@ def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monk
 def test_checkpoint_genuine_rows_are_reused(checkpoint, tmp_path, monkeypatch):
     path, first = checkpoint
     (tmp_path / "hov.sweep.jsonl").write_bytes(path.read_bytes())
-    monkeypatch.setattr(hv.TruncatedMap, "hovering_area", lambda *a, **k: pytest.fail("recomputed a stored point"))
+    from hovering.scenes.kinds import _sweep
+
+    monkeypatch.setattr(_sweep, "hovering_area", lambda *a, **k: pytest.fail("recomputed a stored point"))
     again = run_scene(load_scene(HOV_SCENE), out=tmp_path / "hov.png", quick=True)
     assert again["points_reused"] == first["points_reused"] + sum(len(s["points"]) for s in first["series"])
     assert json.dumps(again["series"], sort_keys=True) == json.dumps(first["series"], sort_keys=True)

@@ -177,18 +177,20 @@ def test_two_writers_never_duplicate_a_point(tmp_path):
 
 @pytest.mark.e2e
 def test_interrupted_sweep_resumes(tmp_path, monkeypatch):
+    from hovering.scenes.kinds import _sweep
+
     scene = scenes.load_scene(SCENE)
     out = tmp_path / "hov.png"
-    real = hovering.TruncatedMap.hovering_area
+    real = _sweep.hovering_area  # the function each sweep point calls (analyses are free functions)
     calls = {"n": 0}
 
-    def flaky(self, *a, **kw):
+    def flaky(m, *a, **kw):
         calls["n"] += 1
         if calls["n"] == 4:
             raise KeyboardInterrupt
-        return real(self, *a, **kw)
+        return real(m, *a, **kw)
 
-    monkeypatch.setattr(hovering.TruncatedMap, "hovering_area", flaky)
+    monkeypatch.setattr(_sweep, "hovering_area", flaky)
     with pytest.raises(KeyboardInterrupt):
         pipeline.run_scene(scene, out=out, quick=True)
     ckpt = out.with_suffix(".sweep.jsonl")
@@ -200,6 +202,6 @@ def test_interrupted_sweep_resumes(tmp_path, monkeypatch):
     total = sum(len(s["points"]) for s in summary["series"])
     assert summary["points_reused"] == 3 and calls["n"] - 100 == total - 3
     # Same numbers as a run that was never interrupted.
-    monkeypatch.setattr(hovering.TruncatedMap, "hovering_area", real)
+    monkeypatch.setattr(_sweep, "hovering_area", real)
     fresh = pipeline.run_scene(scene, out=tmp_path / "fresh.png", quick=True)
     assert json.dumps(fresh["series"], sort_keys=True) == json.dumps(summary["series"], sort_keys=True)
