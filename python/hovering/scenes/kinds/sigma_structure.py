@@ -123,7 +123,7 @@ def compute(scene: SigmaStructureScene, ctx) -> SigmaStructureResult:
     )
     stages.start("corner curves", f"{10 if quick else 24} circles")
     corners = flow_geometry(
-        fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10)
+        fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options["rtol"]
     )
     stages.end()
     return SigmaStructureResult(
