@@ -4,7 +4,7 @@ import-linter (tests/package/test_layout.py) sees import statements, those insid
 included. A lower module can still reach up without one: a registry of hooks that the higher module
 fills at import and the lower one calls at run time (``interface.hook("hovering_area")(m)`` did
 that), a module found by name (``importlib.import_module("hovering._api")``), a function fetched from
-the package's lazy table. Two checks close those doors:
+the package's lazy table. Three checks close those doors:
 
 * **Static**: every call that imports by name (``importlib.import_module``, ``__import__``,
   ``importlib.util.find_spec``) names, when its argument is a constant, a module its caller may
@@ -13,13 +13,21 @@ the package's lazy table. Two checks close those doors:
 * **Dynamic**: a profiler watches every call made while the package works (maps, the flow, the
   analyses, accuracy targets, scenes, saving and loading). A call from module A into a plain
   function of module B that A cannot reach through its imports is legitimate only as a callback: the
-  function object is held (in locals, arguments, closures, or one attribute deep) by each frame up
-  the stack until one whose module can reach B, or the caller's own code, handed it down. A
+  function object is held (in locals, arguments, closures, containers and attributes, a class's
+  declarations included) by each frame up the stack until one whose module can reach B, or the
+  caller's own code, handed it down. A
   function A fetched itself (from a registry, by name, through the package's ``__getattr__``) breaks
   that chain: an upward call. Method calls are dispatch on an object the caller was handed (or, in
   ``hovering._io.serial``, rebuilt from a file that names its class), not arrows, and are not
   counted. The only upward calls allowed are the deprecated forms (``m.hovering_area()``,
   ``FlowMap(accuracy=)``), made by ``hovering._deprecated.call_moved`` after it warned.
+* **State**: after the whole package is imported, no module keeps a function of a module it cannot
+  import (a registry filled from above), but those listed in ``HOLDERS`` with their reason. It sees
+  a registry whose caller keeps the hook in a local, which the profiler lets pass.
+
+On the commit before the hooks went (351d006) the three checks find ``interface``'s import of
+``hovering._api`` by name, the four hooks called (``m.hovering_area()``, ``m.critical_curve()``,
+``FlowMap(accuracy=)``, the spec's check on ``hovering.load``) and ``interface._HOOKS`` holding them.
 
 The detector itself is tested on toy hooks (a registry, a name lookup, the lazy table), so that a
 clean run means something.

@@ -126,7 +126,7 @@ def compute(scene: FlowPortraitScene, ctx) -> FlowPortraitResult:
     lo = min(auto_ylim(flow.K, floor)[0], auto_ylim(model.K, floor)[0])
     hi = max(auto_ylim(flow.K, floor)[1], auto_ylim(model.K, floor)[1])
     stages.start("corner curves", f"{scene.corner_K} circles")
-    fg = flow_geometry(fm, (lo, hi), scene.corner_K, fm.integrator_options.get("rtol", 1e-10))
+    fg = flow_geometry(fm, (lo, hi), scene.corner_K, fm.integrator_options["rtol"])
     stages.end()
     mg = map_geometry(tm, (lo, hi), corner_curves=scene.corner_K > 0)
     p = fm.onset

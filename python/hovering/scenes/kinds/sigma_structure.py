@@ -122,9 +122,7 @@ def compute(scene: SigmaStructureScene, ctx) -> SigmaStructureResult:
         p21=tg.z[:, 1, 3],
     )
     stages.start("corner curves", f"{10 if quick else 24} circles")
-    corners = flow_geometry(
-        fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options.get("rtol", 1e-10)
-    )
+    corners = flow_geometry(fm, (lo, min(scene.K_range[1], 0.0)), 10 if quick else 24, fm.integrator_options["rtol"])
     stages.end()
     return SigmaStructureResult(
         scene=scene,
