@@ -191,3 +191,19 @@ def test_flow_options_pickle_keeps_verify_steps_and_reads_old_pickles():
     old = FlowOptions.__new__(FlowOptions)
     old.__setstate__(("rk8pd", 1e-10, 1e-12, 1e-15, 1000000, 100, 1e-12, 1e-10))  # before verify_steps
     assert old.verify_steps == -1
+
+
+def test_a_tighter_trace_that_cannot_finish_is_no_verdict():
+    # The docs: a tighter trace that cannot finish (its step budget, here the caller's max_steps
+    # just above the first trace's steps, where rtol / 100 needs ~1.8x as many) gives no verdict:
+    # IMPRECISE, with the first trace's values, never a silent OK and never STEP_LIMIT for a return
+    # that did return.
+    sec = hv.Section(hv.paper.system(eps=0.05), 1.0)
+    th, I = np.linspace(-3, 3, 8), np.full(8, 0.3)
+    first = sec.return_map(th, I, stepper="rk8pd", rtol=1e-6, atol=1e-6, verify_steps=0)
+    assert np.all(first.status == hv.FlowStatus.OK)
+    cap = int(first.steps.max()) + 1
+    r = sec.return_map(th, I, stepper="rk8pd", rtol=1e-6, atol=1e-6, verify_steps=1, max_steps=cap)
+    assert np.all(r.status == hv.FlowStatus.IMPRECISE)
+    assert np.array_equal(r.time, first.time) and np.array_equal(r.z, first.z)
+    assert np.all(r.steps > first.steps)  # the unfinished trace's steps are counted
