@@ -115,6 +115,7 @@ API_GROUPS = (
         "What the computations return: each holds its numbers, a summary repr, and saves to NPZ.",
         (
             "IterateResult",
+            "StepJacobian",
             "ReturnMapResult",
             "FlowSteps",
             "OnsetParameters",

@@ -65,6 +65,7 @@ __all__ = [
     "TruncatedMap",
     "TruncatedFamily",
     "IterateResult",
+    "StepJacobian",
     "FlowMap",
     "FlowSteps",
     "ReturnMap",

@@ -55,7 +55,7 @@ from .flow import (
     check_potential,
     onset_parameters,
 )
-from .interface import ReturnMap
+from .interface import ReturnMap, StepJacobian
 from .normal import (
     CornerCurves,
     FlowMap,

@@ -5,6 +5,7 @@
 //   flow/       the oscillators-step flow (sec:setup) and its return map to Sigma_h
 //   normal/     normal coordinates (phi, K) of the flow's section, and the flow as a map on them
 
+#include "hovering/tangent.hpp"
 #include "hovering/types.hpp"
 
 #include "hovering/truncated/arcs.hpp"
