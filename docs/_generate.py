@@ -20,6 +20,7 @@ SUBPACKAGES = (
     "hovering.flow",
     "hovering.normal",
     "hovering.analysis",
+    "hovering.dynamics",
     "hovering.diagnostics",
     "hovering.parallel",
     "hovering.scenes",
@@ -104,6 +105,11 @@ API_GROUPS = (
             "cone_crossing",
             "converse_kam",
         ),
+    ),
+    (
+        "Tangent dynamics",
+        "Jacobians of a return and what they find: periodic orbits with their residues and stability.",
+        ("periodic_orbit", "periodic_orbits", "PeriodicOrbit", "PeriodicOrbits"),
     ),
     (
         "Transport across the impact zone",

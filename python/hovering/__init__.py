@@ -148,6 +148,11 @@ __all__ = [
     "transit",
     "BarrierScan",
     "barrier_scan",
+    "dynamics",
+    "PeriodicOrbit",
+    "PeriodicOrbits",
+    "periodic_orbit",
+    "periodic_orbits",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene

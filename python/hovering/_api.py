@@ -9,7 +9,7 @@ it also registers the hooks the models' convenience methods call (:func:`hoverin
 from __future__ import annotations
 
 # ruff: noqa: F401  (every name here is re-exported by the package's __getattr__)
-from . import _core, analysis, flow, normal, paper, truncated
+from . import _core, analysis, dynamics, flow, normal, paper, truncated
 from ._enums import FlowStatus, Geometry, Region, Status, region_mask, wrap
 from ._provenance import show_versions
 from ._serial import load, save
@@ -38,6 +38,7 @@ from .analysis import (
 )
 from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
+from .dynamics import PeriodicOrbit, PeriodicOrbits, periodic_orbit, periodic_orbits
 from .explore import explore
 from .flow import (
     Bilinear,

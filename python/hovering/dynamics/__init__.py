@@ -1,0 +1,17 @@
+"""Tangent dynamics on the map interface (both models): periodic orbits with their monodromy,
+residues and stability, and the orbits at the centres of island chains. The numerics (steps,
+Jacobians, products along orbits) run in the core; these functions are written once against
+:class:`hovering.ReturnMap`."""
+
+from .islands import IslandCentres, island_centres
+from .periodic import LINES, PeriodicOrbit, PeriodicOrbits, periodic_orbit, periodic_orbits
+
+__all__ = [
+    "LINES",
+    "PeriodicOrbit",
+    "PeriodicOrbits",
+    "periodic_orbit",
+    "periodic_orbits",
+    "IslandCentres",
+    "island_centres",
+]
