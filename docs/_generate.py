@@ -108,8 +108,17 @@ API_GROUPS = (
     ),
     (
         "Tangent dynamics",
-        "Jacobians of a return and what they find: periodic orbits with their residues and stability.",
-        ("periodic_orbit", "periodic_orbits", "PeriodicOrbit", "PeriodicOrbits"),
+        "Jacobians of a return and what they find: periodic orbits with their residues and stability, Lyapunov exponents.",
+        (
+            "periodic_orbit",
+            "periodic_orbits",
+            "PeriodicOrbit",
+            "PeriodicOrbits",
+            "lyapunov",
+            "LyapunovResult",
+            "ftle_field",
+            "FTLEField",
+        ),
     ),
     (
         "Transport across the impact zone",

@@ -153,6 +153,10 @@ __all__ = [
     "PeriodicOrbits",
     "periodic_orbit",
     "periodic_orbits",
+    "lyapunov",
+    "LyapunovResult",
+    "ftle_field",
+    "FTLEField",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene

@@ -38,7 +38,16 @@ from .analysis import (
 )
 from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
-from .dynamics import PeriodicOrbit, PeriodicOrbits, periodic_orbit, periodic_orbits
+from .dynamics import (
+    FTLEField,
+    LyapunovResult,
+    PeriodicOrbit,
+    PeriodicOrbits,
+    ftle_field,
+    lyapunov,
+    periodic_orbit,
+    periodic_orbits,
+)
 from .explore import explore
 from .flow import (
     Bilinear,

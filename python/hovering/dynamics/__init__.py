@@ -1,9 +1,11 @@
 """Tangent dynamics on the map interface (both models): periodic orbits with their monodromy,
-residues and stability, and the orbits at the centres of island chains. The numerics (steps,
+residues and stability, the orbits at the centres of island chains, Lyapunov exponents and the
+finite-time field. The numerics (steps,
 Jacobians, products along orbits) run in the core; these functions are written once against
 :class:`hovering.ReturnMap`."""
 
 from .islands import IslandCentres, island_centres
+from .lyapunov import FTLEField, LyapunovResult, ftle_field, lyapunov
 from .periodic import LINES, PeriodicOrbit, PeriodicOrbits, periodic_orbit, periodic_orbits
 
 __all__ = [
@@ -14,4 +16,8 @@ __all__ = [
     "periodic_orbits",
     "IslandCentres",
     "island_centres",
+    "LyapunovResult",
+    "lyapunov",
+    "FTLEField",
+    "ftle_field",
 ]
