@@ -108,7 +108,7 @@ API_GROUPS = (
     ),
     (
         "Tangent dynamics",
-        "Jacobians of a return and what they find: periodic orbits with their residues and stability, Lyapunov exponents.",
+        "Jacobians of a return and what they find: periodic orbits with their residues and stability, Lyapunov exponents, invariant manifolds and their lobes.",
         (
             "periodic_orbit",
             "periodic_orbits",
@@ -118,6 +118,10 @@ API_GROUPS = (
             "LyapunovResult",
             "ftle_field",
             "FTLEField",
+            "manifold",
+            "Manifold",
+            "lobes",
+            "Lobes",
         ),
     ),
     (

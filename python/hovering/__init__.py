@@ -157,6 +157,10 @@ __all__ = [
     "LyapunovResult",
     "ftle_field",
     "FTLEField",
+    "manifold",
+    "Manifold",
+    "lobes",
+    "Lobes",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene

@@ -40,11 +40,15 @@ from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
 from .dynamics import (
     FTLEField,
+    Lobes,
     LyapunovResult,
+    Manifold,
     PeriodicOrbit,
     PeriodicOrbits,
     ftle_field,
+    lobes,
     lyapunov,
+    manifold,
     periodic_orbit,
     periodic_orbits,
 )

@@ -6,6 +6,7 @@ Jacobians, products along orbits) run in the core; these functions are written o
 
 from .islands import IslandCentres, island_centres
 from .lyapunov import FTLEField, LyapunovResult, ftle_field, lyapunov
+from .manifolds import Lobes, Manifold, intersections, lobes, manifold
 from .periodic import LINES, PeriodicOrbit, PeriodicOrbits, periodic_orbit, periodic_orbits
 
 __all__ = [
@@ -20,4 +21,9 @@ __all__ = [
     "lyapunov",
     "FTLEField",
     "ftle_field",
+    "Manifold",
+    "manifold",
+    "intersections",
+    "Lobes",
+    "lobes",
 ]
