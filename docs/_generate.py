@@ -108,7 +108,7 @@ API_GROUPS = (
     ),
     (
         "Tangent dynamics",
-        "Jacobians of a return and what they find: periodic orbits with their residues and stability, Lyapunov exponents, invariant manifolds and their lobes.",
+        "Jacobians of a return and what they find: periodic orbits with their residues and stability, Lyapunov exponents, invariant manifolds and their lobes, continuation.",
         (
             "periodic_orbit",
             "periodic_orbits",
@@ -122,6 +122,8 @@ API_GROUPS = (
             "Manifold",
             "lobes",
             "Lobes",
+            "continue_orbit",
+            "Branch",
         ),
     ),
     (

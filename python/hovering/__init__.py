@@ -161,6 +161,8 @@ __all__ = [
     "Manifold",
     "lobes",
     "Lobes",
+    "continue_orbit",
+    "Branch",
 ]
 
 # Loaded when first used, so `import hovering` stays light (no core, numpy, matplotlib, dask or scene

@@ -39,12 +39,14 @@ from .analysis import (
 from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, work_precision  # also registers the accuracy-target hook
 from .dynamics import (
+    Branch,
     FTLEField,
     Lobes,
     LyapunovResult,
     Manifold,
     PeriodicOrbit,
     PeriodicOrbits,
+    continue_orbit,
     ftle_field,
     lobes,
     lyapunov,

@@ -4,6 +4,16 @@ finite-time field. The numerics (steps,
 Jacobians, products along orbits) run in the core; these functions are written once against
 :class:`hovering.ReturnMap`."""
 
+from .continuation import Branch, continue_orbit, pseudo_arclength
+from .greene import (
+    GOLDEN,
+    GreeneCritical,
+    GreeneResidues,
+    convergents,
+    greene_critical,
+    greene_residues,
+    symmetric_orbit,
+)
 from .islands import IslandCentres, island_centres
 from .lyapunov import FTLEField, LyapunovResult, ftle_field, lyapunov
 from .manifolds import Lobes, Manifold, intersections, lobes, manifold
@@ -26,4 +36,14 @@ __all__ = [
     "intersections",
     "Lobes",
     "lobes",
+    "Branch",
+    "continue_orbit",
+    "pseudo_arclength",
+    "GOLDEN",
+    "convergents",
+    "symmetric_orbit",
+    "GreeneResidues",
+    "greene_residues",
+    "GreeneCritical",
+    "greene_critical",
 ]
