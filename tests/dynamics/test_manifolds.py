@@ -162,3 +162,61 @@ def test_bad_input(separatrix):
         manifold(sm, x, length=-1.0)
     with pytest.raises(ValueError, match="unstable must be an unstable Manifold"):
         lobes(ws, ws)
+
+
+def test_the_lobe_flux_is_the_leak_of_a_uniform_ensemble_across_the_barrier(separatrix):
+    # The broken separatrix C (W^u from the fixed point to the first intersection, W^s back to the
+    # next copy of the point, a closed loop round the cylinder) and its copies C + (0, 2 pi j) cut
+    # the standard map's cylinder (K-periodic with period 2 pi) into layers. Each step exactly the
+    # exit lobe's points cross C upward: for points uniform on the torus (an invariant measure) the
+    # fraction whose layer index rises by one is A_lobe / (4 pi^2). Measured independently of the
+    # lobe's polygon: the layer index of a point is the signed count of C's copies below it on its
+    # vertical line.
+    sm, x, wu, ws = separatrix
+    L = lobes(wu, ws)
+    pts = L.points
+    h = pts[0]  # the first intersection along W^u (on the copy of W^s shifted by h's shift)
+    from hovering.dynamics.manifolds import _piece
+
+    ux, uy = _piece(wu, 0.0, h[2])
+    sx, sy = _piece(ws, 0.0, h[3], h[4])
+    # every third vertex: chords of ~0.01 move the curve by their sagitta (~1e-5), far below the
+    # Monte Carlo's resolution
+    cx = np.concatenate([ux[::3], ux[-1:], sx[::-1][::3], sx[:1]])
+    cy = np.concatenate([uy[::3], uy[-1:], sy[::-1][::3], sy[:1]])
+    span = cx[-1] - cx[0]
+    assert abs(abs(span) - 2 * np.pi) < 1e-6  # once round the cylinder
+
+    def index(p, k):
+        # signed crossings of the copies of C below (p, k) on the vertical line at p (in blocks of
+        # points: a block x the curve's segments at a time)
+        x0, x1, y0, y1 = cx[:-1], cx[1:], cy[:-1], cy[1:]
+        p = cx[0] + np.mod(p - cx[0], span)  # the copies repeat every turn: one turn of phi
+        total = np.zeros(p.size)
+        for lo in range(0, p.size, 1000):
+            P, Kb = p[lo : lo + 1000, None], k[lo : lo + 1000, None]
+            for m in (-1, 0, 1):
+                X0, X1 = x0 + m * span, x1 + m * span
+                straddle = (X0 <= P) != (X1 <= P)
+                t = (P - X0) / np.where(X1 == X0, 1.0, X1 - X0)
+                ycross = y0 + t * (y1 - y0)
+                direction = np.sign(X1 - X0) * np.sign(span)
+                # copies in K: C + 2 pi j lies below k for j <= floor((k - ycross) / 2 pi)
+                below = np.floor((Kb - ycross) / (2 * np.pi)) + 1
+                total[lo : lo + 1000] += np.sum(np.where(straddle, direction * below, 0.0), axis=1)
+        return np.rint(total)
+
+    rng = np.random.default_rng(1)
+    n = 60_000
+    p = rng.uniform(-np.pi, np.pi, n)
+    k = x.K[0] + rng.uniform(-np.pi, np.pi, n)
+    p1, k1 = sm.step(p, k)
+    # the image's angle, lifted as the step moves it: phi + Omega(K), Omega = 0.3 + K (no wrap)
+    lift = p + (0.3 + k) + hv.wrap(p1 - p - (0.3 + k))
+    d = index(lift, k1) - index(p, k)
+    up, down = np.mean(d == 1), np.mean(d == -1)
+    expect = L.flux / (4 * np.pi**2)
+    sigma = np.sqrt(expect / n)
+    # measured (n = 60,000): 0.00123 up, 0.00147 down, against A_lobe / 4 pi^2 = 0.00147 +- 0.00016
+    assert abs(up - expect) < 4 * sigma and abs(down - expect) < 4 * sigma, (up, down, expect, sigma)
+    assert np.all(np.abs(d) <= 1)
