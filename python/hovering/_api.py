@@ -11,7 +11,7 @@ lazy loading from a stub). Type checkers and editors see them through the packag
 from __future__ import annotations
 
 # ruff: noqa: F401  (every name here is re-exported by the package's __getattr__)
-from . import analysis, diagnostics, flow, normal, paper, pipeline, truncated
+from . import analysis, diagnostics, dynamics, flow, normal, paper, pipeline, truncated
 from ._core.truncated import simd_is_avx2
 from ._enums import FlowStatus, Geometry, Region, Status, region_mask, wrap
 from ._io.provenance import show_versions
@@ -42,6 +42,22 @@ from .analysis import (
 )
 from .curve import Above, Below, Curve
 from .diagnostics import WorkPrecision, accurate_flow_map, work_precision
+from .dynamics import (
+    Branch,
+    FTLEField,
+    Lobes,
+    LyapunovResult,
+    Manifold,
+    PeriodicOrbit,
+    PeriodicOrbits,
+    continue_orbit,
+    ftle_field,
+    lobes,
+    lyapunov,
+    manifold,
+    periodic_orbit,
+    periodic_orbits,
+)
 from .explore import explore
 from .flow import (
     Bilinear,
@@ -59,7 +75,7 @@ from .flow import (
     check_potential,
     onset_parameters,
 )
-from .interface import ReturnMap
+from .interface import ReturnMap, StepJacobian
 from .normal import (
     CornerCurves,
     FlowMap,

@@ -16,13 +16,14 @@ import numpy as np
 from ._checks import _short, check_memory, integer, is_choice, real_number
 from ._deprecated import moved_method
 from ._display import Summarized, status_counts
-from ._enums import Status, region_mask, status_code
+from ._enums import Region, Status, region_mask, status_code
 from ._io.serial import Saveable
 from .curve import StopCondition
 
 __all__ = [
     "ReturnMap",
     "IterateResult",
+    "StepJacobian",
     "MapAnalyses",
     "iterate_arguments",
     "transport_arguments",
@@ -64,6 +65,9 @@ class ReturnMap(Protocol):
     ):
         """Many orbits at once -> IterateResult (progress: see hovering._progress; every, stop: see
         :meth:`hovering.TruncatedMap.iterate`)."""
+
+    def jacobian(self, phi, K):
+        """One step with its Jacobian d(phibar, Kbar)/d(phi, K) -> StepJacobian."""
 
     def with_eps(self, eps: float) -> ReturnMap:
         """The same map at another eps (F_0 for the hovering set's definition)."""
@@ -191,6 +195,22 @@ class IterateResult(Summarized, Saveable):
         ``steps`` (accepted integrator steps). Effects nobody asked for cost nothing: no walls, no
         wall search; eps = 0, no coupling evaluation; no labels, no label operation; no trajectory,
         no dense sample.
+    jacobian_q, jacobian_log, jacobian_r12 : ndarray or None
+        Record ``"jacobian"``: per orbit, the product ``M = J_{n-1} ... J_1 J_0`` of the Jacobians
+        of the ``n = steps_done`` steps it took (every step, whatever ``every``), kept in QR form
+        so that it stays finite however long the orbit (Benettin's renormalisation):
+        ``M = Q R``, ``Q = jacobian_q`` (rotation, shape ``(n_orbits, 2, 2)``), ``R =
+        diag(exp(L1), exp(L2)) [[1, u], [0, 1]]`` with ``(L1, L2) = jacobian_log`` (shape
+        ``(n_orbits, 2)``) and ``u = jacobian_r12``. ``L1 / n`` and ``L2 / n`` are the orbit's
+        finite-time Lyapunov exponents, and ``L1 + L2`` the sum of ``log det J`` (0 for an
+        area-preserving map, up to the Jacobians' own error). :meth:`jacobian` rebuilds ``M``.
+    jacobian_status : ndarray of int8 or None
+        Record ``"jacobian"``: :class:`Status` per orbit: ``OK``; ``CORNER`` (truncated map) when a
+        step was taken from an arc start exactly, where the map is discontinuous and the factor is
+        the one-sided derivative of the arc that owns the start; ``NON_FINITE`` (flow) when a
+        return's Jacobian was not finite (left out of the product). An orbit that stops at a
+        corner or a graze of the flow takes no return there: its status says so, and its product
+        covers the returns it took.
 
     Examples
     --------
@@ -237,6 +257,10 @@ class IterateResult(Summarized, Saveable):
     K_max: np.ndarray | None = None
     residence: np.ndarray | None = None
     every: int = 1
+    jacobian_q: np.ndarray | None = None
+    jacobian_log: np.ndarray | None = None
+    jacobian_r12: np.ndarray | None = None
+    jacobian_status: np.ndarray | None = None
 
     @classmethod
     def from_core(cls, d: dict, m, n_steps: int, every: int, names: dict | None = None) -> IterateResult:
@@ -297,6 +321,31 @@ class IterateResult(Summarized, Saveable):
         """Number of orbits."""
         return int(self.status.shape[0])
 
+    def jacobian(self) -> np.ndarray:
+        """The product of the Jacobians of each orbit's steps, rebuilt from its QR form.
+
+        Returns
+        -------
+        ndarray
+            Shape ``(n_orbits, 2, 2)``: ``Q diag(e^L1, e^L2) [[1, u], [0, 1]]``; entries overflow to
+            +-inf once ``e^L1`` does (``L1 > 709``): use ``jacobian_q`` and ``jacobian_log`` then.
+
+        Raises
+        ------
+        ValueError
+            If ``"jacobian"`` was not recorded.
+        """
+        if self.jacobian_q is None:
+            raise ValueError("no jacobian was recorded: pass record=(..., 'jacobian') to iterate")
+        with np.errstate(over="ignore", invalid="ignore"):
+            a = np.exp(self.jacobian_log[:, 0])
+            d = np.exp(self.jacobian_log[:, 1])
+            R = np.zeros((self.n_orbits, 2, 2))
+            R[:, 0, 0] = a
+            R[:, 0, 1] = a * self.jacobian_r12
+            R[:, 1, 1] = d
+            return np.einsum("nij,njk->nik", self.jacobian_q, R)
+
     def count(self, status: Status | int) -> int:
         """Number of orbits with the given status.
 
@@ -352,6 +401,68 @@ class IterateResult(Summarized, Saveable):
         from ._io.interop import iterate_dataset
 
         return iterate_dataset(self)
+
+
+@dataclass(frozen=True, repr=False)
+class StepJacobian(Summarized):
+    """One step of each point with its Jacobian: what ``m.jacobian(phi, K)`` returns for every map.
+
+    Attributes
+    ----------
+    phi, K : ndarray or float
+        The images (as :meth:`step` gives them; NaN where the step has no number: see ``status``).
+    J : ndarray
+        ``d(phibar, Kbar) / d(phi, K)``, shape ``(..., 2, 2)`` (``(2, 2)`` for one point): rows
+        ``(dphibar/dphi, dphibar/dK)``, ``(dKbar/dphi, dKbar/dK)``. NaN where ``status`` is not
+        OK, except CORNER on the truncated map (see there).
+    status : ndarray of int8 or Status
+        :class:`Status` of each step: OK; CORNER (truncated map: the point lies exactly on an arc
+        start, a corner-singularity curve, where the map jumps: ``J`` is the one-sided derivative
+        of the arc that owns it; flow: the return hits the corner, no number); GRAZING (flow: a
+        wall touched tangentially, where the derivative is infinite: no number); any other flow
+        outcome (OFF_SECTION, STEP_LIMIT, IMPRECISE, ...), no number.
+    region : ndarray of int8 or Region
+        :class:`Region` of each step.
+    """
+
+    phi: np.ndarray
+    K: np.ndarray
+    J: np.ndarray
+    status: np.ndarray
+    region: np.ndarray
+
+    @property
+    def det(self):
+        """``det J`` of each step (1 for an area-preserving map, up to the Jacobian's error)."""
+        return np.linalg.det(self.J)
+
+    def _summary(self) -> list:
+        n = int(np.size(self.phi))
+        out: list[tuple[str, object]] = [("n_points", n)]
+        out.append(("status", status_counts(np.atleast_1d(np.asarray(self.status, dtype=np.int8)), Status)))
+        return out
+
+    @classmethod
+    def from_core(cls, d: dict, shape: tuple) -> StepJacobian:
+        """The result of a core jacobian call (flat arrays ``x, y, J, status, region``) in ``shape``.
+
+        Raises
+        ------
+        KeyboardInterrupt
+            If the core was interrupted (the flow's batch); the result so far is its ``partial``.
+        """
+        x, y = d["x"].reshape(shape), d["y"].reshape(shape)
+        J = d["J"].reshape(shape + (2, 2))
+        st, reg = d["status"].reshape(shape), d["region"].reshape(shape)
+        if shape == ():
+            res = cls(float(x), float(y), J, Status(int(st)), Region(int(reg)))
+        else:
+            res = cls(x, y, J, st, reg)
+        if d.get("interrupted"):
+            exc = KeyboardInterrupt("jacobians interrupted; the finished ones are in .partial")
+            exc.partial = res  # type: ignore[attr-defined]
+            raise exc
+        return res
 
 
 def require_map(name: str, m):

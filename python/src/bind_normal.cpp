@@ -75,6 +75,42 @@ py::dict steps(const FlowMap& fm, const darray& x, const darray& y, bool inverse
     return d;
 }
 
+py::dict jacobians(const FlowMap& fm, const darray& x, const darray& y, int n_threads) {
+    same_size(x, y, "x", "y");
+    const py::ssize_t n = x.size();
+    std::vector<FlowJacobian> res(static_cast<std::size_t>(n));
+    std::atomic<bool> cancel{false};
+    const bool interrupted = hovering_py::run_watched(
+        [&] { fm.jacobians(x.data(), y.data(), n, n_threads, &cancel, res.data()); }, cancel, n >= 16);
+    darray x1(n), y1(n), time(n), J({n, py::ssize_t(2), py::ssize_t(2)});
+    py::array_t<std::int8_t> status(n), region(n);
+    py::array_t<std::int64_t> nsteps(n);
+    std::vector<std::string> itin(static_cast<std::size_t>(n));
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const FlowJacobian& r = res[std::size_t(i)];
+        x1.mutable_data()[i] = r.step.x;
+        y1.mutable_data()[i] = r.step.y;
+        time.mutable_data()[i] = r.step.ret.status == FlowStatus::OffSection ? kNaN : r.step.ret.time;
+        // The map's vocabulary (Status, as iterate's), not the flow's: both models' jacobian() agree.
+        status.mutable_data()[i] = static_cast<std::int8_t>(orbit_status(r.step.ret.status));
+        region.mutable_data()[i] = static_cast<std::int8_t>(r.step.region);
+        nsteps.mutable_data()[i] = r.step.ret.steps;
+        itin[std::size_t(i)] = r.step.ret.itinerary;
+        for (int k = 0; k < 4; ++k) J.mutable_data()[4 * i + k] = r.J[k];
+    }
+    py::dict d;
+    d["x"] = x1;
+    d["y"] = y1;
+    d["J"] = J;
+    d["status"] = status;
+    d["region"] = region;
+    d["time"] = time;
+    d["steps"] = nsteps;
+    d["itinerary"] = itin;
+    d["interrupted"] = interrupted;
+    return d;
+}
+
 py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int64_t n_steps, const py::set& record,
                  unsigned exit_mask, bool stop_on_exit, int n_threads, double trajectory_dt,
                  std::int64_t max_points_per_orbit, py::object progress, std::int64_t every, int stop_side,
@@ -187,6 +223,7 @@ py::dict iterate(const FlowMap& fm, const darray& x0, const darray& y0, std::int
         out.stop_step = a.mutable_data();
         d["stop_step"] = a;
     }
+    if (has("jacobian")) hovering_py::tangent_outputs(n, out.tangent, d);
     hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
     out.trajectory = traj.output();
     FlowWork work;
@@ -301,6 +338,7 @@ void register_normal(py::module_& m) {
              }),
              py::arg("system"), py::arg("h"), py::arg("options"), py::arg("curve"), py::arg("lift"))
         .def("steps", &steps, py::arg("x"), py::arg("y"), py::arg("inverse"), py::arg("n_threads"))
+        .def("jacobians", &jacobians, py::arg("x"), py::arg("y"), py::arg("n_threads"))
         .def("iterate", &iterate, py::arg("x0"), py::arg("y0"), py::arg("n_steps"), py::arg("record"),
              py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
              py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(), py::arg("every") = 1,

@@ -47,7 +47,8 @@ template <class Map>
 py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_t n_steps, bool record_orbit,
                  bool record_regions, bool record_rotation, unsigned exit_mask, bool stop_on_exit, int n_threads,
                  const std::string& kernel, double sin_ulp, bool record_visited, py::object progress,
-                 std::int64_t every, int stop_side, py::object stop_curve, bool record_extrema, bool record_residence) {
+                 std::int64_t every, int stop_side, py::object stop_curve, bool record_extrema, bool record_residence,
+                 bool record_jacobian) {
     if (phi0.ndim() != 1 || K0.ndim() != 1) throw py::value_error("phi0 and K0 must be 1-D arrays");
     same_shape(phi0, K0, "phi0", "K0");
     if (n_steps < 0) throw py::value_error("n_steps must be >= 0, got " + std::to_string(n_steps));
@@ -131,6 +132,7 @@ py::dict iterate(const Map& m, const darray& phi0, const darray& K0, std::int64_
         out.stop_step = st.mutable_data();
         res["stop_step"] = st;
     }
+    if (record_jacobian) hovering_py::tangent_outputs(n, out.tangent, res);
 
     std::atomic<bool> cancel{false};
     std::atomic<std::int64_t> done{0};
@@ -154,6 +156,35 @@ void bind_common(Cls& cls) {
         .def("_step_inverse",
              [](const Map& m, const darray& phi, const darray& K) {
                  return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step_inverse(p, k); });
+             })
+        .def("_jacobian",
+             [](const Map& m, const darray& phi, const darray& K) {
+                 // Flat (n,) inputs: images, Jacobians (n, 2, 2), regions and statuses.
+                 same_shape(phi, K, "phi", "K");
+                 const py::ssize_t n = phi.size();
+                 darray x1(n), y1(n), J({n, py::ssize_t(2), py::ssize_t(2)});
+                 py::array_t<std::int8_t> reg(n), st(n);
+                 const double *p = phi.data(), *k = K.data();
+                 double *a = x1.mutable_data(), *b = y1.mutable_data(), *j = J.mutable_data();
+                 auto *r = reg.mutable_data(), *t = st.mutable_data();
+                 {
+                     hovering_py::GilRelease release;
+                     for (py::ssize_t i = 0; i < n; ++i) {
+                         const StepJacobian sj = m.step_jacobian(p[i], k[i]);
+                         a[i] = sj.phi;
+                         b[i] = sj.K;
+                         for (int c = 0; c < 4; ++c) j[4 * i + c] = sj.J[c];
+                         r[i] = static_cast<std::int8_t>(sj.region);
+                         t[i] = static_cast<std::int8_t>(sj.status);
+                     }
+                 }
+                 py::dict d;
+                 d["x"] = x1;
+                 d["y"] = y1;
+                 d["J"] = J;
+                 d["region"] = reg;
+                 d["status"] = st;
+                 return d;
              })
         .def("_region_rotation",
              [](const Map& m, const darray& phi, const darray& K, const std::string& who) {
@@ -197,7 +228,8 @@ void bind_common(Cls& cls) {
              py::arg("record_regions"), py::arg("record_rotation"), py::arg("exit_mask"), py::arg("stop_on_exit"),
              py::arg("n_threads"), py::arg("kernel"), py::arg("sin_ulp"), py::arg("record_visited") = false,
              py::arg("progress") = py::none(), py::arg("every") = 1, py::arg("stop_side") = 0,
-             py::arg("stop_curve") = py::none(), py::arg("record_extrema") = false, py::arg("record_residence") = false)
+             py::arg("stop_curve") = py::none(), py::arg("record_extrema") = false, py::arg("record_residence") = false,
+             py::arg("record_jacobian") = false)
         .def_property_readonly("eps", &Map::eps, "Perturbation amplitude eps.")
         .def(
             "valid_band", [](const Map& m) { return py::make_tuple(m.band().lo, m.band().hi); },

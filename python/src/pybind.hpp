@@ -9,6 +9,8 @@ namespace py = pybind11;
 
 #include <string>
 
+#include "hovering/tangent.hpp"
+
 /// The value of a Python real number: int, float, a NumPy scalar or a 0-d NumPy array of integer or
 /// float dtype (np.array(2.0)); not bool, str, complex, None or an array with a dimension (even of one
 /// element). False, with no Python error set, for anything else (or an int beyond a double's range).
@@ -49,6 +51,23 @@ inline double real_arg(py::handle o, const char* who, const char* name) {
 
 /// Input arrays: C-contiguous doubles, converted (copied) only when the caller's array is not.
 using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+namespace hovering_py {
+/// Arrays for record "jacobian" of n orbits, wired into t and put into d: jacobian_q (n, 2, 2),
+/// jacobian_log (n, 2), jacobian_r12 (n,), jacobian_status (n,).
+inline void tangent_outputs(py::ssize_t n, hovering::TangentOutput& t, py::dict& d) {
+    py::array_t<double> q({n, py::ssize_t(2), py::ssize_t(2)}), lr({n, py::ssize_t(2)}), u(n);
+    py::array_t<std::int8_t> st(n);
+    t.q = q.mutable_data();
+    t.log_r = lr.mutable_data();
+    t.r12 = u.mutable_data();
+    t.status = st.mutable_data();
+    d["jacobian_q"] = q;
+    d["jacobian_log"] = lr;
+    d["jacobian_r12"] = u;
+    d["jacobian_status"] = st;
+}
+}  // namespace hovering_py
 
 /// Register Region, Status, FlowStatus, Geometry and Kernel (enum.IntEnum classes).
 void register_enums(py::module_& m);

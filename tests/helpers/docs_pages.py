@@ -19,6 +19,7 @@ PAGES = (
     "scenes",
     "flow",
     "normal",
+    "tangent",
     "custom-potentials",
     "errata",
     "accuracy",

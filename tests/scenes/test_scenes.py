@@ -29,6 +29,7 @@ EXPECTED = {"fig_smallepsmany", "fig_smalleps", "fig_hoverinnc", "fig_epsbig", "
 FLOW = {"flow_portrait", "flow_hov_vs_eps", "fig_two_tang", "fig_structure_sigma"}  # tests/scenes/test_flow_scenes.py
 PAPER_FIGURES = {"fig_corner_directions", "fig_sigma0_wall", "fig_wallsection"}  # tests/scenes/test_paper_figures.py
 ZONE = {"impact_zone", "impact_zone_neg", "impact_zone_second"}  # tests/scenes/test_impact_zone_scene.py
+TANGENT = {"ftle_field", "periodic_manifolds", "residue_vs_eps"}  # tests/scenes/test_tangent_scenes.py
 SCENE_FILES = [SCENE_DIR / f"{n}.toml" for n in sorted(EXPECTED)]
 
 
@@ -42,7 +43,7 @@ def _raw(name):
 
 
 def test_one_scene_file_per_figure():
-    assert {p.stem for p in SCENE_DIR.glob("*.toml")} == EXPECTED | FLOW | PAPER_FIGURES | ZONE
+    assert {p.stem for p in SCENE_DIR.glob("*.toml")} == EXPECTED | FLOW | PAPER_FIGURES | ZONE | TANGENT
 
 
 @pytest.mark.parametrize("path", SCENE_FILES, ids=[p.stem for p in SCENE_FILES])

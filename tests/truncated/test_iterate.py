@@ -377,7 +377,7 @@ BAD_ITERATE = [
     (dict(n_steps=None), r"n_steps must be an integer >= 0"),
     (
         dict(record=("orbit", "foo")),
-        r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited', 'extrema', 'residence'\]",
+        r"record: unknown key\(s\) \['foo'\]; allowed: \['orbit', 'regions', 'rotation', 'visited', 'extrema', 'residence', 'jacobian'\]",
     ),
     (dict(record="orbits"), r"record: unknown key\(s\) \['orbits'\]; allowed"),
     (

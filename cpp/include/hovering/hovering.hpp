@@ -7,6 +7,7 @@
 
 #include "hovering/batch.hpp"
 #include "hovering/simd.hpp"
+#include "hovering/tangent.hpp"
 #include "hovering/types.hpp"
 
 #include "hovering/truncated/arcs.hpp"

@@ -41,6 +41,9 @@ class FlowMap:
     def steps(
         self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], inverse: bool, n_threads: int
     ) -> dict[str, object]: ...
+    def jacobians(
+        self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], n_threads: int
+    ) -> dict[str, object]: ...
     def iterate(
         self,
         x0: npt.NDArray[np.float64],

@@ -17,6 +17,7 @@ class _MapCore:
         self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64], who: str
     ) -> tuple[np.ndarray, np.ndarray]: ...
     def _arcs(self, K: npt.NDArray[np.float64]) -> np.ndarray: ...
+    def _jacobian(self, phi: npt.NDArray[np.float64], K: npt.NDArray[np.float64]) -> dict[str, np.ndarray]: ...
     def _iterate(
         self,
         phi0: npt.NDArray[np.float64],
@@ -37,6 +38,7 @@ class _MapCore:
         stop_curve: object | None = ...,
         record_extrema: bool = ...,
         record_residence: bool = ...,
+        record_jacobian: bool = ...,
     ) -> dict[str, object]: ...
 
 class TruncatedMap(_MapCore):

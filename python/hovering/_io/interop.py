@@ -86,6 +86,10 @@ VARIABLES: dict[str, dict] = {
     "rotation_mean": {"units": "rad", "long_name": "rho = <omega_a> of the critical orbit"},
     "digits": {"units": "1", "long_name": "regularity of the orbit (digits of the rotation number)"},
     "K_fail": {**_HEIGHT, "long_name": "highest failing start below K0"},
+    "jacobian_q": {"units": "1", "long_name": "rotation Q of the product of the steps' Jacobians (M = Q R)"},
+    "jacobian_log": {"units": "1", "long_name": "log R_11, log |R_22| of that product (/ steps: Lyapunov exponents)"},
+    "jacobian_r12": {"units": "1", "long_name": "R_12 / R_11 of that product"},
+    "jacobian_status": {"units": "1", "long_name": "OK, or where the product's derivative was one-sided / not finite"},
 }
 
 
@@ -167,6 +171,12 @@ def iterate_dataset(res):
     if res.residence is not None:
         put("residence", ("orbit", "region_name"), res.residence)
         coords["region_name"] = [r.name for r in Region if r.value >= 0][: res.residence.shape[1]]
+    if res.jacobian_q is not None:
+        put("jacobian_q", ("orbit", "row", "column"), res.jacobian_q)
+        put("jacobian_log", ("orbit", "factor"), res.jacobian_log)
+        put("jacobian_r12", per_orbit, res.jacobian_r12)
+        put("jacobian_status", per_orbit, res.jacobian_status, _flags(_attrs("jacobian_status"), Status))
+        coords["factor"] = ["R_11", "R_22"]
     attrs = _common("IterateResult", n_steps=int(res.n_steps), every=int(res.every), map=repr(res.map))
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

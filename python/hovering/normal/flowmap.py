@@ -27,6 +27,7 @@ from ..interface import (
     MAX_TRAJECTORY_POINTS,
     IterateResult,
     MapAnalyses,
+    StepJacobian,
     iterate_arguments,
     recorded_counts,
     trajectory_arguments,
@@ -53,6 +54,7 @@ FLOW_RECORD_KEYS = (
     "trajectory",
     "extrema",
     "residence",
+    "jacobian",
 )
 
 
@@ -460,6 +462,63 @@ class FlowMap(MapAnalyses):
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
         return (float(a), float(b)) if scalar else (a, b)
 
+    def jacobian(self, phi, K, n_threads: int = 0) -> StepJacobian:
+        """One return of each point with its Jacobian ``d(phibar, Kbar) / d(phi, K)``.
+
+        The variational equations are integrated with the state (every stepper: Taylor's method
+        carries their Taylor series, the closed forms their derivatives), through a saltation
+        matrix at every impact, then projected onto Sigma_h along the flow at the return and
+        carried through the charts: H2's action-angle variables (theta, I) and, on normal
+        coordinates, the tangential curve (``K = I - I_tan(theta)``). The return itself is
+        :meth:`step`'s, bit for bit for the explicit steppers and ``"taylor"`` (the step control
+        reads the state only; msadams, rk2imp and rk4imp see the tangents too and can step
+        differently, within the tolerance). A return that is verified at a tighter tolerance
+        (``verify_steps``) gets its Jacobian from the trace that is kept.
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points in map coordinates (broadcast together).
+        n_threads : int, optional
+            Worker threads (0 = all cores).
+
+        Returns
+        -------
+        StepJacobian
+            Images, ``J`` (shape ``(..., 2, 2)``), per-point :class:`Status` and :class:`Region`.
+            A return that hits the corner (CORNER) or touches a wall tangentially (GRAZING), or
+            ends otherwise than OK, has a status and no number (NaN). A near-grazing impact gives
+            a large but finite J: the square-root singularity of the impact map, ``2 |a| / |v|``
+            in the saltation matrix.
+
+        Raises
+        ------
+        ValueError
+            For non-finite or broadcast-incompatible points.
+        KeyboardInterrupt
+            On Ctrl-C, with ``.partial`` (INTERRUPTED for the returns not finished).
+
+        Examples
+        --------
+        >>> import numpy as np, hovering
+        >>> fm = hovering.paper.flow_map(eps=-0.05)
+        >>> t = fm.jacobian(0.3, -0.02)
+        >>> t.status, t.region
+        (<Status.OK: 0>, <Region.ABOVE: 1>)
+        >>> bool(abs(t.det - 1) < 1e-8)          # area preserving, to the integration tolerance
+        True
+        >>> (t.phi, t.K) == fm.step(0.3, -0.02)  # the same return as step()
+        True
+        """
+        p, k, scalar = point_pair(phi, K, "jacobian")
+        shape = () if scalar else p.shape
+        d = self._core.jacobians(
+            np.ascontiguousarray(p.ravel()),
+            np.ascontiguousarray(k.ravel()),
+            _threads(n_threads, self.sys.python_defined),
+        )
+        return StepJacobian.from_core(d, shape)
+
     def step_inverse(self, phi, K):
         """One step back, by time reversal (lem:timerevgen): the exact inverse of :meth:`step` up to
         the integration tolerance.
@@ -526,7 +585,10 @@ class FlowMap(MapAnalyses):
             ``"times"``, ``"energy_error"``, ``"steps"`` (integrator steps), ``"itinerary"``,
             ``"trajectory"`` (the flow between the returns, sampled every ``trajectory_dt``: see
             :class:`IterateResult`), ``"extrema"`` (per orbit the least and greatest K reached:
-            ``K_min``, ``K_max``), ``"residence"`` (per orbit the returns from each region).
+            ``K_min``, ``K_max``), ``"residence"`` (per orbit the returns from each region),
+            ``"jacobian"`` (per orbit the product of its returns' Jacobians, QR-renormalised, as
+            :meth:`jacobian` computes each: see :class:`IterateResult`; the orbit is the same, bit
+            for bit for the explicit steppers and taylor).
             Returns are labelled (crossings of q1 = qw1 tracked, itineraries built) only when
             ``"regions"``, ``"visited"``, ``"itinerary"``, ``"rotation"``, ``"residence"`` or
             ``exit_regions`` need it; the orbit is the same either way.

@@ -19,9 +19,12 @@ from .base import SIDECAR_FORMAT, Geometry, OrbitSet, SceneResult, jsonable, sum
 from .kinds.corner_directions import CornerDirectionsResult, CornerTrajectory
 from .kinds.flow_hovering_area import FlowHoveringResult
 from .kinds.flow_portrait import FlowPortraitResult
+from .kinds.ftle_field import FTLEResult
 from .kinds.hovering_area import HoveringAreaResult, SeriesResult
 from .kinds.impact_zone import ImpactZoneResult, ZoneStudy
 from .kinds.orbits import OrbitPanelResult, OrbitSceneResult, ZoomPanelResult
+from .kinds.periodic_manifolds import PeriodicManifoldsResult
+from .kinds.residue_vs_eps import ResidueResult
 from .kinds.sigma_structure import SigmaStructureResult
 from .kinds.tangent_tori import TangentToriResult, TorusResult
 from .kinds.wall_section import WallSectionResult, WallSegment
@@ -50,6 +53,9 @@ __all__ = [
     "WallSectionResult",
     "ZoneStudy",
     "ImpactZoneResult",
+    "FTLEResult",
+    "PeriodicManifoldsResult",
+    "ResidueResult",
     "load_result",
     "jsonable",
 ]

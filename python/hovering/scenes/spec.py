@@ -19,9 +19,12 @@ from .kinds._truncated import MapSpec, TruncatedScene
 from .kinds.corner_directions import CornerDirectionsScene
 from .kinds.flow_hovering_area import FlowHoveringScene
 from .kinds.flow_portrait import FlowPortraitScene
+from .kinds.ftle_field import FTLEScene
 from .kinds.hovering_area import HoveringAreaScene, SeriesSpec
 from .kinds.impact_zone import ImpactZoneScene
 from .kinds.orbits import SPECIAL_ORBITS, CriticalSpec, OrbitScene, OrbitSpec, PanelSpec, ZoomSpec
+from .kinds.periodic_manifolds import PeriodicManifoldsScene
+from .kinds.residue_vs_eps import ResidueScene
 from .kinds.sigma_structure import SigmaStructureScene
 from .kinds.tangent_tori import TangentToriScene
 from .kinds.wall_section import WallSectionScene
@@ -56,6 +59,9 @@ __all__ = [
     "WallTangencyScene",
     "WallSectionScene",
     "ImpactZoneScene",
+    "FTLEScene",
+    "PeriodicManifoldsScene",
+    "ResidueScene",
     "Scene",
     "figure_inches",
 ]

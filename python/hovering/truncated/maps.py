@@ -28,12 +28,19 @@ from .._core import truncated as _core_truncated
 from .._enums import Region, wrap
 from .._io.records import reduce_record
 from .._progress import check_progress, progress_bar
-from ..interface import IterateResult, MapAnalyses, iterate_arguments, recorded_counts, transport_arguments
+from ..interface import (
+    IterateResult,
+    MapAnalyses,
+    StepJacobian,
+    iterate_arguments,
+    recorded_counts,
+    transport_arguments,
+)
 from . import theory as _geo
 
 __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 
-_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "extrema", "residence")
+_RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "extrema", "residence", "jacobian")
 
 
 class _MapAPI(MapAnalyses):
@@ -110,6 +117,52 @@ class _MapAPI(MapAnalyses):
         p, k, scalar = point_pair(phi, K, "step_inverse")
         a, b = self._step_inverse(p, k)
         return (float(a), float(b)) if scalar else (a, b)
+
+    def jacobian(self, phi, K) -> StepJacobian:
+        """One step of each point with its exact Jacobian ``d(phibar, Kbar) / d(phi, K)``.
+
+        On the arc ``J_a`` that a point lies in, the map is ``phibar = phi + omega_a(K)``,
+        ``Kbar = K + eps f(phibar)``, so ``J = [[1, w], [g, 1 + g w]]`` with ``w = omega_a'(K)`` and
+        ``g = eps f'(phibar)``; ``det J = 1`` (area preservation) to rounding. The arc slopes:
+        ``Omega' = tau0`` (J_0u, J_0), ``+ tau1`` (J_1), ``+ lam / sqrt(-K)`` (J_R: |J_1| =
+        2 lam sqrt(-K) shrinks as K grows, a square-root singularity at the tangency K = 0-);
+        a TruncatedFamily's are its splines' derivatives (|J_1|'s through sqrt(-K)).
+
+        Parameters
+        ----------
+        phi, K : array_like or float
+            Points (broadcast together), K in :meth:`valid_band`.
+
+        Returns
+        -------
+        StepJacobian
+            ``phi, K`` (the images, bit for bit :meth:`step`'s), ``J`` (shape ``(..., 2, 2)``),
+            ``status`` (OK, or CORNER for a point exactly on an arc start: the map jumps there and
+            ``J`` is the one-sided derivative of the arc that owns the start), ``region``.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`step`: a non-finite value or a K outside the band.
+
+        Examples
+        --------
+        >>> import numpy as np, hovering
+        >>> m = hovering.TruncatedMap(eps=0.3, Omega0=hovering.OMEGA_G, theta_w=3 * np.pi / 4)
+        >>> t = m.jacobian(0.3, -0.2)            # J_0: the standard map's Jacobian, twist tau0 = 1
+        >>> t.region, t.status
+        (<Region.ABOVE: 1>, <Status.OK: 0>)
+        >>> np.round(t.J, 4)
+        array([[ 1.    ,  1.    ],
+               [-0.1999,  0.8001]])
+        >>> print(f"{t.det:.15f}")
+        1.000000000000000
+        """
+        p, k, scalar = point_pair(phi, K, "jacobian")
+        shape = () if scalar else p.shape
+        return StepJacobian.from_core(
+            self._jacobian(np.ascontiguousarray(p.ravel()), np.ascontiguousarray(k.ravel())), shape
+        )
 
     def region(self, phi, K):
         """Region of each point: which arc of the circle K it lies on.
@@ -233,8 +286,11 @@ class _MapAPI(MapAnalyses):
             ``"regions"`` (itinerary), ``"rotation"`` (rho = mean omega_a), ``"visited"`` (the set
             of regions each orbit went through, one byte per orbit), ``"extrema"`` (per orbit the
             least and greatest K reached, ``K_min``, ``K_max``), ``"residence"`` (per orbit the
-            returns taken from each region, ``residence``). Nothing else is stored; the last
-            three stream (a few numbers per orbit, whatever ``n_steps``).
+            returns taken from each region, ``residence``), ``"jacobian"`` (per orbit the product
+            of its steps' Jacobians, QR-renormalised: ``jacobian_q``, ``jacobian_log``,
+            ``jacobian_r12``, ``jacobian_status``; see :class:`IterateResult` and
+            :meth:`IterateResult.jacobian`). Nothing else is stored; the last four stream (a few
+            numbers per orbit, whatever ``n_steps``), and none changes the orbit.
         exit_regions : iterable of Region or str, optional
             A set of regions (e.g. ``{"0u", "0"}``, the no-impact set) to watch: ``exit_step`` is
             the first n at which an orbit point lies outside it.
@@ -356,6 +412,7 @@ class _MapAPI(MapAnalyses):
                 stop_curve,
                 "extrema" in record,
                 "residence" in record,
+                "jacobian" in record,
             )
         return IterateResult.from_core(d, self, n_steps, every)
 

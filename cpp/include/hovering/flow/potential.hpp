@@ -73,6 +73,10 @@ public:
     virtual double angle_of(double q, double h) const;
     /// Inverse of the angle: (q, p) on the level h at angle theta in [-pi, pi] (sign(p) = -sign(theta)).
     virtual std::pair<double, double> point_at(double theta, double h) const;
+    /// d(q, p)/dh of point_at(theta, h) at fixed theta (the tangent of the action-angle chart:
+    /// with d(q, p)/dtheta = (p, -V') / omega it inverts d(theta, I)/d(q, p)). Generic path:
+    /// Ridders-extrapolated central differences of point_at in h.
+    virtual std::array<double, 2> point_slope(double theta, double h) const;
     /// Signed angle in [-pi, pi] of the phase point (q, p) on its level h = p^2/2 + V(q); throws
     /// std::invalid_argument unless (q, p) lies on that level to 1e-8 relative.
     double angle_of_point(double q, double p, double h) const;
@@ -124,6 +128,8 @@ public:
     double angle_of(double q, double h) const override;
     /// (q, p) at angle theta in closed form.
     std::pair<double, double> point_at(double theta, double h) const override;
+    /// d(q, p)/dh at fixed theta = (q, p) / (2 h) in closed form.
+    std::array<double, 2> point_slope(double theta, double h) const override;
     /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
     /// Closed forms: a few ulps.
@@ -172,6 +178,8 @@ public:
     double angle_of(double q, double h) const override;
     /// (q, p) at angle theta in closed form.
     std::pair<double, double> point_at(double theta, double h) const override;
+    /// d(q, p)/dh at fixed theta in closed form (the derivative of point_at's expressions).
+    std::array<double, 2> point_slope(double theta, double h) const override;
     /// Signed angle of (q, p) in closed form.
     double angle_on_level(double q, double p, double h) const override;
     /// Closed forms: a few ulps.

@@ -129,6 +129,9 @@ struct ReturnResult {
     std::string itinerary;
     double energy_error = 0;  ///< |H(z) - H(z0)|
     std::int64_t steps = 0;   ///< accepted integrator steps
+    /// Tracers with tangents only: the tangent vectors at z, before the section's projection
+    /// (row-major 4 x 2: row r is component r of each); NaN unless the return ended Ok.
+    std::array<double, 8> tangents{};
 };
 
 /// What the tracer did, counted per worker and summed at the end of a batch (no atomics in the

@@ -9,6 +9,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -16,6 +17,7 @@
 #include "hovering/curve.hpp"
 #include "hovering/flow/return_map.hpp"
 #include "hovering/normal/tangential_curve.hpp"
+#include "hovering/tangent.hpp"
 #include "hovering/truncated/arcs.hpp"
 #include "hovering/types.hpp"
 
@@ -69,6 +71,9 @@ struct FlowIterateOutput {
     /// Dense output of each orbit across its returns (the clock runs on from return to return;
     /// each return's point is the image before the next start is put back on Sigma_h).
     TrajectoryOutput trajectory;
+    /// Record "jacobian": each orbit's product of the Jacobians of the returns it took (QR form;
+    /// status NonFinite if a return's Jacobian was not finite, which is then left out).
+    TangentOutput tangent;
 };
 
 /// One return of the map: the image, its region and what the flow reported.
@@ -76,6 +81,17 @@ struct FlowStep {
     double x = 0, y = 0;           ///< image in map coordinates (NaN unless status is Ok)
     Region region = Region::None;  ///< region of the return (None unless Ok with labels)
     ReturnResult ret;              ///< the flow's return (state, time, itinerary, energy error, steps)
+};
+
+/// One return with its Jacobian (FlowMap::jacobian).
+struct FlowJacobian {
+    FlowStep step;  ///< the return, as FlowMap::step gives it
+    /// d(x1, y1)/d(x, y) in map coordinates, row-major; NaN unless the return is Ok. The variational
+    /// equations carried with the state, a saltation matrix at each impact, the projection onto
+    /// Sigma_h along the flow at the return, and the charts' derivatives: (theta, I) of H2's
+    /// action-angle variables (Potential::point_slope), (phi, K) of the tangential curve.
+    double J[4] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                   std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 /// The flow's return map on one section; see the file comment.
@@ -91,6 +107,12 @@ public:
     FlowStep step(double x, double y) const;
     /// The preimage, by time reversal (lem:timerevgen): F^{-1} = R2 F R2 in (theta, I).
     FlowStep step_inverse(double x, double y) const;
+    /// One return from (x, y) with its Jacobian; the return is step()'s (bit for bit for the
+    /// explicit steppers and taylor: the step control reads the state only).
+    FlowJacobian jacobian(double x, double y) const;
+    /// jacobian() of n points on the core's thread pool, into out[0 .. n) (Interrupted as steps()).
+    void jacobians(const double* x, const double* y, std::int64_t n, int n_threads, const std::atomic<bool>* cancel,
+                   FlowJacobian* out) const;
     /// step (or step_inverse) of n points on the core's thread pool, into out[0 .. n). Points not
     /// reached before *cancel is set get FlowStatus::Interrupted.
     void steps(const double* x, const double* y, std::int64_t n, bool inverse, int n_threads,
@@ -126,6 +148,10 @@ private:
     // return makes.
     bool advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st) const;
     FlowStep advance_end(ReturnResult ret, bool inverse) const;
+    // The tangents d z0 / d(x, y) of the chart at the start z0 of the return from (x, y)
+    // (row-major 4 x 2), and the Jacobian of a finished forward return from there.
+    void start_tangents(double x, const std::array<double, 4>& z0, double I0, double* t0) const;
+    void end_jacobian(const FlowStep& st, double* J) const;
     FlowSystem s_;
     double h_;
     FlowOptions opt_;

@@ -80,6 +80,8 @@ public:
     /// I_tan(theta); throws std::invalid_argument if the curve is not a graph. One evaluation of a
     /// trigonometric interpolant in theta (built by inverting theta(s) at n equispaced angles).
     double I_tan(double theta) const;
+    /// dI_tan/dtheta (the derivative of the same interpolant); same condition.
+    double I_tan_slope(double theta) const;
     /// The wall angle s with theta(s) = theta (mod 2 pi); same condition.
     double parameter_of(double theta) const;
     /// Largest deviation of the interpolant from direct traces at off-grid points: (in theta, in I).

@@ -13,6 +13,13 @@ struct ArcLengths {
     double J1;     ///< length of J_1 (0 for K >= 0)
 };
 
+/// d/dK of Omega(K), |J_R|(K), |J_1|(K) at one K (0 for the arcs at K >= 0, where they do not exist).
+struct ArcSlopes {
+    double Omega;  ///< dOmega / dK
+    double JR;     ///< d|J_R| / dK (0 for K >= 0)
+    double J1;     ///< d|J_1| / dK (0 for K >= 0; unbounded as K -> 0-: a square-root singularity)
+};
+
 /// Open interval of K on which a map is defined.
 struct Band {
     double lo;  ///< lower end (< 0)
@@ -27,6 +34,8 @@ struct AnalyticArcs {
     void validate() const;
     /// Arc lengths at one K.
     ArcLengths at(double K) const;
+    /// Their slopes at one K: (tau0, tau1, -lam / sqrt(-K)) below K = 0, (tau0, 0, 0) above.
+    ArcSlopes slopes(double K) const;
     /// Lowest K of the band: all three arc lengths stay in (0, 2 pi) on (lo, 0).
     double band_lo() const;
 };
@@ -44,6 +53,8 @@ public:
     Spline& operator=(const Spline&) = delete;
     /// Value at x (x inside [x.front(), x.back()]); thread-safe (no shared accelerator).
     double operator()(double x) const;
+    /// First derivative at x (the spline's own, x clamped as by operator()).
+    double derivative(double x) const;
     /// Smallest grid abscissa.
     double xmin() const { return x_.front(); }
     /// Largest grid abscissa.
@@ -69,6 +80,8 @@ struct TabulatedArcs {
                   const std::vector<double>& J1);
     /// Arc lengths at one K (K inside the grid).
     ArcLengths at(double K) const;
+    /// Their slopes at one K: the splines' derivatives, |J_1|'s through s = sqrt(-K) (d/dK = -1 / (2 s) d/ds).
+    ArcSlopes slopes(double K) const;
     /// Lowest K of the grid range on which all arc lengths stay in (0, 2 pi) up to K = 0.
     double band_lo() const;
     /// Largest K of the grid.

@@ -18,6 +18,7 @@
 #include "hovering/batch.hpp"
 #include "hovering/curve.hpp"
 #include "hovering/simd.hpp"  // simd_width, simd_level, ...: declared here before they served every kernel
+#include "hovering/tangent.hpp"
 #include "hovering/truncated/arcs.hpp"
 #include "hovering/truncated/forcing.hpp"
 #include "hovering/types.hpp"
@@ -50,6 +51,19 @@ struct IterateOutput {
     /// the one that leaves the watched set: the returns whose region `visited` sets)
     std::int64_t* residence = nullptr;
     std::int64_t* stop_step = nullptr;  ///< (n_orbits,) first n with x_n in the stop set, else -1
+    /// Record "jacobian": each orbit's product of the step Jacobians it took (QR form); status
+    /// Corner when a step was taken from an arc start (the derivative there is one-sided).
+    TangentOutput tangent;
+};
+
+/// One step with the derivative of the branch it takes (the truncated map is smooth on each arc).
+struct StepJacobian {
+    double phi = 0, K = 0;         ///< the image (as step())
+    double J[4] = {1, 0, 0, 1};    ///< d(phibar, Kbar) / d(phi, K), row-major
+    Region region = Region::None;  ///< the arc the point lies in
+    /// Ok, or Corner for a point exactly on an arc start (a corner-singularity curve): the map is
+    /// discontinuous there and J is the one-sided derivative of the arc that owns the start.
+    Status status = Status::Ok;
 };
 
 /// What a batch iteration of a truncated map does besides stepping: the shared BatchOptions and
@@ -75,6 +89,9 @@ public:
     std::pair<Region, double> classify_point(double phi, double K, const char* who) const;
     /// One forward step (scalar libm path); arcs are half-open [start, next start), see arc_starts().
     std::pair<double, double> step(double phi, double K) const;
+    /// One step and its Jacobian [[1, w'], [eps f'(phibar), 1 + eps f'(phibar) w']], w' = d omega_a / dK
+    /// of the point's arc (determinant 1: the map preserves area); throws as step().
+    StepJacobian step_jacobian(double phi, double K) const;
     /// One backward step: inverse of step() on the band, with the same boundary convention.
     std::pair<double, double> step_inverse(double phi, double K) const;
     /// Left ends of J_1, J_R, J_0 on the circle K (K < 0), each in [-pi, pi): each arc owns its start.

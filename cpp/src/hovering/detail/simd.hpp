@@ -38,6 +38,57 @@ inline Packet psin(const Packet& x) {
 #endif
 }
 
+// cos on one packet, the same SLEEF builds as psin (the tangent of the truncated map's kick).
+template <bool Fast>
+inline Packet pcos(const Packet& x) {
+#if defined(EIGEN_VECTORIZE_AVX512)
+    return Fast ? Sleef_cosd8_u35avx512f(x) : Sleef_cosd8_u10avx512f(x);
+#elif defined(EIGEN_VECTORIZE_AVX) && defined(__AVX2__) && defined(__FMA__)
+    return Fast ? Sleef_cosd4_u35avx2(x) : Sleef_cosd4_u10avx2(x);
+#elif defined(EIGEN_VECTORIZE_AVX)
+    return Fast ? Sleef_cosd4_u35avx(x) : Sleef_cosd4_u10avx(x);
+#elif defined(EIGEN_VECTORIZE_SSE4_1)
+    return Fast ? Sleef_cosd2_u35sse4(x) : Sleef_cosd2_u10sse4(x);
+#elif defined(EIGEN_VECTORIZE_SSE2)
+    return Fast ? Sleef_cosd2_u35sse2(x) : Sleef_cosd2_u10sse2(x);
+#else
+    return Fast ? Sleef_cos_u35(x) : Sleef_cos_u10(x);
+#endif
+}
+
+// log and exp on one packet (SLEEF, 1.0 ulp): the tangent products of record "jacobian".
+inline Packet plog_u10(const Packet& x) {
+#if defined(EIGEN_VECTORIZE_AVX512)
+    return Sleef_logd8_u10avx512f(x);
+#elif defined(EIGEN_VECTORIZE_AVX) && defined(__AVX2__) && defined(__FMA__)
+    return Sleef_logd4_u10avx2(x);
+#elif defined(EIGEN_VECTORIZE_AVX)
+    return Sleef_logd4_u10avx(x);
+#elif defined(EIGEN_VECTORIZE_SSE4_1)
+    return Sleef_logd2_u10sse4(x);
+#elif defined(EIGEN_VECTORIZE_SSE2)
+    return Sleef_logd2_u10sse2(x);
+#else
+    return Sleef_log_u10(x);
+#endif
+}
+
+inline Packet pexp_u10(const Packet& x) {
+#if defined(EIGEN_VECTORIZE_AVX512)
+    return Sleef_expd8_u10avx512f(x);
+#elif defined(EIGEN_VECTORIZE_AVX) && defined(__AVX2__) && defined(__FMA__)
+    return Sleef_expd4_u10avx2(x);
+#elif defined(EIGEN_VECTORIZE_AVX)
+    return Sleef_expd4_u10avx(x);
+#elif defined(EIGEN_VECTORIZE_SSE4_1)
+    return Sleef_expd2_u10sse4(x);
+#elif defined(EIGEN_VECTORIZE_SSE2)
+    return Sleef_expd2_u10sse2(x);
+#else
+    return Sleef_exp_u10(x);
+#endif
+}
+
 // Correctly rounded sqrt on one packet, as std::sqrt. Eigen 3.4's psqrt for AVX-512 doubles is, by
 // default (EIGEN_FAST_MATH), rsqrt14 and two Newton steps: off by 1-4 ulp, which made the SIMD
 // kernel's |J_1| and so phi differ from step() on ~2% of the points of J_R.

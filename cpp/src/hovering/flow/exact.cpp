@@ -146,6 +146,33 @@ std::pair<double, double> AngleOscillator::at(double th) const {
     return V->point_at(wrap_angle(th), h);
 }
 
+void AngleOscillator::tangent(double t, double* J) const {
+    if (!(h > 0)) {
+        const double d = 1e-6, c0 = (V->dV(d) - V->dV(-d)) / (2 * d), w = std::sqrt(std::max(c0, 0.0));
+        const double a = w * t, c = std::cos(a), s = w > 0 ? std::sin(a) / w : t;
+        J[0] = c;
+        J[1] = s;
+        J[2] = -c0 * s;
+        J[3] = c;
+        return;
+    }
+    const auto [q0, p0] = at(theta);
+    const double th1 = theta + omega * t;
+    const auto [q1, p1] = at(th1);
+    const std::array<double, 2> v0 = V->point_slope(theta, h), v1 = V->point_slope(wrap_angle(th1), h);
+    // omega'(h) = -omega^2 T'(h) / (2 pi).
+    const double dw = -omega * omega * V->period_slope(h).value / kTwoPi;
+    const double X0[2] = {p0 / omega, -V->dV(q0) / omega}, X1[2] = {p1 / omega, -V->dV(q1) / omega};
+    const double M1[4] = {X1[0], v1[0] + X1[0] * dw * t, X1[1], v1[1] + X1[1] * dw * t};
+    // M0^{-1}: M0 = [[X0q, v0q], [X0p, v0p]].
+    const double det = X0[0] * v0[1] - v0[0] * X0[1];
+    const double I0[4] = {v0[1] / det, -v0[0] / det, -X0[1] / det, X0[0] / det};
+    J[0] = M1[0] * I0[0] + M1[1] * I0[2];
+    J[1] = M1[0] * I0[1] + M1[1] * I0[3];
+    J[2] = M1[2] * I0[0] + M1[3] * I0[2];
+    J[3] = M1[2] * I0[1] + M1[3] * I0[3];
+}
+
 // ------------------------------------------------------------------------------- event-driven returns
 
 void Tracer::sample_angles(const AngleOscillator* o, double t0, double t_end) {

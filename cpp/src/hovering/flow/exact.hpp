@@ -59,6 +59,10 @@ struct AngleOscillator {
     bool set(double q, double p);
     /// (q, p) at angle th (any real: wrapped to [-pi, pi)).
     std::pair<double, double> at(double th) const;
+    /// d(q, p)(t) / d(q, p)(0) of the flow over time t from the current angle, row-major 2x2: the
+    /// action-angle chart's tangent M = [X / omega, d(q, p)/dh] carried by theta += omega(h) t
+    /// (the h column gains X omega'(h) t / omega). At rest, the small oscillation of V''(0).
+    void tangent(double t, double* J) const;
 };
 
 /// th wrapped to [-pi, pi).

@@ -29,8 +29,8 @@ const gsl_odeiv2_step_type* stepper_type(Stepper s) {
     bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
 }
 
-Integrator::Integrator(const FlowSystem& s, const FlowOptions& o)
-    : field_(s), atol_(o.atol), rtol_(o.rtol), qlim1_(s.V1->q_limit()), qlim2_(s.V2->q_limit()) {
+Integrator::Integrator(const FlowSystem& s, const FlowOptions& o, int n_tangents)
+    : field_(s, n_tangents), atol_(o.atol), rtol_(o.rtol), qlim1_(s.V1->q_limit()), qlim2_(s.V2->q_limit()) {
     gsl_quiet();
     sys_ = gsl_odeiv2_system{field_.fn, &Field::jacobian, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
@@ -217,7 +217,10 @@ int Integrator::hadjust(const double* y, const double* err, double* h) const {
     // by rmax^(-1/(order+1)); here the same root rmax^(-1/order) serves both, which for rk8pd is
     // three square roots: GSL's pow took 5% of a return's time, and cbrt for the 9th root more.
     double rmax = std::numeric_limits<double>::min();
-    for (int i = 0; i < field_.dim; ++i) rmax = std::max(rmax, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
+    // The state's components only: the tangents (when integrated) do not change the steps, so a
+    // return's state is the same with them as without.
+    for (int i = 0; i < field_.state; ++i)
+        rmax = std::max(rmax, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
     // The root rmax^(1/order) (three square roots for rk8pd) only where the step changes: above
     // 1.1, and below 0.9^order where the growth factor exceeds 1 (in between GSL's rule keeps h).
     auto root = [&] { return order_ == 8 ? std::sqrt(std::sqrt(std::sqrt(rmax))) : std::pow(rmax, 1.0 / order_); };
@@ -244,14 +247,16 @@ void Integrator::prepare_extension(const double* y0, const double* d0, double h)
     gsl_odeiv2_step_reset(ext_);
     gsl_odeiv2_step_apply(ext_, 0.0, h, y, err, din, nullptr, &sys_);
     double ratio = 0;
-    for (int i = 0; i < n; ++i) ratio = std::max(ratio, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
+    for (int i = 0; i < field_.state; ++i)
+        ratio = std::max(ratio, std::fabs(err[i]) / (atol_ + rtol_ * std::fabs(y[i])));
     ext_sub_ = std::isfinite(ratio) ? std::min(64, std::max(1, int(std::ceil(1.2 * std::pow(ratio, 0.125))))) : 64;
 }
 
 void Integrator::exact(const double* y0, const double* d0, double dt, double* y1) {
     const int n = field_.dim;
     if (kind_ == ExactKind::Linear) {
-        linear_->propagate(y0, dt, y1);
+        // The flow is linear: its tangents move by the same propagator (both potentials Harmonic: no aux).
+        for (int j = 0; j <= field_.tangents; ++j) linear_->propagate(y0 + 4 * j, dt, y1 + 4 * j);
         return;
     }
     if (taylor_) {
@@ -269,11 +274,25 @@ void Integrator::exact(const double* y0, const double* d0, double dt, double* y1
             AngleOscillator& a = osc_[i];
             if (!a.set(y0[2 * i], y0[2 * i + 1])) {
                 y1[2 * i] = y1[2 * i + 1] = kNaN;
+                for (int j = 0; j < field_.tangents; ++j)
+                    y1[field_.state + 4 * j + 2 * i] = y1[field_.state + 4 * j + 2 * i + 1] = kNaN;
                 continue;
             }
             const auto [q, p] = a.at(a.theta + a.omega * dt);
             y1[2 * i] = q;
             y1[2 * i + 1] = p;
+            if (field_.tangents > 0) {
+                // Uncoupled: each oscillator's tangent block moves by its own angle flow's derivative.
+                double J[4];
+                a.tangent(dt, J);
+                for (int j = 0; j < field_.tangents; ++j) {
+                    const double* v = y0 + field_.state + 4 * j + 2 * i;
+                    double* w = y1 + field_.state + 4 * j + 2 * i;
+                    const double dq = v[0], dp = v[1];
+                    w[0] = J[0] * dq + J[1] * dp;
+                    w[1] = J[2] * dq + J[3] * dp;
+                }
+            }
         }
         field_.sync_aux(y1);
         return;

@@ -36,15 +36,19 @@ inline constexpr double kMinEventStep = 1e-7;
 /// order and length the tolerances set, and the extension that polynomial (taylor.hpp).
 class Integrator {
 public:
-    Integrator(const FlowSystem& s, const FlowOptions& o);
+    /// An integrator of s with options o, carrying n_tangents tangent vectors with the state
+    /// (the variational equations; Field).
+    Integrator(const FlowSystem& s, const FlowOptions& o, int n_tangents = 0);
     ~Integrator();
     Integrator(const Integrator&) = delete;
     Integrator& operator=(const Integrator&) = delete;
 
     /// The field (with its auxiliary variables) this integrator steps.
     const Field& field() const { return field_; }
-    /// State dimension (4 plus one per Tan potential).
+    /// Integrated dimension: the state (4 plus one per Tan potential) and 4 per tangent vector.
     int dim() const { return field_.dim; }
+    /// The state's dimension (4 plus one per Tan potential): what the step control reads.
+    int state_dim() const { return field_.state; }
     /// Order of the stepper (8 for rk8pd; "exact": 8, only the first trial step reads it, and exact steps ignore it).
     int order() const { return taylor_ ? taylor_->order() : step_ ? int(gsl_odeiv2_step_order(step_)) : 8; }
     /// The Taylor expansion of stepper "taylor" (null for the others).

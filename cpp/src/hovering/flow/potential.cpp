@@ -429,6 +429,17 @@ Estimate Potential::period_slope(double h) const {
     return ridders([&](double e) { return period(e); }, h, 0.25 * h, relative_accuracy() * T);
 }
 
+std::array<double, 2> Potential::point_slope(double theta, double h) const {
+    check_energy(h, "point_slope");
+    // point_at is smooth in h on the scale h (the level's size), its noise the quadratures'
+    // relative accuracy times the level's extent.
+    const auto tp = turning_points(h);
+    const double extent = std::max(-tp.first, tp.second), w = frequency(h);
+    const double nq = relative_accuracy() * extent, np = relative_accuracy() * extent * w;
+    return {ridders([&](double e) { return point_at(theta, e).first; }, h, 0.25 * h, nq).value,
+            ridders([&](double e) { return point_at(theta, e).second; }, h, 0.25 * h, np).value};
+}
+
 Estimate Potential::angle_slope(double q, double h) const {
     check_energy(h, "angle_slope");
     const double D = h - V(q);
@@ -486,6 +497,11 @@ std::pair<double, double> Harmonic::point_at(double theta, double h) const {
         bad(name() + ".point_at: theta must lie in [-pi, pi], got " + fmt(theta));
     const double A = turning_points(h).second;
     return {A * std::cos(theta), -A * omega_ * std::sin(theta)};
+}
+
+std::array<double, 2> Harmonic::point_slope(double theta, double h) const {
+    const auto [q, p] = point_at(theta, h);  // A (cos theta, -omega sin theta), A = sqrt(2 h) / omega
+    return {q / (2 * h), p / (2 * h)};
 }
 
 double Harmonic::angle_on_level(double q, double p, double) const {
@@ -573,6 +589,21 @@ std::pair<double, double> Tan::point_at(double theta, double h) const {
     const double w = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
     const double p = -w * k * std::sin(theta) / (alpha_ * std::sqrt(1 - kc * kc));
     return {q, p};
+}
+
+std::array<double, 2> Tan::point_slope(double theta, double h) const {
+    check_energy(h, "point_slope");
+    // point_at: q = asin(k c) / alpha, p = -W k s / (alpha r), c = cos theta, s = sin theta,
+    // k = alpha sqrt(2 h) / W, W = sqrt(omega^2 + 2 alpha^2 h), r = sqrt(1 - k^2 c^2); and
+    // dk/dh = alpha omega^2 / (sqrt(2 h) W^3), dW/dh = alpha^2 / W.
+    const double c = std::cos(theta), sn = std::sin(theta);
+    const double W = std::sqrt(omega_ * omega_ + 2 * alpha_ * alpha_ * h);
+    const double k = alpha_ / std::sqrt(alpha_ * alpha_ + omega_ * omega_ / (2 * h));
+    const double dk = alpha_ * omega_ * omega_ / (std::sqrt(2 * h) * W * W * W), dW = alpha_ * alpha_ / W;
+    const double r = std::sqrt(1 - k * k * c * c);
+    const double dq = c * dk / (alpha_ * r);
+    const double dp = -sn / alpha_ * ((dW * k + W * dk) / r + W * k * k * c * c * dk / (r * r * r));
+    return {dq, dp};
 }
 
 double Tan::angle_on_level(double q, double p, double h) const {

@@ -78,7 +78,9 @@ std::string taylor_unsupported(const FlowSystem& s) {
 Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) {
     const std::string why = taylor_unsupported(s);
     if (!why.empty()) bad(why);
-    m_.n = f.dim;
+    m_.n = f.state;  // the step rule reads the state only: tangents do not change the steps
+    m_.nt = f.tangents;
+    m_.nv = f.dim;
     // The order for the tolerance: the truncation error of the p-th order polynomial at the step
     // f rho is ~ f^p = tol.
     m_.p = std::clamp(int(std::ceil(1.0 + std::log(rtol) / kLogStepFraction)), 2, kMaxTaylorOrder);
@@ -97,6 +99,7 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) {
         m_.kind[i] = forces[i]->kind;
         m_.a[i] = forces[i]->a;
         m_.aux[i] = forces[i]->aux;
+        m_.b[i] = forces[i]->b;
         for (int k = 0; k < kMaxTaylorOrder; ++k) m_.binv[i][k] = forces[i]->b / (k + 1);
     }
     for (int k = 0; k < kMaxTaylorOrder; ++k) m_.inv[k] = 1.0 / (k + 1);
@@ -128,7 +131,7 @@ bool Taylor::expand(const double* y0, double hmax, double* h) {
 
 bool Taylor::expanded_at(const double* y0, double* h) const {
     if (!valid_ || buf_->round != round_) return false;
-    for (int i = 0; i < m_.n; ++i)
+    for (int i = 0; i < m_.nv; ++i)
         if (c_[std::size_t(i) * kTaylorStride * std::size_t(width_)] != y0[i]) return false;
     if (h) *h = step_.h;
     return true;
@@ -136,16 +139,16 @@ bool Taylor::expanded_at(const double* y0, double* h) const {
 
 void Taylor::eval(double tau, double* y) const {
     if (!valid_ || buf_->round != round_) {  // no caller does this: every one checks expanded_at first
-        for (int i = 0; i < m_.n; ++i) y[i] = std::numeric_limits<double>::quiet_NaN();
+        for (int i = 0; i < m_.nv; ++i) y[i] = std::numeric_limits<double>::quiet_NaN();
         return;
     }
     if (tau == step_.tau) {  // the step's end, evaluated in the lanes already (the same bits)
-        for (int i = 0; i < m_.n; ++i) y[i] = step_.y[i];
+        for (int i = 0; i < m_.nv; ++i) y[i] = step_.y[i];
         return;
     }
     const double* c = c_;
     const std::size_t w = std::size_t(width_);
-    estrin<double>([c, w](int i, int k) { return c[(std::size_t(i) * kTaylorStride + std::size_t(k)) * w]; }, m_.n,
+    estrin<double>([c, w](int i, int k) { return c[(std::size_t(i) * kTaylorStride + std::size_t(k)) * w]; }, m_.nv,
                    m_.p, tau, y);
 }
 

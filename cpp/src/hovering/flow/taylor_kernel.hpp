@@ -22,10 +22,13 @@ inline constexpr int kMaxCouplingDegree = 20;
 
 /// Everything the recurrences read besides the coefficients: fixed per system and tolerance.
 struct TaylorModel {
-    int n = 4;                                          ///< state dimension
+    int n = 4;                                          ///< state dimension (what the step rule reads)
+    int nt = 0;                                         ///< tangent vectors after the state (Field)
+    int nv = 4;                                         ///< rows expanded: n + 4 nt
     int p = 8;                                          ///< order
     Kind kind[2] = {Kind::Harmonic, Kind::Harmonic};    ///< force kinds (Harmonic or Tan)
     double a[2] = {0, 0};                               ///< Harmonic: omega^2; Tan: omega^2 / alpha
+    double b[2] = {0, 0};                               ///< Tan: alpha
     int aux[2] = {-1, -1};                              ///< Tan: index of u = tan(alpha q)
     double eps = 0;                                     ///< coupling strength
     CKind ckind = CKind::None;                          ///< coupling kind
@@ -39,7 +42,8 @@ struct TaylorModel {
 };
 
 /// Work arrays of one expansion (V per entry): c points to the state coefficients (the caller's,
-/// kMaxDim rows), Tan's w = 1 + u^2, the coupling gradient g; for a General coupling pow1, pow2
+/// kMaxDim rows), Tan's w = 1 + u^2, the coupling gradient g, and with tangents V'' of each
+/// oscillator (hs) and the coupling's Hessian (hh: h11, h12, h22); for a General coupling pow1, pow2
 /// point to (deg + 1) x kTaylorStride entries each for the powers of q1 and q2 (the caller's, sized
 /// by TaylorModel::deg1, deg2).
 template <class V>
@@ -47,6 +51,8 @@ struct TaylorSeries {
     V (*c)[kTaylorStride] = nullptr;
     V w[2][kTaylorStride];
     V g[2][kTaylorStride];
+    V hs[2][kTaylorStride];
+    V hh[3][kTaylorStride];
     V* pow1 = nullptr;
     V* pow2 = nullptr;
 };
@@ -66,6 +72,52 @@ inline V cauchy(const V* a, const V* b, int k, V zero) {
     }
     for (; j <= k; ++j) r0 += a[j] * b[k - j];
     return (r0 + r1) + (r2 + r3);
+}
+
+// Order k + 1 of the tangents (rows n .. n + 4 nt) from orders <= k of the state and the tangents:
+// d(dq)/dt = dp, d(dp)/dt = -Hess(V) dq, with Hess(V)'s series from the state's (V'' of Tan is
+// a b (3 w^2 - 2 w), a product of series again; the coupling's Hessian from the powers of q1, q2).
+template <class V, Kind K1, Kind K2, CKind C>
+inline void tangent_order(const TaylorModel& m, TaylorSeries<V>& S, int k, V zero) {
+    constexpr int P = kTaylorStride;
+    constexpr Kind kinds[2] = {K1, K2};
+    V (*c)[P] = S.c;
+    for (int i = 0; i < 2; ++i)
+        if (kinds[i] == Kind::Tan) {
+            const V* w = S.w[i];
+            S.hs[i][k] = (m.a[i] * m.b[i]) * (3.0 * cauchy(w, w, k, zero) - 2.0 * w[k]);
+        }
+    if constexpr (C == CKind::General) {
+        V h11 = zero, h12 = zero, h22 = zero;
+        for (const auto& t : m.terms) {
+            const int i = int(t[1]), j = int(t[2]);
+            if (i >= 2) h11 += t[0] * (i * (i - 1)) * cauchy(&S.pow1[(i - 2) * P], &S.pow2[j * P], k, zero);
+            if (i >= 1 && j >= 1) h12 += t[0] * (i * j) * cauchy(&S.pow1[(i - 1) * P], &S.pow2[(j - 1) * P], k, zero);
+            if (j >= 2) h22 += t[0] * (j * (j - 1)) * cauchy(&S.pow1[i * P], &S.pow2[(j - 2) * P], k, zero);
+        }
+        S.hh[0][k] = m.eps * h11;
+        S.hh[1][k] = m.eps * h12;
+        S.hh[2][k] = m.eps * h22;
+    }
+    const double inv = m.inv[k];
+    for (int j = 0; j < m.nt; ++j) {
+        const int b = m.n + 4 * j;
+        const V* dq1 = c[b];
+        const V* dq2 = c[b + 2];
+        V f1 = kinds[0] == Kind::Tan ? cauchy(S.hs[0], dq1, k, zero) : m.a[0] * dq1[k];
+        V f2 = kinds[1] == Kind::Tan ? cauchy(S.hs[1], dq2, k, zero) : m.a[1] * dq2[k];
+        if constexpr (C == CKind::Bilinear) {
+            f1 += (m.eps * m.bilinear_c) * dq2[k];
+            f2 += (m.eps * m.bilinear_c) * dq1[k];
+        } else if constexpr (C == CKind::General) {
+            f1 += cauchy(S.hh[0], dq1, k, zero) + cauchy(S.hh[1], dq2, k, zero);
+            f2 += cauchy(S.hh[1], dq1, k, zero) + cauchy(S.hh[2], dq2, k, zero);
+        }
+        c[b][k + 1] = c[b + 1][k] * inv;
+        c[b + 1][k + 1] = -f1 * inv;
+        c[b + 2][k + 1] = c[b + 3][k] * inv;
+        c[b + 3][k + 1] = -f2 * inv;
+    }
 }
 
 template <class V, Kind K1, Kind K2, CKind C>
@@ -157,6 +209,7 @@ void series(const TaylorModel& m, TaylorSeries<V>& S) {
             c[qi][k + 1] = c[pi][k] * inv;
             c[pi][k + 1] = -force * inv;
         }
+        if (m.nt > 0) tangent_order<V, K1, K2, C>(m, S, k, zero);
     }
 }
 

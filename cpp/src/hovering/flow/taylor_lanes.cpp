@@ -139,7 +139,7 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
     V hm;
     for (int l = 0; l < L; ++l) {
         const int src = l < count ? l : 0;  // idle lanes repeat lane 0
-        for (int i = 0; i < m.n; ++i) S.c[i][0][l] = y[src][i];
+        for (int i = 0; i < m.nv; ++i) S.c[i][0][l] = y[src][i];
         hm[l] = hmax[src];
     }
     detail::taylor_series(m, S);
@@ -151,12 +151,12 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
     }
     const V tau = min_lanes(h, hm);
     V ye[detail::kMaxDim];
-    detail::estrin<V>([&](int i, int k) { return S.c[i][k]; }, m.n, m.p, tau, ye);
+    detail::estrin<V>([&](int i, int k) { return S.c[i][k]; }, m.nv, m.p, tau, ye);
     for (int l = 0; l < count; ++l) {
         detail::TaylorStep& o = out[l];
         o.h = h[l];
         o.tau = tau[l];
-        for (int i = 0; i < m.n; ++i) o.y[i] = ye[i][l];
+        for (int i = 0; i < m.nv; ++i) o.y[i] = ye[i][l];
         o.ok = ok[l / 4][l % 4] != 0;
     }
 }

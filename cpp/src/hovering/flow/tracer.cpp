@@ -90,7 +90,8 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
 
 }  // namespace
 
-Tracer::Tracer(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o), in_(s, o) {
+Tracer::Tracer(const FlowSystem& s, const FlowOptions& o, int tangents)
+    : s_(s), o_(o), in_(s, o, tangents), tangents_(in_.field().tangents) {
     cands_.reserve(8);
     // The events below read each step's two ends and at most one turn of q1 (section, right wall)
     // and of q2 (upper wall) inside it: the integrator ends steps so that no more turns occur.
@@ -134,15 +135,16 @@ void Tracer::sample(const double* y0, const double* d0, double t0, double t_end)
     }
 }
 
-ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
-    if (in_.exact_kind() == ExactKind::Angles && event_driven_) return trace_angles(z0, first_crossing, cancel);
-    begin(z0, first_crossing);
+ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel,
+                           const double* t0) {
+    if (!steps_apply()) return trace_angles(z0, first_crossing, cancel);
+    begin(z0, first_crossing, t0);
     while (!step(cancel)) {
     }
     return end();
 }
 
-void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing) {
+void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing, const double* t0) {
     const FlowSystem& s = s_;
     Ret& R = ret_;
     R = Ret{};
@@ -151,6 +153,17 @@ void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing) {
     for (int i = 0; i < 4; ++i) y[i] = z0[std::size_t(i)];
     for (int i = 4; i < kMaxDim; ++i) y[i] = 0;
     in_.field().sync_aux(y);
+    if (tangents_ > 0) {
+        // The tangents follow the state (aux variables included) in the integrated vector, one
+        // block of (dq1, dp1, dq2, dp2) per vector; t0 is row-major 4 x tangents.
+        const int m = in_.field().state;
+        for (int j = 0; j < tangents_; ++j)
+            for (int r = 0; r < 4; ++r) {
+                const double v = t0 ? t0[r * tangents_ + j] : (r == j ? 1.0 : 0.0);
+                y[m + 4 * j + r] = v;
+                R.t0[r * tangents_ + j] = v;
+            }
+    }
     in_.restart();
     // Step bound: a fraction of the shorter oscillator period, so one step never holds both a
     // minimum and a maximum of q1 or q2 (two sign changes of p would cancel); 1/8 leaves a factor 4
@@ -322,6 +335,7 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
         for (const Candidate& c : cands_) {
             auto stop = [&](FlowStatus status) {
                 for (int i = 0; i < 4; ++i) r.z[std::size_t(i)] = c.y[i];
+                if (tangents_ > 0) take_tangents(c.y, r);
                 r.time = t0 + c.tau;
                 r.status = status;
                 done = true;
@@ -388,6 +402,12 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
                 const int pi = is_right ? 1 : 3;
                 const double w = kTwoPi / (8 * R.hmax);
                 R.amplification *= std::max(1.0, 2 * std::fabs(dy[pi]) / (std::fabs(y[pi]) * w));
+                if (tangents_ > 0) {
+                    // dy[pi] is the force on the wall: a function of the positions, which the
+                    // reflection keeps; c.y[pi] the velocity before the impact.
+                    saltation(y, pi - 1, c.y[pi], dy[pi]);
+                    field(y, dy);  // the tangents' derivatives after the jump
+                }
             }
             in_.restart();
             reflected = true;
@@ -404,6 +424,27 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
         R.armed = R.armed || (R.seen_negative && y[1] > 0);
         }
     return false;
+}
+
+void Tracer::saltation(double* y, int gi, double v, double a) const {
+    // S = R + (f+ - R f-) n^T / (n . f-) for the wall g = q_i - qw (n = e_qi) and the reflection
+    // R: p_i -> -p_i. f+ - R f- = -2 v e_qi - 2 V_,i e_pi (the force is the same on both sides),
+    // n . f- = v: S sends dq_i -> -dq_i and dp_i -> (2 a / v) dq_i - dp_i (a = -V_,i), all else
+    // unchanged. A shallow impact (v -> 0) amplifies the tangent by 2 |a| / |v|: the grazing
+    // square-root singularity, finite while v != 0.
+    const int m = in_.field().state;
+    for (int j = 0; j < tangents_; ++j) {
+        double* t = y + m + 4 * j;
+        const double dq = t[gi], dp = t[gi + 1];
+        t[gi] = -dq;
+        t[gi + 1] = (2 * a / v) * dq - dp;
+    }
+}
+
+void Tracer::take_tangents(const double* y, ReturnResult& r) const {
+    const int m = in_.field().state;
+    for (int j = 0; j < tangents_; ++j)
+        for (int row = 0; row < 4; ++row) r.tangents[std::size_t(row * tangents_ + j)] = y[m + 4 * j + row];
 }
 
 ReturnResult Tracer::end() {
@@ -456,7 +497,7 @@ ReturnResult Tracer::verify(ReturnResult r0) {
             v.atol = std::max(o_.atol * factor, 1e-300);
             v.verify_steps = 0;
             v.max_steps = std::max<std::int64_t>(o_.max_steps, 1);
-            verifier_[level] = std::make_unique<Tracer>(s_, v);
+            verifier_[level] = std::make_unique<Tracer>(s_, v, tangents_);
             verifier_[level]->set_event_driven(event_driven_);
         }
         Tracer& V = *verifier_[level];
@@ -473,7 +514,7 @@ ReturnResult Tracer::verify(ReturnResult r0) {
             dense_->truncated = ret_.dense_truncated;
         }
         V.set_dense(dense_);
-        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, ret_.cancel);
+        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, ret_.cancel, tangents_ > 0 ? ret_.t0 : nullptr);
         V.set_dense(nullptr);
         steps += r.steps;
         if (r.status == FlowStatus::StepLimit || r.status == FlowStatus::NonFinite ||
@@ -530,6 +571,7 @@ void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool 
     }
     r.energy_error = std::fabs(s_.energy(r.z.data()) - H0);
     if (r.status == FlowStatus::Ok && !on_chart(r.z, H0)) r.status = FlowStatus::OffSection;
+    if (tangents_ > 0 && r.status != FlowStatus::Ok) r.tangents.fill(kNaN);
     work_.steps += r.steps;
 }
 
@@ -552,15 +594,17 @@ bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
     return std::fabs(p[0] - z[0]) <= 1e-9 * (1 + std::fabs(z[0])) + 4 * e / std::fabs(dz[1]);
 }
 
-TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o) : taylor_(o.stepper == Stepper::Taylor) {
+TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o, int tangents)
+    : taylor_(o.stepper == Stepper::Taylor) {
     // Eight lanes (two 4-double vectors) rather than four: measured up to 10% more returns per
     // second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;
-    for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o));
+    for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o, tangents));
     if (taylor_) coef_.reset(new TaylorLanes);  // uninitialised: each round writes what it reads
 }
 
-void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel) {
+void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel,
+                        const double* t0) {
     Tracer& t = lane(l);
     busy_ |= 1u << l;
     if (!t.steps_apply()) {  // the event-driven closed form: a whole return at once
@@ -568,7 +612,7 @@ void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_cross
         ready_ |= 1u << l;
         return;
     }
-    t.begin(z0, first_crossing);
+    t.begin(z0, first_crossing, t0);
 }
 
 unsigned TracerGroup::step(const std::atomic<bool>* cancel) {

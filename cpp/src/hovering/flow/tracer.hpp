@@ -54,16 +54,22 @@ struct DenseRecorder {
 /// the GSL objects, so a worker builds one and traces many returns with it.
 class Tracer {
 public:
-    /// A tracer of system s with integrator options o (s must outlive it).
-    Tracer(const FlowSystem& s, const FlowOptions& o);
+    /// A tracer of system s with integrator options o (s must outlive it). With tangents (0 or
+    /// kMaxTangents), every return also carries that many tangent vectors (the variational
+    /// equations, a saltation matrix at every impact: ReturnResult::tangents); the state is the
+    /// same as without them (the step control reads the state only) for every stepper but
+    /// msadams, rk2imp and rk4imp, whose control or Newton iteration sees all components.
+    Tracer(const FlowSystem& s, const FlowOptions& o, int tangents = 0);
     /// One return from z0 (on Sigma_h): the first crossing of Sigma_h after q1 has passed its
     /// minimum. With first_crossing, the first crossing of Sigma_h at all (z0 need not lie on it:
-    /// the tangential curve starts at q1's minimum). cancel is polled every 256 steps.
+    /// the tangential curve starts at q1's minimum). cancel is polled every 256 steps. t0: the
+    /// starting tangents (4 x tangents, row-major: row r is component r of each vector), tracers
+    /// with tangents only.
     ReturnResult trace(const std::array<double, 4>& z0, bool first_crossing = false,
-                       const std::atomic<bool>* cancel = nullptr);
+                       const std::atomic<bool>* cancel = nullptr, const double* t0 = nullptr);
     /// trace() in pieces, for drivers that interleave several returns (a lane group): begin a
     /// return from z0 (not for the event-driven closed form, stepper "exact" at eps = 0) ...
-    void begin(const std::array<double, 4>& z0, bool first_crossing = false);
+    void begin(const std::array<double, 4>& z0, bool first_crossing = false, const double* t0 = nullptr);
     /// ... take one accepted step with its events (true: the return is over) ...
     bool step(const std::atomic<bool>* cancel = nullptr);
     /// ... and collect its result. trace() is begin, step until over, end.
@@ -72,8 +78,11 @@ public:
     const double* next_start() const { return ret_.y; }
     /// The longest step the next step() may take (the return's step bound).
     double next_hmax() const { return ret_.hmax; }
-    /// Whether begin() and step() apply (every stepper but the event-driven closed form).
-    bool steps_apply() const { return !(in_.exact_kind() == ExactKind::Angles && event_driven_); }
+    /// Whether begin() and step() apply (every stepper but the event-driven closed form, which
+    /// tangents turn off: they are carried on the closed form's steps).
+    bool steps_apply() const { return !(in_.exact_kind() == ExactKind::Angles && event_driven_ && tangents_ == 0); }
+    /// Tangent vectors carried with each return.
+    int tangents() const { return tangents_; }
     /// The integrator (a lane group expands its Taylor series for it).
     Integrator& integrator() { return in_; }
     /// Whether returns are labelled (itinerary, crossings of q1 = qw1 above the step; default on).
@@ -102,6 +111,7 @@ private:
         bool over = false;  // step() will take no more steps
         double amplification = 1;    // product of the impacts' error amplifications (verify_from)
         std::array<double, 4> z0{};  // where the return started (verification traces it again)
+        double t0[4 * kMaxTangents] = {};  // and its starting tangents
         bool first_crossing = false;
         const std::atomic<bool>* cancel = nullptr;  // the last step()'s, polled by verification too
         // The dense output's state when the return began: a verified return replaces its points.
@@ -146,6 +156,12 @@ private:
     bool event_driven_ = true;
     DenseRecorder* dense_ = nullptr;
     std::unique_ptr<Tracer> verifier_[2];  // at rtol / 100 and / 10^4, built on first use
+    int tangents_ = 0;
+    // The state y's tangents at an impact on coordinate gi, through the saltation matrix: y holds
+    // the reflected state (positions on the wall), v the velocity before the impact, a = dp/dt.
+    void saltation(double* y, int gi, double v, double a) const;
+    // Copy the tangents of the integrated vector y into r (row-major 4 x tangents).
+    void take_tangents(const double* y, ReturnResult& r) const;
 };
 
 /// Several returns traced side by side by one worker. With stepper "taylor" eight lanes: every
@@ -154,8 +170,9 @@ private:
 /// Either way a lane's return is bit for bit what Tracer::trace() gives it alone.
 class TracerGroup {
 public:
-    /// Lanes of one system with integrator options o (s must outlive the group).
-    TracerGroup(const FlowSystem& s, const FlowOptions& o);
+    /// Lanes of one system with integrator options o (s must outlive the group), carrying
+    /// `tangents` tangent vectors (Tracer).
+    TracerGroup(const FlowSystem& s, const FlowOptions& o, int tangents = 0);
     /// How many returns run side by side (kMaxTaylorGroup for stepper "taylor", else 1).
     int lanes() const { return int(t_.size()); }
     /// Lane l's tracer (labels, dense output, work).
@@ -165,7 +182,8 @@ public:
     /// Whether any lane does.
     bool any_busy() const { return busy_ != 0; }
     /// Start a return in the idle lane l (as Tracer::trace).
-    void start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel);
+    void start(int l, const std::array<double, 4>& z0, bool first_crossing, const std::atomic<bool>* cancel,
+               const double* t0 = nullptr);
     /// One step of every busy lane; the set of lanes whose return is over (bit l: lane l).
     unsigned step(const std::atomic<bool>* cancel);
     /// Collect lane l's finished return; the lane is idle again.

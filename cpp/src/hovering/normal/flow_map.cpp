@@ -92,6 +92,128 @@ FlowStep FlowMap::advance_end(ReturnResult ret, bool inverse) const {
     return st;
 }
 
+namespace {
+
+// The chart of H2's action-angle variables at (q, p) = point_at(theta, e): d(q, p)/dtheta =
+// (p, -V') / omega and d(q, p)/dI = omega d(q, p)/de (Potential::point_slope), omega = de/dI.
+struct Chart {
+    double dth[2], dI[2], omega;
+};
+Chart chart(const Potential& V, double theta, double e, double q, double p) {
+    const double w = V.frequency(e);
+    const std::array<double, 2> v = V.point_slope(theta, e);
+    return {{p / w, -V.dV(q) / w}, {w * v[0], w * v[1]}, w};
+}
+
+}  // namespace
+
+void FlowMap::start_tangents(double x, const std::array<double, 4>& z, double I0, double* t0) const {
+    // Sigma_h's chart: (q2, p2) = S2^{-1}(theta, I), p1 = 0, q1 from V1(q1) + eps Vc(q1, q2) = h - H2(I):
+    // (V1' + eps Vc_1) dq1 = -(eps Vc_2 dq2 + omega dI).
+    const double th = wrap(x);
+    const double e2 = s_.V2->energy(I0);
+    const Chart c = chart(*s_.V2, th, e2, z[2], z[3]);
+    std::array<double, 2> g{0.0, 0.0};
+    if (s_.eps != 0) g = s_.coupling.gradient(z[0], z[2]);
+    const double F1 = s_.V1->dV(z[0]) + s_.eps * g[0], F2 = s_.eps * g[1];
+    const double col_th[4] = {-F2 * c.dth[0] / F1, 0.0, c.dth[0], c.dth[1]};
+    const double col_I[4] = {-(F2 * c.dI[0] + c.omega) / F1, 0.0, c.dI[0], c.dI[1]};
+    // Map coordinates: (theta, I) = (x, y + I_tan(x)), so d/dx = d/dtheta + I_tan' d/dI, d/dy = d/dI.
+    const double slope = curve_ ? curve_->I_tan_slope(th) : 0.0;
+    for (int r = 0; r < 4; ++r) {
+        t0[2 * r] = col_th[r] + slope * col_I[r];
+        t0[2 * r + 1] = col_I[r];
+    }
+}
+
+void FlowMap::end_jacobian(const FlowStep& st, double* J) const {
+    for (int k = 0; k < 4; ++k) J[k] = kNaN;
+    if (st.ret.status != FlowStatus::Ok) return;
+    const std::array<double, 4>& z = st.ret.z;
+    const std::array<double, 8>& T = st.ret.tangents;
+    // Projection onto Sigma_h along the flow: the return time moves by -dp1 / (dp1/dt).
+    double f[4];
+    s_.rhs(z.data(), f);
+    double dz[4][2];
+    for (int j = 0; j < 2; ++j) {
+        const double dt = -T[2 + j] / f[1];
+        for (int r = 0; r < 4; ++r) dz[r][j] = T[2 * r + j] + f[r] * dt;
+    }
+    // (theta, I) = S2(q2, p2): the inverse of the chart [d/dtheta, d/dI] (determinant 1).
+    const double e2 = 0.5 * z[3] * z[3] + s_.V2->V(z[2]);
+    if (!(e2 > 0)) return;
+    double th = s_.V2->angle_on_level(z[2], z[3], e2);
+    if (th >= kPi) th -= kTwoPi;
+    const Chart c = chart(*s_.V2, th, e2, z[2], z[3]);
+    const double det = c.dth[0] * c.dI[1] - c.dI[0] * c.dth[1];
+    const double D[4] = {c.dI[1] / det, -c.dI[0] / det, -c.dth[1] / det, c.dth[0] / det};
+    double A[4];
+    for (int j = 0; j < 2; ++j) {
+        A[j] = D[0] * dz[2][j] + D[1] * dz[3][j];
+        A[2 + j] = D[2] * dz[2][j] + D[3] * dz[3][j];
+    }
+    // Map coordinates: y1 = I1 - I_tan(theta1).
+    const double slope = curve_ ? curve_->I_tan_slope(wrap(th)) : 0.0;
+    J[0] = A[0];
+    J[1] = A[1];
+    J[2] = A[2] - slope * A[0];
+    J[3] = A[3] - slope * A[1];
+}
+
+FlowJacobian FlowMap::jacobian(double x, double y) const {
+    FlowJacobian out;
+    jacobians(&x, &y, 1, 1, nullptr, &out);
+    return out;
+}
+
+void FlowMap::jacobians(const double* x, const double* y, std::int64_t n, int n_threads,
+                        const std::atomic<bool>* cancel, FlowJacobian* out) const {
+    if (n < 0) bad("number of points must be >= 0, got " + std::to_string(n));
+    if (n_threads < 0 || n_threads > detail::kMaxThreads)
+        bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
+            std::to_string(n_threads));
+    for (std::int64_t i = 0; i < n; ++i) {
+        detail::require_angle(x[i], "x[" + std::to_string(i) + "]");
+        detail::require_finite(y[i], "y[" + std::to_string(i) + "]");
+    }
+    if (n == 0) return;
+    const int threads = detail::worker_count(n_threads, n);
+    detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
+    detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
+        // As steps(): one return per point, side by side, each carrying the chart's two tangents.
+        detail::TracerGroup group(s_, opt_, 2);
+        const int L = group.lanes();
+        std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
+        auto fill = [&](int l) {
+            for (std::int64_t i; cur.pop(i);) {
+                std::array<double, 4> z{};
+                out[i] = FlowJacobian{};
+                if (cancel && cancel->load(std::memory_order_relaxed)) {
+                    out[i].step.x = out[i].step.y = kNaN;
+                    out[i].step.ret.status = FlowStatus::Interrupted;
+                } else if (advance_start(x[i], y[i], false, z, out[i].step)) {
+                    double t0[8];
+                    start_tangents(x[i], z, to_section(x[i], y[i]).second, t0);
+                    idx[std::size_t(l)] = i;
+                    group.start(l, z, false, cancel, t0);
+                    return;
+                }
+            }
+        };
+        for (int l = 0; l < L; ++l) fill(l);
+        while (group.any_busy()) {
+            const unsigned over = group.step(cancel);
+            for (int l = 0; l < L; ++l) {
+                if (!((over >> l) & 1u)) continue;
+                FlowJacobian& o = out[idx[std::size_t(l)]];
+                o.step = advance_end(group.collect(l), false);
+                end_jacobian(o.step, o.J);
+                fill(l);
+            }
+        }
+    });
+}
+
 FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const {
     std::array<double, 4> z{};
     FlowStep st;
@@ -245,7 +367,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         // Orbits side by side, one per lane of a TracerGroup (8 for stepper "taylor": their Taylor
         // series are expanded together); each lane runs its orbit's returns one after another
         // and takes the next orbit when it ends. An orbit is bit for bit what it is alone.
-        detail::TracerGroup group(s_, opt_);
+        const bool tangent = out.tangent.active();
+        detail::TracerGroup group(s_, opt_, tangent ? 2 : 0);
         const int L = group.lanes();
         for (int l = 0; l < L; ++l) group.lane(l).set_labels(opt.labels);
         detail::ProgressShare progress(opt.progress, 1);
@@ -258,11 +381,14 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             int visited = 0;
             Status status = Status::Ok;
             detail::DenseRecorder rec;
+            TangentProduct tp;                 // record "jacobian"
+            Status tangent_status = Status::Ok;  // NonFinite once a return's Jacobian was not
         };
         std::vector<Orbit> lane(static_cast<std::size_t>(L));
         // The end of lane l's orbit: its outputs, its recorded tails, the progress it will not make.
         auto close = [&](Orbit& o) {
             finish(o.i, o.x, o.y, o.rot, o.k, o.status, o.visited, o.y_lo, o.y_hi, o.res, o.returns);
+            out.tangent.write(o.i, o.tp, o.tangent_status);
             if (traj.truncated) traj.truncated[o.i] = o.rec.truncated ? 1 : 0;
             // The returns an orbit that stopped early will not take are accounted for (not when
             // cancelled: the count then shows how far the run got).
@@ -283,7 +409,13 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 o.status = orbit_status(st.ret.status);
                 return false;
             }
-            group.start(l, z, false, opt.cancel);
+            if (tangent) {
+                double t0[8];
+                start_tangents(o.x, z, to_section(o.x, o.y).second, t0);
+                group.start(l, z, false, opt.cancel, t0);
+            } else {
+                group.start(l, z, false, opt.cancel);
+            }
             return true;
         };
         // After lane l's return: the bookkeeping of one iteration (false: the orbit ends here).
@@ -310,6 +442,14 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 }
             }
             if (out.rotation) o.rot += rotation_of(o.x, o.y, st.region, st.x);
+            if (tangent) {
+                double J[4];
+                end_jacobian(st, J);
+                if (std::isfinite(J[0]) && std::isfinite(J[1]) && std::isfinite(J[2]) && std::isfinite(J[3]))
+                    o.tp.multiply(J);
+                else if (o.tangent_status == Status::Ok)
+                    o.tangent_status = Status::NonFinite;
+            }
             o.x = st.x;
             o.y = st.y;
             o.y_lo = std::min(o.y_lo, o.y);
@@ -333,6 +473,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 o.reported = false;
                 o.visited = 0;
                 o.status = Status::Ok;
+                o.tp = TangentProduct{};
+                o.tangent_status = Status::Ok;
                 if (out.exit_step) out.exit_step[i] = -1;
                 if (out.stop_step) out.stop_step[i] = -1;
                 if (traj.truncated) traj.truncated[i] = 0;
@@ -340,6 +482,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
                 if (!state(o.x, o.y, z)) {
                     record_point(i, 0, o.x, o.y, nullptr);
                     finish(i, o.x, o.y, 0.0, 0, Status::OffSection, 0, o.y_lo, o.y_hi, o.res, 0);
+                    out.tangent.write(i, TangentProduct{}, Status::Ok);
                     progress.add(ns);
                     o.i = -1;
                     continue;

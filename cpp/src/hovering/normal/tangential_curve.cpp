@@ -288,6 +288,11 @@ double TangentialCurve::I_tan(double theta) const {
     return Itheta_(theta);
 }
 
+double TangentialCurve::I_tan_slope(double theta) const {
+    if (!is_graph()) bad(not_graph_reason());
+    return Itheta_.with_derivative(theta).second;
+}
+
 TangentialCurve TangentialCurve::measure_refined(const FlowSystem& s, double h, const FlowOptions& opt, int n_check) {
     int n = 64;
     TangentialCurve c = measure(s, h, n, opt, n_check);

@@ -53,6 +53,11 @@ ArcLengths AnalyticArcs::at(double K) const {
     return {Omega0 + tau0 * K, 2.0 * (kPi - theta_w) + tau1 * K, 2.0 * lam * std::sqrt(-K)};
 }
 
+ArcSlopes AnalyticArcs::slopes(double K) const {
+    if (!(K < 0.0)) return {tau0, 0.0, 0.0};
+    return {tau0, tau1, -lam / std::sqrt(-K)};
+}
+
 double AnalyticArcs::band_lo() const {
     // With K = -s^2 the three lengths are |J_1| = 2 lam s, |J_R| = 2(pi - theta_w) - tau1 s^2 and
     // |J_0| = 2 pi - |J_1| - |J_R|; all lie in (0, 2 pi) iff |J_R| > 0 and |J_0| > 0.
@@ -105,6 +110,11 @@ double Spline::operator()(double x) const {
     // Clamp rounding-level excursions; callers keep x inside the grid (the band is inside it).
     x = std::min(std::max(x, x_.front()), x_.back());
     return gsl_spline_eval(static_cast<const gsl_spline*>(spline_), x, nullptr);
+}
+
+double Spline::derivative(double x) const {
+    x = std::min(std::max(x, x_.front()), x_.back());
+    return gsl_spline_eval_deriv(static_cast<const gsl_spline*>(spline_), x, nullptr);
 }
 
 namespace {
@@ -192,6 +202,12 @@ ArcLengths TabulatedArcs::at(double K) const {
     return {Omega(K), JR(K), J1s(std::sqrt(-K))};
 }
 
+ArcSlopes TabulatedArcs::slopes(double K) const {
+    if (!(K < 0.0)) return {Omega.derivative(K), 0.0, 0.0};
+    const double s = std::sqrt(-K);
+    return {Omega.derivative(K), JR.derivative(K), -J1s.derivative(s) / (2.0 * s)};
+}
+
 double TabulatedArcs::band_lo() const {
     auto ok = [this](double s) {
         const ArcLengths a = at(-s * s);
@@ -252,6 +268,17 @@ double TabulatedArcs::omega_limit(double direction) const {
 
 double SineForcing::at(double phi) const {
     return std::sin(phi);
+}
+
+double SineForcing::slope(double phi) const {
+    return std::cos(phi);
+}
+
+double FourierForcing::slope(double phi) const {
+    double f = 0.0;
+    for (std::size_t k = 0; k < b.size(); ++k)
+        if (b[k] != 0.0) f += double(k + 1) * b[k] * std::cos(double(k + 1) * phi);
+    return f;
 }
 
 double FourierForcing::at(double phi) const {

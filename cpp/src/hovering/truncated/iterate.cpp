@@ -37,6 +37,7 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
     const Finisher finish(opt, out, progress);
     const std::int64_t ns = opt.n_steps, every = opt.every;
     const bool rec_states = out.orbit_phi || out.orbit_K;
+    const bool tangent = out.tangent.active();
     const StopCondition& stop = opt.stop;
     for (std::int64_t i; src.pop(i);) {
         double phi = detail::wrap(phi0[i]), K = K0[i];
@@ -87,8 +88,10 @@ void run_scalar(const MapCore<A, F>& m, const double* phi0, const double* K0, Wo
                 }
             }
             t.rot += c.omega;
+            const double phi_from = phi, K_from = K;
             phi = detail::rotate(phi, c.omega);
             K += m.eps() * m.forcing().at(phi);
+            if (tangent) detail::tangent_step(m, phi_from, K_from, c.region, phi, t);
             t.K_min = std::min(t.K_min, K);
             t.K_max = std::max(t.K_max, K);
             if (++phase == every) phase = 0;

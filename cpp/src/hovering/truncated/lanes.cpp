@@ -34,6 +34,7 @@ using detail::kPi;
 using detail::kTwoPi;
 using detail::kW;
 using detail::Packet;
+using detail::pcos;
 using detail::psin;
 using detail::Tally;
 using detail::WorkCursor;
@@ -67,6 +68,48 @@ inline void arcs_packet(const TabulatedArcs& a, const Packet& k, Packet& Om, Pac
 template <bool Fast>
 inline Packet force_packet(const SineForcing&, const Packet& p) {
     return psin<Fast>(p);
+}
+
+// d omega_a / dK of each lane's arc (record "jacobian"): Omega' plus |J_R|' on J_1, minus |J_1|' on
+// J_R (up, rt: the lanes in J_1, J_R; both masks are 0 for K >= 0, so what the K >= 0 lanes compute
+// for the arcs' slopes, -lam / 0 or NaN, is masked away).
+inline Packet slope_packet(const AnalyticArcs& a, const Packet& k, const Packet& up, const Packet& rt) {
+    const Packet sJ1 = ei::pdiv(ei::pset1<Packet>(-a.lam), detail::psqrt_rn(ei::pnegate(k)));
+    return ei::psub(ei::padd(ei::pset1<Packet>(a.tau0), ei::pand(up, ei::pset1<Packet>(a.tau1))), ei::pand(rt, sJ1));
+}
+
+inline Packet slope_packet(const TabulatedArcs& a, const Packet& k, const Packet& up, const Packet& rt) {
+    alignas(64) double kk[kW], w[kW], mu[kW], mr[kW];
+    ei::pstore(kk, k);
+    ei::pstore(mu, up);
+    ei::pstore(mr, rt);
+    auto set = [](double mask) {  // a lane mask is all ones or all zeros
+        std::uint64_t b;
+        std::memcpy(&b, &mask, 8);
+        return b != 0;
+    };
+    for (int l = 0; l < kW; ++l) {
+        const ArcSlopes d = a.slopes(kk[l]);
+        w[l] = d.Omega;
+        if (set(mu[l])) w[l] += d.JR;
+        if (set(mr[l])) w[l] -= d.J1;
+    }
+    return ei::pload<Packet>(w);
+}
+
+template <bool Fast>
+inline Packet force_slope_packet(const SineForcing&, const Packet& p) {
+    return pcos<Fast>(p);
+}
+
+template <bool Fast>
+inline Packet force_slope_packet(const FourierForcing& f, const Packet& p) {
+    Packet acc = ei::pset1<Packet>(0.0);
+    for (std::size_t k = 0; k < f.b.size(); ++k)
+        if (f.b[k] != 0.0)
+            acc = ei::padd(acc, ei::pmul(ei::pset1<Packet>(double(k + 1) * f.b[k]),
+                                         pcos<Fast>(ei::pmul(ei::pset1<Packet>(double(k + 1)), p))));
+    return acc;
 }
 
 template <bool Fast>
@@ -104,6 +147,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     const bool need_reg = watch || out.regions || out.visited;  // region codes are only built when read
     const bool extrema = out.K_min || out.K_max, residence = out.residence != nullptr;
     const bool rec_states = out.orbit_phi || out.orbit_K, rec = rec_states || out.regions;
+    const bool tangent = out.tangent.active();
     const StopCondition& stop = opt.stop;
     const bool stopping = stop.active(), above = stop.side == StopSide::Above;
     const Curve* curve = stopping ? stop.curve.get() : nullptr;
@@ -153,6 +197,10 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     // Regions visited (record "visited" only): one all-ones mask per region code 0..3 and lane.
     Packet seen[4][kP];
     alignas(64) double lseen[4][kLanes];
+    // Record "jacobian": each lane's tangent product (TangentProduct: c, s, L1, L2, u), whether it
+    // took a step from an arc start, and the slope d omega_a / dK of the current step's arc.
+    Packet tc[kP], ts[kP], tl1[kP], tl2[kP], tu[kP], tcor[kP], wsl[kP];
+    alignas(64) double ltc[kLanes], lts[kLanes], ltl1[kLanes], ltl2[kLanes], ltu[kLanes], ltcor[kLanes];
     const Packet code[4] = {zero, one, two, three};
     std::int64_t idx[kLanes], start[kLanes], due[kLanes];  // due: the next n whose state / return is recorded
     std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
@@ -175,6 +223,14 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 ei::pstore(lright + q * kW, nright[q]);
                 ei::pstore(lbelow + q * kW, nbelow[q]);
             }
+            if (tangent) {
+                ei::pstore(ltc + q * kW, tc[q]);
+                ei::pstore(lts + q * kW, ts[q]);
+                ei::pstore(ltl1 + q * kW, tl1[q]);
+                ei::pstore(ltl2 + q * kW, tl2[q]);
+                ei::pstore(ltu + q * kW, tu[q]);
+                ei::pstore(ltcor + q * kW, tcor[q]);
+            }
         }
     };
     auto pack = [&] {
@@ -194,6 +250,14 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 nup[q] = ei::pload<Packet>(lup + q * kW);
                 nright[q] = ei::pload<Packet>(lright + q * kW);
                 nbelow[q] = ei::pload<Packet>(lbelow + q * kW);
+            }
+            if (tangent) {
+                tc[q] = ei::pload<Packet>(ltc + q * kW);
+                ts[q] = ei::pload<Packet>(lts + q * kW);
+                tl1[q] = ei::pload<Packet>(ltl1 + q * kW);
+                tl2[q] = ei::pload<Packet>(ltl2 + q * kW);
+                tu[q] = ei::pload<Packet>(ltu + q * kW);
+                tcor[q] = ei::pload<Packet>(ltcor + q * kW);
             }
         }
     };
@@ -216,12 +280,18 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         t.right = lright[j];
         t.below = lbelow[j];
         t.counted = it - start[j] + (exiting ? 1 : 0);
+        if (tangent) {
+            t.tangent = TangentProduct{ltc[j], lts[j], ltl1[j], ltl2[j], ltu[j], it - start[j]};
+            if (std::memcmp(&ltcor[j], &on, 8) == 0) t.tangent_status = Status::Corner;
+        }
         return t;
     };
     auto clear = [&](int j) {
         lrot[j] = 0.0;
         for (int r = 0; r < 4; ++r) lseen[r][j] = 0.0;
         lup[j] = lright[j] = lbelow[j] = 0.0;
+        ltc[j] = 1.0;
+        lts[j] = ltl1[j] = ltl2[j] = ltu[j] = ltcor[j] = 0.0;
     };
     // Put the next orbit that starts inside the band and outside the stop set into lane j (the
     // others finish at once); with no work left the lane computes a harmless point that is ignored.
@@ -335,6 +405,19 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 const Packet up = ei::pand(neg, in1);
                 const Packet rt = ei::pandnot(ei::pand(neg, inR), up);
                 omega[q] = ei::psub(ei::padd(Om, ei::pand(up, JR)), ei::pand(rt, J1));
+                if (tangent) {
+                    wsl[q] = slope_packet(m.arcs(), K[q], up, rt);
+                    if constexpr (decltype(exact)::value) {
+                        // A step from an arc start exactly: the derivative is one-sided there (only
+                        // this pass can see it: the fast pass sends every lane near an arc end here).
+                        const Packet s1 = pwrap(p01);
+                        const Packet uR = ei::padd(s1, J1);
+                        const Packet sR = wrap_once(uR), s0 = wrap_once(ei::padd(uR, JR));
+                        const Packet at = ei::por(ei::por(ei::pcmp_eq(phi[q], s1), ei::pcmp_eq(phi[q], sR)),
+                                                  ei::pcmp_eq(phi[q], s0));
+                        tcor[q] = ei::por(tcor[q], ei::pand(live[q], ei::pand(neg, at)));
+                    }
+                }
                 if (need_reg) reg[q] = ei::pselect(neg, ei::pselect(up, two, ei::pselect(rt, three, one)), zero);
                 if (residence) {
                     mup[q] = up;
@@ -413,6 +496,22 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             const Packet p = pwrap(ei::padd(phi[q], omega[q]));
             phi[q] = p;
             K[q] = ei::padd(K[q], ei::pmul(eps, force_packet<Fast>(m.forcing(), p)));
+            if (tangent) {
+                // TangentProduct::multiply on packets, J = [[1, w], [g, 1 + g w]].
+                const Packet w = wsl[q], g = ei::pmul(eps, force_slope_packet<Fast>(m.forcing(), p));
+                const Packet d = ei::padd(one, ei::pmul(g, w));
+                const Packet x1 = ei::padd(tc[q], ei::pmul(w, ts[q])), y1 = ei::padd(ei::pmul(g, tc[q]), ei::pmul(d, ts[q]));
+                const Packet x2 = ei::psub(ei::pmul(w, tc[q]), ts[q]), y2 = ei::psub(ei::pmul(d, tc[q]), ei::pmul(g, ts[q]));
+                const Packet r11 = detail::psqrt_rn(ei::padd(ei::pmul(x1, x1), ei::pmul(y1, y1)));
+                const Packet cn = ei::pdiv(x1, r11), sn = ei::pdiv(y1, r11);
+                const Packet r12 = ei::padd(ei::pmul(cn, x2), ei::pmul(sn, y2));
+                const Packet r22 = ei::psub(ei::pmul(cn, y2), ei::pmul(sn, x2));
+                tu[q] = ei::padd(tu[q], ei::pmul(ei::pdiv(r12, r11), detail::pexp_u10(ei::psub(tl2[q], tl1[q]))));
+                tl1[q] = ei::padd(tl1[q], detail::plog_u10(r11));
+                tl2[q] = ei::padd(tl2[q], detail::plog_u10(ei::pabs(r22)));
+                tc[q] = cn;
+                ts[q] = sn;
+            }
             const Packet inside = ei::pand(ei::pcmp_lt(plo, K[q]), ei::pcmp_lt(K[q], phi_));
             outside = ei::por(outside, ei::pandnot(live[q], inside));
             if (extrema) {

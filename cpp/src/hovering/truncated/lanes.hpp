@@ -10,6 +10,7 @@
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/parallel.hpp"
+#include "hovering/truncated/classify.hpp"
 #include "hovering/truncated/map.hpp"
 
 namespace hovering::detail {
@@ -23,7 +24,26 @@ struct Tally {
     // arcs), and in all (those taken, plus the exiting one with stop_on_exit); J_0 and J_0u follow.
     double upper = 0, right = 0, below = 0;
     std::int64_t counted = 0;
+    TangentProduct tangent;         // record "jacobian": the product of the steps' Jacobians
+    Status tangent_status = Status::Ok;  // Corner once a step was taken from an arc start
 };
+
+// The Jacobian of the step from (phi, K) in arc r to the image angle p (MapCore::step_jacobian's
+// formula), multiplied into t; a start exactly on an arc start marks the product one-sided.
+template <class A, class F>
+inline void tangent_step(const MapCore<A, F>& m, double phi, double K, Region r, double p, Tally& t) {
+    const ArcSlopes d = m.arcs().slopes(K);
+    double w = d.Omega;
+    if (r == Region::Upper) w += d.JR;
+    if (r == Region::Right) w -= d.J1;
+    const double g = m.eps() * m.forcing().slope(p);
+    const double J[4] = {1.0, w, g, 1.0 + g * w};
+    t.tangent.multiply(J);
+    if (K < 0.0 && t.tangent_status == Status::Ok) {
+        const ArcStarts s = arc_starts(m.arcs().at(K));
+        if (phi == s.s1 || phi == s.sR || phi == s.s0) t.tangent_status = Status::Corner;
+    }
+}
 
 // Writes an orbit's outputs once it stops, and the NaN / None tail of its recorded arrays.
 struct Finisher {
@@ -61,6 +81,7 @@ struct Finisher {
         if (out.status) out.status[i] = static_cast<std::int8_t>(st);
         if (out.steps_done) out.steps_done[i] = steps;
         if (out.stop_step && st == Status::Stopped) out.stop_step[i] = steps;
+        out.tangent.write(i, t.tangent, t.tangent_status);
         if (out.K_min) out.K_min[i] = t.K_min;
         if (out.K_max) out.K_max[i] = t.K_max;
         if (out.residence) {

@@ -113,6 +113,32 @@ std::pair<double, double> MapCore<A, F>::step(double phi, double K) const {
     return {p, K + eps_ * forcing_.at(p)};
 }
 
+template <class A, class F>
+StepJacobian MapCore<A, F>::step_jacobian(double phi, double K) const {
+    check_point(phi, K, "jacobian");
+    const double q = detail::wrap(phi);
+    const ArcLengths a = arcs_.at(K);
+    const Classified c = classify(q, K, a);
+    StepJacobian out;
+    out.phi = detail::rotate(q, c.omega);  // step()'s expressions: the same image bit for bit
+    out.K = K + eps_ * forcing_.at(out.phi);
+    out.region = c.region;
+    const ArcSlopes d = arcs_.slopes(K);
+    double w = d.Omega;  // d omega_a / dK of the point's arc (classify.hpp: arc_rotation)
+    if (c.region == Region::Upper) w += d.JR;
+    if (c.region == Region::Right) w -= d.J1;
+    const double g = eps_ * forcing_.slope(out.phi);
+    out.J[0] = 1.0;
+    out.J[1] = w;
+    out.J[2] = g;
+    out.J[3] = 1.0 + g * w;
+    if (K < 0.0) {
+        const detail::ArcStarts s = detail::arc_starts(a);
+        if (q == s.s1 || q == s.sR || q == s.s0) out.status = Status::Corner;
+    }
+    return out;
+}
+
 namespace {
 
 // The point of the half-open arc [lo, hi) nearest to q (q itself if it lies there).
