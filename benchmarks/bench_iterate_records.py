@@ -12,6 +12,9 @@ the time of ``iterate`` with
   * ``record=("orbit",), every=1000`` (every 1000th state kept),
 
 printed as the ratio to ``record=()`` (the target of issue 20: at most 2 on the SIMD kernel).
+Then the whole orbit (``every=1``, 16 bytes per step, and the regions, 1 more) on 1 and 2
+threads against the map alone and against writing as many bytes into fresh NumPy arrays (the
+machine's write rate with the same page faults): what recording costs beyond its bytes.
 Each time is the best of ``--repeat`` runs on one thread (the other core of a shared machine
 stays free); the truncated orbits are invariant circles of the paper's map at eps = 0.3 (K0 in
 [0.02, 0.45] on L1), so none stops or escapes and every configuration does the same steps.
@@ -84,6 +87,36 @@ def truncated(n_orbits: int, n_steps: int, repeat: int) -> None:
         )
 
 
+def recording(n_orbits: int, n_steps: int, repeat: int) -> None:
+    m = paper.truncated_map(eps=0.3)
+    K0 = np.linspace(0.02, 0.45, n_orbits)
+    phi0 = m.L1(K0)
+    shape = (n_orbits, n_steps + 1)
+    steps = n_orbits * n_steps
+
+    def write():  # the bytes of record=("orbit",) into fresh arrays, as iterate allocates them
+        a, b = np.empty(shape), np.empty(shape)
+        a.fill(1.0)
+        b.fill(1.0)
+
+    print(f"\nRecording every state: {n_orbits} orbits x {n_steps} steps (SIMD kernel), best of {repeat}")
+    for threads in (1, 2):
+        fns = [
+            lambda: m.iterate(phi0, K0, n_steps, n_threads=threads),
+            lambda: m.iterate(phi0, K0, n_steps, n_threads=threads, record=("orbit",)),
+            lambda: m.iterate(phi0, K0, n_steps, n_threads=threads, record=("orbit", "regions")),
+            write,
+        ]
+        t_map, t_orbit, t_reg, t_write = best_times(fns, repeat)
+        print(
+            f"  {threads} thread(s): map {steps / t_map / 1e6:.0f} M steps/s; orbit {steps / t_orbit / 1e6:.0f} M "
+            f"steps/s ({t_orbit / t_map:.2f}x the map, {16 * steps / t_orbit / 1e9:.1f} GB/s); orbit + regions "
+            f"{t_reg / t_map:.2f}x; writing 16 B/step into fresh arrays alone (1 thread): "
+            f"{16 * steps / t_write / 1e9:.1f} GB/s, recording's cost beyond the map "
+            f"{(t_orbit - t_map) / t_write:.2f}x that write"
+        )
+
+
 def flow(n_orbits: int, n_steps: int, repeat: int) -> None:
     fm = paper.flow_map(eps=0.05)
     K0 = np.linspace(0.02, 0.1, n_orbits)
@@ -107,12 +140,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--orbits", type=int, default=2048)
     ap.add_argument("--steps", type=int, default=20_000)
+    ap.add_argument("--record-steps", type=int, default=2000, help="steps of the every-state rows")
     ap.add_argument("--flow-orbits", type=int, default=16)
     ap.add_argument("--flow-returns", type=int, default=200)
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
     print(f"hovering {hovering.__version__}, SIMD width {hovering.simd_width()}")
     truncated(a.orbits, a.steps, a.repeat)
+    recording(a.orbits, a.record_steps, a.repeat)
     flow(a.flow_orbits, a.flow_returns, a.repeat)
 
 

@@ -203,6 +203,15 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
     alignas(64) double ltc[kLanes], lts[kLanes], ltl1[kLanes], ltl2[kLanes], ltu[kLanes], ltcor[kLanes];
     const Packet code[4] = {zero, one, two, three};
     std::int64_t idx[kLanes], start[kLanes], due[kLanes];  // due: the next n whose state / return is recorded
+    std::int64_t slot[kLanes];  // due / every: where that record goes in the orbit's row
+    bool busy[kLanes];          // the lane holds an orbit (llive without an unpack)
+    // Recorded states and regions wait here, one row per iteration (kLanes wide), and are written
+    // kBlock at a time as one run per orbit: a per-iteration write unpacked every packet and
+    // divided twice per lane (4x the map's own time at every = 1). Flushed before any lane
+    // changes hands, so every buffered row belongs to the lane's current orbit.
+    constexpr int kBlock = 32;
+    alignas(64) double bphi[kBlock][kLanes], bK[kBlock][kLanes], breg[kBlock][kLanes];
+    int bfill = 0;  // rows buffered: iterations it - bfill .. it - 1
     std::int64_t it = 0;  // iterations of this worker; lane j has taken it - start[j] steps
 
     auto unpack = [&] {
@@ -322,6 +331,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             idx[j] = i;
             start[j] = it;
             due[j] = 0;
+            slot[j] = 0;
+            busy[j] = true;
             return true;
         }
         lphi[j] = 0.0;
@@ -331,6 +342,8 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         lkmin[j] = lkmax[j] = 0.0;
         clear(j);
         due[j] = 0;
+        slot[j] = 0;
+        busy[j] = false;
         return false;
     };
     int nlive = 0;
@@ -342,18 +355,50 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             if (is_live(j)) c = std::min(c, ns - (it - start[j]));
         return c;
     };
-    // The first iteration at which some live lane records its state / return.
-    auto next_record = [&] {
-        std::int64_t r = std::numeric_limits<std::int64_t>::max();
-        if (rec)
-            for (int j = 0; j < kLanes; ++j)
-                if (is_live(j)) r = std::min(r, start[j] + due[j]);
-        return r;
+    // Write the buffered rows: lane j records x_n (and the region of its return) for n = due[j],
+    // due[j] + every, ..., which sit at rows start[j] + n - (it - bfill).
+    auto flush = [&] {
+        const std::int64_t base = it - bfill, e = every;
+        const int nb = bfill;
+        for (int j = 0; j < kLanes; ++j) {
+            if (!busy[j]) continue;
+            double* __restrict op = out.orbit_phi ? out.orbit_phi + idx[j] * finish.n_states : nullptr;
+            double* __restrict oK = out.orbit_K ? out.orbit_K + idx[j] * finish.n_states : nullptr;
+            std::int8_t* __restrict orr = out.regions ? out.regions + idx[j] * finish.n_returns : nullptr;
+            std::int64_t r = start[j] + due[j] - base, sl = slot[j];
+            if (e == 1) {  // one tight copy per array (the common case)
+                const std::int64_t n = nb - r;
+                if (op)
+                    for (std::int64_t k = 0; k < n; ++k) op[sl + k] = bphi[r + k][j];
+                if (oK)
+                    for (std::int64_t k = 0; k < n; ++k) oK[sl + k] = bK[r + k][j];
+                if (orr)
+                    for (std::int64_t k = 0; k < n; ++k) orr[sl + k] = static_cast<std::int8_t>(breg[r + k][j]);
+                sl += n;
+                // The next flush writes the next kBlock records of this orbit: ask for their lines
+                // now (a fresh output array misses each one, and one miss at a time stalled the copy).
+                for (int k = 0; k < kBlock; k += 8) {
+                    if (op) __builtin_prefetch(op + sl + k, 1);
+                    if (oK) __builtin_prefetch(oK + sl + k, 1);
+                }
+                if (orr) __builtin_prefetch(orr + sl, 1);
+            } else {
+                for (; r < nb; r += e, ++sl) {
+                    if (op) op[sl] = bphi[r][j];
+                    if (oK) oK[sl] = bK[r][j];
+                    if (orr) orr[sl] = static_cast<std::int8_t>(breg[r][j]);
+                }
+            }
+            slot[j] = sl;
+            due[j] = sl * e;
+        }
+        bfill = 0;
     };
-    std::int64_t countdown = next_completion(), record_at = next_record();
+    std::int64_t countdown = next_completion();
 
     while (nlive > 0) {
         if ((it & 63) == 0 && opt.cancelled()) {
+            if (rec) flush();
             unpack();
             for (int j = 0; j < kLanes; ++j)
                 if (is_live(j)) finish(idx[j], lphi[j], lK[j], it - start[j], Status::Interrupted, tally(j));
@@ -443,6 +488,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
                 }
             }
         if (watch && ei::predux_any(leaving)) {
+            if (rec) flush();
             unpack();
             for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
             bool refilled = false;
@@ -467,21 +513,19 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             pack();
             if (refilled) {  // refilled lanes need their own classification
                 countdown = next_completion();
-                record_at = next_record();
                 continue;
             }
         }
-        if (it == record_at) {  // some lane records its state x_n and the region of its return
-            unpack();
-            if (out.regions)  // reg is only built when something reads it
-                for (int q = 0; q < kP; ++q) ei::pstore(lreg + q * kW, reg[q]);
-            for (int j = 0; j < kLanes; ++j) {
-                if (!is_live(j) || it - start[j] != due[j]) continue;
-                if (rec_states) finish.state(idx[j], due[j], lphi[j], lK[j]);
-                if (out.regions) finish.region(idx[j], due[j], int(lreg[j]));
-                due[j] += every;
+        if (rec) {  // every lane's state x_n and the region of its return, into the buffer
+            if (bfill == kBlock) flush();  // (rows it - kBlock .. it - 1)
+            for (int q = 0; q < kP; ++q) {
+                if (rec_states) {
+                    ei::pstore(bphi[bfill] + q * kW, phi[q]);
+                    ei::pstore(bK[bfill] + q * kW, K[q]);
+                }
+                if (out.regions) ei::pstore(breg[bfill] + q * kW, reg[q]);  // reg is built when read
             }
-            record_at = next_record();
+            ++bfill;
         }
         if (residence)
             for (int q = 0; q < kP; ++q) {
@@ -534,6 +578,7 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
         --countdown;
         progress.add(nlive);  // every live lane took one step
         if (countdown == 0 || ei::predux_any(outside) || ei::predux_any(hit)) {
+            if (rec) flush();
             unpack();
             for (int j = 0; j < kLanes; ++j) {
                 if (!is_live(j)) continue;
@@ -550,7 +595,6 @@ void run_simd(const MapCore<A, F>& m, const double* phi0, const double* K0, Work
             }
             pack();
             countdown = next_completion();
-            record_at = next_record();
         }
     }
 }
