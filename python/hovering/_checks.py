@@ -242,6 +242,32 @@ def check_points(names: tuple, shapes: tuple) -> tuple:
     return shape
 
 
+#: Exact types of a number a one-point fast path takes as it is (bools and other types, and
+#: anything non-finite or out of range, take the checked array path, which names what is wrong).
+_PLAIN = (float, int, np.float64)
+_DBL_MAX = 1.7976931348623157e308
+
+
+def plain_point(phi, K) -> bool:
+    """Whether (phi, K) is one point that needs no array checks: each a Python float or int or a
+    NumPy float64 (not a bool), K finite, phi a finite angle with ``|phi| <= MAX_ANGLE``.
+
+    The one-point fast paths (``step`` of both models, ``Section.return_map``) take such a point
+    straight to the core; everything else goes through :func:`point_pair`, whose messages name the
+    offending value. Comparisons, not ``math.isfinite``: a huge int compares exactly (no overflow).
+
+    Parameters
+    ----------
+    phi, K : object
+        What was passed.
+
+    Returns
+    -------
+    bool
+    """
+    return type(phi) in _PLAIN and type(K) in _PLAIN and -MAX_ANGLE <= phi <= MAX_ANGLE and -_DBL_MAX <= K <= _DBL_MAX
+
+
 def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
     """Points (phi, K) of a map: real, finite, |phi| <= 1e6, broadcast together (C-ordered); and
     whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0).

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, point_pair
+from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, plain_point, point_pair
 from .._core import normal as _core_normal
 from .._deprecated import call_moved, moved_argument, moved_method
 from .._enums import Region, wrap
@@ -456,7 +456,16 @@ class FlowMap(MapAnalyses):
         -------
         phi1, K1 : ndarray or float
             Images, ``phi1`` in ``[-pi, pi)``; floats when both inputs are scalars.
+
+        Notes
+        -----
+        One point given as two floats (or ints) goes straight to the core on this thread, a tuple
+        back, no arrays: the same return as :meth:`returns` bit for bit, at the cost of the return
+        itself plus ~1-2 us (``benchmarks/bench_per_call.py``).
         """
+        if plain_point(phi, K):
+            x, y, _, _ = self._core.step1(phi, K, False)
+            return x, y
         p, k, scalar = point_pair(phi, K, "step")
         r = self.returns(p, k)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
@@ -532,6 +541,9 @@ class FlowMap(MapAnalyses):
         -------
         phi0, K0 : ndarray or float
         """
+        if plain_point(phi, K):  # one point: as step()
+            x, y, _, _ = self._core.step1(phi, K, True)
+            return x, y
         p, k, scalar = point_pair(phi, K, "step_inverse")
         r = self.returns(p, k, inverse=True)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
@@ -549,6 +561,8 @@ class FlowMap(MapAnalyses):
         -------
         Region or ndarray of int8
         """
+        if plain_point(phi, K):  # one point: as step()
+            return Region(self._core.step1(phi, K, False)[3])
         p, k, scalar = point_pair(phi, K, "region")
         r = self.returns(p, k).region.reshape(p.shape)
         return Region(int(r)) if scalar else r
