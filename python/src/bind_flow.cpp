@@ -221,8 +221,9 @@ void register_flow(py::module_& m) {
         .def(
             "point",
             [](const ReturnMapper& rm, double h, double theta, double I) {
-                // One return of the point (theta, I) of Sigma_h, on this thread: no arrays, no
-                // watcher (Ctrl-C is seen when the return ends), the section coordinates of an Ok image.
+                // One return of the point (theta, I) of Sigma_h, on this thread: no watcher (Ctrl-C
+                // is seen when the return ends), the section coordinates of an Ok image; the fields
+                // of a ReturnMapResult of one return, as the batch path fills them.
                 const FlowSystem& s = rm.system();
                 std::array<double, 4> z0{};
                 ReturnResult r;
@@ -239,11 +240,36 @@ void register_flow(py::module_& m) {
                 if (r.status == FlowStatus::Ok) c = section_coordinates(s, r.z.data());
                 if (r.status == FlowStatus::OffSection) r.z = {nan, nan, nan, nan};
                 const Region reg = r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None;
-                return py::make_tuple(c[0], c[1], py::make_tuple(r.z[0], r.z[1], r.z[2], r.z[3]), r.time,
-                                      int(r.status), int(reg), r.energy_error, r.steps, r.itinerary,
-                                      hovering_py::work_dict(work));
+                auto one = [](double v) {
+                    darray a(1);
+                    a.mutable_data()[0] = v;
+                    return a;
+                };
+                darray z({py::ssize_t(1), py::ssize_t(4)});
+                for (int k = 0; k < 4; ++k) z.mutable_data()[k] = r.z[std::size_t(k)];
+                py::array_t<std::int8_t> status(1), region(1);
+                status.mutable_data()[0] = static_cast<std::int8_t>(r.status);
+                region.mutable_data()[0] = static_cast<std::int8_t>(reg);
+                py::array_t<std::int64_t> steps(1);
+                steps.mutable_data()[0] = r.steps;
+                py::list itin;
+                itin.append(r.itinerary);
+                py::dict d;
+                d["theta"] = one(c[0]);
+                d["I"] = one(c[1]);
+                d["z"] = z;
+                d["time"] = one(r.time);
+                d["itinerary"] = itin;
+                d["status"] = status;
+                d["energy_error"] = one(r.energy_error);
+                d["steps"] = steps;
+                d["region"] = region;
+                d["work"] = hovering_py::work_dict(work);
+                for (const char* k : {"trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"})
+                    d[k] = py::none();
+                return d;
             },
             py::arg("h"), py::arg("theta"), py::arg("I"),
-            "One return of the section point (theta, I): (theta1, I1, z, time, status, region, energy_error, steps, "
-            "itinerary, work); ValueError for theta outside [-pi, pi] or a non-finite I, as section_points.");
+            "One return of the section point (theta, I): the fields of a ReturnMapResult of one point (arrays of "
+            "length 1); ValueError for theta outside [-pi, pi] or a non-finite I, as section_points.");
 }

@@ -12,7 +12,7 @@ from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
 from .._io.records import reduce_record
 from .._io.serial import Saveable
-from .._progress import check_progress, progress_bar
+from .._progress import check_progress, progress_bar, stop_hook
 from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .system import StepSystem
 
@@ -310,6 +310,8 @@ class Section:
 
     def _points(self, theta, I):
         """Points of Sigma_h, a mask of those that exist, and why the others do not."""
+        if plain_point(theta, I):  # one plain point: the core checks the angle's range itself
+            return _core_flow.section_points(self.sys.core, self.h, np.array([float(theta)]), np.array([float(I)]))
         t, i = real_array("theta", theta), real_array("I", I)  # type errors first, named
         check_points(("theta", "I"), (t.shape, i.shape))  # before the copies of ravel
         t, i = np.broadcast_arrays(t, i)
@@ -470,25 +472,7 @@ class Section:
         if progress is False and trajectory_dt is None and plain_point(theta, I):
             # One point: on this thread, a tuple from the core, no progress machinery (the same
             # return as the batch path, bit for bit).
-            t1, i1, z, time, status, region, err, steps, itin, work = mapper.point(self.h, theta, I)
-            return ReturnMapResult._make(
-                dict(
-                    theta=np.array([t1]),
-                    I=np.array([i1]),
-                    z=np.array([z]),
-                    time=np.array([time]),
-                    itinerary=[itin],
-                    status=np.array([status], dtype=np.int8),
-                    energy_error=np.array([err]),
-                    steps=np.array([steps], dtype=np.int64),
-                    region=np.array([region], dtype=np.int8),
-                    work=work,
-                    trajectory=None,
-                    trajectory_index=None,
-                    trajectory_kind=None,
-                    trajectory_truncated=None,
-                )
-            )
+            return ReturnMapResult._make(mapper.point(self.h, float(theta), float(I)))
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
         dt, per_orbit = (
@@ -496,8 +480,8 @@ class Section:
             if trajectory_dt is None
             else trajectory_arguments(trajectory_dt, max_trajectory_points, z0.shape[0])
         )
-        if progress is False:
-            d = mapper.run(z0, threads, dt, per_orbit, None)
+        if progress is False:  # no bar; inside a parallel run's piece, its stop check (stop_hook)
+            d = mapper.run(z0, threads, dt, per_orbit, stop_hook())
         else:
             with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
                 d = mapper.run(z0, threads, dt, per_orbit, bar.part(0) or None)
