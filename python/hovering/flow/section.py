@@ -468,11 +468,12 @@ class Section:
         mapper = self._mapper(
             (rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)
         )
-        threads = _threads(n_threads, self.sys.python_defined)
         if progress is False and trajectory_dt is None and plain_point(theta, I):
-            # One point: on this thread, a tuple from the core, no progress machinery (the same
-            # return as the batch path, bit for bit).
+            # One point: on this thread (n_threads is checked, not used), the result's fields
+            # from the core, no progress machinery: the batch path's return, bit for bit.
+            thread_count(n_threads)
             return ReturnMapResult._make(mapper.point(self.h, float(theta), float(I)))
+        threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
         dt, per_orbit = (
