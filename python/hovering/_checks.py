@@ -226,7 +226,8 @@ def check_points(names: tuple, shapes: tuple) -> tuple:
         largest count allowed).
     """
     try:
-        shape = np.broadcast_shapes(*shapes)
+        # Equal shapes (the common case) broadcast to themselves.
+        shape = shapes[0] if len(set(shapes)) == 1 else np.broadcast_shapes(*shapes)
     except ValueError:
         raise ValueError(
             f"{' and '.join(names)} must have broadcastable shapes, got {' and '.join(str(s) for s in shapes)}"
@@ -242,10 +243,38 @@ def check_points(names: tuple, shapes: tuple) -> tuple:
     return shape
 
 
+#: Exact types of a number a one-point fast path takes as it is (bools and other types, and
+#: anything non-finite or out of range, take the checked array path, which names what is wrong).
+_PLAIN = (float, int, np.float64)
+_DBL_MAX = 1.7976931348623157e308
+
+
+def plain_point(phi, K) -> bool:
+    """Whether (phi, K) is one point that needs no array checks: each a Python float or int or a
+    NumPy float64 (not a bool), K finite, phi a finite angle with ``|phi| <= MAX_ANGLE``.
+
+    The one-point fast paths (``step`` of both models, ``Section.return_map``) take such a point
+    straight to the core; everything else goes through :func:`point_pair`, whose messages name the
+    offending value. Comparisons, not ``math.isfinite``: a huge int compares exactly (no overflow).
+
+    Parameters
+    ----------
+    phi, K : object
+        What was passed.
+
+    Returns
+    -------
+    bool
+    """
+    return type(phi) in _PLAIN and type(K) in _PLAIN and -MAX_ANGLE <= phi <= MAX_ANGLE and -_DBL_MAX <= K <= _DBL_MAX
+
+
 def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
     """Points (phi, K) of a map: real, finite, |phi| <= 1e6, broadcast together (C-ordered); and
     whether both were scalars. Messages name ``who: phi`` (or the given names, e.g. phi0, K0).
     The broadcast size is checked (:func:`check_points`) before the copies are made."""
+    if plain_point(phi, K):  # one plain point: nothing to check or broadcast
+        return np.array(float(phi)), np.array(float(K)), True
     na, nb = (f"{who}: {n}" if who else n for n in names)
     scalar = np.ndim(phi) == 0 and np.ndim(K) == 0
     p, k = real_array(na, phi), real_array(nb, K)  # type errors first, named
@@ -255,7 +284,8 @@ def point_pair(phi, K, who: str = "", names=("phi", "K")) -> tuple:
         check_points(tuple(names), (p.shape, k.shape))
     except ValueError as e:
         raise ValueError(f"{who}: {e}" if who else str(e)) from None
-    p, k = np.broadcast_arrays(p, k)
+    if p.shape != k.shape:
+        p, k = np.broadcast_arrays(p, k)
     # np.ascontiguousarray would turn 0-d into 1-d; the bindings copy non-contiguous views themselves.
     return np.asarray(p, order="C"), np.asarray(k, order="C"), scalar
 
@@ -274,6 +304,8 @@ def real_array(name: str, value) -> np.ndarray:
 def require_finite(name: str, a) -> None:
     """Raise a ValueError naming the first non-finite entry of ``a``."""
     a = np.asarray(a)
+    if a.dtype.kind in "iub" or np.isfinite(a).all():  # one pass where all is well
+        return
     bad = ~np.isfinite(a)
     if bad.any():
         i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
@@ -282,8 +314,12 @@ def require_finite(name: str, a) -> None:
 
 def require_angles(name: str, a) -> None:
     """Raise unless every entry is a finite angle that can be wrapped accurately (|x| <= MAX_ANGLE)."""
-    require_finite(name, a)
     a = np.asarray(a)
+    if a.size and a.dtype.kind == "f":
+        lo, hi = a.min(), a.max()
+        if -MAX_ANGLE <= lo and hi <= MAX_ANGLE:  # finite angles in range (NaN fails both): done
+            return
+    require_finite(name, a)
     if a.size and np.max(np.abs(a)) > MAX_ANGLE:
         i = np.unravel_index(int(np.argmax(np.abs(a.ravel()) > MAX_ANGLE)), a.shape)
         raise ValueError(
@@ -292,12 +328,17 @@ def require_angles(name: str, a) -> None:
         )
 
 
+_MEMORY: list = []  # physical_memory(), asked once (two system calls a call otherwise)
+
+
 def physical_memory() -> int:
     """Bytes of physical memory of this machine (64 GiB where the system does not say)."""
-    try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return 2**36
+    if not _MEMORY:
+        try:
+            _MEMORY.append(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        except (ValueError, OSError, AttributeError):
+            _MEMORY.append(2**36)
+    return _MEMORY[0]
 
 
 def check_memory(what: str, nbytes: int) -> None:

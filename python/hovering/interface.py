@@ -287,9 +287,15 @@ class IterateResult(Summarized, Saveable):
             If the core was interrupted; the result so far is its ``partial`` attribute.
         """
         names = names or {}
-        given: dict = {"n_steps": n_steps, "map": m, "every": every}
-        values: dict = {f.name: d.get(names.get(f.name, f.name)) for f in fields(cls) if f.name not in given}
-        res = cls(**values, **given)
+        keys = cls.__dict__.get("_field_names")
+        if keys is None:  # the fields, listed once per class (dataclasses.fields costs ~1 us a field)
+            keys = tuple(f.name for f in fields(cls) if f.name not in ("n_steps", "map", "every"))
+            cls._field_names = keys
+        values = {k: d.get(names.get(k, k)) for k in keys}
+        values.update(n_steps=n_steps, map=m, every=every)
+        # Every field given: the dataclass's __init__ would only set them, one frozen setattr each.
+        res = object.__new__(cls)
+        res.__dict__.update(values)
         if d["interrupted"]:
             exc = KeyboardInterrupt("iteration interrupted; the state reached is in .partial")
             exc.partial = res  # type: ignore[attr-defined]

@@ -31,6 +31,53 @@ FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<cons
     return s;
 }
 
+// A batch of returns of states z0 (n, 4) as the dict Section.return_map reads; run(z0, n, cancel,
+// out, progress) computes them (return_maps, or a ReturnMapper's).
+template <class Run>
+py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_points_per_orbit, py::object progress,
+                      Run run) {
+    if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
+    if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
+        throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
+                              std::to_string(trajectory_dt));
+    const py::ssize_t n = z0.shape(0);
+    darray z({n, py::ssize_t(4)}), time(n), err(n);
+    py::array_t<std::int8_t> status(n), region(n);
+    py::array_t<std::int64_t> steps(n);
+    std::vector<std::string> itin{static_cast<std::size_t>(n)};
+    hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
+    FlowWork work;
+    ReturnMapsOutput out;
+    out.z = z.mutable_data();
+    out.time = time.mutable_data();
+    out.energy_error = err.mutable_data();
+    out.status = status.mutable_data();
+    out.region = region.mutable_data();
+    out.steps = steps.mutable_data();
+    out.itinerary = itin.data();
+    out.work = &work;
+    out.trajectory = traj.output();
+    std::atomic<bool> cancel{false};
+    std::atomic<std::int64_t> done{0};
+    const hovering_py::ProgressReport report{&done, std::int64_t(n), std::move(progress)};
+    // Orbits are independent and write disjoint slots of freshly allocated arrays.
+    const bool interrupted = hovering_py::run_watched(
+        [&] { run(z0.data(), std::int64_t(n), &cancel, out, report.active() ? &done : nullptr); }, cancel, n >= 64,
+        &report);
+    py::dict d;
+    d["z"] = z;
+    d["time"] = time;
+    d["energy_error"] = err;
+    d["status"] = status;
+    d["region"] = region;
+    d["steps"] = steps;
+    d["itinerary"] = itin;
+    d["work"] = hovering_py::work_dict(work);
+    traj.put(d);
+    d["interrupted"] = interrupted;
+    return d;
+}
+
 }  // namespace
 
 void register_flow(py::module_& m) {
@@ -144,49 +191,85 @@ void register_flow(py::module_& m) {
         [](const FlowSystem& s, const darray& z0, const FlowOptions& o, int n_threads, double trajectory_dt,
            std::int64_t max_points_per_orbit, py::object progress) {
             o.validate();
-            if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
-            if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
-                throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
-                                      std::to_string(trajectory_dt));
-            const py::ssize_t n = z0.shape(0);
-            darray z({n, py::ssize_t(4)}), time(n), err(n);
-            py::array_t<std::int8_t> status(n), region(n);
-            py::array_t<std::int64_t> steps(n);
-            std::vector<std::string> itin{static_cast<std::size_t>(n)};
-            hovering_py::Trajectories traj(n, trajectory_dt, max_points_per_orbit);
-            FlowWork work;
-            ReturnMapsOutput out;
-            out.z = z.mutable_data();
-            out.time = time.mutable_data();
-            out.energy_error = err.mutable_data();
-            out.status = status.mutable_data();
-            out.region = region.mutable_data();
-            out.steps = steps.mutable_data();
-            out.itinerary = itin.data();
-            out.work = &work;
-            out.trajectory = traj.output();
-            std::atomic<bool> cancel{false};
-            std::atomic<std::int64_t> done{0};
-            const hovering_py::ProgressReport report{&done, std::int64_t(n), std::move(progress)};
-            // Orbits are independent and write disjoint slots of freshly allocated arrays.
-            const bool interrupted = hovering_py::run_watched(
-                [&] { return_maps(s, z0.data(), n, o, n_threads, &cancel, out, report.active() ? &done : nullptr); },
-                cancel, n >= 64, &report);
-            py::dict d;
-            d["z"] = z;
-            d["time"] = time;
-            d["energy_error"] = err;
-            d["status"] = status;
-            d["region"] = region;
-            d["steps"] = steps;
-            d["itinerary"] = itin;
-            d["work"] = hovering_py::work_dict(work);
-            traj.put(d);
-            d["interrupted"] = interrupted;
-            return d;
+            return returns_dict(z0, trajectory_dt, max_points_per_orbit, std::move(progress),
+                                [&](const double* z, std::int64_t n, const std::atomic<bool>* cancel,
+                                    const ReturnMapsOutput& out, std::atomic<std::int64_t>* done) {
+                                    return_maps(s, z, n, o, n_threads, cancel, out, done);
+                                });
         },
         py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,
         py::arg("max_points_per_orbit") = 0, py::arg("progress") = py::none(),
         "Returns of states z0 (n, 4): per-orbit outcomes, never a batch error for one orbit; with trajectory_dt > 0 "
         "each return's trajectory too; progress(done, total) is called every ~0.1 s and at the end.");
+
+    py::class_<ReturnMapper>(m, "ReturnMapper",
+                             "return_maps of one system with one set of options, validated once, its tracers kept "
+                             "from call to call (what a Section keeps per options).")
+        .def(py::init<const FlowSystem&, const FlowOptions&>(), py::arg("system"), py::arg("options"))
+        .def(
+            "run",
+            [](const ReturnMapper& rm, const darray& z0, int n_threads, double trajectory_dt,
+               std::int64_t max_points_per_orbit, py::object progress) {
+                return returns_dict(z0, trajectory_dt, max_points_per_orbit, std::move(progress),
+                                    [&](const double* z, std::int64_t n, const std::atomic<bool>* cancel,
+                                        const ReturnMapsOutput& out, std::atomic<std::int64_t>* done) {
+                                        rm.run(z, n, n_threads, cancel, out, done);
+                                    });
+            },
+            py::arg("z0"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0, py::arg("max_points_per_orbit") = 0,
+            py::arg("progress") = py::none(), "return_maps(system, z0, options, ...) on the kept tracers (the same dict).")
+        .def(
+            "point",
+            [](const ReturnMapper& rm, double h, double theta, double I) {
+                // One return of the point (theta, I) of Sigma_h, on this thread: no watcher (Ctrl-C
+                // is seen when the return ends), the section coordinates of an Ok image; the fields
+                // of a ReturnMapResult of one return, as the batch path fills them.
+                const FlowSystem& s = rm.system();
+                std::array<double, 4> z0{};
+                ReturnResult r;
+                FlowWork work;
+                {
+                    hovering_py::GilRelease release;  // a Python-defined potential takes it back
+                    if (try_section_point(s, h, theta, I, z0))
+                        r = rm.one(z0, &work);
+                    else
+                        r.status = FlowStatus::OffSection;
+                }
+                const double nan = std::numeric_limits<double>::quiet_NaN();
+                std::array<double, 2> c{nan, nan};
+                if (r.status == FlowStatus::Ok) c = section_coordinates(s, r.z.data());
+                if (r.status == FlowStatus::OffSection) r.z = {nan, nan, nan, nan};
+                const Region reg = r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None;
+                auto one = [](double v) {
+                    darray a(1);
+                    a.mutable_data()[0] = v;
+                    return a;
+                };
+                darray z({py::ssize_t(1), py::ssize_t(4)});
+                for (int k = 0; k < 4; ++k) z.mutable_data()[k] = r.z[std::size_t(k)];
+                py::array_t<std::int8_t> status(1), region(1);
+                status.mutable_data()[0] = static_cast<std::int8_t>(r.status);
+                region.mutable_data()[0] = static_cast<std::int8_t>(reg);
+                py::array_t<std::int64_t> steps(1);
+                steps.mutable_data()[0] = r.steps;
+                py::list itin;
+                itin.append(r.itinerary);
+                py::dict d;
+                d["theta"] = one(c[0]);
+                d["I"] = one(c[1]);
+                d["z"] = z;
+                d["time"] = one(r.time);
+                d["itinerary"] = itin;
+                d["status"] = status;
+                d["energy_error"] = one(r.energy_error);
+                d["steps"] = steps;
+                d["region"] = region;
+                d["work"] = hovering_py::work_dict(work);
+                for (const char* k : {"trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"})
+                    d[k] = py::none();
+                return d;
+            },
+            py::arg("h"), py::arg("theta"), py::arg("I"),
+            "One return of the section point (theta, I): the fields of a ReturnMapResult of one point (arrays of "
+            "length 1); ValueError for theta outside [-pi, pi] or a non-finite I, as section_points.");
 }

@@ -338,6 +338,20 @@ void register_normal(py::module_& m) {
              }),
              py::arg("system"), py::arg("h"), py::arg("options"), py::arg("curve"), py::arg("lift"))
         .def("steps", &steps, py::arg("x"), py::arg("y"), py::arg("inverse"), py::arg("n_threads"))
+        .def(
+            "step1",
+            [](const FlowMap& fm, double x, double y, bool inverse) {
+                // One point on this thread, a tuple back: no arrays, no watcher thread (a return
+                // takes microseconds; Ctrl-C is seen when it ends). The same return as steps().
+                FlowStep st;
+                {
+                    hovering_py::GilRelease release;  // a Python-defined potential takes it back
+                    st = inverse ? fm.step_inverse(x, y) : fm.step(x, y);
+                }
+                return py::make_tuple(st.x, st.y, int(st.ret.status), int(st.region));
+            },
+            py::arg("x"), py::arg("y"), py::arg("inverse") = false,
+            "One return of one point: (x1, y1, FlowStatus, Region), steps()' numbers bit for bit.")
         .def("jacobians", &jacobians, py::arg("x"), py::arg("y"), py::arg("n_threads"))
         .def("iterate", &iterate, py::arg("x0"), py::arg("y0"), py::arg("n_steps"), py::arg("record"),
              py::arg("exit_mask"), py::arg("stop_on_exit"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,

@@ -153,6 +153,17 @@ void bind_common(Cls& cls) {
             [](const Map& m, const darray& phi, const darray& K) {
                 return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step(p, k); });
             })
+        .def("_step1",
+             [](const Map& m, double phi, double K) {
+                 // One point, a tuple back (no arrays): _step's numbers for a scalar.
+                 const auto r = m.step(phi, K);
+                 return py::make_tuple(r.first, r.second);
+             })
+        .def("_step_inverse1",
+             [](const Map& m, double phi, double K) {
+                 const auto r = m.step_inverse(phi, K);
+                 return py::make_tuple(r.first, r.second);
+             })
         .def("_step_inverse",
              [](const Map& m, const darray& phi, const darray& K) {
                  return map2(m, phi, K, [](const Map& mm, double p, double k) { return mm.step_inverse(p, k); });

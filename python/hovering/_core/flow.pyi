@@ -164,3 +164,15 @@ def return_maps(
     max_points_per_orbit: int = ...,
     progress: Callable[[int, int], object] | None = ...,
 ) -> dict[str, object]: ...
+
+class ReturnMapper:
+    def __init__(self, system: FlowSystem, options: FlowOptions) -> None: ...
+    def run(
+        self,
+        z0: npt.NDArray[np.float64],
+        n_threads: int,
+        trajectory_dt: float = ...,
+        max_points_per_orbit: int = ...,
+        progress: Callable[[int, int], object] | None = ...,
+    ) -> dict[str, object]: ...
+    def point(self, h: float, theta: float, I: float) -> dict[str, object]: ...

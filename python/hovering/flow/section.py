@@ -6,13 +6,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import check_points, integer, real_array, real_number, thread_count
+from .._checks import check_points, integer, plain_point, real_array, real_number, thread_count
 from .._core import flow as _core_flow
 from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
 from .._io.records import reduce_record
 from .._io.serial import Saveable
-from .._progress import check_progress, progress_bar
+from .._progress import check_progress, progress_bar, stop_hook
 from ..interface import MAX_TRAJECTORY_POINTS, trajectory_arguments, trajectory_rows
 from .system import StepSystem
 
@@ -153,6 +153,15 @@ class ReturnMapResult(Summarized, Saveable):
     trajectory_kind: np.ndarray | None = field(default=None, repr=False)
     trajectory_truncated: np.ndarray | None = field(default=None, repr=False)
 
+    @classmethod
+    def _make(cls, fields: dict) -> ReturnMapResult:
+        """The result with these fields (every one named; the core's own arrays, no checks): what
+        the dataclass constructor makes, without its 14 frozen-attribute assignments (4 us of a
+        one-point call)."""
+        r = object.__new__(cls)
+        r.__dict__.update(fields)
+        return r
+
     def trajectory_of(self, i: int) -> np.ndarray:
         """The recorded flow of return i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
 
@@ -247,8 +256,32 @@ class Section:
         return cls(record["sys"], record["h"])
 
     def __reduce__(self):
-        """Pickle as the record (and any other instance attribute)."""
-        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h")})
+        """Pickle as the record (and any other instance attribute but the kept core mappers)."""
+        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h", "_mappers")})
+
+    #: Distinct option sets whose validated core mapper a section keeps (beyond, it starts afresh).
+    _MAX_MAPPERS = 16
+
+    def _mapper(self, args: tuple) -> _core_flow.ReturnMapper:
+        """The core's return mapper for these integrator options (rtol, atol, stepper, event_tol,
+        max_steps, max_impacts, grazing_tol, corner_tol, verify_steps): validated (flow_options,
+        validate_for) at the first call with them, then kept with its tracers. The key holds the
+        arguments' types too, so that True is never taken for a validated 1."""
+        key = args + tuple(map(type, args))
+        mappers = self.__dict__.get("_mappers")
+        if mappers is None:
+            mappers = self.__dict__["_mappers"] = {}
+        try:
+            return mappers[key]
+        except KeyError:
+            pass
+        except TypeError:  # an unhashable argument: validation names it
+            return _core_flow.ReturnMapper(self.sys.core, flow_options(*args))
+        m = _core_flow.ReturnMapper(self.sys.core, flow_options(*args))  # validate_for inside
+        if len(mappers) >= self._MAX_MAPPERS:
+            mappers.clear()
+        mappers[key] = m
+        return m
 
     def point(self, theta, I) -> np.ndarray:
         """States (q1, 0, q2, p2) of Sigma_h at section coordinates (theta, I).
@@ -277,6 +310,8 @@ class Section:
 
     def _points(self, theta, I):
         """Points of Sigma_h, a mask of those that exist, and why the others do not."""
+        if plain_point(theta, I):  # one plain point: the core checks the angle's range itself
+            return _core_flow.section_points(self.sys.core, self.h, np.array([float(theta)]), np.array([float(I)]))
         t, i = real_array("theta", theta), real_array("I", I)  # type errors first, named
         check_points(("theta", "I"), (t.shape, i.shape))  # before the copies of ravel
         t, i = np.broadcast_arrays(t, i)
@@ -428,10 +463,16 @@ class Section:
         >>> sec.return_map([0.0], [0.8]).count("OFF_SECTION")
         1
         """
-        opts = flow_options(
-            rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps
+        # Options are validated once per distinct set (the mapper is kept); n_threads and progress
+        # every call (cheap), the points every call.
+        mapper = self._mapper(
+            (rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)
         )
-        opts.validate_for(self.sys.core)
+        if progress is False and trajectory_dt is None and plain_point(theta, I):
+            # One point: on this thread (n_threads is checked, not used), the result's fields
+            # from the core, no progress machinery: the batch path's return, bit for bit.
+            thread_count(n_threads)
+            return ReturnMapResult._make(mapper.point(self.h, float(theta), float(I)))
         threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
@@ -440,29 +481,34 @@ class Section:
             if trajectory_dt is None
             else trajectory_arguments(trajectory_dt, max_trajectory_points, z0.shape[0])
         )
-        with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
-            d = _core_flow.return_maps(self.sys.core, z0, opts, threads, dt, per_orbit, bar.part(0) or None)
+        if progress is False:  # no bar; inside a parallel run's piece, its stop check (stop_hook)
+            d = mapper.run(z0, threads, dt, per_orbit, stop_hook())
+        else:
+            with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
+                d = mapper.run(z0, threads, dt, per_orbit, bar.part(0) or None)
         # The image's coordinates where there is an image: a stopped orbit's z is its last state,
         # which need not have coordinates (a runaway's H2 overflows), and its records are NaN.
         c = np.full((z0.shape[0], 2), np.nan)
         ok = d["status"] == _OK  # an int: comparing with the IntEnum member costs 5 us per call
         if ok.any():  # the core's own states: no checks needed
             c[ok] = _core_flow.section_coordinates(self.sys.core, d["z"][ok])
-        res = ReturnMapResult(
-            theta=c[:, 0],
-            I=c[:, 1],
-            z=d["z"],
-            time=d["time"],
-            itinerary=d["itinerary"],
-            status=d["status"],
-            energy_error=d["energy_error"],
-            steps=d["steps"],
-            region=d["region"],
-            work=d["work"],
-            trajectory=d.get("trajectory"),
-            trajectory_index=d.get("trajectory_index"),
-            trajectory_kind=d.get("trajectory_kind"),
-            trajectory_truncated=d.get("trajectory_truncated"),
+        res = ReturnMapResult._make(
+            dict(
+                theta=c[:, 0],
+                I=c[:, 1],
+                z=d["z"],
+                time=d["time"],
+                itinerary=d["itinerary"],
+                status=d["status"],
+                energy_error=d["energy_error"],
+                steps=d["steps"],
+                region=d["region"],
+                work=d["work"],
+                trajectory=d.get("trajectory"),
+                trajectory_index=d.get("trajectory_index"),
+                trajectory_kind=d.get("trajectory_kind"),
+                trajectory_truncated=d.get("trajectory_truncated"),
+            )
         )
         if d["interrupted"]:
             exc = KeyboardInterrupt("return map interrupted; the finished returns are in .partial")

@@ -14,13 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, point_pair
+from .._checks import MAX_MODES, check_memory, flag, forcing_array, integer, is_choice, plain_point, point_pair
 from .._core import normal as _core_normal
+from .._core import wrap as _core_wrap
 from .._deprecated import call_moved, moved_argument, moved_method
 from .._enums import Region, wrap
 from .._io.records import reduce_record
 from .._io.serial import Saveable
-from .._progress import check_progress, progress_bar
+from .._progress import check_progress, progress_bar, stop_hook
 from ..flow.section import Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
 from ..interface import (
@@ -427,7 +428,9 @@ class FlowMap(MapAnalyses):
             flag("inverse", inverse),
             _threads(n_threads, self.sys.python_defined),
         )
-        res = FlowSteps(
+        # Every field given, the core's own arrays: no dataclass __init__ (a frozen setattr each).
+        res = object.__new__(FlowSteps)
+        res.__dict__.update(
             phi=d["x"],
             K=d["y"],
             status=d["status"],
@@ -456,7 +459,16 @@ class FlowMap(MapAnalyses):
         -------
         phi1, K1 : ndarray or float
             Images, ``phi1`` in ``[-pi, pi)``; floats when both inputs are scalars.
+
+        Notes
+        -----
+        One point given as two floats (or ints) goes straight to the core on this thread, a tuple
+        back, no arrays: the same return as :meth:`returns` bit for bit, at the cost of the return
+        itself plus ~1-2 us (``benchmarks/bench_per_call.py``).
         """
+        if plain_point(phi, K):
+            x, y, _, _ = self._core.step1(phi, K, False)
+            return x, y
         p, k, scalar = point_pair(phi, K, "step")
         r = self.returns(p, k)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
@@ -532,6 +544,9 @@ class FlowMap(MapAnalyses):
         -------
         phi0, K0 : ndarray or float
         """
+        if plain_point(phi, K):  # one point: as step()
+            x, y, _, _ = self._core.step1(phi, K, True)
+            return x, y
         p, k, scalar = point_pair(phi, K, "step_inverse")
         r = self.returns(p, k, inverse=True)
         a, b = r.phi.reshape(p.shape), r.K.reshape(p.shape)
@@ -549,6 +564,8 @@ class FlowMap(MapAnalyses):
         -------
         Region or ndarray of int8
         """
+        if plain_point(phi, K):  # one point: as step()
+            return Region(self._core.step1(phi, K, False)[3])
         p, k, scalar = point_pair(phi, K, "region")
         r = self.returns(p, k).region.reshape(p.shape)
         return Region(int(r)) if scalar else r
@@ -661,12 +678,13 @@ class FlowMap(MapAnalyses):
         every, stop_side, stop_curve = transport_arguments(every, stop)
         progress = check_progress(progress)
         p, k, _ = point_pair(phi0, K0, names=("phi0", "K0"))
-        # The recorded orbit starts on [-pi, pi) like every later point.
-        p, k = np.ascontiguousarray(np.asarray(wrap(p), dtype=float).ravel()), np.ascontiguousarray(k.ravel())
+        # The recorded orbit starts on [-pi, pi) like every later point (point_pair checked
+        # |phi0| <= 1e6: the core's wrap directly).
+        p, k = np.ascontiguousarray(_core_wrap(p.ravel()), dtype=float), np.ascontiguousarray(k.ravel())
         n_states, n_returns = recorded_counts(n_steps, every)
-        per_point = sum(2 for key in ("orbit", "section") if key in record) + (4 if "states" in record else 0)
+        per_point = 2 * ("orbit" in record) + 2 * ("section" in record) + 4 * ("states" in record)
         per_return = (
-            8 * sum(key in record for key in ("times", "energy_error", "steps"))
+            8 * (("times" in record) + ("energy_error" in record) + ("steps" in record))
             + ("regions" in record)
             + 64 * ("itinerary" in record)
         )
@@ -688,22 +706,12 @@ class FlowMap(MapAnalyses):
                 "or leave trajectory_dt out"
             )
         threads = _threads(n_threads, self.sys.python_defined)
-        with progress_bar(progress, p.size * n_steps, desc="FlowMap.iterate", unit="return") as bar:
-            d = self._core.iterate(
-                p,
-                k,
-                n_steps,
-                set(record),
-                mask,
-                bool(stop_on_exit),
-                threads,
-                dt,
-                per_orbit,
-                bar.part(0) or None,
-                every,
-                stop_side,
-                stop_curve,
-            )
+        args = (p, k, n_steps, set(record), mask, bool(stop_on_exit), threads, dt, per_orbit)
+        if progress is False:  # no bar machinery; inside a parallel run's piece, its stop check
+            d = self._core.iterate(*args, stop_hook(), every, stop_side, stop_curve)
+        else:
+            with progress_bar(progress, p.size * n_steps, desc="FlowMap.iterate", unit="return") as bar:
+                d = self._core.iterate(*args, bar.part(0) or None, every, stop_side, stop_curve)
         return IterateResult.from_core(d, self, n_steps, every, names=_CORE_NAMES)
 
     def with_eps(self, eps: float) -> FlowMap:

@@ -17,6 +17,7 @@ from .._checks import (
     check_memory,
     forcing_array,
     is_choice,
+    plain_point,
     point_pair,
     real_array,
     real_number,
@@ -75,6 +76,8 @@ class _MapAPI(MapAnalyses):
         ``|K| < ~1e-30`` - can hold no double; its start then lies in the next arc.) The SIMD
         kernel of :meth:`iterate` follows the same convention bit for bit.
         """
+        if plain_point(phi, K):  # one point: a tuple from the core, no arrays (the same numbers)
+            return self._step1(phi, K)
         p, k, scalar = point_pair(phi, K, "step")
         a, b = self._step(p, k)
         return (float(a), float(b)) if scalar else (a, b)
@@ -114,6 +117,8 @@ class _MapAPI(MapAnalyses):
         as that start; arcs shorter than the rounding (within ~1e-15 of the band floor, J_1 for
         ``|K| < ~1e-28``) can share their starts' images, and one of those starts comes back.
         """
+        if plain_point(phi, K):  # one point: as step()
+            return self._step_inverse1(phi, K)
         p, k, scalar = point_pair(phi, K, "step_inverse")
         a, b = self._step_inverse(p, k)
         return (float(a), float(b)) if scalar else (a, b)

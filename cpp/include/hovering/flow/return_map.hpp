@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@
 #include "hovering/types.hpp"
 
 namespace hovering {
+
+namespace detail {
+class TracerPool;
+}
 
 /// Per-orbit outcome of a return-map computation.
 enum class FlowStatus : std::int8_t {
@@ -148,6 +153,8 @@ struct FlowWork {
     std::int64_t steps = 0;                 ///< accepted integrator steps
     /// Add another worker's counts.
     FlowWork& operator+=(const FlowWork& o);
+    /// Take away counts made before (what a kept tracer counted in earlier calls).
+    FlowWork& operator-=(const FlowWork& o);
 };
 
 /// What a recorded trajectory point is.
@@ -205,5 +212,27 @@ struct ReturnMapsOutput {
 void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
                  const std::atomic<bool>* cancel, const ReturnMapsOutput& out,
                  std::atomic<std::int64_t>* progress = nullptr);
+
+/// return_maps of one system with one set of options, validated once, whose tracers are kept from
+/// call to call (detail::TracerPool): for callers that map a few points at a time, many times (a
+/// section's repeated return_map calls). Results are return_maps' bit for bit.
+class ReturnMapper {
+public:
+    /// The system and options (both validated here; std::invalid_argument names what is wrong).
+    ReturnMapper(const FlowSystem& s, const FlowOptions& opt);
+    /// return_maps(system(), z0, n, options(), ...) on the kept tracers.
+    void run(const double* z0, std::int64_t n, int n_threads, const std::atomic<bool>* cancel,
+             const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress = nullptr) const;
+    /// One return from z0 on the calling thread (a non-finite z0: OffSection, nothing traced);
+    /// its work counters go to *work when given (as run()'s out.work).
+    ReturnResult one(const std::array<double, 4>& z0, FlowWork* work = nullptr) const;
+    /// The system.
+    const FlowSystem& system() const;
+    /// The options.
+    const FlowOptions& options() const;
+
+private:
+    std::shared_ptr<detail::TracerPool> pool_;
+};
 
 }  // namespace hovering

@@ -25,6 +25,7 @@ namespace hovering {
 
 namespace detail {
 class Tracer;
+class TracerPool;
 }
 
 /// What a flow-map iteration does besides stepping: the shared BatchOptions (counts in returns;
@@ -158,6 +159,9 @@ private:
     std::shared_ptr<const TangentialCurve> curve_;
     std::shared_ptr<const AnalyticArcs> lift_;
     double lift_I0_ = 0;
+    // The tracers of earlier calls, kept for the next (a loop of one-point calls paid ~10 us a call
+    // to build them); shared by copies of this map (the pool owns its system and options).
+    std::shared_ptr<detail::TracerPool> pool_;
 };
 
 }  // namespace hovering

@@ -52,6 +52,17 @@ FlowWork& FlowWork::operator+=(const FlowWork& o) {
     return *this;
 }
 
+FlowWork& FlowWork::operator-=(const FlowWork& o) {
+    field_evaluations -= o.field_evaluations;
+    coupling_evaluations -= o.coupling_evaluations;
+    wall_searches -= o.wall_searches;
+    section_searches -= o.section_searches;
+    label_operations -= o.label_operations;
+    dense_samples -= o.dense_samples;
+    steps -= o.steps;
+    return *this;
+}
+
 void TrajectoryOutput::validate() const {
     if (!active()) return;
     if (!(dt > 0 && std::isfinite(dt))) bad("trajectory dt must be finite and > 0, got " + detail::fmt(dt));
@@ -77,11 +88,12 @@ ReturnResult return_map(const FlowSystem& s, const std::array<double, 4>& z0, co
     return tracer.trace(z0);
 }
 
-void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
-                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress) {
-    detail::gsl_quiet();
-    opt.validate(s);
-    s.validate();
+namespace {
+
+// return_maps on validated s and opt, its tracers from pool (null: new ones).
+void run_returns(detail::TracerPool* pool, const FlowSystem& s, const double* z0, std::int64_t n,
+                 const FlowOptions& opt, int n_threads, const std::atomic<bool>* cancel, const ReturnMapsOutput& out,
+                 std::atomic<std::int64_t>* progress) {
     if (n < 0) bad("number of orbits must be >= 0, got " + std::to_string(n));
     if (n_threads < 0 || n_threads > detail::kMaxThreads)
         bad("n_threads must be in [0, " + std::to_string(detail::kMaxThreads) + "] (0 = all cores), got " +
@@ -107,7 +119,8 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
         // Returns side by side (8 lanes for stepper "taylor"): each lane takes the next orbit as
         // soon as its return is over; an orbit's result does not depend on its lane or partners.
-        detail::TracerGroup group(s, opt);
+        detail::PooledGroup pooled(pool, s, opt);
+        detail::TracerGroup& group = *pooled;
         const int L = group.lanes();
         std::vector<detail::DenseRecorder> rec(static_cast<std::size_t>(L));
         std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
@@ -152,11 +165,59 @@ void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const Fl
             }
         }
         if (out.work) {
-            const FlowWork w = group.work();
+            const FlowWork w = pooled.work();
             std::lock_guard<std::mutex> lock(mu);
             *out.work += w;
         }
     });
+}
+
+}  // namespace
+
+void return_maps(const FlowSystem& s, const double* z0, std::int64_t n, const FlowOptions& opt, int n_threads,
+                 const std::atomic<bool>* cancel, const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress) {
+    detail::gsl_quiet();
+    opt.validate(s);
+    s.validate();
+    run_returns(nullptr, s, z0, n, opt, n_threads, cancel, out, progress);
+}
+
+ReturnMapper::ReturnMapper(const FlowSystem& s, const FlowOptions& opt) {
+    detail::gsl_quiet();
+    opt.validate(s);
+    s.validate();
+    pool_ = std::make_shared<detail::TracerPool>(s, opt);
+}
+
+void ReturnMapper::run(const double* z0, std::int64_t n, int n_threads, const std::atomic<bool>* cancel,
+                       const ReturnMapsOutput& out, std::atomic<std::int64_t>* progress) const {
+    run_returns(pool_.get(), pool_->system(), z0, n, pool_->options(), n_threads, cancel, out, progress);
+}
+
+ReturnResult ReturnMapper::one(const std::array<double, 4>& z0, FlowWork* work) const {
+    ReturnResult r;
+    r.z = z0;
+    if (!(std::isfinite(z0[0]) && std::isfinite(z0[1]) && std::isfinite(z0[2]) && std::isfinite(z0[3]))) {
+        r.status = FlowStatus::OffSection;
+        return r;
+    }
+    // As run() with one orbit: lane 0 of a kept group, traced alone.
+    detail::PooledGroup pooled(pool_.get(), pool_->system(), pool_->options());
+    detail::TracerGroup& group = *pooled;
+    group.start(0, z0, false, nullptr);
+    while (!group.step(nullptr)) {
+    }
+    r = group.collect(0);
+    if (work) *work = pooled.work();
+    return r;
+}
+
+const FlowSystem& ReturnMapper::system() const {
+    return pool_->system();
+}
+
+const FlowOptions& ReturnMapper::options() const {
+    return pool_->options();
 }
 
 }  // namespace hovering

@@ -17,8 +17,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <thread>
 
 #include "hovering/detail/common.hpp"
+#include "hovering/detail/parallel.hpp"
 
 namespace hovering::detail {
 
@@ -649,6 +652,48 @@ ReturnResult TracerGroup::collect(int l) {
 FlowWork TracerGroup::work() const {
     FlowWork w;
     for (const auto& t : t_) w += t->work();
+    return w;
+}
+
+std::unique_ptr<TracerGroup> TracerPool::take(int tangents) {
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        auto& v = kept_[tangents];
+        if (!v.empty()) {
+            std::unique_ptr<TracerGroup> g = std::move(v.back());
+            v.pop_back();
+            return g;
+        }
+    }
+    return std::make_unique<TracerGroup>(s_, o_, tangents);
+}
+
+void TracerPool::give(std::unique_ptr<TracerGroup> g, int tangents) {
+    if (!g || g->any_busy()) return;
+    // What a call may have set: the next call starts as with a new group.
+    for (int l = 0; l < g->lanes(); ++l) {
+        g->lane(l).set_labels(true);
+        g->lane(l).set_dense(nullptr);
+    }
+    const std::size_t most = std::max(1u, hardware_threads());
+    std::lock_guard<std::mutex> lock(mu_);
+    auto& v = kept_[tangents];
+    if (v.size() < most) v.push_back(std::move(g));
+}
+
+PooledGroup::PooledGroup(TracerPool* pool, const FlowSystem& s, const FlowOptions& o, int tangents)
+    : pool_(pool), tangents_(tangents), unwinding_(std::uncaught_exceptions()) {
+    g_ = pool_ ? pool_->take(tangents) : std::make_unique<TracerGroup>(s, o, tangents);
+    before_ = g_->work();
+}
+
+PooledGroup::~PooledGroup() {
+    if (pool_ && std::uncaught_exceptions() == unwinding_) pool_->give(std::move(g_), tangents_);
+}
+
+FlowWork PooledGroup::work() const {
+    FlowWork w = g_->work();
+    w -= before_;
     return w;
 }
 

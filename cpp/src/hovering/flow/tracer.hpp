@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "hovering/flow/exact.hpp"
@@ -197,6 +198,60 @@ private:
     std::unique_ptr<TaylorLanes> coef_;   // stepper "taylor": the lanes' coefficients of the last round
     unsigned busy_ = 0, ready_ = 0;
     bool taylor_ = false;
+};
+
+/// The TracerGroups of one map (FlowMap, ReturnMapper), kept from call to call: building a group
+/// (eight tracers with their integrators for taylor) cost ~10 us, as much as a return, and a user's
+/// loop of one-point calls paid it every call. The pool owns its copy of the system and options,
+/// which every group it builds refers to, so the maps that share it may be copied freely.
+/// Thread-safe: each worker takes its own group and gives it back when its call ends. A kept group
+/// traces exactly as a new one (a lane's returns never depend on the lane's earlier returns).
+class TracerPool {
+public:
+    /// A pool for system s with integrator options o (copied).
+    TracerPool(const FlowSystem& s, const FlowOptions& o) : s_(s), o_(o) {}
+    TracerPool(const TracerPool&) = delete;
+    TracerPool& operator=(const TracerPool&) = delete;
+    /// A group carrying `tangents` tangent vectors: a kept one (labels on, no dense output, as a new
+    /// one) or a new one.
+    std::unique_ptr<TracerGroup> take(int tangents);
+    /// Keep an idle group (all its returns collected) for the next take; beyond a few per tangent
+    /// count (one per hardware thread) it is dropped.
+    void give(std::unique_ptr<TracerGroup> g, int tangents);
+    /// The pool's system (the one its groups trace).
+    const FlowSystem& system() const { return s_; }
+    /// The pool's integrator options.
+    const FlowOptions& options() const { return o_; }
+
+private:
+    const FlowSystem s_;
+    const FlowOptions o_;
+    std::mutex mu_;
+    std::vector<std::unique_ptr<TracerGroup>> kept_[kMaxTangents + 1];
+};
+
+/// One worker's group for one call: taken from a pool (or new without one) and given back when the
+/// call ends, unless an exception is unwinding through it (its lanes may be mid-return).
+class PooledGroup {
+public:
+    /// A group of `tangents` tangent vectors from pool (null: a new group of s and o, not kept).
+    PooledGroup(TracerPool* pool, const FlowSystem& s, const FlowOptions& o, int tangents = 0);
+    ~PooledGroup();
+    PooledGroup(const PooledGroup&) = delete;
+    PooledGroup& operator=(const PooledGroup&) = delete;
+    /// The group.
+    TracerGroup& operator*() { return *g_; }
+    /// The group's members.
+    TracerGroup* operator->() { return g_.get(); }
+    /// What the group counted during this call (FlowWork; a kept group counted earlier calls too).
+    FlowWork work() const;
+
+private:
+    TracerPool* pool_;
+    std::unique_ptr<TracerGroup> g_;
+    FlowWork before_;
+    int tangents_;
+    int unwinding_;
 };
 
 }  // namespace hovering::detail

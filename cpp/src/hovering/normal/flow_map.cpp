@@ -35,6 +35,7 @@ FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const 
     if (lift_) lift_->validate();
     const double E1 = h_ - s_.V1->V(s_.qw1);
     lift_I0_ = E1 > 0 ? s_.V2->action(E1) : 0.0;
+    pool_ = std::make_shared<detail::TracerPool>(s_, opt_);
 }
 
 std::pair<double, double> FlowMap::to_section(double x, double y) const {
@@ -181,7 +182,8 @@ void FlowMap::jacobians(const double* x, const double* y, std::int64_t n, int n_
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
         // As steps(): one return per point, side by side, each carrying the chart's two tangents.
-        detail::TracerGroup group(s_, opt_, 2);
+        detail::PooledGroup pooled(pool_.get(), s_, opt_, 2);
+        detail::TracerGroup& group = *pooled;
         const int L = group.lanes();
         std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
         auto fill = [&](int l) {
@@ -224,15 +226,15 @@ FlowStep FlowMap::advance(detail::Tracer& tr, double x, double y, bool inverse, 
 FlowStep FlowMap::step(double x, double y) const {
     detail::require_angle(x, "step: x");
     detail::require_finite(y, "step: y");
-    detail::Tracer tr(s_, opt_);
-    return advance(tr, x, y, false, nullptr);
+    detail::PooledGroup pooled(pool_.get(), s_, opt_);
+    return advance(pooled->lane(0), x, y, false, nullptr);
 }
 
 FlowStep FlowMap::step_inverse(double x, double y) const {
     detail::require_angle(x, "step_inverse: x");
     detail::require_finite(y, "step_inverse: y");
-    detail::Tracer tr(s_, opt_);
-    return advance(tr, x, y, true, nullptr);
+    detail::PooledGroup pooled(pool_.get(), s_, opt_);
+    return advance(pooled->lane(0), x, y, true, nullptr);
 }
 
 void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inverse, int n_threads,
@@ -250,7 +252,8 @@ void FlowMap::steps(const double* x, const double* y, std::int64_t n, bool inver
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
     detail::run_workers(threads, queue, [&](detail::WorkCursor& cur) {
         // One return per point, side by side in a TracerGroup (8 lanes for taylor).
-        detail::TracerGroup group(s_, opt_);
+        detail::PooledGroup pooled(pool_.get(), s_, opt_);
+        detail::TracerGroup& group = *pooled;
         const int L = group.lanes();
         std::vector<std::int64_t> idx(static_cast<std::size_t>(L), -1);
         auto fill = [&](int l) {
@@ -368,7 +371,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         // series are expanded together); each lane runs its orbit's returns one after another
         // and takes the next orbit when it ends. An orbit is bit for bit what it is alone.
         const bool tangent = out.tangent.active();
-        detail::TracerGroup group(s_, opt_, tangent ? 2 : 0);
+        detail::PooledGroup pooled(pool_.get(), s_, opt_, tangent ? 2 : 0);
+        detail::TracerGroup& group = *pooled;
         const int L = group.lanes();
         for (int l = 0; l < L; ++l) group.lane(l).set_labels(opt.labels);
         detail::ProgressShare progress(opt.progress, 1);
@@ -511,7 +515,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             }
         }
         if (out.work) {
-            const FlowWork w = group.work();
+            const FlowWork w = pooled.work();
             std::lock_guard<std::mutex> lock(mu);
             *out.work += w;
         }

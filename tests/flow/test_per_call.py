@@ -1,0 +1,153 @@
+"""One point per call (issue 33): the fast paths of FlowMap.step / step_inverse / region,
+Section.return_map and TruncatedMap.step give what the array paths give, bit for bit; bad input is
+still refused with a message naming it; the tracers a map keeps between calls change nothing.
+
+No timing here (benchmarks/bench_per_call.py measures the costs)."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+
+import hovering as hv
+from hovering import paper
+from hovering.flow.system import Bilinear, Harmonic, StepSystem, Tan
+
+H = paper.H
+
+
+def _random_system(rng, geometry):
+    """A random system of the kinds taylor and rk8pd both take: Harmonic or Tan potentials, a bilinear coupling."""
+    V1 = Harmonic(rng.uniform(0.8, 1.3))
+    V2 = Tan(rng.uniform(1.1, 1.6), rng.uniform(0.5, 0.8)) if rng.random() < 0.7 else Harmonic(rng.uniform(1.2, 1.6))
+    return StepSystem(V1, V2, Bilinear(), eps=rng.uniform(-0.08, 0.08), qw1=-1.0, qw2=-0.5, geometry=geometry)
+
+
+def _same(a, b):
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
+
+
+@pytest.mark.parametrize("geometry", ["step", "wall"])
+@pytest.mark.parametrize("stepper", ["taylor", "rk8pd"])
+def test_one_point_fast_paths_equal_the_array_paths_bit_for_bit(geometry, stepper):
+    rng = np.random.default_rng(33 + (geometry == "wall") + 2 * (stepper == "taylor"))
+    for _ in range(2):
+        sys_ = _random_system(rng, geometry)
+        sec = hv.Section(sys_, H)
+        fm = hv.FlowMap(sys_, H, coordinates="section", stepper=stepper, rtol=1e-9)
+        I_tan = sys_.V2.action(H - sys_.V1.V(sys_.qw1))
+        th = rng.uniform(-np.pi, np.pi, 12)
+        I = I_tan * rng.uniform(0.3, 1.3, 12)
+        I[-1] = 50.0  # no point of Sigma_h: OFF_SECTION / NaN on both paths
+        batch = sec.return_map(th, I, stepper=stepper, rtol=1e-9, n_threads=1)
+        steps = fm.returns(th, I, n_threads=1)
+        back = fm.returns(th, I, inverse=True, n_threads=1)
+        assert np.count_nonzero(batch.status == hv.FlowStatus.OK) >= 6
+        for i in range(th.size):
+            t, k = float(th[i]), float(I[i])
+            one = sec.return_map(t, k, stepper=stepper, rtol=1e-9, n_threads=1)
+            arr = sec.return_map(th[i : i + 1], I[i : i + 1], stepper=stepper, rtol=1e-9, n_threads=1)
+            for name in ("theta", "I", "z", "time", "status", "energy_error", "steps", "region"):
+                a, b = getattr(one, name), getattr(arr, name)
+                assert _same(a, b) and a.dtype == b.dtype and a.shape == b.shape, (name, a, b)
+                assert _same(a, getattr(batch, name)[i : i + 1]), name
+            assert one.itinerary == arr.itinerary == batch.itinerary[i : i + 1]
+            assert one.work == arr.work
+            assert one.trajectory is None and arr.trajectory is None
+            assert _same(fm.step(t, k), (steps.phi[i], steps.K[i]))
+            assert _same(fm.step_inverse(t, k), (back.phi[i], back.K[i]))
+            assert int(fm.region(t, k)) == int(steps.region[i])
+            assert isinstance(fm.step(t, k)[0], float) and isinstance(fm.region(t, k), hv.Region)
+
+
+def test_normal_coordinates_and_other_scalar_types_take_the_same_path():
+    fm = paper.flow_map(eps=-0.05)
+    phi, K = np.linspace(-3, 3, 7), np.linspace(-0.1, 0.1, 7)
+    ref = fm.returns(phi, K, n_threads=1)
+    for i in range(phi.size):
+        for p, k in ((float(phi[i]), float(K[i])), (phi[i], K[i]), (np.float32(phi[i]), K[i])):
+            assert _same(fm.step(p, k), (ref.phi[i], ref.K[i]))
+    a, b = fm.step(np.array([1.0]), np.array([0.0]))
+    assert _same(fm.step(1, 0), (a[0], b[0]))  # ints: the fast path too
+
+
+def test_truncated_step_fast_path_equals_the_array_path():
+    rng = np.random.default_rng(3)
+    tm = paper.truncated_map(-0.05)
+    lo, hi = tm.valid_band()
+    phi, K = rng.uniform(-10, 10, 50), rng.uniform(lo, hi, 50)
+    a, b = tm.step(phi, K)
+    ai, bi = tm.step_inverse(phi, K)
+    for i in range(phi.size):
+        assert tm.step(float(phi[i]), float(K[i])) == (a[i], b[i])
+        assert tm.step_inverse(float(phi[i]), float(K[i])) == (ai[i], bi[i])
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda fm, sec, tm: fm.step(float("nan"), 0.1), r"step: phi must be finite, got nan"),
+        (lambda fm, sec, tm: fm.step(0.1, float("inf")), r"step: K must be finite, got inf"),
+        (lambda fm, sec, tm: fm.step(2e6, 0.1), r"step: phi must be an angle in \[-1e6, 1e6\]"),
+        (lambda fm, sec, tm: fm.step(10**400, 0.1), r"step: phi must be"),
+        (lambda fm, sec, tm: fm.step(0.1, 10**400), r"K must be"),
+        (lambda fm, sec, tm: fm.step(True, 0.1), r"step: phi must be real numbers"),
+        (lambda fm, sec, tm: fm.step_inverse(0.1, float("nan")), r"step_inverse: K must be finite"),
+        (lambda fm, sec, tm: fm.region(float("nan"), 0.0), r"region: phi must be finite"),
+        (lambda fm, sec, tm: sec.return_map(5.0, 0.3), r"theta must lie in \[-pi, pi\], got 5"),
+        (lambda fm, sec, tm: sec.return_map(0.3, float("nan")), r"I must be finite"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, rtol=True), r"rtol"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, max_steps=True), r"max_steps"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, rtol=[1e-9]), r"rtol"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, stepper="nope"), r"nope"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, n_threads=-1), r"n_threads must be an integer"),
+        (lambda fm, sec, tm: tm.step(0.1, -5.0), r"step: K = -5 is outside the band"),
+        (lambda fm, sec, tm: tm.step(float("nan"), 0.0), r"step: phi must be finite"),
+    ],
+)
+def test_bad_one_point_input_is_still_refused_by_name(call, match):
+    fm = paper.flow_map(eps=-0.05)
+    sec = fm.section
+    tm = paper.truncated_map(-0.05)
+    # The good calls first: the options and tracers they leave behind must not let bad input through.
+    fm.step(0.1, 0.0)
+    sec.return_map(0.3, 0.3)
+    sec.return_map(0.3, 0.3, max_steps=1)  # then max_steps=True (== 1) must still be refused
+    sec.return_map(0.3, 0.3, rtol=1e-9)
+    with pytest.raises(ValueError, match=match):
+        call(fm, sec, tm)
+
+
+def test_kept_tracers_change_no_result_and_no_work_count():
+    # A map keeps its tracers from call to call; a fresh map must give the same numbers, and each
+    # call's work counters must count that call only.
+    sys_ = paper.system(-0.05)
+    th = np.linspace(-3, 3, 21)
+    I = np.full(21, 0.3)
+    for stepper in ("taylor", "rk8pd"):
+        kw = dict(stepper=stepper, rtol=1e-10, n_threads=1)
+        used = hv.Section(sys_, H)
+        for t in th[:5]:
+            used.return_map(float(t), 0.3, **kw)
+        used.return_map(th, I, trajectory_dt=0.3, **kw)
+        a = used.return_map(th, I, **kw)
+        b = hv.Section(sys_, H).return_map(th, I, **kw)
+        assert _same(a.z, b.z) and a.itinerary == b.itinerary and a.work == b.work
+        assert a.trajectory is None
+        fm = hv.FlowMap(sys_, H, coordinates="section", stepper=stepper)
+        fm.iterate(th, I, 3, record=("orbit", "trajectory"), trajectory_dt=0.2, n_threads=2)
+        fm.jacobian(th, I, n_threads=1)
+        r1 = fm.iterate(th, I, 5, record=("orbit", "regions"), n_threads=1)
+        fresh = hv.FlowMap(sys_, H, coordinates="section", stepper=stepper)
+        r2 = fresh.iterate(th, I, 5, record=("orbit", "regions"), n_threads=1)
+        assert _same(r1.phi, r2.phi) and _same(r1.region, r2.region) and r1.work == r2.work
+
+
+def test_a_used_section_pickles_without_its_kept_mappers():
+    sec = paper.section(-0.05)
+    sec.return_map(0.3, 0.3)
+    back = pickle.loads(pickle.dumps(sec))
+    assert back == sec and "_mappers" not in back.__dict__
+    assert _same(back.return_map(0.3, 0.3).z, sec.return_map(0.3, 0.3).z)
