@@ -100,7 +100,11 @@ void register_flow(py::module_& m) {
         .def_readonly("verify_steps", &FlowOptions::verify_steps)
         .def(
             "validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
-            "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");
+            "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).")
+        .def(
+            "resolved_for", [](const FlowOptions& o, const FlowSystem& s) { return o.resolved(s); }, py::arg("system"),
+            "A copy whose stepper is the one that runs on the system: \"auto\" is \"taylor\" where Taylor's method "
+            "applies (V1, V2 each Harmonic or Tan), else \"rk8pd\"; any other stepper is itself.");
 
     m.def(
         "section_points",
@@ -183,6 +187,7 @@ void register_flow(py::module_& m) {
             d["work"] = hovering_py::work_dict(work);
             traj.put(d);
             d["interrupted"] = interrupted;
+            d["stepper"] = std::string(stepper_name(resolve_stepper(o.stepper, s)));  // what ran ("auto" resolved)
             return d;
         },
         py::arg("system"), py::arg("z0"), py::arg("options"), py::arg("n_threads"), py::arg("trajectory_dt") = 0.0,

@@ -1,0 +1,197 @@
+"""Issue 33, part 4: the error floor of one return, against the exact solution of a linear system.
+
+What is measured (one run):
+
+The system is linear: V1 = Harmonic(w1), V2 = Harmonic(w2), bilinear coupling eps q1 q2, walls at
+(qw1, qw2) = (-1, -0.5), h = 1. Its flow is q'' = -K q with K = [[w1^2, eps], [eps, w2^2]]: the
+reference is that flow in closed form through its normal modes at 40 digits (mpmath), every event
+(section crossing p1 = 0 downward once armed, wall crossings, a wall distance's minimum dipping
+below zero) a root of the closed form refined by findroot to 40 digits; reflections exact (the
+wall coordinate set, the momentum negated). Starts: --n random points of Sigma_h (theta uniform,
+I uniform in (0.02, 0.6)), the same for every method.
+
+For each method and rtol = atol = 1e-8 .. 1e-16 it prints the maximum over the starts of
+  dz    max |z - z_ref| over the image state (q1, p1, q2, p2) (section coordinates of the flow),
+  dt    |t - t_ref| of the return time,
+  dthI  max(|wrap(d theta)|, |d I|) of the image's (theta, I) = S2(q2, p2) (the core's conversion of
+        the core's state, against the conversion of the reference state at 40 digits),
+and the median of dz. Methods: each hovering stepper that applies (taylor, rk8pd, rkck, and
+"exact" once: it ignores the tolerances), and heyoka.py's Taylor integrator with events
+(hovering.diagnostics.heyoka_return_map) at the same tolerances (its tol is clamped at 1e-16
+by heyoka itself, below machine epsilon it is not meaningful).
+
+Run:  python benchmarks/bench_error_floor.py [--n 200] [--seed 1] [--eps -0.05] [--geometry step]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import mpmath as mp
+import numpy as np
+
+import hovering
+from hovering import _core
+
+mp.mp.dps = 40
+QW1, QW2 = -1.0, -0.5
+
+
+class LinearFlow:
+    """q'' = -K q in closed form at mpmath precision (K symmetric positive definite)."""
+
+    def __init__(self, w1, w2, eps):
+        K = mp.matrix([[mp.mpf(w1) ** 2, mp.mpf(eps)], [mp.mpf(eps), mp.mpf(w2) ** 2]])
+        lam, U = mp.eigsy(K)
+        assert min(lam) > 0, "the linear flow must be oscillatory"
+        self.U = U
+        self.om = [mp.sqrt(lam[k]) for k in range(2)]
+
+    def at(self, z, tau):
+        """The state tau after z (a list of 4 mpf)."""
+        U, om = self.U, self.om
+        a = [U[0, k] * z[0] + U[1, k] * z[2] for k in range(2)]
+        b = [U[0, k] * z[1] + U[1, k] * z[3] for k in range(2)]
+        c = [mp.cos(om[k] * tau) for k in range(2)]
+        s = [mp.sin(om[k] * tau) for k in range(2)]
+        at = [a[k] * c[k] + b[k] / om[k] * s[k] for k in range(2)]
+        bt = [-a[k] * om[k] * s[k] + b[k] * c[k] for k in range(2)]
+        return [
+            U[0, 0] * at[0] + U[0, 1] * at[1],
+            U[0, 0] * bt[0] + U[0, 1] * bt[1],
+            U[1, 0] * at[0] + U[1, 1] * at[1],
+            U[1, 0] * bt[0] + U[1, 1] * bt[1],
+        ]
+
+    def ret(self, z0, geometry, dt=mp.mpf("0.05")):  # noqa: B008 (an immutable number)
+        """One return to Sigma_h from z0: (state, time, itinerary)."""
+        z = [mp.mpf(float(x)) for x in z0]
+        t, armed, itinerary = mp.mpf(0), False, ""
+        walls = geometry != "none"
+
+        def root(z, j, off, lo, hi):
+            return mp.findroot(lambda tau: self.at(z, tau)[j] - off, (lo, hi), solver="anderson")
+
+        for _ in range(100000):
+            z1 = self.at(z, dt)
+            events = []
+            for j, off, kind, on in ((0, QW1, "R", walls), (2, QW2, "U", geometry == "step")):
+                if not on:
+                    continue
+                if z[j] > off and z1[j] <= off:
+                    events.append((root(z, j, off, 0, dt), kind))
+                elif z[j] > off and z1[j] > off and z[j + 1] < 0 and z1[j + 1] > 0:  # a minimum may dip through
+                    tm = mp.findroot(lambda tau: self.at(z, tau)[j + 1], (0, dt), solver="anderson")
+                    if self.at(z, tm)[j] < off:
+                        events.append((root(z, j, off, 0, tm), kind))
+            if z[1] < 0 and z1[1] >= 0:  # q1's minimum: the next downward crossing of p1 = 0 returns
+                armed = True
+            if armed and z[1] > 0 and z1[1] <= 0:
+                events.append((root(z, 1, 0, 0, dt), "section"))
+            handled = False
+            for tau, kind in sorted(events, key=lambda e: e[0]):
+                ze = self.at(z, tau)
+                if kind == "section":
+                    return ze, t + tau, itinerary
+                if kind == "R":
+                    hit = geometry == "wall" or ze[2] < QW2
+                    j = 0
+                else:
+                    hit = ze[0] < QW1
+                    j = 2
+                if not hit:
+                    continue
+                ze[j] = mp.mpf(QW1 if kind == "R" else QW2)
+                ze[j + 1] = -ze[j + 1]
+                itinerary += "R" if kind == "R" else "1"
+                z, t, armed, handled = ze, t + tau, True, True
+                break
+            if not handled:
+                z, t = z1, t + dt
+        raise AssertionError("no return")
+
+
+def theta_I(w2, q2, p2):
+    """(theta, I) of Harmonic(w2) at (q2, p2), at mpmath precision: the core's convention
+    (theta in [-pi, pi), sign(theta) = -sign(p2)): q2 = sqrt(2 I / w2) cos(theta)."""
+    w2 = mp.mpf(w2)
+    I = (p2**2 + w2**2 * q2**2) / (2 * w2)
+    return mp.atan2(-p2 / w2, q2), I
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--eps", type=float, default=-0.05)
+    ap.add_argument("--w2", type=float, default=1.3)
+    ap.add_argument("--geometry", default="step", choices=("step", "wall", "none"))
+    ap.add_argument("--steppers", default="taylor,rk8pd,rkck")
+    ap.add_argument("--no-heyoka", action="store_true")
+    a = ap.parse_args()
+    w1, w2 = 1.0, a.w2
+    sys = hovering.StepSystem(
+        hovering.Harmonic(w1), hovering.Harmonic(w2), hovering.Bilinear(), eps=a.eps, qw1=QW1, qw2=QW2,
+        geometry=a.geometry,
+    )
+    rng = np.random.default_rng(a.seed)
+    z0, ok, _ = _core.flow.section_points(sys.core, 1.0, rng.uniform(-np.pi, np.pi, 4 * a.n), rng.uniform(0.02, 0.6, 4 * a.n))
+    z0 = np.ascontiguousarray(z0[ok][: a.n])
+    t0 = time.perf_counter()
+    flow = LinearFlow(w1, w2, a.eps)
+    ref = [flow.ret(z, a.geometry) for z in z0]
+    zr = np.array([[float(x) for x in r[0]] for r in ref])
+    tr = np.array([float(r[1]) for r in ref])
+    thIr = [theta_I(w2, r[0][2], r[0][3]) for r in ref]
+    itin = [r[2] for r in ref]
+    print(
+        f"linear system: Harmonic({w1}) x Harmonic({w2}), eps {a.eps}, geometry {a.geometry}, h = 1, "
+        f"{len(z0)} starts (seed {a.seed}); reference at {mp.mp.dps} digits in {time.perf_counter() - t0:.1f} s; "
+        f"itineraries {dict(zip(*np.unique(itin, return_counts=True)))}"
+    )
+
+    def errors(z, t, good):
+        if not good.all():
+            return None
+        dz = np.max(np.abs(z - zr), axis=1)
+        dt = np.abs(t - tr)
+        c = _core.flow.section_coordinates(sys.core, np.ascontiguousarray(z))
+        dth = [abs(float(mp.remainder(mp.mpf(c[k, 0]) - thIr[k][0], 2 * mp.pi))) for k in range(len(z))]
+        dI = [abs(float(mp.mpf(c[k, 1]) - thIr[k][1])) for k in range(len(z))]
+        return dz.max(), np.median(dz), dt.max(), max(max(dth), max(dI))
+
+    rows = []
+    tols = [10.0**-k for k in range(8, 17)]
+    for st in a.steppers.split(","):
+        for tol in tols:
+            d = _core.flow.return_maps(sys.core, z0, hovering.flow.flow_options(rtol=tol, atol=tol, stepper=st), 1)
+            good = d["status"] == 0
+            rows.append((st, tol, errors(d["z"], d["time"], good), int((~good).sum())))
+    d = _core.flow.return_maps(sys.core, z0, hovering.flow.flow_options(stepper="exact"), 1)
+    rows.append(("exact", math.nan, errors(d["z"], d["time"], d["status"] == 0), int((d["status"] != 0).sum())))
+    if not a.no_heyoka:
+        from hovering.diagnostics import heyoka_return_map
+
+        for tol in tols:
+            out, _ = heyoka_return_map(sys, list(z0), tol)
+            good = np.array([o is not None for o in out])
+            z = np.array([o[:4] if o is not None else [np.nan] * 4 for o in out])
+            # heyoka's returned state has no time here: dt is not measured for it (NaN).
+            e = errors(z, tr, good)
+            rows.append(("heyoka", tol, None if e is None else (e[0], e[1], math.nan, e[3]), int((~good).sum())))
+    print(f"{'method':8} {'rtol':>7} {'max dz':>9} {'med dz':>9} {'max dt':>9} {'max dthI':>9}  failed")
+    for st, tol, e, bad in rows:
+        if e is None:
+            print(f"{st:8} {tol:7.0e}  (not every start returned: {bad} failed)")
+            continue
+        print(f"{st:8} {tol:7.0e} {e[0]:9.2e} {e[1]:9.2e} {e[2]:9.2e} {e[3]:9.2e}  {bad}")
+    for st in {r[0] for r in rows}:
+        best = min((r for r in rows if r[0] == st and r[2] is not None), key=lambda r: r[2][0], default=None)
+        if best:
+            print(f"floor {st:8}: max dz {best[2][0]:.2e} at rtol {best[1]:.0e}")
+
+
+if __name__ == "__main__":
+    main()
