@@ -21,16 +21,17 @@ and the median of dz. Methods: each hovering stepper that applies (taylor, rk8pd
 by heyoka itself, below machine epsilon it is not meaningful).
 
 Run:  python benchmarks/bench_error_floor.py [--n 200] [--seed 1] [--eps -0.05] [--geometry step]
+      python benchmarks/bench_error_floor.py --classes   (the floor on the Tan and strong-coupling
+      systems, which have no exact solution: see classes())
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import time
-
 import pathlib
 import sys as _sys
+import time
 
 import mpmath as mp
 import numpy as np
@@ -39,7 +40,7 @@ import hovering
 from hovering import _core
 
 _sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
-from helpers.linear_reference import QW1, QW2, LinearFlow  # noqa: E402 (the tests' reference, one copy)
+from helpers.linear_reference import QW1, QW2, LinearFlow, theta_I, wrap  # noqa: E402 (the tests' reference, one copy)
 
 mp.mp.dps = 40
 
@@ -56,11 +57,18 @@ def main():
     a = ap.parse_args()
     w1, w2 = 1.0, a.w2
     sys = hovering.StepSystem(
-        hovering.Harmonic(w1), hovering.Harmonic(w2), hovering.Bilinear(), eps=a.eps, qw1=QW1, qw2=QW2,
+        hovering.Harmonic(w1),
+        hovering.Harmonic(w2),
+        hovering.Bilinear(),
+        eps=a.eps,
+        qw1=QW1,
+        qw2=QW2,
         geometry=a.geometry,
     )
     rng = np.random.default_rng(a.seed)
-    z0, ok, _ = _core.flow.section_points(sys.core, 1.0, rng.uniform(-np.pi, np.pi, 4 * a.n), rng.uniform(0.02, 0.6, 4 * a.n))
+    z0, ok, _ = _core.flow.section_points(
+        sys.core, 1.0, rng.uniform(-np.pi, np.pi, 4 * a.n), rng.uniform(0.02, 0.6, 4 * a.n)
+    )
     z0 = np.ascontiguousarray(z0[ok][: a.n])
     t0 = time.perf_counter()
     flow = LinearFlow(w1, w2, a.eps)
@@ -116,5 +124,55 @@ def main():
             print(f"floor {st:8}: max dz {best[2][0]:.2e} at rtol {best[1]:.0e}")
 
 
+def classes():
+    """The floor per system class where no exact solution exists: taylor (rtol 1e-16, 1e-15) and rk8pd
+    (1e-14) against heyoka.py at tol 1e-16 (two independent Taylor codes: their distance bounds the
+    sum of their errors), and against the closed form at eps = 0 (the event-driven angle flow,
+    rounding only); 200 starts each, max |dz| over the starts every method returned."""
+    from hovering.diagnostics import heyoka_return_map
+
+    def starts(s, n=200, h=1.0):
+        rng = np.random.default_rng(1)
+        z, ok, _ = _core.flow.section_points(
+            s.core, h, rng.uniform(-np.pi, np.pi, 8 * n), rng.uniform(0.02, 0.6, 8 * n)
+        )
+        return np.ascontiguousarray(z[ok][:n])
+
+    hv = hovering
+    cases = {
+        "Tan, eps=0 (exact ref)": (
+            hv.StepSystem(hv.Harmonic(1.0), hv.Tan(1.4, 0.7), hv.Bilinear(), eps=0.0, qw1=-1, qw2=-0.5),
+            True,
+        ),
+        "README Tan eps=-0.05": (hv.paper.system(-0.05), False),
+        "Tan x Tan eps=0.05": (
+            hv.StepSystem(hv.Tan(1.0, 0.5), hv.Tan(1.4, 0.7), hv.Bilinear(), eps=0.05, qw1=-1, qw2=-0.5),
+            False,
+        ),
+        "strong coupling eps=0.6": (hv.paper.system(0.6), False),
+    }
+    for name, (s, ex) in cases.items():
+        z0 = starts(s)
+        t = _core.flow.return_maps(s.core, z0, hv.flow.flow_options(rtol=1e-16, atol=1e-16, stepper="taylor"), 1)
+        t15 = _core.flow.return_maps(s.core, z0, hv.flow.flow_options(rtol=1e-15, atol=1e-15, stepper="taylor"), 1)
+        r8 = _core.flow.return_maps(s.core, z0, hv.flow.flow_options(rtol=1e-14, atol=1e-14, stepper="rk8pd"), 1)
+        if ex:
+            ref = _core.flow.return_maps(s.core, z0, hv.flow.flow_options(stepper="exact"), 1)["z"]
+            rn = "exact"
+        else:
+            out, _ = heyoka_return_map(s, list(z0), 1e-16)
+            ref = np.array([o[:4] if o is not None else [np.nan] * 4 for o in out])
+            rn = "heyoka 1e-16"
+        ok = (t["status"] == 0) & np.isfinite(ref).all(1) & (t15["status"] == 0) & (r8["status"] == 0)
+
+        def f(d, ok=ok, ref=ref):
+            return np.max(np.abs(d["z"][ok] - ref[ok]))
+
+        print(f"{name:28} n={ok.sum()} vs {rn}: taylor1e-16 {f(t):.2e} taylor1e-15 {f(t15):.2e} rk8pd1e-14 {f(r8):.2e}")
+
+
 if __name__ == "__main__":
-    main()
+    if "--classes" in _sys.argv:
+        classes()
+    else:
+        main()

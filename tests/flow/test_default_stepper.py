@@ -6,10 +6,9 @@ import numpy as np
 import pytest
 
 import hovering as hv
+from helpers.linear_reference import QW1, QW2, LinearFlow
 from hovering import _core, paper
 from hovering.flow import STEPPERS
-
-from helpers.linear_reference import QW1, QW2, LinearFlow
 
 THETA, I = np.array([0.0, 1.0, 2.0, -2.5]), np.array([0.3, 0.3, 0.45, 0.2])
 
