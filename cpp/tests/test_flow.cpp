@@ -74,10 +74,10 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     for (const char* name : kSteppers) CHECK(std::string(stepper_name(parse_stepper(name))) == name);
     // The default "auto" is taylor on a polynomial field (Harmonic x Tan), and never reaches a tracer
     // unresolved; any other stepper is itself.
-    CHECK(FlowOptions{}.stepper == Stepper::Auto && std::string(kSteppers[0]) == "auto");
+    CHECK((FlowOptions{}.stepper == Stepper::Auto && std::string(kSteppers[0]) == "auto"));
     CHECK(resolve_stepper(Stepper::Auto, s) == Stepper::Taylor);
     CHECK(FlowOptions{}.resolved(s).stepper == Stepper::Taylor);
-    CHECK(resolve_stepper(Stepper::Rk8pd, s) == Stepper::Rk8pd && resolve_stepper(Stepper::Exact, s) == Stepper::Exact);
+    CHECK((resolve_stepper(Stepper::Rk8pd, s) == Stepper::Rk8pd && resolve_stepper(Stepper::Exact, s) == Stepper::Exact));
     bad.rtol = 0;
     CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
     bad = o;
