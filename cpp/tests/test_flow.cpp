@@ -27,6 +27,7 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     s.qw2 = -0.5;
     const double h = 1.0;
     FlowOptions o;
+    o.stepper = Stepper::Rk8pd;  // the GSL path (the default, "auto", is taylor here): its errors below
     o.rtol = 1e-12;
     o.atol = 1e-14;
 
@@ -71,6 +72,12 @@ TEST_CASE("return map: exact eps = 0 answers, time reversal, regions, grazing, m
     CHECK(parse_stepper("rk8pd") == Stepper::Rk8pd);
     CHECK(std::string(stepper_name(Stepper::Exact)) == "exact");
     for (const char* name : kSteppers) CHECK(std::string(stepper_name(parse_stepper(name))) == name);
+    // The default "auto" is taylor on a polynomial field (Harmonic x Tan), and never reaches a tracer
+    // unresolved; any other stepper is itself.
+    CHECK((FlowOptions{}.stepper == Stepper::Auto && std::string(kSteppers[0]) == "auto"));
+    CHECK(resolve_stepper(Stepper::Auto, s) == Stepper::Taylor);
+    CHECK(FlowOptions{}.resolved(s).stepper == Stepper::Taylor);
+    CHECK((resolve_stepper(Stepper::Rk8pd, s) == Stepper::Rk8pd && resolve_stepper(Stepper::Exact, s) == Stepper::Exact));
     bad.rtol = 0;
     CHECK_INVALID(return_map(s, section_point(s, h, 0.3, 0.3), bad), "rtol must lie in (0, 1)");
     bad = o;

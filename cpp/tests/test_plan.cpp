@@ -172,7 +172,7 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     };
     CHECK(parse_plan(kFlow, "f.toml").points[0].system.coupling.size() == 1);
     flow("stepper = \"rk8pd\"", "stepper = \"euler\"",
-         "points[0].integrator.stepper = 'euler': allowed: one of 'rk8pd'");
+         "points[0].integrator.stepper = 'euler': allowed: one of 'auto' 'rk8pd'");
     flow("rtol = 1e-10", "rtol = 2.0", "points[0].integrator.rtol = 2: allowed: a finite number in (0, 1)");
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 21]]", "points[0].system.coupling[0] = an array of 3");
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 1], [2.0, 1, 1]]", "each (i, j) once");

@@ -35,7 +35,7 @@ FlowSystem make_system(std::shared_ptr<const Potential> V1, std::shared_ptr<cons
 // out, progress) computes them (return_maps, or a ReturnMapper's).
 template <class Run>
 py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_points_per_orbit, py::object progress,
-                      Run run) {
+                      const char* stepper, Run run) {
     if (z0.ndim() != 2 || z0.shape(1) != 4) throw py::value_error("z0 must have shape (n, 4)");
     if (!(trajectory_dt >= 0 && std::isfinite(trajectory_dt)))
         throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
@@ -75,6 +75,7 @@ py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_p
     d["work"] = hovering_py::work_dict(work);
     traj.put(d);
     d["interrupted"] = interrupted;
+    d["stepper"] = stepper;  // what ran ("auto" resolved)
     return d;
 }
 
@@ -147,7 +148,11 @@ void register_flow(py::module_& m) {
         .def_readonly("verify_steps", &FlowOptions::verify_steps)
         .def(
             "validate_for", [](const FlowOptions& o, const FlowSystem& s) { o.validate(s); }, py::arg("system"),
-            "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).");
+            "Raise ValueError unless the stepper applies to the system (\"exact\" needs a closed-form flow).")
+        .def(
+            "resolved_for", [](const FlowOptions& o, const FlowSystem& s) { return o.resolved(s); }, py::arg("system"),
+            "A copy whose stepper is the one that runs on the system: \"auto\" is \"taylor\" where Taylor's method "
+            "applies (V1, V2 each Harmonic or Tan), else \"rk8pd\"; any other stepper is itself.");
 
     m.def(
         "section_points",
@@ -192,6 +197,7 @@ void register_flow(py::module_& m) {
            std::int64_t max_points_per_orbit, py::object progress) {
             o.validate();
             return returns_dict(z0, trajectory_dt, max_points_per_orbit, std::move(progress),
+                                stepper_name(resolve_stepper(o.stepper, s)),
                                 [&](const double* z, std::int64_t n, const std::atomic<bool>* cancel,
                                     const ReturnMapsOutput& out, std::atomic<std::int64_t>* done) {
                                     return_maps(s, z, n, o, n_threads, cancel, out, done);
@@ -211,6 +217,7 @@ void register_flow(py::module_& m) {
             [](const ReturnMapper& rm, const darray& z0, int n_threads, double trajectory_dt,
                std::int64_t max_points_per_orbit, py::object progress) {
                 return returns_dict(z0, trajectory_dt, max_points_per_orbit, std::move(progress),
+                                    stepper_name(resolve_stepper(rm.options().stepper, rm.system())),
                                     [&](const double* z, std::int64_t n, const std::atomic<bool>* cancel,
                                         const ReturnMapsOutput& out, std::atomic<std::int64_t>* done) {
                                         rm.run(z, n, n_threads, cancel, out, done);
@@ -265,6 +272,7 @@ void register_flow(py::module_& m) {
                 d["steps"] = steps;
                 d["region"] = region;
                 d["work"] = hovering_py::work_dict(work);
+                d["stepper"] = stepper_name(resolve_stepper(rm.options().stepper, s));
                 for (const char* k : {"trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"})
                     d[k] = py::none();
                 return d;

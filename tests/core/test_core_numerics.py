@@ -139,11 +139,14 @@ def test_integrator_defaults_and_steppers_are_the_cores():
     assert hv.flow.flow_options(rtol=1e-8).rtol == 1e-8 and hv.flow.flow_options(rtol=1e-8).atol == 1e-8
     assert hv.flow.flow_options(rtol=1e-8, atol=1e-13).atol == 1e-13
     fm = paper.flow_map(0.05, coordinates="section")
-    assert fm.integrator_options == dict(rtol=d.rtol, atol=d.rtol, stepper=d.stepper)
+    # The default "auto" as the map resolved it on its system (Harmonic x Tan: taylor).
+    assert fm.integrator_options == dict(rtol=d.rtol, atol=d.rtol, stepper=d.resolved_for(fm.sys.core).stepper)
+    assert d.stepper == "auto" and fm.integrator_options["stepper"] == "taylor"
     spec = hv.scenes.load_scene(Path(hv.scenes.__file__).parent / "data" / "demo.toml", check_output=False)
     assert (spec.integrator.stepper, spec.integrator.rtol, spec.integrator.atol) == (d.stepper, 1e-10, 1e-10)
     # The stepper is parsed once, by the core: its message names the value and every stepper.
     with pytest.raises(
-        ValueError, match=r"stepper must be one of rk8pd, rkck, .*GSL's bsimp and msbdf are not offered.*got 'euler'"
+        ValueError,
+        match=r"stepper must be one of auto .*, rk8pd, rkck, .*GSL's bsimp and msbdf are not offered.*got 'euler'",
     ):
         hv.flow.flow_options(stepper="euler")

@@ -67,7 +67,7 @@ BAD = {
     ),
     "return_map stepper=3": (
         lambda: SEC.return_map([0.1], [0.3], stepper=3),
-        r"stepper must be one of rk8pd, .*got '3'",
+        r"stepper must be one of auto .*rk8pd, .*got '3'",
     ),
     "return_map max_steps=2**70": (
         lambda: SEC.return_map([0.1], [0.3], max_steps=2**70),

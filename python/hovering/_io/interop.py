@@ -198,7 +198,10 @@ def return_map_dataset(res):
     if res.region is not None:
         data["region"] = ("start", res.region, _flags(_attrs("region"), Region))
     coords = {"start": np.arange(n), "component": ["q1", "p1", "q2", "p2"]}
-    return xr.Dataset(data, coords=coords, attrs=_common("ReturnMapResult"))
+    attrs = _common("ReturnMapResult")
+    if res.stepper is not None:  # the stepper that ran (results saved before it was recorded have none)
+        attrs["stepper"] = res.stepper
+    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def hovering_area_dataset(h):

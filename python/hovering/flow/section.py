@@ -18,9 +18,10 @@ from .system import StepSystem
 
 __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS"]
 
-#: Steppers the flow offers, its default first: GSL's explicit Runge-Kutta methods, Adams multistep
-#: method and implicit Gauss-Legendre methods, and ``"exact"``, the flow in closed form where the
-#: system has one (see :meth:`Section.return_map`). The core's list (``hovering._core.flow.STEPPERS``).
+#: Steppers the flow offers, its default first: ``"auto"`` (``"taylor"`` where Taylor's method
+#: applies, else ``"rk8pd"``), GSL's explicit Runge-Kutta methods, Adams multistep method and
+#: implicit Gauss-Legendre methods, Taylor's method, and ``"exact"``, the flow in closed form where
+#: the system has one (see :meth:`Section.return_map`). The core's list (``hovering._core.flow.STEPPERS``).
 STEPPERS = tuple(_core_flow.STEPPERS)
 
 _OK = int(FlowStatus.OK)
@@ -56,7 +57,7 @@ def flow_options(
     rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps
         See :meth:`Section.return_map` (``"exact"`` ignores rtol and atol; whether it applies
         depends on the system: ``FlowOptions.validate_for(system)``). None: the core's default
-        (``hovering._core.flow.FlowOptions()``: rk8pd, rtol 1e-10, event_tol 1e-15, max_steps 1e6,
+        (``hovering._core.flow.FlowOptions()``: auto, rtol 1e-10, event_tol 1e-15, max_steps 1e6,
         max_impacts 100, grazing_tol 1e-12, corner_tol 1e-10, verify_steps -1; atol: the core's
         one policy, ``default_atol(rtol)`` = rtol).
 
@@ -118,6 +119,9 @@ class ReturnMapResult(Summarized, Saveable):
         ``|H(image) - H(start)|``.
     steps : ndarray of int64
         Accepted integrator steps (of every trace of a verified return).
+    stepper : str or None
+        The stepper that ran (``"auto"`` resolved on the system: ``"taylor"`` or ``"rk8pd"``); None
+        in results saved before it was recorded.
     work : dict or None
         What the integration did, summed over the call (see :attr:`hovering.IterateResult.work`).
     trajectory, trajectory_index, trajectory_kind, trajectory_truncated : ndarray or None
@@ -148,6 +152,7 @@ class ReturnMapResult(Summarized, Saveable):
     steps: np.ndarray
     region: np.ndarray | None = None
     work: dict | None = None
+    stepper: str | None = None
     trajectory: np.ndarray | None = field(default=None, repr=False)
     trajectory_index: np.ndarray | None = field(default=None, repr=False)
     trajectory_kind: np.ndarray | None = field(default=None, repr=False)
@@ -366,7 +371,9 @@ class Section:
             Tolerances of the step-size control (not read by ``"exact"``; default rtol 1e-10, and atol
             rtol's: the core's one policy, ``FlowOptions::default_atol``, as for :class:`FlowMap`).
             Every integrator setting left None takes the core's default (:func:`flow_options`).
-        stepper : {"rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "taylor", "exact"}, optional
+        stepper : {"auto", "rk8pd", "rkck", "rkf45", "rk4", "rk2", "msadams", "rk4imp", "rk2imp", "taylor", "exact"}, optional
+            ``"auto"`` (default): ``"taylor"`` where it applies (V1, V2 each Harmonic or Tan, or
+            Numerical of them), else ``"rk8pd"``; the result's ``stepper`` names the one that ran.
             ``"taylor"``: Taylor's method on the field, which is a polynomial in the state once each
             Tan potential carries u = tan(alpha q) (coefficients by recurrences, four orbits at a
             time in SIMD lanes; order ceil(1 - ln(rtol) / 1.2), step exp(-1.2) times the radius of
@@ -375,7 +382,7 @@ class Section:
             of them) with any polynomial coupling, others raise ValueError. The fastest stepper at
             every tolerance measured and the only one that reaches the rounding floor (docs:
             Accuracy). Else a
-            GSL stepper (default rk8pd): an explicit Runge-Kutta method, or the variable-order Adams multistep
+            GSL stepper: an explicit Runge-Kutta method, or the variable-order Adams multistep
             method (its events are located on an rk8pd extension of each step; on this smooth,
             oscillatory flow it is ~7x slower than rk8pd at matched accuracy), or an implicit
             Gauss-Legendre method (``rk4imp``, ``rk2imp``: symplectic at a fixed step, with the
@@ -504,6 +511,7 @@ class Section:
                 steps=d["steps"],
                 region=d["region"],
                 work=d["work"],
+                stepper=d["stepper"],
                 trajectory=d.get("trajectory"),
                 trajectory_index=d.get("trajectory_index"),
                 trajectory_kind=d.get("trajectory_kind"),

@@ -137,8 +137,10 @@ class FlowMap(MapAnalyses):
         momentum crosses zero: at rtol 1e-10, atol 1e-12 costs 17% more steps for a 2.5x smaller
         error per return).
     stepper : str, optional
-        GSL stepper (default the core's, ``"rk8pd"``), or ``"exact"`` for the closed-form flow (see :data:`hovering.flow.STEPPERS`
-        and :meth:`hovering.Section.return_map`; it ignores rtol and atol).
+        One of :data:`hovering.flow.STEPPERS` (default the core's, ``"auto"``: ``"taylor"`` where
+        Taylor's method applies, V1 and V2 each Harmonic or Tan, else ``"rk8pd"``; the map keeps and
+        shows the one chosen), or ``"exact"`` for the closed-form flow (see
+        :meth:`hovering.Section.return_map`; it ignores rtol and atol).
     curve : TangentialCurve, optional
         The tangential curve of this section (measured at rtol 1e-13 if not given, with as many
         wall points as its interpolation error below 1e-12 needs).
@@ -229,7 +231,8 @@ class FlowMap(MapAnalyses):
         # None: the core's default (its FlowOptions{} and default_atol, the one policy).
         self._options = flow_options(rtol=rtol, atol=atol, stepper=stepper, **options)
         self._options.validate_for(sys.core)  # before the tangential curve is measured
-        o = self._options
+        # "auto" resolved once, here: integrator_options, the repr and saved records name the stepper that runs.
+        self._options = o = self._options.resolved_for(sys.core)
         self.integrator_options = dict(rtol=float(o.rtol), atol=float(o.atol), stepper=o.stepper, **options)
         #: Why there are no onset parameters (None when there are): below the step energy, or
         #: too close to it for them to be accurate (onset_parameters raises rather than guess).
@@ -252,7 +255,10 @@ class FlowMap(MapAnalyses):
         self._delta = None  # the tangential curve's measured error (forcing_tolerance), on first use
 
     def __repr__(self) -> str:
-        base = f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, rtol={self._options.rtol!r})"
+        base = (
+            f"FlowMap({self.sys!r}, h={self.h!r}, coordinates={self.coordinates!r}, "
+            f"stepper={self._options.stepper!r}, rtol={self._options.rtol!r})"
+        )
         # What a user needs before reading any result: the perturbation the truncated model sees is
         # eps b1 (the measured forcing's first mode), not eps - or, where b1 vanishes within its
         # measurement error, that the higher modes act; and where points of Sigma_h exist. A

@@ -41,27 +41,34 @@ Status orbit_status(FlowStatus s);
 /// The integrator of a return, parsed once from its name (parse_stepper) where a name enters the
 /// core (the bindings, the plan reader) and compared as this enum everywhere else.
 enum class Stepper : std::int8_t {
-    Rk8pd = 0,    ///< GSL's explicit Runge-Kutta Prince-Dormand 8(9) (the default)
-    Rkck = 1,     ///< GSL's explicit Runge-Kutta Cash-Karp 4(5)
-    Rkf45 = 2,    ///< GSL's explicit Runge-Kutta-Fehlberg 4(5)
-    Rk4 = 3,      ///< GSL's classical explicit Runge-Kutta 4
-    Rk2 = 4,      ///< GSL's explicit Runge-Kutta 2(3)
-    Msadams = 5,  ///< GSL's variable-order Adams multistep method
-    Rk4imp = 6,   ///< GSL's implicit Gauss-Legendre 4 (with the Jacobian)
-    Rk2imp = 7,   ///< GSL's implicit Gauss-Legendre 2 (with the Jacobian)
-    Taylor = 8,   ///< Taylor's method (order and step from the tolerances; Harmonic and Tan potentials)
-    Exact = 9,    ///< the flow in closed form, where the system has one
+    Auto = 0,     ///< the default: Taylor where it applies, else Rk8pd (resolve_stepper, per system)
+    Rk8pd = 1,    ///< GSL's explicit Runge-Kutta Prince-Dormand 8(9)
+    Rkck = 2,     ///< GSL's explicit Runge-Kutta Cash-Karp 4(5)
+    Rkf45 = 3,    ///< GSL's explicit Runge-Kutta-Fehlberg 4(5)
+    Rk4 = 4,      ///< GSL's classical explicit Runge-Kutta 4
+    Rk2 = 5,      ///< GSL's explicit Runge-Kutta 2(3)
+    Msadams = 6,  ///< GSL's variable-order Adams multistep method
+    Rk4imp = 7,   ///< GSL's implicit Gauss-Legendre 4 (with the Jacobian)
+    Rk2imp = 8,   ///< GSL's implicit Gauss-Legendre 2 (with the Jacobian)
+    Taylor = 9,   ///< Taylor's method (order and step from the tolerances; Harmonic and Tan potentials)
+    Exact = 10,   ///< the flow in closed form, where the system has one
 };
 
 /// The names of the steppers in Stepper's order, its default first (bound as
-/// hovering.flow.STEPPERS; the choices of scene files and plans).
-inline constexpr std::array<const char*, 10> kSteppers = {"rk8pd",  "rkck",   "rkf45",  "rk4",    "rk2",
-                                                          "msadams", "rk4imp", "rk2imp", "taylor", "exact"};
+/// hovering.flow.STEPPERS; the choices of scene files and plans). Names are what is stored
+/// (pickles, scene files, plans, results), never the enum's values.
+inline constexpr std::array<const char*, 11> kSteppers = {"auto",   "rk8pd",  "rkck",   "rkf45",
+                                                          "rk4",    "rk2",    "msadams", "rk4imp",
+                                                          "rk2imp", "taylor", "exact"};
 
 /// The stepper a name means; throws std::invalid_argument naming the value and every allowed name.
 Stepper parse_stepper(const std::string& name);
 /// The name of a stepper (an entry of kSteppers).
 const char* stepper_name(Stepper s);
+/// The stepper that runs for st on s: "auto" is "taylor" where Taylor's method applies (V1 and V2
+/// each Harmonic or Tan: a polynomial field; the fastest stepper at every tolerance measured, and
+/// the only one reaching the rounding floor) and "rk8pd" elsewhere; any other stepper is itself.
+Stepper resolve_stepper(Stepper st, const FlowSystem& s);
 
 /// Kinetic energy, relative to 1 + |h|, beyond which an orbit is a runaway (status NonFinite): a
 /// coupling unbounded below lets it grow without bound; bounded motion keeps it below h - min V,
@@ -81,7 +88,7 @@ inline constexpr std::int64_t kVerifyStepsGsl = 40;
 /// quadratic coupling: the normal modes of the linear flow); it ignores rtol and atol, and its
 /// "steps" are events passed (uncoupled) or closed-form steps of 1/8 period (linear).
 struct FlowOptions {
-    Stepper stepper = Stepper::Rk8pd;  ///< the integrator (see Stepper; by name: parse_stepper)
+    Stepper stepper = Stepper::Auto;  ///< the integrator (see Stepper; by name: parse_stepper; resolved per system)
     double rtol = 1e-10;               ///< relative tolerance of the step control (not read by "exact")
     double atol = default_atol(rtol);  ///< absolute tolerance of the step control (not read by "exact")
     double event_tol = 1e-15;          ///< time accuracy of located events (Newton on exact steps)
@@ -106,6 +113,8 @@ struct FlowOptions {
     /// validate(), and that the stepper applies to s ("exact" needs a closed-form flow; the message
     /// names what s has and what "exact" needs).
     void validate(const FlowSystem& s) const;
+    /// A copy whose stepper is resolved on s (resolve_stepper): what a tracer runs and a map reports.
+    FlowOptions resolved(const FlowSystem& s) const;
 };
 
 /// Point of Sigma_h from section coordinates (theta, I) of the unperturbed H2 at energy h:

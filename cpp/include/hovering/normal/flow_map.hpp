@@ -137,7 +137,7 @@ public:
     const FlowSystem& system() const { return s_; }
     /// Energy of the section.
     double h() const { return h_; }
-    /// Integrator options.
+    /// Integrator options, their stepper resolved on the system (never "auto").
     const FlowOptions& options() const { return opt_; }
     /// The tangential curve (null: section coordinates).
     const std::shared_ptr<const TangentialCurve>& curve() const { return curve_; }

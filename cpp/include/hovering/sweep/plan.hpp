@@ -48,7 +48,7 @@ struct SystemSpec {
 
 /// The integrator of a flow point (the other FlowOptions keep their defaults).
 struct IntegratorSpec {
-    Stepper stepper = Stepper::Rk8pd;  ///< parsed from the plan's name (kSteppers)
+    Stepper stepper = Stepper::Auto;  ///< parsed from the plan's name (kSteppers)
     double rtol = 0, atol = 0;         ///< both explicit in a plan
 };
 

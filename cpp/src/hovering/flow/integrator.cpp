@@ -25,12 +25,18 @@ const gsl_odeiv2_step_type* stepper_type(Stepper s) {
         case Stepper::Rk2imp: return gsl_odeiv2_step_rk2imp;
         case Stepper::Taylor:
         case Stepper::Exact: return nullptr;
+        case Stepper::Auto: break;  // resolved on the system before (FlowOptions::resolved): never here
     }
     bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
 }
 
-Integrator::Integrator(const FlowSystem& s, const FlowOptions& o, int n_tangents)
-    : field_(s, n_tangents), atol_(o.atol), rtol_(o.rtol), qlim1_(s.V1->q_limit()), qlim2_(s.V2->q_limit()) {
+Integrator::Integrator(const FlowSystem& s, const FlowOptions& options, int n_tangents)
+    : field_(s, n_tangents),
+      atol_(options.atol),
+      rtol_(options.rtol),
+      qlim1_(s.V1->q_limit()),
+      qlim2_(s.V2->q_limit()) {
+    const FlowOptions o = options.resolved(s);  // "auto": the stepper it means on s
     gsl_quiet();
     sys_ = gsl_odeiv2_system{field_.fn, &Field::jacobian, std::size_t(field_.dim), &field_};
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);

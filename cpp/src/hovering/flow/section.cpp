@@ -20,7 +20,7 @@ using detail::kPi;
 Stepper parse_stepper(const std::string& name) {
     for (std::size_t i = 0; i < kSteppers.size(); ++i)
         if (name == kSteppers[i]) return static_cast<Stepper>(i);
-    bad("stepper must be one of rk8pd, rkck, rkf45, rk4, rk2 (explicit one-step methods), msadams "
+    bad("stepper must be one of auto (the default: taylor where it applies, else rk8pd), rk8pd, rkck, rkf45, rk4, rk2 (explicit one-step methods), msadams "
         "(variable-order Adams multistep), rk4imp, rk2imp (implicit Gauss-Legendre, symplectic at a fixed "
         "step; with the Jacobian), taylor (Taylor's method, order and step from the tolerances; Harmonic and Tan "
         "potentials) or exact (closed-form flow, where the system has one); GSL's bsimp and msbdf are not "
@@ -32,6 +32,17 @@ const char* stepper_name(Stepper s) {
     const auto i = static_cast<std::size_t>(s);
     if (i >= kSteppers.size()) bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
     return kSteppers[i];
+}
+
+Stepper resolve_stepper(Stepper st, const FlowSystem& s) {
+    if (st != Stepper::Auto) return st;
+    return detail::taylor_unsupported(s).empty() ? Stepper::Taylor : Stepper::Rk8pd;
+}
+
+FlowOptions FlowOptions::resolved(const FlowSystem& s) const {
+    FlowOptions o = *this;
+    o.stepper = resolve_stepper(stepper, s);
+    return o;
 }
 
 void FlowOptions::validate() const {

@@ -94,7 +94,7 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
 }  // namespace
 
 Tracer::Tracer(const FlowSystem& s, const FlowOptions& o, int tangents)
-    : s_(s), o_(o), in_(s, o, tangents), tangents_(in_.field().tangents) {
+    : s_(s), o_(o.resolved(s)), in_(s, o_, tangents), tangents_(in_.field().tangents) {
     cands_.reserve(8);
     // The events below read each step's two ends and at most one turn of q1 (section, right wall)
     // and of q2 (upper wall) inside it: the integrator ends steps so that no more turns occur.
@@ -598,7 +598,7 @@ bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
 }
 
 TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o, int tangents)
-    : taylor_(o.stepper == Stepper::Taylor) {
+    : taylor_(resolve_stepper(o.stepper, s) == Stepper::Taylor) {
     // Eight lanes (two 4-double vectors) rather than four: measured up to 10% more returns per
     // second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;

@@ -25,6 +25,7 @@ FlowMap::FlowMap(FlowSystem s, double h, FlowOptions opt, std::shared_ptr<const 
     : s_(std::move(s)), h_(h), opt_(std::move(opt)), curve_(std::move(curve)), lift_(std::move(lift)) {
     detail::gsl_quiet();
     opt_.validate(s_);
+    opt_ = opt_.resolved(s_);  // options() reports the stepper that runs, never "auto"
     s_.validate();
     if (!std::isfinite(h_)) bad("h must be finite, got " + fmt(h_));
     if (curve_) {

@@ -37,7 +37,7 @@ FlowOptions build_options(const IntegratorSpec& it, const FlowSystem& s) {
     o.rtol = it.rtol;
     o.atol = it.atol;
     o.validate(s);
-    return o;
+    return o.resolved(s);
 }
 
 TruncatedFamily build_model(const ModelSpec& m) {

@@ -252,7 +252,8 @@ class IntegratorSpec:
     Attributes
     ----------
     stepper : str
-        One of :data:`hovering.flow.STEPPERS` (default the core's, ``rk8pd``), e.g. ``exact`` (the
+        One of :data:`hovering.flow.STEPPERS` (default the core's, ``auto``: ``taylor`` where it
+        applies, V1 and V2 each Harmonic or Tan, else ``rk8pd``; results record the one that ran), e.g. ``exact`` (the
         closed-form flow: eps = 0 with Harmonic/Tan potentials, or Harmonic ones with a bilinear
         coupling; it ignores the tolerances).
     rtol, atol : float
