@@ -10,4 +10,7 @@ if [ -z "${CMAKE_CXX_COMPILER_LAUNCHER+x}" ] && command -v ccache >/dev/null 2>&
   # (build/<wheel tag>) and the C++ tests' (build/ctest), at the same depth, share the core's
   # objects: the C++ tests' build then compiles only the tests and the sweep executable.
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
+  # ccache hashes the compiler's name too, and left to themselves the two configurations name the
+  # same GCC differently (scikit-build-core's /usr/bin/g++, a plain cmake /usr/bin/c++): one name.
+  export CXX="${CXX:-c++}"
 fi
