@@ -68,7 +68,9 @@ fi
 # in the venv: the build below runs without isolation, in the same environment every time.
 mapfile -t BUILD_REQUIRES < <(python scripts/floors.py --requires build)
 python -m pip install -q cmake ninja "${BUILD_REQUIRES[@]}"
-echo "[setup] building (or re-using the build of) hovering's C++ core and installing it into $VENV"
+# shellcheck source=scripts/compiler_cache.sh
+. scripts/compiler_cache.sh
+echo "[setup] building (or re-using the build of) hovering's C++ core and installing it into $VENV${CMAKE_CXX_COMPILER_LAUNCHER:+ (compiler launcher: $CMAKE_CXX_COMPILER_LAUNCHER)}"
 start=$(date +%s)
 python -m pip install -q --no-build-isolation ".[$EXTRAS]" --config-settings=build-dir="$BUILD_DIR"
 echo "[setup] build and install: $(( $(date +%s) - start )) s"

@@ -34,6 +34,8 @@ fi
 . "$VENV/bin/activate"
 if [ "$OLDEST" = 0 ]; then
   echo "[test] C++ unit tests (ctest)"
+  # shellcheck source=scripts/compiler_cache.sh
+  . scripts/compiler_cache.sh
   cmake -S . -B build/ctest -G Ninja -DCMAKE_BUILD_TYPE=Release -DHOVERING_BUILD_TESTS=ON -DHOVERING_BUILD_APPS=ON >/dev/null
   cmake --build build/ctest
   (cd build/ctest && ctest --output-on-failure)

@@ -80,3 +80,58 @@ def test_an_option_value_outside_on_off_auto_is_refused(tmp_path):
     rc, out, _ = configure(tmp_path, "-DHOVERING_BUILD_APPS=maybe")
     assert rc != 0
     assert "HOVERING_BUILD_APPS=maybe: allowed values are ON, OFF and AUTO" in " ".join(out.split())
+
+
+# The build-time choices (CHANGELOG 0.3.0, "Build time"): the Python package's configuration as
+# scikit-build-core makes it (SKBUILD, Release), read from the generated build.ninja.
+def configure_module(tmp_path, *defines):
+    pybind11 = pytest.importorskip("pybind11")
+    return configure(
+        tmp_path,
+        "-DSKBUILD=ON",
+        "-DCMAKE_BUILD_TYPE=Release",
+        f"-Dpybind11_DIR={pybind11.get_cmake_dir()}",
+        f"-DPython_EXECUTABLE={sys.executable}",
+        *defines,
+    )
+
+
+def compile_lines(ninja: str, source: str) -> list[str]:
+    """The FLAGS lines of every object built from `source` (one per target compiling it)."""
+    blocks = ninja.split("\nbuild ")
+    return [b for b in blocks if b.split(":", 1)[0].endswith(source + ".o")]
+
+
+def test_the_module_binds_in_two_unity_sources_without_lto(tmp_path):
+    rc, out, build = configure_module(tmp_path)
+    assert rc == 0, out[-3000:]
+    ninja = targets(build)
+    assert "-flto" not in ninja  # pybind11's LTO of the bindings: off
+    assert "Unity/unity_bindings_a_cxx.cxx.o" in ninja and "Unity/unity_bindings_b_cxx.cxx.o" in ninja
+    assert "bind_flow.cpp.o" not in ninja
+    # the core is never a unity build
+    assert "hovering_core.dir/Unity" not in ninja
+
+
+def test_unity_build_off_compiles_the_bindings_one_by_one(tmp_path):
+    rc, out, build = configure_module(tmp_path, "-DCMAKE_UNITY_BUILD=OFF")
+    assert rc == 0, out[-3000:]
+    ninja = targets(build)
+    assert "Unity/" not in ninja
+    assert "bind_flow.cpp.o" in ninja and "bind_pickle.cpp.o" in ninja
+
+
+def test_the_lane_kernels_compile_at_o2_in_release(tmp_path):
+    # -O2 after Release's -O3 (the last -O wins): the six compilations of the two lane kernels.
+    rc, out, build = configure_module(tmp_path)
+    assert rc == 0, out[-3000:]
+    ninja = targets(build)
+    for source in ("truncated/lanes.cpp", "flow/taylor_lanes.cpp"):
+        lines = compile_lines(ninja, source)
+        assert lines, source
+        for block in lines:
+            flags = next(ln for ln in block.splitlines() if ln.strip().startswith("FLAGS ="))
+            assert flags.rindex("-O2") > flags.index("-O3"), flags
+    # the rest of the core keeps -O3 alone
+    flags = next(ln for ln in compile_lines(ninja, "flow/tracer.cpp")[0].splitlines() if "FLAGS =" in ln)
+    assert "-O3" in flags and "-O2" not in flags
