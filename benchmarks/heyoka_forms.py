@@ -19,7 +19,7 @@ import time
 import heyoka as hy
 import numpy as np
 
-from hovering.flow.system import Bilinear, Harmonic, Tan
+from hovering.flow.system import Bilinear, Harmonic, Polynomial, Tan
 
 __all__ = ["HeyokaFlow", "collect_crossings", "NEG", "POS", "TIME_LIMIT"]
 
@@ -37,6 +37,26 @@ def _force(V, q):
     raise ValueError(f"heyoka forms need Harmonic or Tan potentials, got {V!r}")
 
 
+def _coupling_forces(coupling, q1, q2):
+    """(-dVc/dq1, -dVc/dq2) of a Polynomial coupling sum c q1^i q2^j as heyoka expressions, term by
+    term (c i q1^(i-1) q2^j; integer powers as heyoka's pow, whose recurrences heyoka picks itself)."""
+    if isinstance(coupling, Polynomial):
+
+        def mono(i, j):
+            out = 1.0
+            for v, e in ((q1, i), (q2, j)):
+                if e == 1:
+                    out = out * v
+                elif e > 1:
+                    out = out * v**e
+            return out
+
+        g1 = sum((c * i * mono(i - 1, j) for (i, j), c in coupling.coefficients.items() if i > 0), 0.0 * q1)
+        g2 = sum((c * j * mono(i, j - 1) for (i, j), c in coupling.coefficients.items() if j > 0), 0.0 * q2)
+        return -g1, -g2
+    raise ValueError(f"a Polynomial coupling expected, got {coupling!r}")
+
+
 class HeyokaFlow:
     """heyoka.py integrators of one system's flow in the four forms, compiled once per (form, tol).
 
@@ -50,14 +70,17 @@ class HeyokaFlow:
         s = sec.sys
         if s.geometry not in ("wall", "step"):
             raise ValueError(f"walls needed, got geometry {s.geometry!r}")
-        if s.eps != 0 and not isinstance(s.coupling, Bilinear):
-            raise ValueError(f"only the bilinear coupling is written out here, got {s.coupling!r}")
+        if s.eps != 0 and not isinstance(s.coupling, (Bilinear, Polynomial)):
+            raise ValueError(f"only the bilinear and polynomial couplings are written out here, got {s.coupling!r}")
         self.sec, self.sys = sec, s
         self.step = s.geometry == "step"
         self.vars = q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
         f1, f2 = _force(s.V1, q1), _force(s.V2, q2)
-        if s.eps != 0:
+        if s.eps != 0 and isinstance(s.coupling, Bilinear):
             f1, f2 = f1 - s.eps * q2, f2 - s.eps * q1
+        elif s.eps != 0:
+            c1, c2 = _coupling_forces(s.coupling, q1, q2)
+            f1, f2 = f1 + s.eps * c1, f2 + s.eps * c2
         self.eqs = [(q1, p1), (p1, f1), (q2, p2), (p2, f2)]
         self.impacts = [0]  # reflections counted by the callbacks (part 3)
         self._cache = {}

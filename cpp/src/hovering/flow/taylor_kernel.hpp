@@ -74,6 +74,17 @@ inline V cauchy(const V* a, const V* b, int k, V zero) {
     return (r0 + r1) + (r2 + r3);
 }
 
+// Order k of the product q1^i q2^j from the powers' series (pow1, pow2: rows of kTaylorStride).
+// q^0 is the constant series 1, whose product with the other power is that power's own
+// coefficient: no convolution (a Cauchy product with 1 adds only zeros to it: the same number).
+template <class V>
+inline V monomial(const V* pow1, const V* pow2, int i, int j, int k, V zero) {
+    constexpr int P = kTaylorStride;
+    if (j == 0) return pow1[i * P + k];
+    if (i == 0) return pow2[j * P + k];
+    return cauchy(&pow1[i * P], &pow2[j * P], k, zero);
+}
+
 // Order k + 1 of the tangents (rows n .. n + 4 nt) from orders <= k of the state and the tangents:
 // d(dq)/dt = dp, d(dp)/dt = -Hess(V) dq, with Hess(V)'s series from the state's (V'' of Tan is
 // a b (3 w^2 - 2 w), a product of series again; the coupling's Hessian from the powers of q1, q2).
@@ -91,9 +102,9 @@ inline void tangent_order(const TaylorModel& m, TaylorSeries<V>& S, int k, V zer
         V h11 = zero, h12 = zero, h22 = zero;
         for (const auto& t : m.terms) {
             const int i = int(t[1]), j = int(t[2]);
-            if (i >= 2) h11 += t[0] * (i * (i - 1)) * cauchy(&S.pow1[(i - 2) * P], &S.pow2[j * P], k, zero);
-            if (i >= 1 && j >= 1) h12 += t[0] * (i * j) * cauchy(&S.pow1[(i - 1) * P], &S.pow2[(j - 1) * P], k, zero);
-            if (j >= 2) h22 += t[0] * (j * (j - 1)) * cauchy(&S.pow1[i * P], &S.pow2[(j - 2) * P], k, zero);
+            if (i >= 2) h11 += t[0] * (i * (i - 1)) * monomial(S.pow1, S.pow2, i - 2, j, k, zero);
+            if (i >= 1 && j >= 1) h12 += t[0] * (i * j) * monomial(S.pow1, S.pow2, i - 1, j - 1, k, zero);
+            if (j >= 2) h22 += t[0] * (j * (j - 1)) * monomial(S.pow1, S.pow2, i, j - 2, k, zero);
         }
         S.hh[0][k] = m.eps * h11;
         S.hh[1][k] = m.eps * h12;
@@ -148,8 +159,8 @@ void series(const TaylorModel& m, TaylorSeries<V>& S) {
             for (const auto& t : m.terms) {
                 const int i = int(t[1]), j = int(t[2]);
                 // d/dq1 c q1^i q2^j = c i q1^(i-1) q2^j.
-                if (i > 0) g1 += t[0] * i * cauchy(&S.pow1[(i - 1) * P], &S.pow2[j * P], k, zero);
-                if (j > 0) g2 += t[0] * j * cauchy(&S.pow1[i * P], &S.pow2[(j - 1) * P], k, zero);
+                if (i > 0) g1 += t[0] * i * monomial(S.pow1, S.pow2, i - 1, j, k, zero);
+                if (j > 0) g2 += t[0] * j * monomial(S.pow1, S.pow2, i, j - 1, k, zero);
             }
             S.g[0][k] = m.eps * g1;
             S.g[1][k] = m.eps * g2;
