@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import hovering as hv
@@ -34,6 +34,8 @@ def _closes(m, o, tol):
 
 @settings(max_examples=20, deadline=None)
 @given(st.floats(0.05, 1.2), st.floats(0.5, 2.0), st.floats(-3.0, 3.0))
+@example(eps=1.0, tau0=2.0, Omega0=0.0)  # k = 2: the half orbit's R = 1 exactly (parabolic)
+@example(eps=1.2, tau0=2.0, Omega0=0.5)  # k = 2.4: R = 1.44, inverse hyperbolic
 def test_the_standard_maps_fixed_points_and_half_orbit(eps, tau0, Omega0):
     # Fixed points: Omega(K) = 2 pi j, phi in {0, pi}: residue -k cos(phi) / 4 (k = eps tau0).
     m = hv.TruncatedMap(eps=eps, Omega0=Omega0, theta_w=2.0, tau0=tau0)
@@ -47,12 +49,19 @@ def test_the_standard_maps_fixed_points_and_half_orbit(eps, tau0, Omega0):
         assert o.stability == ("elliptic" if sign > 0 else "hyperbolic")
         assert o.det_error < 1e-13
         _closes(m, o, 1e-12)
-    # The symmetric 1/2 orbit {(0, K), (pi, K)} with Omega(K) = 3 pi: residue k^2 / 4, elliptic.
+    # The symmetric 1/2 orbit {(0, K), (pi, K)} with Omega(K) = 3 pi: residue k^2 / 4, elliptic for
+    # k < 2, parabolic at k = 2, inverse hyperbolic beyond (k reaches 2.4 here).
     K_half = (3 * np.pi - Omega0) / tau0
     o = hv.periodic_orbit(m, 0.0, K_half + 0.01, 2, symmetric=True, line="0")
     assert o.converged and o.line == "0" and o.winding == int(round((Omega0 + tau0 * K_half) * 2 / (2 * np.pi)))
     assert np.allclose(o.K, K_half, atol=1e-12)
-    assert abs(o.residue - k**2 / 4) < 1e-12 and o.stability == "elliptic"
+    R = k**2 / 4
+    assert abs(o.residue - R) < 1e-12
+    # the classification's parabolic band is ~1e-13 wide (100 x the map's rounding x the period)
+    if abs(R - 1) <= 1e-14:
+        assert o.stability == "parabolic"
+    elif abs(R - 1) > 1e-11:
+        assert o.stability == ("elliptic" if R < 1 else "inverse hyperbolic")
     _closes(m, o, 1e-12)
 
 

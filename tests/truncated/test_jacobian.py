@@ -82,7 +82,11 @@ def test_on_the_no_impact_regions_it_is_the_standard_maps():
     c = 0.3 * np.cos(t.phi[smooth])
     expect = np.stack([np.ones_like(c), np.full_like(c, 1.3), c, 1 + 1.3 * c], axis=-1).reshape(-1, 2, 2)
     assert smooth.sum() > 200
-    assert np.array_equal(t.J[smooth], expect)
+    # The first row (1, tau0) is exact. The second holds eps cos(phibar): the core's cos and NumPy's
+    # are different implementations (numpy 1.23's differed from the core's in the last bit where
+    # numpy 2's agreed), each within an ulp, so the entries (|.| <= 1.4) agree to two ulps of 1.
+    assert np.array_equal(t.J[smooth][:, 0], expect[:, 0])
+    assert np.all(np.abs(t.J[smooth][:, 1] - expect[:, 1]) <= 2 * np.finfo(float).eps)
     # J_R: the slope of omega_R = Omega0 + tau0 K - 2 lam sqrt(-K) is tau0 + lam / sqrt(-K)
     right = t.region == hv.Region.RIGHT
     assert right.sum() > 20
