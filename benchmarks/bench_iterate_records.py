@@ -102,7 +102,7 @@ def recording(n_orbits: int, n_steps: int, repeat: int) -> None:
     print(f"\nRecording every state: {n_orbits} orbits x {n_steps} steps (SIMD kernel), best of {repeat}")
     for threads in (1, 2):
         fns = [
-            lambda: m.iterate(phi0, K0, n_steps, n_threads=threads),
+            lambda: m.iterate(phi0, K0, n_steps, n_threads=threads, record=()),  # (the default records)
             lambda: m.iterate(phi0, K0, n_steps, n_threads=threads, record=("orbit",)),
             lambda: m.iterate(phi0, K0, n_steps, n_threads=threads, record=("orbit", "regions")),
             write,
