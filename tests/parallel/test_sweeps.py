@@ -9,7 +9,6 @@ import re
 
 import pytest
 
-import hovering
 from hovering import pipeline, scenes
 from hovering.parallel.checkpoint import Checkpoint, canonical
 
