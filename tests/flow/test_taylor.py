@@ -211,6 +211,52 @@ def test_flowmap_orbits_are_the_same_alone_and_in_lane_groups():
         assert np.array_equal(back.phi[i : i + 1], one.phi, equal_nan=True)
 
 
+def _verified_system(geometry):
+    """Tan x Tan with a degree-4 coupling: ~9% of its returns at rtol 1e-10 are long enough (in
+    steps times the impacts' amplification) to be verified, i.e. traced again at rtol / 100."""
+    return StepSystem(
+        V1=Tan(1.0, 0.6),
+        V2=Tan(1.4, 0.7),
+        coupling=hovering.Polynomial({(2, 1): 1.0, (1, 3): 1.0}),
+        eps=0.05,
+        qw1=-1.0,
+        qw2=-0.5,
+        geometry=geometry,
+    )
+
+
+@pytest.mark.parametrize("geometry", ["wall", "step"])
+def test_verifying_traces_in_lane_groups_are_the_traces_alone(geometry, restore_level):
+    # A return under verification is traced again beside the other lanes' returns, in the same
+    # kernel call (its verifier keeps the return's order, with shorter steps): alone, in a group
+    # of eight, on one thread or two, and at every SIMD level (one 8-double register on AVX-512,
+    # two 4-double vectors below) the returns must be the same bit for bit.
+    core = restore_level
+    sec = Section(_verified_system(geometry), H)
+    th, I = _starts(sec, 21, seed=3)
+    kw = dict(stepper="taylor", rtol=1e-10, atol=1e-10, n_threads=1)
+    fm = hovering.FlowMap(sec.sys, H, coordinates="section", **{k: v for k, v in kw.items() if k != "n_threads"})
+    first = fm.iterate(th, I, 12, record=("orbit",), n_threads=1)
+    plain = hovering.FlowMap(sec.sys, H, coordinates="section", verify_steps=0, stepper="taylor", rtol=1e-10, atol=1e-10)
+    unverified = plain.iterate(th, I, 12, record=(), n_threads=1)
+    # Some returns were verified (each verifying trace searches the section once more: 30 of the
+    # 252 returns with walls, 7 with the step), else this test would test nothing.
+    assert first.work["section_searches"] - unverified.work["section_searches"] >= 4, (first.work, unverified.work)
+    assert np.count_nonzero(first.status == 0) >= 15
+    two = fm.iterate(th, I, 12, record=("orbit",), n_threads=2)
+    assert np.array_equal(first.phi, two.phi, equal_nan=True) and np.array_equal(first.K, two.K, equal_nan=True)
+    for i in range(th.size):
+        alone = fm.iterate(th[i : i + 1], I[i : i + 1], 12, record=("orbit",), n_threads=1)
+        assert np.array_equal(first.phi[i], alone.phi[0], equal_nan=True)
+        assert np.array_equal(first.K[i], alone.K[0], equal_nan=True)
+        assert first.status[i] == alone.status[0]
+    for level in core.simd_levels():
+        core.set_simd_level(level)
+        other = fm.iterate(th, I, 12, record=("orbit",), n_threads=1)
+        assert np.array_equal(first.phi, other.phi, equal_nan=True), level
+        assert np.array_equal(first.K, other.K, equal_nan=True), level
+
+
 def test_every_simd_level_gives_the_same_orbits(restore_level):
     # The 4-orbit kernel is compiled per instruction set (baseline SSE2, AVX2, AVX-512) and chosen
     # at run time with the truncated map's (HOVERING_SIMD, set_simd_level): every level this CPU

@@ -48,6 +48,8 @@ public:
     virtual double V(double q) const = 0;
     /// V'(q).
     virtual double dV(double q) const = 0;
+    /// (V(q), V'(q)), the same numbers as V and dV (a potential may share their work).
+    virtual std::array<double, 2> V_dV(double q) const { return {V(q), dV(q)}; }
     /// Short description, e.g. "Harmonic(omega=1)".
     virtual std::string name() const = 0;
     /// Largest |q| for which V is defined (infinity if unbounded).
@@ -162,6 +164,8 @@ public:
     double V(double q) const override;
     /// V'(q) in closed form.
     double dV(double q) const override;
+    /// V and V' from one tan.
+    std::array<double, 2> V_dV(double q) const override;
     /// Short description with the parameters.
     std::string name() const override;
     /// pi / (2 alpha): the wall of the well.
@@ -207,6 +211,8 @@ public:
     double V(double q) const override { return base_->V(q); }
     /// The base's V'.
     double dV(double q) const override { return base_->dV(q); }
+    /// The base's V_dV.
+    std::array<double, 2> V_dV(double q) const override { return base_->V_dV(q); }
     /// "Numerical(<base>)".
     std::string name() const override { return "Numerical(" + base_->name() + ")"; }
     /// The base's q_limit.

@@ -30,7 +30,7 @@ const gsl_odeiv2_step_type* stepper_type(Stepper s) {
     bad("stepper: not a Stepper value (" + std::to_string(int(s)) + ")");
 }
 
-Integrator::Integrator(const FlowSystem& s, const FlowOptions& options, int n_tangents)
+Integrator::Integrator(const FlowSystem& s, const FlowOptions& options, int n_tangents, int taylor_order)
     : field_(s, n_tangents),
       atol_(options.atol),
       rtol_(options.rtol),
@@ -42,7 +42,7 @@ Integrator::Integrator(const FlowSystem& s, const FlowOptions& options, int n_ta
     const gsl_odeiv2_step_type* T = stepper_type(o.stepper);
     kind_ = detail::exact_kind(s, o);
     if (o.stepper == Stepper::Taylor) {
-        taylor_ = std::make_unique<Taylor>(field_, s, o.rtol, o.atol);
+        taylor_ = std::make_unique<Taylor>(field_, s, o.rtol, o.atol, taylor_order);
     } else if (kind_ != ExactKind::None) {
         if (kind_ == ExactKind::Linear) linear_ = std::make_unique<LinearFlow>(s);
         osc_[0].V = s.V1.get();

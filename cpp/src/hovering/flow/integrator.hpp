@@ -38,7 +38,9 @@ class Integrator {
 public:
     /// An integrator of s with options o, carrying n_tangents tangent vectors with the state
     /// (the variational equations; Field).
-    Integrator(const FlowSystem& s, const FlowOptions& o, int n_tangents = 0);
+    /// taylor_order > 0: stepper "taylor" at that order (Taylor), for a verifying trace expanded
+    /// in the lanes of the returns it verifies.
+    Integrator(const FlowSystem& s, const FlowOptions& o, int n_tangents = 0, int taylor_order = 0);
     ~Integrator();
     Integrator(const Integrator&) = delete;
     Integrator& operator=(const Integrator&) = delete;

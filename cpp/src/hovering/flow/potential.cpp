@@ -546,6 +546,12 @@ double Tan::dV(double q) const {
     const double t = std::tan(alpha_ * q);
     return omega_ * omega_ / alpha_ * t * (1 + t * t);
 }
+std::array<double, 2> Tan::V_dV(double q) const {
+    // The section point's Newton iteration needs both at each q: tan once instead of twice.
+    if (!(std::fabs(q) < q_limit())) return {V(q), dV(q)};
+    const double t = std::tan(alpha_ * q);
+    return {0.5 * omega_ * omega_ / (alpha_ * alpha_) * t * t, omega_ * omega_ / alpha_ * t * (1 + t * t)};
+}
 std::string Tan::name() const {
     return "Tan(omega=" + fmt(omega_) + ", alpha=" + fmt(alpha_) + ")";
 }

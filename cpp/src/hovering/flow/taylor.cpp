@@ -51,7 +51,10 @@ void Taylor::expand_group(Taylor* const* t, const double* const* y, const double
     const TaylorLaneKernels& k = lane_kernels();
     const int width = count <= 4 ? 4 : 8;
     ++lanes.round;  // first: were the kernel ever to throw midway, no lane would trust its rows
-    (width == 4 ? k.expand4 : k.expand8)(t[0]->m_, y, hmax, count, lanes.c, out);
+    // One model for the call (t[0]'s: every lane's but for the step rule's numbers, rule[l]).
+    TaylorLaneRule rule[kMaxTaylorGroup];
+    for (int l = 0; l < count; ++l) rule[l] = {t[l]->m_.scale_floor, t[l]->m_.factor};
+    (width == 4 ? k.expand4 : k.expand8)(t[0]->m_, y, hmax, rule, count, lanes.c, out);
     for (int l = 0; l < count; ++l) t[l]->take(&lanes, l, width, out[l]);
 }
 
@@ -75,7 +78,7 @@ std::string taylor_unsupported(const FlowSystem& s) {
     return "";
 }
 
-Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) {
+Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol, int order) {
     const std::string why = taylor_unsupported(s);
     if (!why.empty()) bad(why);
     m_.n = f.state;  // the step rule reads the state only: tangents do not change the steps
@@ -91,9 +94,11 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol) {
     int degree = 0;
     if (f.ckind == CKind::General)
         for (const auto& t : s.coupling.terms) degree = std::max(degree, int(t[1] + t[2]));
-    m_.p = std::clamp(std::max(m_.p, degree + 4), 2, kMaxTaylorOrder);
+    m_.p = std::clamp(std::max(order > 0 ? order : m_.p, degree + 4), 2, kMaxTaylorOrder);
     m_.scale_floor = atol / rtol;
-    m_.factor = std::exp(kLogStepFraction - 0.7 / (m_.p - 1));
+    // A given order below the tolerance's takes shorter steps: f^(p - 1) = rtol.
+    const double log_f = std::min(kLogStepFraction, std::log(rtol) / (m_.p - 1));
+    m_.factor = std::exp(log_f - 0.7 / (m_.p - 1));
     const Force* forces[2] = {&f.f1, &f.f2};
     for (int i = 0; i < 2; ++i) {
         m_.kind[i] = forces[i]->kind;
@@ -123,7 +128,8 @@ bool Taylor::expand(const double* y0, double hmax, double* h) {
     if (!own_) own_.reset(new TaylorLanes);
     TaylorStep out{};
     ++own_->round;
-    lane_kernels().expand4(m_, &y0, &hmax, 1, own_->c, &out);
+    const TaylorLaneRule rule{m_.scale_floor, m_.factor};
+    lane_kernels().expand4(m_, &y0, &hmax, &rule, 1, own_->c, &out);
     take(own_.get(), 0, 4, out);
     *h = step_.h;
     return valid_;

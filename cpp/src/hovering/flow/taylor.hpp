@@ -24,7 +24,7 @@
 // the very polynomial the step took (same accuracy at no further expansion).
 //
 // Several orbits can be expanded at once (expand_group): 4 in the lanes of one SIMD register (8 in
-// two), on the instruction set the core's SIMD level selects (taylor_lanes.cpp), bit for bit what
+// two, or in one AVX-512 register), on the instruction set the core's SIMD level selects (taylor_lanes.cpp), bit for bit what
 // each would get alone; the lanes also apply the step rule and evaluate each polynomial at its
 // step's end.
 
@@ -59,8 +59,10 @@ struct alignas(64) TaylorLanes {
 /// The Taylor expansion of the flow through one point, and its step rule (see the file comment).
 class Taylor {
 public:
-    /// For the field f of system s (throws std::invalid_argument where taylor_unsupported says why).
-    Taylor(const Field& f, const FlowSystem& s, double rtol, double atol);
+    /// For the field f of system s (throws std::invalid_argument where taylor_unsupported says why);
+    /// order > 0: at that order instead of the tolerance's, with the step fraction f at most
+    /// rtol^(1 / (p - 1)) (shorter steps where the tolerance would take a higher order).
+    Taylor(const Field& f, const FlowSystem& s, double rtol, double atol, int order = 0);
     Taylor(const Taylor&) = delete;  // c_ points into own_ or a group's lanes
     Taylor& operator=(const Taylor&) = delete;
     /// The order p.
@@ -69,9 +71,10 @@ public:
     /// step the tolerances allow goes to *h (infinite for a polynomial solution of degree < p); the
     /// polynomial at min(*h, hmax) is ready for eval().
     bool expand(const double* y0, double hmax, double* h);
-    /// expand() for count <= kMaxTaylorGroup orbits of the same system and tolerances at once (SIMD
-    /// lanes), their coefficients in lanes (which stay t[l]'s until lanes is written again): t[l]
-    /// expanded through y[l] with step bound hmax[l]. Bit for bit t[l]->expand(y[l], hmax[l], .).
+    /// expand() for count <= kMaxTaylorGroup orbits of the same system and order at once (SIMD
+    /// lanes; the tolerances may differ: a verifying trace's beside the returns'), their
+    /// coefficients in lanes (which stay t[l]'s until lanes is written again): t[l] expanded
+    /// through y[l] with step bound hmax[l]. Bit for bit t[l]->expand(y[l], hmax[l], .).
     static void expand_group(Taylor* const* t, const double* const* y, const double* hmax, TaylorLanes& lanes,
                              int count);
     /// Whether the current expansion is the one through y0 (bit for bit) and finite, and its step.

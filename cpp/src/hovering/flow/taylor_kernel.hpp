@@ -41,6 +41,13 @@ struct TaylorModel {
     double factor = 0;                                  ///< step rule: exp(ln f - 0.7 / (p - 1))
 };
 
+/// The step rule's per-orbit numbers (TaylorModel's), which may differ between the lanes of one
+/// kernel call: a verifying trace (a tighter tolerance at the same order) beside the returns.
+struct TaylorLaneRule {
+    double scale_floor;  ///< atol / rtol
+    double factor;       ///< exp(ln f - 0.7 / (p - 1))
+};
+
 /// Work arrays of one expansion (V per entry): c points to the state coefficients (the caller's,
 /// kMaxDim rows), Tan's w = 1 + u^2, the coupling gradient g, and with tangents V'' of each
 /// oscillator (hs) and the coupling's Hessian (hh: h11, h12, h22); for a General coupling pow1, pow2
@@ -289,12 +296,13 @@ struct TaylorLaneKernels {
     const char* level;  ///< "sse2", "avx2", "avx512", ...
     /// Expand count <= 4 starting states y[l] (m.n entries each) into c, lane-interleaved
     /// (c[(i kTaylorStride + k) 4 + l]: variable i, order k, lane l; 32-byte aligned), apply the
-    /// step rule with step bound hmax[l] and evaluate each polynomial at its step: out[l].
-    void (*expand4)(const TaylorModel& m, const double* const* y, const double* hmax, int count, double* c,
-                    TaylorStep* out);
-    /// The same for count <= 8 (two 4-double vectors; c[(i kTaylorStride + k) 8 + l]).
-    void (*expand8)(const TaylorModel& m, const double* const* y, const double* hmax, int count, double* c,
-                    TaylorStep* out);
+    /// step rule with rule[l] (in place of m's) and step bound hmax[l], and evaluate each
+    /// polynomial at its step: out[l].
+    void (*expand4)(const TaylorModel& m, const double* const* y, const double* hmax, const TaylorLaneRule* rule,
+                    int count, double* c, TaylorStep* out);
+    /// The same for count <= 8 (two 4-double vectors or one 8-double vector; c[(i kTaylorStride + k) 8 + l]).
+    void (*expand8)(const TaylorModel& m, const double* const* y, const double* hmax, const TaylorLaneRule* rule,
+                    int count, double* c, TaylorStep* out);
 };
 
 }  // namespace hovering::detail

@@ -93,8 +93,8 @@ double locate(Integrator& in, const double* y0, const double* d0, const double* 
 
 }  // namespace
 
-Tracer::Tracer(const FlowSystem& s, const FlowOptions& o, int tangents)
-    : s_(s), o_(o.resolved(s)), in_(s, o_, tangents), tangents_(in_.field().tangents) {
+Tracer::Tracer(const FlowSystem& s, const FlowOptions& o, int tangents, int taylor_order)
+    : s_(s), o_(o.resolved(s)), in_(s, o_, tangents, taylor_order), tangents_(in_.field().tangents) {
     cands_.reserve(8);
     // The events below read each step's two ends and at most one turn of q1 (section, right wall)
     // and of q2 (upper wall) inside it: the integrator ends steps so that no more turns occur.
@@ -142,7 +142,7 @@ ReturnResult Tracer::trace(const std::array<double, 4>& z0, bool first_crossing,
                            const double* t0) {
     if (!steps_apply()) return trace_angles(z0, first_crossing, cancel);
     begin(z0, first_crossing, t0);
-    while (!step(cancel)) {
+    while (!(stepping().step(cancel) && settle())) {
     }
     return end();
 }
@@ -151,6 +151,7 @@ void Tracer::begin(const std::array<double, 4>& z0, bool first_crossing, const d
     const FlowSystem& s = s_;
     Ret& R = ret_;
     R = Ret{};
+    vf_.level = -1;
     R.H0 = s.energy(z0.data());
     double* y = R.y;
     for (int i = 0; i < 4; ++i) y[i] = z0[std::size_t(i)];
@@ -450,14 +451,61 @@ void Tracer::take_tangents(const double* y, ReturnResult& r) const {
         for (int row = 0; row < 4; ++row) r.tangents[std::size_t(row * tangents_ + j)] = y[m + 4 * j + row];
 }
 
+bool Tracer::settle() {
+    if (vf_.level < 0) {
+        Ret& R = ret_;
+        finish(R.r, R.y, R.t, R.done, R.crossed, R.H0);
+        const std::int64_t from = verify_from();
+        // Step errors add up over a return and impacts multiply them: steps x amplification.
+        if (from > 0 && R.r.status == FlowStatus::Ok && double(R.r.steps) * R.amplification >= double(from)) {
+            vf_.prev_tol = o_.rtol;
+            vf_.steps0 = vf_.steps = R.r.steps;
+            vf_.prev = std::move(R.r);
+            return verify_at(0);
+        }
+        result_ = std::move(R.r);
+        return true;
+    }
+    // The verifying trace at level vf_.level is over: judge the first trace by it.
+    Tracer& V = *verifier_[vf_.level];
+    V.settle();  // never verified itself (verify_steps = 0): its result is final
+    ReturnResult r = V.end();
+    V.set_dense(nullptr);
+    ReturnResult& prev = vf_.prev;
+    vf_.steps += r.steps;
+    if (r.status == FlowStatus::StepLimit || r.status == FlowStatus::NonFinite || r.status == FlowStatus::OutsideWell) {
+        prev.steps = vf_.steps;  // the tighter trace could not be completed: not verified
+        prev.status = FlowStatus::Imprecise;
+        return conclude(std::move(prev));
+    }
+    if (r.status != FlowStatus::Ok) {  // the tighter trace decides (a graze, a corner, ...)
+        r.steps = vf_.steps;
+        return conclude(std::move(r));
+    }
+    // The difference in units of the band (time: rtol max(1, t); state: rtol |z| + atol), and
+    // the tighter trace's error estimated from it.
+    double d = std::fabs(prev.time - r.time) / (o_.rtol * std::max(1.0, std::fabs(r.time)));
+    for (int i = 0; i < 4; ++i) {
+        const double zi = r.z[std::size_t(i)];
+        d = std::max(d, std::fabs(prev.z[std::size_t(i)] - zi) / (o_.rtol * std::fabs(zi) + o_.atol));
+    }
+    if (prev.itinerary != r.itinerary) d = kInf;
+    const double estimate = 0.1 * d;
+    r.steps = vf_.steps;
+    prev = std::move(r);
+    vf_.prev_tol = verifier_[vf_.level]->o_.rtol;
+    if (estimate <= 1) return conclude(std::move(prev));
+    return verify_at(vf_.level + 1);
+}
+
 ReturnResult Tracer::end() {
-    Ret& R = ret_;
-    finish(R.r, R.y, R.t, R.done, R.crossed, R.H0);
-    const std::int64_t from = verify_from();
-    // Step errors add up over a return and impacts multiply them: steps x amplification.
-    if (from > 0 && R.r.status == FlowStatus::Ok && double(R.r.steps) * R.amplification >= double(from))
-        return verify(std::move(R.r));
-    return std::move(R.r);
+    return std::move(result_);
+}
+
+bool Tracer::conclude(ReturnResult r) {
+    vf_.level = -1;
+    result_ = std::move(r);
+    return true;
 }
 
 std::int64_t Tracer::verify_from() const {
@@ -474,79 +522,58 @@ std::int64_t Tracer::verify_from() const {
     return std::int64_t(std::clamp(n, 16.0, 1e15));
 }
 
-ReturnResult Tracer::verify(ReturnResult r0) {
+bool Tracer::verify_at(int level) {
     // A long return's error is not bounded by its steps' tolerance: local errors add up over
     // hundreds of steps, and a chaotic return (strong coupling, near a tangency) or a shallow
     // impact amplifies them (~3e-5 in time at rtol 1e-8 measured). Tracing it again at rtol / 100
     // measures the error of the first trace. The tighter trace's own error is taken as a tenth
     // of that difference: measured 30-300x smaller, but only ~3x where rk8pd's steps sit at the
     // step bound and its error hardly follows the tolerance (slow oscillators at rtol 1e-6), so
-    // a tenth is kept only if the difference is within 10 bands; else one level tighter.
-    // The floor: below it a tighter tolerance stops reducing the error (rounding): ~1e-15 for
-    // taylor; GSL's steppers, whose error estimates are differences of stages, stall sooner.
+    // a tenth is kept only if the difference is within 10 bands; else one level tighter (level
+    // 1, rtol / 10^4). The floor: below it a tighter tolerance stops reducing the error
+    // (rounding): ~1e-15 for taylor; GSL's steppers, whose error estimates are differences of
+    // stages, stall sooner. The tighter trace is stepped like any return (stepping()), so that a
+    // lane group expands the verifying traces of its lanes together.
     const bool taylor = o_.stepper == Stepper::Taylor;
     const double floor = taylor ? 1e-15 : 1e-14;
-    ReturnResult prev = std::move(r0);
-    double prev_tol = o_.rtol;
-    const std::int64_t steps0 = prev.steps;
-    std::int64_t steps = prev.steps;
-    for (int level = 0; level < 2; ++level) {
-        const double factor = level == 0 ? 1e-2 : 1e-4;
-        const double tol = std::max(o_.rtol * factor, floor);
-        if (!(tol < 0.5 * prev_tol)) break;  // nothing tighter to compare with
-        if (!verifier_[level]) {
-            FlowOptions v = o_;
-            v.rtol = tol;
-            v.atol = std::max(o_.atol * factor, 1e-300);
-            v.verify_steps = 0;
-            v.max_steps = std::max<std::int64_t>(o_.max_steps, 1);
-            verifier_[level] = std::make_unique<Tracer>(s_, v, tangents_);
-            verifier_[level]->set_event_driven(event_driven_);
-        }
-        Tracer& V = *verifier_[level];
-        V.set_labels(labels_);
-        // A budget of steps: the tighter trace needs about (prev_tol / tol)^(1/order) times the
-        // steps; ten times that means it cannot meet its tolerance (rounding), so no verdict.
-        const double growth = std::pow(prev_tol / tol, 1.0 / std::max(1, in_.order()));
-        V.o_.max_steps = std::min<std::int64_t>(o_.max_steps, std::int64_t(10 * growth * double(prev.steps)) + 1000);
-        if (dense_) {  // the trajectory shows the return that is kept: the tighter one's points
-            dense_->points->resize(ret_.dense_points);
-            dense_->kinds->resize(ret_.dense_kinds);
-            dense_->next = ret_.dense_next;
-            dense_->room = ret_.dense_room;
-            dense_->truncated = ret_.dense_truncated;
-        }
-        V.set_dense(dense_);
-        ReturnResult r = V.trace(ret_.z0, ret_.first_crossing, ret_.cancel, tangents_ > 0 ? ret_.t0 : nullptr);
-        V.set_dense(nullptr);
-        steps += r.steps;
-        if (r.status == FlowStatus::StepLimit || r.status == FlowStatus::NonFinite ||
-            r.status == FlowStatus::OutsideWell) {
-            prev.steps = steps;  // the tighter trace could not be completed: not verified
-            prev.status = FlowStatus::Imprecise;
-            return prev;
-        }
-        if (r.status != FlowStatus::Ok) {  // the tighter trace decides (a graze, a corner, ...)
-            r.steps = steps;
-            return r;
-        }
-        // The difference in units of the band (time: rtol max(1, t); state: rtol |z| + atol), and
-        // the tighter trace's error estimated from it.
-        double d = std::fabs(prev.time - r.time) / (o_.rtol * std::max(1.0, std::fabs(r.time)));
-        for (int i = 0; i < 4; ++i) {
-            const double zi = r.z[std::size_t(i)];
-            d = std::max(d, std::fabs(prev.z[std::size_t(i)] - zi) / (o_.rtol * std::fabs(zi) + o_.atol));
-        }
-        if (prev.itinerary != r.itinerary) d = kInf;
-        const double estimate = 0.1 * d;
-        r.steps = steps;
-        prev = std::move(r);
-        prev_tol = tol;
-        if (estimate <= 1) return prev;
+    ReturnResult& prev = vf_.prev;
+    const double factor = level == 0 ? 1e-2 : 1e-4;
+    const double tol = std::max(o_.rtol * factor, floor);
+    if (level > 1 || !(tol < 0.5 * vf_.prev_tol)) {  // nothing tighter to compare with
+        if (prev.steps != vf_.steps0) prev.status = FlowStatus::Imprecise;  // else rtol is at the floor
+        return conclude(std::move(prev));
     }
-    if (prev.steps == steps0) return prev;  // no tighter trace was possible (rtol at the floor)
-    prev.status = FlowStatus::Imprecise;
-    return prev;
+    if (!verifier_[level]) {
+        FlowOptions v = o_;
+        v.rtol = tol;
+        v.atol = std::max(o_.atol * factor, 1e-300);
+        v.verify_steps = 0;
+        v.max_steps = std::max<std::int64_t>(o_.max_steps, 1);
+        // Taylor's verifier keeps this trace's order, its tighter tolerance in shorter steps: a
+        // lane group then expands verifying traces in the same kernel call as the returns (one
+        // order per call). Alone at its own order (25 at rtol 1e-12, against 21) the verifying
+        // trace of 9% of the returns took 20% of the time (Tan x Tan, walls).
+        const int order = taylor ? in_.order() : 0;
+        verifier_[level] = std::make_unique<Tracer>(s_, v, tangents_, order);
+        verifier_[level]->set_event_driven(event_driven_);
+    }
+    Tracer& V = *verifier_[level];
+    V.set_labels(labels_);
+    // A budget of steps: the tighter trace needs about (prev_tol / tol)^(1/order) times the
+    // steps; ten times that means it cannot meet its tolerance (rounding), so no verdict.
+    const double growth = std::pow(vf_.prev_tol / tol, 1.0 / std::max(1, in_.order()));
+    V.o_.max_steps = std::min<std::int64_t>(o_.max_steps, std::int64_t(10 * growth * double(prev.steps)) + 1000);
+    if (dense_) {  // the trajectory shows the return that is kept: the tighter one's points
+        dense_->points->resize(ret_.dense_points);
+        dense_->kinds->resize(ret_.dense_kinds);
+        dense_->next = ret_.dense_next;
+        dense_->room = ret_.dense_room;
+        dense_->truncated = ret_.dense_truncated;
+    }
+    V.set_dense(dense_);
+    vf_.level = level;
+    V.begin(ret_.z0, ret_.first_crossing, tangents_ > 0 ? ret_.t0 : nullptr);
+    return false;
 }
 
 bool Tracer::halted(ReturnResult& r, const std::atomic<bool>* cancel) const {
@@ -599,8 +626,8 @@ bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
 
 TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o, int tangents)
     : taylor_(resolve_stepper(o.stepper, s) == Stepper::Taylor) {
-    // Eight lanes (two 4-double vectors) rather than four: measured up to 10% more returns per
-    // second on AVX2, the two chains overlapping.
+    // Eight lanes (two 4-double vectors, or one 8-double vector on AVX-512) rather than four:
+    // measured up to 10% more returns per second on AVX2, the two chains overlapping.
     const int n = taylor_ ? kMaxTaylorGroup : 1;
     for (int l = 0; l < n; ++l) t_.push_back(std::make_unique<Tracer>(s, o, tangents));
     if (taylor_) coef_.reset(new TaylorLanes);  // uninitialised: each round writes what it reads
@@ -621,22 +648,25 @@ void TracerGroup::start(int l, const std::array<double, 4>& z0, bool first_cross
 unsigned TracerGroup::step(const std::atomic<bool>* cancel) {
     unsigned over = ready_;
     const unsigned stepping = busy_ & ~ready_;
-    if (taylor_ && (stepping & (stepping - 1))) {  // two or more lanes: expand them together
+    if (taylor_ && (stepping & (stepping - 1))) {
+        // Two or more lanes: expand them together, the returns and the verifying traces (a
+        // verifier keeps the order of the trace it verifies: Tracer::verify_at).
         Taylor* tt[kMaxTaylorGroup];
         const double* y[kMaxTaylorGroup];
         double hmax[kMaxTaylorGroup];
         int m = 0;
         for (int l = 0; l < lanes(); ++l)
             if ((stepping >> l) & 1u) {
-                tt[m] = lane(l).integrator().taylor();
-                y[m] = lane(l).next_start();
-                hmax[m] = lane(l).next_hmax();
+                Tracer& a = lane(l).stepping();
+                tt[m] = a.integrator().taylor();
+                y[m] = a.next_start();
+                hmax[m] = a.next_hmax();
                 ++m;
             }
         Taylor::expand_group(tt, y, hmax, *coef_, m);
     }
     for (int l = 0; l < lanes(); ++l)
-        if (((stepping >> l) & 1u) && lane(l).step(cancel)) over |= 1u << l;
+        if (((stepping >> l) & 1u) && lane(l).stepping().step(cancel) && lane(l).settle()) over |= 1u << l;
     ready_ |= over;
     return over;
 }

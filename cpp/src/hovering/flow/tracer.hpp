@@ -60,7 +60,8 @@ public:
     /// equations, a saltation matrix at every impact: ReturnResult::tangents); the state is the
     /// same as without them (the step control reads the state only) for every stepper but
     /// msadams, rk2imp and rk4imp, whose control or Newton iteration sees all components.
-    Tracer(const FlowSystem& s, const FlowOptions& o, int tangents = 0);
+    /// taylor_order > 0: stepper "taylor" at that order (Integrator), for a verifier.
+    Tracer(const FlowSystem& s, const FlowOptions& o, int tangents = 0, int taylor_order = 0);
     /// One return from z0 (on Sigma_h): the first crossing of Sigma_h after q1 has passed its
     /// minimum. With first_crossing, the first crossing of Sigma_h at all (z0 need not lie on it:
     /// the tangential curve starts at q1's minimum). cancel is polled every 256 steps. t0: the
@@ -71,10 +72,20 @@ public:
     /// trace() in pieces, for drivers that interleave several returns (a lane group): begin a
     /// return from z0 (not for the event-driven closed form, stepper "exact" at eps = 0) ...
     void begin(const std::array<double, 4>& z0, bool first_crossing = false, const double* t0 = nullptr);
-    /// ... take one accepted step with its events (true: the return is over) ...
+    /// ... take one accepted step with its events of the trace stepping() names (true: that
+    /// trace is over) ...
     bool step(const std::atomic<bool>* cancel = nullptr);
-    /// ... and collect its result. trace() is begin, step until over, end.
+    /// ... settle it when it is over (true: the return's result is final; false: a verifying trace
+    /// has begun, stepped through stepping()) ...
+    bool settle();
+    /// ... and collect the settled result. trace() is begin, stepping().step() until a trace is
+    /// over and settle() says final, end.
     ReturnResult end();
+    /// The tracer whose step() advances the return: this one, or while the return is verified
+    /// (FlowOptions::verify_steps) the verifier tracing it again at a tighter tolerance.
+    Tracer& stepping() { return vf_.level < 0 ? *this : *verifier_[vf_.level]; }
+    /// The verification level in progress (-1: none; 0: rtol / 100; 1: rtol / 10^4).
+    int verifying() const { return vf_.level; }
     /// The state (with its auxiliary variables) the next step() starts from.
     const double* next_start() const { return ret_.y; }
     /// The longest step the next step() may take (the return's step bound).
@@ -140,9 +151,22 @@ private:
     void finish(ReturnResult& r, const double* y, double t, bool done, bool crossed, double H0);
     // The steps from which a return is verified (0: never), from FlowOptions::verify_steps.
     std::int64_t verify_from() const;
-    // A finished Ok return r0 of verify_from() steps or more, traced again at rtol / 100 (and
-    // / 10^4): the first tighter result whose estimated error is within the band, else Imprecise.
-    ReturnResult verify(ReturnResult r0);
+    // Begin verifying vf_.prev (a finished Ok return of verify_from() steps or more) at level
+    // (rtol / 100, then / 10^4): the first tighter result whose estimated error is within the
+    // band is kept, else Imprecise (settle()). False: a verifying trace has begun; true: nothing
+    // tighter to trace, the result is final.
+    bool verify_at(int level);
+    // The return's final result is r (settle()'s true).
+    bool conclude(ReturnResult r);
+    // A return under verification: the result to judge and the steps so far.
+    struct Verification {
+        int level = -1;        // verifier_[level] is tracing (-1: none)
+        ReturnResult prev;     // the last result kept
+        double prev_tol = 0;   // its rtol
+        std::int64_t steps0 = 0, steps = 0;  // the first trace's steps; all traces' so far
+    };
+    Verification vf_;
+    ReturnResult result_;  // the settled result (end())
     // Whether the return's end z is the point of Sigma_h (energy h) that its section coordinates
     // name (see finish()).
     bool on_chart(const std::array<double, 4>& z, double h) const;
