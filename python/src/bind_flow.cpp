@@ -244,7 +244,7 @@ void register_flow(py::module_& m) {
                 }
                 const double nan = std::numeric_limits<double>::quiet_NaN();
                 std::array<double, 2> c{nan, nan};
-                if (r.status == FlowStatus::Ok) c = section_coordinates(s, r.z.data());
+                if (r.status == FlowStatus::Ok) c = r.chart;  // the tracer's section_coordinates of z
                 if (r.status == FlowStatus::OffSection) r.z = {nan, nan, nan, nan};
                 const Region reg = r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None;
                 auto one = [](double v) {
@@ -261,20 +261,23 @@ void register_flow(py::module_& m) {
                 steps.mutable_data()[0] = r.steps;
                 py::list itin;
                 itin.append(r.itinerary);
+                static const auto k = hovering_py::interned(
+                    {"theta", "I", "z", "time", "itinerary", "status", "energy_error", "steps", "region", "work",
+                     "stepper", "trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"});
+                using hovering_py::set_item;
                 py::dict d;
-                d["theta"] = one(c[0]);
-                d["I"] = one(c[1]);
-                d["z"] = z;
-                d["time"] = one(r.time);
-                d["itinerary"] = itin;
-                d["status"] = status;
-                d["energy_error"] = one(r.energy_error);
-                d["steps"] = steps;
-                d["region"] = region;
-                d["work"] = hovering_py::work_dict(work);
-                d["stepper"] = stepper_name(resolve_stepper(rm.options().stepper, s));
-                for (const char* k : {"trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"})
-                    d[k] = py::none();
+                set_item(d, k[0], one(c[0]));
+                set_item(d, k[1], one(c[1]));
+                set_item(d, k[2], z);
+                set_item(d, k[3], one(r.time));
+                set_item(d, k[4], itin);
+                set_item(d, k[5], status);
+                set_item(d, k[6], one(r.energy_error));
+                set_item(d, k[7], steps);
+                set_item(d, k[8], region);
+                set_item(d, k[9], hovering_py::work_dict(work));
+                set_item(d, k[10], py::str(stepper_name(resolve_stepper(rm.options().stepper, s))));
+                for (int i = 11; i < 15; ++i) set_item(d, k[std::size_t(i)], py::none());
                 return d;
             },
             py::arg("h"), py::arg("theta"), py::arg("I"),

@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -146,6 +147,9 @@ struct ReturnResult {
     /// Tracers with tangents only: the tangent vectors at z, before the section's projection
     /// (row-major 4 x 2: row r is component r of each); NaN unless the return ended Ok.
     std::array<double, 8> tangents{};
+    /// An Ok return's section coordinates (theta, I) = section_coordinates(z), computed once where
+    /// the tracer checks that z lies on Sigma_h's chart; NaN for every other status.
+    std::array<double, 2> chart{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 /// What the tracer did, counted per worker and summed at the end of a batch (no atomics in the

@@ -504,6 +504,7 @@ ReturnResult Tracer::end() {
 
 bool Tracer::conclude(ReturnResult r) {
     vf_.level = -1;
+    if (r.status != FlowStatus::Ok) r.chart = {kNaN, kNaN};  // Imprecise: no coordinates promised
     result_ = std::move(r);
     return true;
 }
@@ -600,18 +601,21 @@ void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool 
         ++work_.label_operations;
     }
     r.energy_error = std::fabs(s_.energy(r.z.data()) - H0);
-    if (r.status == FlowStatus::Ok && !on_chart(r.z, H0)) r.status = FlowStatus::OffSection;
+    if (r.status == FlowStatus::Ok && !on_chart(r, H0)) r.status = FlowStatus::OffSection;
+    if (r.status != FlowStatus::Ok) r.chart = {kNaN, kNaN};
     if (tangents_ > 0 && r.status != FlowStatus::Ok) r.tangents.fill(kNaN);
     work_.steps += r.steps;
 }
 
-bool Tracer::on_chart(const std::array<double, 4>& z, double h) const {
+bool Tracer::on_chart(ReturnResult& r, double h) const {
+    const std::array<double, 4>& z = r.z;
     // A return is a maximum of q1 at energy h; Sigma_h's chart (try_section_point) holds one such
     // maximum per (theta, I): the root of V1 + eps Vc = h - H2 with q1 > 0 and dp1/dt < 0. At
     // strong coupling a maximum of q1 can lie elsewhere (q1 < 0, another root): its (theta, I)
     // would name a different point, so such a return is not reported Ok.
     if (!(z[0] > 0)) return false;
     const std::array<double, 2> c = section_coordinates(s_, z.data());
+    r.chart = c;  // the callers' coordinates of the image: computed once
     if (!(c[1] > 0)) return std::isfinite(c[1]);  // I = 0: oscillator 2 at rest, the chart's centre
     std::array<double, 4> p{};
     if (!try_section_point(s_, h, c[0], c[1], p, nullptr)) return false;

@@ -167,9 +167,9 @@ private:
     };
     Verification vf_;
     ReturnResult result_;  // the settled result (end())
-    // Whether the return's end z is the point of Sigma_h (energy h) that its section coordinates
-    // name (see finish()).
-    bool on_chart(const std::array<double, 4>& z, double h) const;
+    // Whether the return's end r.z is the point of Sigma_h (energy h) that its section
+    // coordinates name (see finish()); they go to r.chart.
+    bool on_chart(ReturnResult& r, double h) const;
     // Uniform samples in [t0, t_end) of the angle flow from the angles of o at t0.
     void sample_angles(const AngleOscillator* o, double t0, double t_end);
     const FlowSystem& s_;

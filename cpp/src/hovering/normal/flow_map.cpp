@@ -82,7 +82,7 @@ FlowStep FlowMap::advance_end(ReturnResult ret, bool inverse) const {
     st.ret = std::move(ret);
     if (st.ret.status != FlowStatus::Ok) return st;
     // ret.energy_error is |H(image) - H(start)|; the start solves H = h to rounding (1e-16).
-    auto c = section_coordinates(s_, st.ret.z.data());
+    std::array<double, 2> c = st.ret.chart;  // the tracer's section_coordinates of z
     if (inverse) {
         c[0] = wrap(-c[0]);
         std::reverse(st.ret.itinerary.begin(), st.ret.itinerary.end());
