@@ -62,6 +62,38 @@ def test_one_point_fast_paths_equal_the_array_paths_bit_for_bit(geometry, steppe
             assert isinstance(fm.step(t, k)[0], float) and isinstance(fm.region(t, k), hv.Region)
 
 
+@pytest.mark.parametrize("geometry", ["step", "wall"])
+@pytest.mark.parametrize("stepper", ["taylor", "rk8pd"])
+def test_an_orbit_is_its_one_return_steps_chained(geometry, stepper):
+    # iterate starts each return (but an orbit's first) from the point of Sigma_h that the last
+    # return's chart check solved, instead of solving it again: the orbit must be, bit for bit,
+    # the chain of one-return steps, each solving its start afresh; with a polynomial coupling
+    # too (its section point takes the coupling's terms), and in normal coordinates (where the
+    # coordinates' round trip need not give the same start, so nothing may be reused wrongly).
+    rng = np.random.default_rng(7 + (geometry == "wall") + 2 * (stepper == "taylor"))
+    base = _random_system(rng, geometry)
+    poly = StepSystem(
+        base.V1, base.V2, hv.Polynomial({(2, 1): 1.0, (1, 3): 1.0}), eps=0.05, qw1=-1.0, qw2=-0.5, geometry=geometry
+    )
+    for sys_ in (base, poly):
+        for coords in ("section", "normal"):
+            fm = hv.FlowMap(sys_, H, coordinates=coords, stepper=stepper, rtol=1e-9)
+            I_tan = sys_.V2.action(H - sys_.V1.V(sys_.qw1))
+            th = rng.uniform(-np.pi, np.pi, 5)
+            I = I_tan * rng.uniform(0.4, 1.2, 5)
+            if coords == "normal":  # K is measured from the tangential curve (near I_tan)
+                I = I - I_tan
+            orbit = fm.iterate(th, I, 15, record=("orbit",), n_threads=1)
+            assert np.count_nonzero(orbit.status == 0) >= 3
+            for i in range(th.size):
+                x, y = float(th[i]), float(I[i])
+                for k in range(15):
+                    if not np.isfinite(orbit.phi[i, k + 1]):
+                        break
+                    x, y = fm.step(x, y)
+                    assert _same((x, y), (orbit.phi[i, k + 1], orbit.K[i, k + 1])), (coords, i, k)
+
+
 def test_normal_coordinates_and_other_scalar_types_take_the_same_path():
     fm = paper.flow_map(eps=-0.05)
     phi, K = np.linspace(-3, 3, 7), np.linspace(-0.1, 0.1, 7)

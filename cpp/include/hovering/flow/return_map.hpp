@@ -150,6 +150,10 @@ struct ReturnResult {
     /// An Ok return's section coordinates (theta, I) = section_coordinates(z), computed once where
     /// the tracer checks that z lies on Sigma_h's chart; NaN for every other status.
     std::array<double, 2> chart{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    /// An Ok return's point of Sigma_h at chart (the check's own, at the tracer's section energy):
+    /// what a next return from the image starts from; NaN for every other status.
+    std::array<double, 4> chart_point{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                      std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 /// What the tracer did, counted per worker and summed at the end of a batch (no atomics in the

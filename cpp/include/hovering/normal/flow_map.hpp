@@ -145,9 +145,12 @@ public:
 private:
     FlowStep advance(detail::Tracer& tr, double x, double y, bool inverse, const std::atomic<bool>* cancel) const;
     // advance() in two halves around the trace (for interleaved returns): the start state of the
-    // return from (x, y) (false: none, st then holds the OffSection step), and the step a finished
-    // return makes.
-    bool advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st) const;
+    // return from (x, y) (false: none, st then holds the OffSection step; chart, chart_point: the
+    // last image's ReturnResult ones, traced at section energy h_, reused where (x, y) names the
+    // same coordinates), and the step a finished return makes.
+    bool advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st,
+                       const std::array<double, 2>* chart = nullptr,
+                       const std::array<double, 4>* chart_point = nullptr) const;
     FlowStep advance_end(ReturnResult ret, bool inverse) const;
     // The tangents d z0 / d(x, y) of the chart at the start z0 of the return from (x, y)
     // (row-major 4 x 2), and the Jacobian of a finished forward return from there.

@@ -504,7 +504,10 @@ ReturnResult Tracer::end() {
 
 bool Tracer::conclude(ReturnResult r) {
     vf_.level = -1;
-    if (r.status != FlowStatus::Ok) r.chart = {kNaN, kNaN};  // Imprecise: no coordinates promised
+    if (r.status != FlowStatus::Ok) {  // Imprecise: no coordinates promised
+        r.chart = {kNaN, kNaN};
+        r.chart_point = {kNaN, kNaN, kNaN, kNaN};
+    }
     result_ = std::move(r);
     return true;
 }
@@ -560,6 +563,7 @@ bool Tracer::verify_at(int level) {
     }
     Tracer& V = *verifier_[level];
     V.set_labels(labels_);
+    V.set_section_energy(section_h_);
     // A budget of steps: the tighter trace needs about (prev_tol / tol)^(1/order) times the
     // steps; ten times that means it cannot meet its tolerance (rounding), so no verdict.
     const double growth = std::pow(vf_.prev_tol / tol, 1.0 / std::max(1, in_.order()));
@@ -602,13 +606,19 @@ void Tracer::finish(ReturnResult& r, const double* y, double t, bool done, bool 
     }
     r.energy_error = std::fabs(s_.energy(r.z.data()) - H0);
     if (r.status == FlowStatus::Ok && !on_chart(r, H0)) r.status = FlowStatus::OffSection;
-    if (r.status != FlowStatus::Ok) r.chart = {kNaN, kNaN};
+    if (r.status != FlowStatus::Ok) {
+        r.chart = {kNaN, kNaN};
+        r.chart_point = {kNaN, kNaN, kNaN, kNaN};
+    }
     if (tangents_ > 0 && r.status != FlowStatus::Ok) r.tangents.fill(kNaN);
     work_.steps += r.steps;
 }
 
-bool Tracer::on_chart(ReturnResult& r, double h) const {
+bool Tracer::on_chart(ReturnResult& r, double H0) const {
     const std::array<double, 4>& z = r.z;
+    // The section's energy: the caller's (set_section_energy: the next return starts from the
+    // very point computed here), else the start's.
+    const double h = std::isnan(section_h_) ? H0 : section_h_;
     // A return is a maximum of q1 at energy h; Sigma_h's chart (try_section_point) holds one such
     // maximum per (theta, I): the root of V1 + eps Vc = h - H2 with q1 > 0 and dp1/dt < 0. At
     // strong coupling a maximum of q1 can lie elsewhere (q1 < 0, another root): its (theta, I)
@@ -617,15 +627,15 @@ bool Tracer::on_chart(ReturnResult& r, double h) const {
     const std::array<double, 2> c = section_coordinates(s_, z.data());
     r.chart = c;  // the callers' coordinates of the image: computed once
     if (!(c[1] > 0)) return std::isfinite(c[1]);  // I = 0: oscillator 2 at rest, the chart's centre
-    std::array<double, 4> p{};
+    std::array<double, 4>& p = r.chart_point;
     if (!try_section_point(s_, h, c[0], c[1], p, nullptr)) return false;
     // The same root moves by the return's energy error e over dF/dq1 = -dp1/dt (F(q1) = e at
     // the return); a distinct root lies O(1) away, or the two merge where dp1/dt = 0 (Sigma_h's
-    // edge) and the return is not on its chart anyway.
-    double dz[4];
-    s_.rhs(z.data(), dz);
-    const double e = std::fabs(s_.energy(z.data()) - h);
-    return std::fabs(p[0] - z[0]) <= 1e-9 * (1 + std::fabs(z[0])) + 4 * e / std::fabs(dz[1]);
+    // edge) and the return is not on its chart anyway. (-dp1/dt as FlowSystem::rhs has it.)
+    double dp1 = -s_.V1->dV(z[0]);
+    if (s_.eps != 0.0) dp1 -= s_.eps * s_.coupling.gradient(z[0], z[2])[0];
+    const double e = h == H0 ? r.energy_error : std::fabs(s_.energy(z.data()) - h);
+    return std::fabs(p[0] - z[0]) <= 1e-9 * (1 + std::fabs(z[0])) + 4 * e / std::fabs(dp1);
 }
 
 TracerGroup::TracerGroup(const FlowSystem& s, const FlowOptions& o, int tangents)
@@ -708,6 +718,7 @@ void TracerPool::give(std::unique_ptr<TracerGroup> g, int tangents) {
     for (int l = 0; l < g->lanes(); ++l) {
         g->lane(l).set_labels(true);
         g->lane(l).set_dense(nullptr);
+        g->lane(l).set_section_energy(kNaN);
     }
     const std::size_t most = std::max(1u, hardware_threads());
     std::lock_guard<std::mutex> lock(mu_);

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -105,6 +106,10 @@ public:
     void set_event_driven(bool on) { event_driven_ = on; }
     /// Record the following returns into this trajectory (null: no dense output, no dense work).
     void set_dense(DenseRecorder* d) { dense_ = d; }
+    /// The energy h of the section Sigma_h the caller's returns end on (NaN: each start's own
+    /// energy): the image's ReturnResult::chart_point is then the point of Sigma_h at its section
+    /// coordinates, bit for bit what try_section_point gives the next start from there.
+    void set_section_energy(double h) { section_h_ = h; }
     /// Everything counted since construction (FlowWork), field evaluations included.
     FlowWork work() const;
     /// The system traced.
@@ -167,9 +172,10 @@ private:
     };
     Verification vf_;
     ReturnResult result_;  // the settled result (end())
-    // Whether the return's end r.z is the point of Sigma_h (energy h) that its section
-    // coordinates name (see finish()); they go to r.chart.
-    bool on_chart(ReturnResult& r, double h) const;
+    // Whether the return's end r.z is the point of Sigma_h that its section coordinates name
+    // (see finish(); the section's energy, or the start's H0); the coordinates go to r.chart, the
+    // point to r.chart_point.
+    bool on_chart(ReturnResult& r, double H0) const;
     // Uniform samples in [t0, t_end) of the angle flow from the angles of o at t0.
     void sample_angles(const AngleOscillator* o, double t0, double t_end);
     const FlowSystem& s_;
@@ -180,6 +186,7 @@ private:
     bool labels_ = true;
     bool event_driven_ = true;
     DenseRecorder* dense_ = nullptr;
+    double section_h_ = std::numeric_limits<double>::quiet_NaN();  // set_section_energy
     std::unique_ptr<Tracer> verifier_[2];  // at rtol / 100 and / 10^4, built on first use
     int tangents_ = 0;
     // The state y's tangents at an impact on coordinate gi, through the saltation matrix: y holds

@@ -65,9 +65,16 @@ double FlowMap::rotation_of(double x, double y, Region r, double x1) const {
     return ref + wrap(adv - ref);
 }
 
-bool FlowMap::advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st) const {
+bool FlowMap::advance_start(double x, double y, bool inverse, std::array<double, 4>& z, FlowStep& st,
+                            const std::array<double, 2>* chart, const std::array<double, 4>* chart_point) const {
     auto [th, I] = to_section(x, y);
     if (inverse) th = -th;  // R2: theta -> -theta (section_point accepts [-pi, pi])
+    if (chart && th == (*chart)[0] && I == (*chart)[1]) {
+        // The last image's chart check solved this very point (same coordinates, same h_): in
+        // section coordinates every start of an orbit but the first.
+        z = *chart_point;
+        return true;
+    }
     if (try_section_point(s_, h_, th, I, z)) return true;
     st = FlowStep{};
     st.x = st.y = kNaN;
@@ -375,7 +382,10 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
         detail::PooledGroup pooled(pool_.get(), s_, opt_, tangent ? 2 : 0);
         detail::TracerGroup& group = *pooled;
         const int L = group.lanes();
-        for (int l = 0; l < L; ++l) group.lane(l).set_labels(opt.labels);
+        for (int l = 0; l < L; ++l) {
+            group.lane(l).set_labels(opt.labels);
+            group.lane(l).set_section_energy(h_);  // an image's chart point is the next start
+        }
         detail::ProgressShare progress(opt.progress, 1);
         struct Orbit {
             std::int64_t i = -1;
@@ -388,6 +398,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             detail::DenseRecorder rec;
             TangentProduct tp;                 // record "jacobian"
             Status tangent_status = Status::Ok;  // NonFinite once a return's Jacobian was not
+            std::array<double, 2> chart{kNaN, kNaN};  // the last image's section coordinates
+            std::array<double, 4> chart_point{};      // and its point of Sigma_h (ReturnResult)
         };
         std::vector<Orbit> lane(static_cast<std::size_t>(L));
         // The end of lane l's orbit: its outputs, its recorded tails, the progress it will not make.
@@ -410,7 +422,7 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             }
             std::array<double, 4> z{};
             FlowStep st;
-            if (!advance_start(o.x, o.y, false, z, st)) {
+            if (!advance_start(o.x, o.y, false, z, st, &o.chart, &o.chart_point)) {
                 o.status = orbit_status(st.ret.status);
                 return false;
             }
@@ -457,6 +469,8 @@ void FlowMap::iterate(const double* x0, const double* y0, std::int64_t n, const 
             }
             o.x = st.x;
             o.y = st.y;
+            o.chart = st.ret.chart;
+            o.chart_point = st.ret.chart_point;
             o.y_lo = std::min(o.y_lo, o.y);
             o.y_hi = std::max(o.y_hi, o.y);
             if ((k + 1) % every == 0) record_point(o.i, k + 1, o.x, o.y, nullptr);
