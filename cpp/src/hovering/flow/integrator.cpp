@@ -327,7 +327,8 @@ double Integrator::taylor_cut(double step) {
     RootBracket br[2];
     double cut = step;
     for (int w = 0; w < 2; ++w) {
-        if (!((watched_ >> w) & 1u) || !taylor_->scaled_coefficients(2 * w + 1, step, b)) continue;
+        if (!((watched_ >> w) & 1u) || taylor_->keeps_sign(w, step)) continue;  // most steps: settled in the lanes
+        if (!taylor_->scaled_coefficients(2 * w + 1, step, b)) continue;
         // The step's own polynomial is the solution it takes: its sign changes are exact, so the
         // step ends between the first two (on the same polynomial: no new expansion).
         if (!at_most_one_root(b, p) && isolate_roots(b, p, br, 2) == 2)

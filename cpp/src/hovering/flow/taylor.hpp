@@ -82,6 +82,9 @@ public:
     /// The current expansion at time tau from its point: dim entries (NaN unless expanded_at
     /// would find the expansion current: a later round overwrote a group's coefficients).
     void eval(double tau, double* y) const;
+    /// Whether the lanes found that the velocity of oscillator w + 1 keeps its sign over the step
+    /// `step` (TaylorStep::keeps_sign; false unless step is the step they took).
+    bool keeps_sign(int w, double step) const { return valid_ && step == step_.tau && step_.keeps_sign[w]; }
     /// The p + 1 coefficients of variable i of the current expansion, scaled to the step length h
     /// (c_k h^k: the polynomial in s = tau / h); false unless an expansion is current.
     bool scaled_coefficients(int i, double h, double* out) const;

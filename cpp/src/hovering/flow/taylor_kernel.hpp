@@ -289,6 +289,10 @@ struct TaylorStep {
     double tau;             ///< min(h, hmax): the step taken unless it leaves a bounded well
     double y[kMaxDim];      ///< the polynomial at tau
     bool ok;                ///< orders p - 1 and p finite, hence all (else h, tau and y mean nothing)
+    /// Whether the polynomial of p1 (w = 0) and of p2 (w = 1) over [0, tau], scaled as
+    /// Integrator::taylor_cut scales it, passes keeps_sign (poly_roots.hpp): no sign change, no
+    /// root search; the same bits and the same verdict as the scalar test.
+    bool keeps_sign[2];
 };
 
 /// One build of the lane kernel (taylor_lanes.cpp): its instruction set and entry points.

@@ -121,6 +121,31 @@ V4 step_rule(const detail::TaylorModel& m, V4 floor, V4 factor, Coef c, I4* ok) 
     return exp2_fast(lrho) * factor;
 }
 
+// keeps_sign (poly_roots.hpp) of the polynomial c(k) s^k, s in [0, 1] after scaling by tau (b_k =
+// c_k tau^k, the powers by repeated products as Taylor::scaled_coefficients forms them), on four
+// lanes: the same operations in the same order, so the same verdict bit for bit.
+template <class Coef>
+I4 keeps_sign(Coef c, int n, V4 tau) {
+    const I4 sign = I4{} + 0x7fffffffffffffffLL;
+    V4 b[detail::kTaylorStride];
+    V4 hk = V4{} + 1.0;
+    for (int k = 0; k <= n; ++k) {
+        b[k] = c(k) * hk;
+        hk = hk * tau;
+    }
+    V4 tail = V4{};
+    for (int k = 3; k <= n; ++k) tail += (V4)((I4)b[k] & sign);
+    const V4 b0 = b[0], b1 = b[1], b2 = b[2];
+    const V4 end = b0 + b1 + b2;
+    V4 lo = end < b0 ? end : b0, hi = b0 < end ? end : b0;  // std::min, std::max
+    const V4 v = -b1 / (2.0 * b2);
+    const I4 inside = (b2 != 0.0) & (v > 0.0) & (v < 1.0);
+    const V4 q = b0 + v * (b1 + v * b2);
+    lo = inside ? (q < lo ? q : lo) : lo;
+    hi = inside ? (hi < q ? q : hi) : hi;
+    return (lo > tail) | (hi < -tail);
+}
+
 inline V4 half(const V4& v, int) { return v; }
 inline V4 min_lanes(V4 a, V4 b) { return b < a ? b : a; }  // std::min(a, b)
 #if defined(__AVX512F__)
@@ -167,6 +192,11 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
         for (int l = 0; l < 4; ++l) h[4 * j + l] = hj[l];
     }
     const V tau = min_lanes(h, hm);
+    I4 keeps[2][L / 4];
+    for (int w = 0; w < 2; ++w)
+        for (int j = 0; j < L / 4; ++j)
+            keeps[w][j] = 2 * w + 1 < m.n ? keeps_sign([&](int k) { return half(S.c[2 * w + 1][k], j); }, m.p, half(tau, j))
+                                          : I4{};
     V ye[detail::kMaxDim];
     detail::estrin<V>([&](int i, int k) { return S.c[i][k]; }, m.nv, m.p, tau, ye);
     for (int l = 0; l < count; ++l) {
@@ -175,6 +205,7 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
         o.tau = tau[l];
         for (int i = 0; i < m.nv; ++i) o.y[i] = ye[i][l];
         o.ok = ok[l / 4][l % 4] != 0;
+        for (int w = 0; w < 2; ++w) o.keeps_sign[w] = keeps[w][l / 4][l % 4] != 0;
     }
 }
 
