@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "hovering/detail/common.hpp"
 #include "hovering/detail/simd_dispatch.hpp"
@@ -41,6 +45,117 @@ const TaylorLaneKernels* const kTaylorBuilds[kSimdBuilds] = {
 
 const TaylorLaneKernels& lane_kernels() {
     return selected_build(kTaylorBuilds);
+}
+
+// A gradient program under construction (CouplingProgram): rows for the powers of q1, q2 made on
+// demand and shared.
+struct ProgramBuilder {
+    CouplingProgram g;
+    std::map<std::pair<int, int>, int> power;  // (variable 0 or 1, exponent >= 2) -> row
+    int products = 0;
+
+    int new_row() {
+        if (g.rows >= kMaxProgramRows) bad("coupling: its gradient needs more than " + std::to_string(kMaxProgramRows) +
+                                           " series rows (internal limit)");
+        return g.rows++;
+    }
+    // The row of q_(var+1)^e (e >= 0: row 0 is the constant 1).
+    int pow_row(int var, int e) {
+        if (e == 0) return 0;
+        if (e == 1) return 1 + var;
+        auto it = power.find({var, e});
+        if (it != power.end()) return it->second;
+        // q^e = q^(e/2)^2 (a square) for even e, q^(e-1) q for odd: ~log2(e) squares.
+        const int a = e % 2 == 0 ? pow_row(var, e / 2) : pow_row(var, e - 1);
+        const int b = e % 2 == 0 ? a : 1 + var;
+        const int r = new_row();
+        g.ops.push_back({true, r, a, b, 0, 0});
+        ++products;
+        power[{var, e}] = r;
+        return r;
+    }
+    int product(int a, int b) {
+        const int r = new_row();
+        g.ops.push_back({true, r, a, b, 0, 0});
+        ++products;
+        return r;
+    }
+    int sum(const std::vector<std::pair<double, int>>& t) {
+        const int r = new_row();
+        g.ops.push_back({false, r, 0, 0, int(g.terms.size()), int(t.size())});
+        g.terms.insert(g.terms.end(), t.begin(), t.end());
+        return r;
+    }
+    // The row of sum c q1^a q2^b over terms ((a, b) -> c): the common factor q1^a0 q2^b0 times
+    // the rest in Horner form in q_(var+1).
+    int component(const std::map<std::pair<int, int>, double>& terms, int var) {
+        if (terms.empty()) return sum({});
+        int lo[2] = {1 << 30, 1 << 30};
+        for (const auto& [e, c] : terms) {
+            lo[0] = std::min(lo[0], e.first);
+            lo[1] = std::min(lo[1], e.second);
+        }
+        // P_l: (coefficient, power of the other variable) of x^l.
+        std::vector<std::vector<std::pair<double, int>>> P;
+        for (const auto& [e, c] : terms) {
+            const int ex[2] = {e.first - lo[0], e.second - lo[1]};
+            if (int(P.size()) <= ex[var]) P.resize(std::size_t(ex[var]) + 1);
+            P[std::size_t(ex[var])].push_back({c, ex[1 - var]});
+        }
+        auto level = [&](int l) {  // P_l's (coefficient, row) terms
+            std::vector<std::pair<double, int>> t;
+            for (const auto& [c, e] : P[std::size_t(l)]) t.push_back({c, pow_row(1 - var, e)});
+            return t;
+        };
+        const int L = int(P.size()) - 1;
+        // S_L, and the constant it may be (then x S_L is a sum term, not a product).
+        bool constant = std::all_of(P.back().begin(), P.back().end(), [](const auto& t) { return t.second == 0; });
+        double c_last = 0;
+        for (const auto& t : P.back()) c_last += t.first;
+        int S = constant && L > 0 ? -1 : sum(level(L));
+        for (int l = L - 1; l >= 0; --l) {
+            std::vector<std::pair<double, int>> t = level(l);
+            if (S < 0)
+                t.push_back({c_last, 1 + var});
+            else
+                t.push_back({1.0, product(1 + var, S)});
+            S = sum(t);
+        }
+        if (lo[0] > 0) S = product(pow_row(0, lo[0]), S);
+        if (lo[1] > 0) S = product(pow_row(1, lo[1]), S);
+        return S;
+    }
+};
+
+// The terms ((a, b) -> c) of dVc/dq_i = sum c q1^a q2^b (like powers merged, zeros dropped).
+std::map<std::pair<int, int>, double> gradient_terms(const std::vector<std::array<double, 3>>& vc, int i) {
+    std::map<std::pair<int, int>, double> g;
+    for (const auto& t : vc) {
+        const int a = int(t[1]), b = int(t[2]);
+        if (i == 0 && a > 0) g[{a - 1, b}] += t[0] * a;
+        if (i == 1 && b > 0) g[{a, b - 1}] += t[0] * b;
+    }
+    for (auto it = g.begin(); it != g.end();) it = it->second == 0 ? g.erase(it) : std::next(it);
+    return g;
+}
+
+// The gradient program of Vc = sum c q1^i q2^j with the fewest Cauchy products over the four
+// choices of Horner variable (one per component).
+CouplingProgram gradient_program(const std::vector<std::array<double, 3>>& vc) {
+    const std::map<std::pair<int, int>, double> g[2] = {gradient_terms(vc, 0), gradient_terms(vc, 1)};
+    CouplingProgram best;
+    int fewest = 1 << 30;
+    for (int v0 = 0; v0 < 2; ++v0)
+        for (int v1 = 0; v1 < 2; ++v1) {
+            ProgramBuilder b;
+            b.g.grad[0] = b.component(g[0], v0);
+            b.g.grad[1] = b.component(g[1], v1);
+            if (b.products < fewest) {
+                fewest = b.products;
+                best = std::move(b.g);
+            }
+        }
+    return best;
 }
 
 }  // namespace
@@ -113,10 +228,12 @@ Taylor::Taylor(const Field& f, const FlowSystem& s, double rtol, double atol, in
     m_.bilinear_c = f.bilinear_c;
     if (m_.ckind == CKind::General) {
         m_.terms = s.coupling.terms;
-        for (const auto& t : m_.terms) {
-            m_.deg1 = std::max(m_.deg1, int(t[1]));
-            m_.deg2 = std::max(m_.deg2, int(t[2]));
-        }
+        if (m_.nt > 0)  // the Hessian's powers (tangent_order)
+            for (const auto& t : m_.terms) {
+                m_.deg1 = std::max(m_.deg1, int(t[1]));
+                m_.deg2 = std::max(m_.deg2, int(t[2]));
+            }
+        m_.grad = gradient_program(m_.terms);
     }
 }
 

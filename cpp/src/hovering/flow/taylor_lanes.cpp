@@ -170,10 +170,11 @@ void expand(const detail::TaylorModel& m, const double* const* y, const double* 
     S.c = reinterpret_cast<V(*)[detail::kTaylorStride]>(cbuf);
     if (m.ckind == detail::CKind::General) {
         thread_local std::vector<V> pow;
-        const std::size_t rows = std::size_t(m.deg1 + 1 + m.deg2 + 1) * detail::kTaylorStride;
+        const std::size_t rows = std::size_t(m.deg1 + 1 + m.deg2 + 1 + m.grad.rows - 3) * detail::kTaylorStride;
         if (pow.size() < rows) pow.resize(rows);
         S.pow1 = pow.data();
         S.pow2 = pow.data() + std::size_t(m.deg1 + 1) * detail::kTaylorStride;
+        S.prog = pow.data() + std::size_t(m.deg1 + 1 + m.deg2 + 1) * detail::kTaylorStride;
     }
     V hm, floor, factor;
     for (int l = 0; l < L; ++l) {
