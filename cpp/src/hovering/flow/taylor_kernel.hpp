@@ -128,16 +128,25 @@ inline V square(const V* a, int k, V zero) {
     return r + 2.0 * (a[0] * a[k]);
 }
 
-// Order k of the gradient program (CouplingProgram) on the rows it names.
+// Order k of the gradient program (CouplingProgram) on the rows it names. Inlined into the order
+// loop, with the two-term sum unrolled (most of a program's sums): the program as a loop of calls
+// cost 0.3 us of a 1.6 us expansion (eight orbits, order 21).
 template <class V>
-inline void run_program(const CouplingProgram& g, V* const* row, int k, V zero) {
+__attribute__((always_inline)) inline void run_program(const CouplingProgram& g, V* const* row, int k, V zero) {
+    const std::pair<double, int>* terms = g.terms.data();
     for (const CouplingOp& op : g.ops) {
         V v;
         if (op.product) {
             v = op.a == op.b ? square(row[op.a], k, zero) : cauchy(row[op.a], row[op.b], k, zero);
         } else {
+            const std::pair<double, int>* t = terms + op.first;
             v = zero;
-            for (int t = op.first; t < op.first + op.count; ++t) v += g.terms[std::size_t(t)].first * row[g.terms[std::size_t(t)].second][k];
+            if (op.count == 2) {
+                v += t[0].first * row[t[0].second][k];
+                v += t[1].first * row[t[1].second][k];
+            } else {
+                for (int i = 0; i < op.count; ++i) v += t[i].first * row[t[i].second][k];
+            }
         }
         row[op.dst][k] = v;
     }
