@@ -247,18 +247,18 @@ void register_flow(py::module_& m) {
                 if (r.status == FlowStatus::Ok) c = r.chart;  // the tracer's section_coordinates of z
                 if (r.status == FlowStatus::OffSection) r.z = {nan, nan, nan, nan};
                 const Region reg = r.status == FlowStatus::Ok ? region_of(r.itinerary) : Region::None;
-                auto one = [](double v) {
-                    darray a(1);
-                    a.mutable_data()[0] = v;
+                using hovering_py::array_data;
+                using hovering_py::small_array;
+                auto one = [](auto v) {
+                    py::object a = small_array<decltype(v)>({1});
+                    array_data<decltype(v)>(a)[0] = v;
                     return a;
                 };
-                darray z({py::ssize_t(1), py::ssize_t(4)});
-                for (int k = 0; k < 4; ++k) z.mutable_data()[k] = r.z[std::size_t(k)];
-                py::array_t<std::int8_t> status(1), region(1);
-                status.mutable_data()[0] = static_cast<std::int8_t>(r.status);
-                region.mutable_data()[0] = static_cast<std::int8_t>(reg);
-                py::array_t<std::int64_t> steps(1);
-                steps.mutable_data()[0] = r.steps;
+                py::object z = small_array<double>({1, 4});
+                for (int k = 0; k < 4; ++k) array_data<double>(z)[k] = r.z[std::size_t(k)];
+                py::object status = one(static_cast<std::int8_t>(r.status));
+                py::object region = one(static_cast<std::int8_t>(reg));
+                py::object steps = one(static_cast<std::int64_t>(r.steps));
                 py::list itin;
                 itin.append(r.itinerary);
                 static const auto k = hovering_py::interned(

@@ -84,10 +84,6 @@ def flow_options(
     return _core_flow.FlowOptions(**kw)
 
 
-# Section._mapper's arguments when every integrator option takes the core's default.
-_NO_OPTIONS = (None,) * 9
-
-
 def _threads(n_threads, python_defined: bool) -> int:
     n = thread_count(n_threads)
     # Every Python call takes the GIL: two threads measured 3.4x slower than one.
@@ -276,9 +272,10 @@ class Section:
         max_steps, max_impacts, grazing_tol, corner_tol, verify_steps): validated (flow_options,
         validate_for) at the first call with them, then kept with its tracers. The key holds the
         arguments' types too, so that True is never taken for a validated 1."""
-        # The defaults (all None) are their own key: building the typed key is 0.5 us of a
-        # one-point call, and no other key is 9 long.
-        key = args if args == _NO_OPTIONS else args + tuple(map(type, args))
+        # Only a value equal to True or False (a bool, or 1, 0) can alias another type's; without
+        # one the arguments are their own key (no other key is 9 long): the typed key took 0.5 us
+        # of a one-point call.
+        key = args if not (args.count(True) or args.count(False)) else args + tuple(map(type, args))
         mappers = self.__dict__.get("_mappers")
         if mappers is None:
             mappers = self.__dict__["_mappers"] = {}
