@@ -273,7 +273,9 @@ def test_verifying_traces_in_lane_groups_are_the_traces_alone(geometry, restore_
     kw = dict(stepper="taylor", rtol=1e-10, atol=1e-10, n_threads=1)
     fm = hovering.FlowMap(sec.sys, H, coordinates="section", **{k: v for k, v in kw.items() if k != "n_threads"})
     first = fm.iterate(th, I, 12, record=("orbit",), n_threads=1)
-    plain = hovering.FlowMap(sec.sys, H, coordinates="section", verify_steps=0, stepper="taylor", rtol=1e-10, atol=1e-10)
+    plain = hovering.FlowMap(
+        sec.sys, H, coordinates="section", verify_steps=0, stepper="taylor", rtol=1e-10, atol=1e-10
+    )
     unverified = plain.iterate(th, I, 12, record=(), n_threads=1)
     # Some returns were verified (each verifying trace searches the section once more: 30 of the
     # 252 returns with walls, 7 with the step), else this test would test nothing.

@@ -414,10 +414,11 @@ class Section:
         verify_steps : int, optional
             Which returns are verified. rtol bounds each step's error, not a return's: errors add
             up over long returns, and chaos or impacts amplify them. A verified return is traced
-            again at rtol / 100 (and rtol / 10^4 if needed); the tighter trace is kept once a
-            tenth of the difference is within the band (return time within ``rtol * max(1, t)``,
-            each state component within ``rtol * |z| + atol``), else the return gets status
-            IMPRECISE. A return is verified when its steps times its impacts' error
+            again at rtol / 100 (and rtol / 10^4 if needed; with ``"taylor"`` at the return's own
+            order in shorter steps, in the SIMD lanes beside the other returns); the tighter
+            trace is kept once a tenth of the difference is within the band (return time within
+            ``rtol * max(1, t)``, each state component within ``rtol * |z| + atol``), else the
+            return gets status IMPRECISE. A return is verified when its steps times its impacts' error
             amplification (the product over impacts of ``2 |a| / (|v| w)``, at least 1 each:
             a shallow impact's saltation) reach N. -1 (default): N = 128 with ``"taylor"``,
             ``40 (1e-8 / rtol)^(1/p)`` (at least 16) with a GSL stepper of order p (rk8pd: 40 at
