@@ -275,7 +275,11 @@ class Section:
         # Only a value equal to True or False (a bool, or 1, 0) can alias another type's; without
         # one the arguments are their own key (no other key is 9 long): the typed key took 0.5 us
         # of a one-point call.
-        key = args if not (args.count(True) or args.count(False)) else args + tuple(map(type, args))
+        try:
+            plain = not (args.count(True) or args.count(False))
+        except Exception:  # an array's == (or any odd value's): the typed path names it
+            plain = False
+        key = args if plain else args + tuple(map(type, args))
         mappers = self.__dict__.get("_mappers")
         if mappers is None:
             mappers = self.__dict__["_mappers"] = {}
