@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hovering/flow/return_map.hpp"
+#include "hovering/detail/poly_roots.hpp"
 #include "hovering/flow/taylor.hpp"
 #include "testing.hpp"
 
@@ -377,4 +378,82 @@ TEST_CASE("stepper taylor: lane groups own their coefficients until the next rou
         tp[l]->eval(0.1, g);  // what another orbit's round left there is never evaluated
         for (int i = 0; i < f.dim; ++i) CHECKF(std::isnan(g[i]), "lane %d: stale eval y[%d] = %g", l, i, g[i]);
     }
+}
+
+TEST_CASE("stepper taylor: the lanes' sign test is the scalar one; per-lane step rules in one round", "[flow]") {
+    // Tan x Tan with a degree-4 coupling. Lanes 0-3 at rtol 1e-10; lanes 4-7 are verifiers of the
+    // same states (rtol 1e-12 at lanes 0-3's order, as Tracer::verify_at builds them), expanded
+    // in the same kernel call. The lanes' keeps_sign verdict (TaylorStep) must be exactly the
+    // scalar keeps_sign of the coefficients taylor_cut scales (else a step with two sign changes
+    // of p1 or p2 could go unsearched), and every lane must be bit for bit its lone expansion.
+    FlowSystem s;
+    s.V1 = std::make_shared<Tan>(1.0, 0.6);
+    s.V2 = std::make_shared<Tan>(1.4, 0.7);
+    s.coupling = Coupling{{{1.0, 2.0, 1.0}, {1.0, 1.0, 3.0}}};
+    s.eps = 0.05;
+    s.qw1 = -1.0;
+    s.qw2 = -0.5;
+    s.geometry = Geometry::Step;
+    detail::Field f(s);
+    detail::Taylor base(f, s, 1e-10, 1e-10);
+    const int p = base.order();
+    std::vector<std::unique_ptr<detail::Taylor>> t;
+    for (int l = 0; l < detail::kMaxTaylorGroup; ++l)
+        t.push_back(l < 4 ? std::make_unique<detail::Taylor>(f, s, 1e-10, 1e-10)
+                          : std::make_unique<detail::Taylor>(f, s, 1e-12, 1e-12, p));
+    detail::Taylor alone(f, s, 1e-10, 1e-10), alone_v(f, s, 1e-12, 1e-12, p);
+    CHECKF(alone_v.order() == p, "the verifier keeps order %d (got %d)", p, alone_v.order());
+    std::uint64_t seed = 12345;
+    auto uniform = [&seed](double a, double b) {
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        return a + (b - a) * double(seed >> 11) * 0x1.0p-53;
+    };
+    int kept[2] = {0, 0}, changed[2] = {0, 0};
+    detail::TaylorLanes lanes;
+    for (int round = 0; round < 200; ++round) {
+        std::vector<std::array<double, detail::kMaxDim>> y(detail::kMaxTaylorGroup);
+        for (int l = 0; l < 4; ++l) {
+            auto& v = y[std::size_t(l)];
+            // Velocities near 0 in some rounds: steps whose p1 or p2 polynomial changes sign.
+            const double small = round % 3 == 0 ? 1e-3 : 1.0;
+            v = {uniform(-0.8, 0.8), small * uniform(-1, 1), uniform(-0.6, 0.6), small * uniform(-1, 1), 0.0, 0.0};
+            f.sync_aux(v.data());
+            y[std::size_t(l + 4)] = v;
+        }
+        detail::Taylor* tp[detail::kMaxTaylorGroup];
+        const double* yp[detail::kMaxTaylorGroup];
+        double hmax[detail::kMaxTaylorGroup];
+        for (int l = 0; l < detail::kMaxTaylorGroup; ++l) {
+            tp[l] = t[std::size_t(l)].get();
+            yp[l] = y[std::size_t(l)].data();
+            hmax[l] = round % 2 ? 0.2 : HUGE_VAL;
+        }
+        detail::Taylor::expand_group(tp, yp, hmax, lanes, detail::kMaxTaylorGroup);
+        for (int l = 0; l < detail::kMaxTaylorGroup; ++l) {
+            double hg = 0, ha = 0;
+            detail::Taylor& a = l < 4 ? alone : alone_v;
+            CHECKF(tp[l]->expanded_at(yp[l], &hg) && a.expand(yp[l], hmax[l], &ha) && ha == hg,
+                   "round %d lane %d: step %.17g alone, %.17g in the round", round, l, ha, hg);
+            const double step = std::min(hg, hmax[l]);
+            for (int w = 0; w < 2; ++w) {
+                double b[detail::kMaxTaylorOrder + 1];
+                CHECKF(tp[l]->scaled_coefficients(2 * w + 1, step, b), "round %d lane %d: coefficients", round, l);
+                const bool scalar = detail::keeps_sign(b, p);
+                CHECKF(tp[l]->keeps_sign(w, step) == scalar && a.keeps_sign(w, step) == scalar,
+                       "round %d lane %d w %d: lanes say %d, alone %d, scalar %d", round, l, w,
+                       int(tp[l]->keeps_sign(w, step)), int(a.keeps_sign(w, step)), int(scalar));
+                ++(scalar ? kept : changed)[w];
+            }
+        }
+        // The verifier's tighter rule takes shorter steps from the same state, in the same call.
+        for (int l = 0; l < 4; ++l) {
+            double h0 = 0, h1 = 0;
+            tp[l]->expanded_at(yp[l], &h0);
+            tp[l + 4]->expanded_at(yp[l + 4], &h1);
+            CHECKF(h1 < h0, "round %d lane %d: verifier step %.17g, return's %.17g", round, l, h1, h0);
+        }
+    }
+    // Both verdicts occurred for both velocities, else the comparison tested one branch only.
+    CHECKF(kept[0] > 0 && changed[0] > 0 && kept[1] > 0 && changed[1] > 0, "verdicts p1 %d/%d, p2 %d/%d", kept[0],
+           changed[0], kept[1], changed[1]);
 }

@@ -41,7 +41,7 @@ py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_p
         throw py::value_error("trajectory_dt must be finite and >= 0 (0: no trajectory), got " +
                               std::to_string(trajectory_dt));
     const py::ssize_t n = z0.shape(0);
-    darray z({n, py::ssize_t(4)}), time(n), err(n);
+    darray z({n, py::ssize_t(4)}), time(n), err(n), chart({n, py::ssize_t(2)});
     py::array_t<std::int8_t> status(n), region(n);
     py::array_t<std::int64_t> steps(n);
     std::vector<std::string> itin{static_cast<std::size_t>(n)};
@@ -55,6 +55,7 @@ py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_p
     out.region = region.mutable_data();
     out.steps = steps.mutable_data();
     out.itinerary = itin.data();
+    out.chart = chart.mutable_data();
     out.work = &work;
     out.trajectory = traj.output();
     std::atomic<bool> cancel{false};
@@ -72,6 +73,7 @@ py::dict returns_dict(const darray& z0, double trajectory_dt, std::int64_t max_p
     d["region"] = region;
     d["steps"] = steps;
     d["itinerary"] = itin;
+    d["chart"] = chart;  // the image's section coordinates, computed once by the tracer's chart check
     d["work"] = hovering_py::work_dict(work);
     traj.put(d);
     d["interrupted"] = interrupted;

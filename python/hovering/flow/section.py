@@ -24,7 +24,6 @@ __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS
 #: the system has one (see :meth:`Section.return_map`). The core's list (``hovering._core.flow.STEPPERS``).
 STEPPERS = tuple(_core_flow.STEPPERS)
 
-_OK = int(FlowStatus.OK)
 
 # flow_options' checks: each names its option and the allowed range.
 _OPTION_CHECKS = dict(
@@ -501,12 +500,9 @@ class Section:
         else:
             with progress_bar(progress, z0.shape[0], desc="Section.return_map", unit="return") as bar:
                 d = mapper.run(z0, threads, dt, per_orbit, bar.part(0) or None)
-        # The image's coordinates where there is an image: a stopped orbit's z is its last state,
-        # which need not have coordinates (a runaway's H2 overflows), and its records are NaN.
-        c = np.full((z0.shape[0], 2), np.nan)
-        ok = d["status"] == _OK  # an int: comparing with the IntEnum member costs 5 us per call
-        if ok.any():  # the core's own states: no checks needed
-            c[ok] = _core_flow.section_coordinates(self.sys.core, d["z"][ok])
+        # The image's coordinates, computed once by the tracer's chart check; NaN where there is no
+        # image (a stopped orbit's z is its last state, which need not have coordinates).
+        c = d["chart"]
         res = ReturnMapResult._make(
             dict(
                 theta=c[:, 0],

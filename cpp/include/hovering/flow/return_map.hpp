@@ -217,6 +217,7 @@ struct ReturnMapsOutput {
     double* energy_error = nullptr;    ///< |H(image) - H(start)|
     std::int64_t* steps = nullptr;     ///< accepted integrator steps
     std::string* itinerary = nullptr;  ///< itinerary of each return
+    double* chart = nullptr;           ///< (theta, I) of each Ok image (ReturnResult::chart), NaN otherwise
     FlowWork* work = nullptr;          ///< the batch's work counters (summed over workers)
     TrajectoryOutput trajectory;       ///< dense output of each return (its clock starts at 0)
 };

@@ -111,6 +111,10 @@ void run_returns(detail::TracerPool* pool, const FlowSystem& s, const double* z0
         if (out.energy_error) out.energy_error[i] = r.energy_error;
         if (out.steps) out.steps[i] = r.steps;
         if (out.itinerary) out.itinerary[i] = r.itinerary;
+        if (out.chart) {
+            out.chart[2 * i] = r.chart[0];
+            out.chart[2 * i + 1] = r.chart[1];
+        }
     };
     const int threads = detail::worker_count(n_threads, n);
     detail::WorkQueue queue(n, detail::balanced_block(n, threads, 16));
