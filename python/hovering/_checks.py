@@ -113,14 +113,18 @@ def is_choice(value, choices) -> bool:
     return isinstance(value, str) and value in choices
 
 
+#: Most worker threads a call takes (the core's kMaxThreads).
+MAX_THREADS = 4096
+
+
 def thread_count(value) -> int:
     """The ``n_threads`` argument every parallel call takes: an integer in [0, 4096], 0 = all cores."""
     try:
         v = operator.index(value)
     except TypeError:
         v = None
-    if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= 4096:
-        raise ValueError(f"n_threads must be an integer in [0, 4096] (0 = all cores), got {value!r}")
+    if v is None or isinstance(value, (bool, np.bool_)) or not 0 <= v <= MAX_THREADS:
+        raise ValueError(f"n_threads must be an integer in [0, {MAX_THREADS}] (0 = all cores), got {value!r}")
     return v
 
 

@@ -1,11 +1,14 @@
 """Type stubs of hovering._core.flow (use hovering.StepSystem, Section and the potentials)."""
 
 from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from . import Geometry
+
+_T = TypeVar("_T")
 
 class Potential:
     def __init__(self) -> None: ...
@@ -175,4 +178,4 @@ class ReturnMapper:
         max_points_per_orbit: int = ...,
         progress: Callable[[int, int], object] | None = ...,
     ) -> dict[str, object]: ...
-    def point(self, h: float, theta: float, I: float) -> dict[str, object]: ...
+    def point(self, h: float, theta: float, I: float, result_type: type[_T]) -> _T: ...

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import check_points, integer, plain_point, real_array, real_number, thread_count
+from .._checks import MAX_THREADS, check_points, integer, plain_point, real_array, real_number, thread_count
 from .._core import flow as _core_flow
 from .._display import Summarized, status_counts
 from .._enums import FlowStatus, status_code
@@ -483,10 +483,11 @@ class Section:
             (rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)
         )
         if progress is False and trajectory_dt is None and plain_point(theta, I):
-            # One point: on this thread (n_threads is checked, not used), the result's fields
-            # from the core, no progress machinery: the batch path's return, bit for bit.
-            thread_count(n_threads)
-            return ReturnMapResult._make(mapper.point(self.h, float(theta), float(I)))
+            # One point: on this thread (n_threads is checked, not used), the result made by the
+            # core, no progress machinery: the batch path's return, bit for bit.
+            if type(n_threads) is not int or not 0 <= n_threads <= MAX_THREADS:
+                thread_count(n_threads)  # its message
+            return mapper.point(self.h, theta, I, ReturnMapResult)
         threads = _threads(n_threads, self.sys.python_defined)
         progress = check_progress(progress)
         z0, _, _ = self._points(theta, I)
