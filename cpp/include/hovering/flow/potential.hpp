@@ -59,6 +59,9 @@ public:
     /// |q| with V(q) <= h (the root to 1 ulp; for a bounded well whose V stays below h up to its
     /// wall in double precision, e.g. Tan above ~1e31, the last double before q_limit).
     virtual std::pair<double, double> turning_points(double h) const;
+    /// A cheap estimate of q_max = turning_points(h).second where one exists in closed form (a
+    /// starting point for Newton's method, not an answer), else NaN.
+    virtual double q_max_estimate(double h) const;
     /// Period T(h) = 2 int dq / sqrt(2 (h - V)). The generic energy-dependent quantities (period,
     /// action, angle_of, point_at) throw std::invalid_argument for a level above the largest value
     /// V reaches before the wall of a bounded well: its turning points are the wall to rounding.
@@ -120,6 +123,8 @@ public:
     std::string name() const override;
     /// Turning points in closed form.
     std::pair<double, double> turning_points(double h) const override;
+    /// q_max in closed form (no check of h: NaN for h <= 0).
+    double q_max_estimate(double h) const override;
     /// T(h) in closed form.
     double period(double h) const override;
     /// I(h) in closed form.
@@ -172,6 +177,8 @@ public:
     double q_limit() const override;
     /// Turning points in closed form.
     std::pair<double, double> turning_points(double h) const override;
+    /// q_max in closed form (no check of h: NaN for h <= 0).
+    double q_max_estimate(double h) const override;
     /// T(h) in closed form.
     double period(double h) const override;
     /// I(h) in closed form.

@@ -194,6 +194,10 @@ void Potential::check_energy(double h, const char* who) const {
         bad(name() + "." + who + ": energy must be finite and > 0 (the minimum is V(0) = 0), got " + fmt(h));
 }
 
+double Potential::q_max_estimate(double) const {
+    return detail::kNaN;
+}
+
 std::pair<double, double> Potential::turning_points(double h) const {
     check_energy(h, "turning_points");
     // Subnormal levels: h - V(q) has too few significant bits for any quadrature.
@@ -474,6 +478,9 @@ std::pair<double, double> Harmonic::turning_points(double h) const {
     const double A = std::sqrt(2 * h) / omega_;
     return {-A, A};
 }
+double Harmonic::q_max_estimate(double h) const {
+    return std::sqrt(2 * h) / omega_;
+}
 double Harmonic::period(double h) const {
     check_energy(h, "period");
     return 2 * kPi / omega_;
@@ -562,6 +569,9 @@ std::pair<double, double> Tan::turning_points(double h) const {
     check_energy(h, "turning_points");
     const double b = std::atan(alpha_ * std::sqrt(2 * h) / omega_) / alpha_;
     return {-b, b};
+}
+double Tan::q_max_estimate(double h) const {
+    return std::atan(alpha_ * std::sqrt(2 * h) / omega_) / alpha_;
 }
 double Tan::period(double h) const {
     check_energy(h, "period");
