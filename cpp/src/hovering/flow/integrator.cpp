@@ -258,6 +258,11 @@ void Integrator::prepare_extension(const double* y0, const double* d0, double h)
     ext_sub_ = std::isfinite(ratio) ? std::min(64, std::max(1, int(std::ceil(1.2 * std::pow(ratio, 0.125))))) : 64;
 }
 
+bool Integrator::solve_on_step(const double* y0, int i, double off, double lo, double hi, bool lo_above, double guess,
+                               double* tau) const {
+    return taylor_ && taylor_->expanded_at(y0) && taylor_->solve(i, off, lo, hi, lo_above, guess, tau);
+}
+
 void Integrator::exact(const double* y0, const double* d0, double dt, double* y1) {
     const int n = field_.dim;
     if (kind_ == ExactKind::Linear) {

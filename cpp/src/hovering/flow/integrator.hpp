@@ -79,6 +79,11 @@ public:
     void prepare_extension(const double* y0, const double* d0, double h);
     /// The continuous extension of the current step at length dt from y0 (derivative d0).
     void exact(const double* y0, const double* d0, double dt, double* y1);
+    /// With taylor, the current step's polynomial through y0: the time in [lo, hi] where variable
+    /// i crosses off (Taylor::solve) into *tau; false for the other steppers (or no expansion
+    /// through y0), whose events are located on exact() by Newton's method.
+    bool solve_on_step(const double* y0, int i, double off, double lo, double hi, bool lo_above, double guess,
+                       double* tau) const;
     /// Coordinates whose velocity may change sign at most once in a step (bit 0: p1, bit 1: p2),
     /// which the event search relies on (tracer.cpp): advance() shortens a step until it holds.
     void set_watched(unsigned mask) { watched_ = mask; }

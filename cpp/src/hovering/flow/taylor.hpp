@@ -85,6 +85,11 @@ public:
     /// Whether the lanes found that the velocity of oscillator w + 1 keeps its sign over the step
     /// `step` (TaylorStep::keeps_sign; false unless step is the step they took).
     bool keeps_sign(int w, double step) const { return valid_ && step == step_.tau && step_.keeps_sign[w]; }
+    /// The time in [lo, hi] where variable i of the current expansion equals off, for a crossing
+    /// on that interval (lo_above: the variable is above off at lo): Newton's method on the
+    /// variable's own polynomial from guess, bisection where it would leave the bracket, until the
+    /// correction is below rounding. False unless an expansion is current (or it fails to settle).
+    bool solve(int i, double off, double lo, double hi, bool lo_above, double guess, double* tau) const;
     /// The p + 1 coefficients of variable i of the current expansion, scaled to the step length h
     /// (c_k h^k: the polynomial in s = tau / h); false unless an expansion is current.
     bool scaled_coefficients(int i, double h, double* out) const;

@@ -68,6 +68,11 @@ double locate_in(Integrator& in, const double* y0, const double* d0, double lo, 
         return hi;
     }
     const double guess = lo + hermite_root(f0, dlo[idx], f1, dhi[idx], hi - lo);
+    // Taylor: on the step's own polynomial, to the last bits, and the state there.
+    if (double tau; in.solve_on_step(y0, idx, off, lo, hi, f0 > 0, guess, &tau)) {
+        in.exact(y0, d0, tau, yout);
+        return tau;
+    }
     in.prepare_extension(y0, d0, hi);
     double dy[kMaxDim];
     auto fdf = [&](double tau, double* f, double* df) {
