@@ -132,6 +132,9 @@ def test_truncated_step_fast_path_equals_the_array_path():
         (lambda fm, sec, tm: sec.return_map(0.3, float("nan")), r"I must be finite"),
         (lambda fm, sec, tm: sec.return_map(0.3, 0.3, rtol=True), r"rtol"),
         (lambda fm, sec, tm: sec.return_map(0.3, 0.3, max_steps=True), r"max_steps"),
+        # Equal to a validated option (2000 == 2000.0, hash equal) but not an integer.
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, max_steps=2000.0), r"max_steps must be an integer"),
+        (lambda fm, sec, tm: sec.return_map(0.3, 0.3, max_impacts=50.0), r"max_impacts must be an integer"),
         (lambda fm, sec, tm: sec.return_map(0.3, 0.3, rtol=[1e-9]), r"rtol"),
         (lambda fm, sec, tm: sec.return_map(0.3, 0.3, stepper="nope"), r"nope"),
         (lambda fm, sec, tm: sec.return_map(0.3, 0.3, n_threads=-1), r"n_threads must be an integer"),
@@ -147,6 +150,8 @@ def test_bad_one_point_input_is_still_refused_by_name(call, match):
     fm.step(0.1, 0.0)
     sec.return_map(0.3, 0.3)
     sec.return_map(0.3, 0.3, max_steps=1)  # then max_steps=True (== 1) must still be refused
+    sec.return_map(0.3, 0.3, max_steps=2000)  # and 2000.0
+    sec.return_map(0.3, 0.3, max_impacts=50)
     sec.return_map(0.3, 0.3, rtol=1e-9)
     with pytest.raises(ValueError, match=match):
         call(fm, sec, tm)

@@ -270,15 +270,9 @@ class Section:
         """The core's return mapper for these integrator options (rtol, atol, stepper, event_tol,
         max_steps, max_impacts, grazing_tol, corner_tol, verify_steps): validated (flow_options,
         validate_for) at the first call with them, then kept with its tracers. The key holds the
-        arguments' types too, so that True is never taken for a validated 1."""
-        # Only a value equal to True or False (a bool, or 1, 0) can alias another type's; without
-        # one the arguments are their own key (no other key is 9 long): the typed key took 0.5 us
-        # of a one-point call.
-        try:
-            plain = not (args.count(True) or args.count(False))
-        except Exception:  # an array's == (or any odd value's): the typed path names it
-            plain = False
-        key = args if plain else args + tuple(map(type, args))
+        arguments' types too: a value equal to a validated one but of another type (True == 1,
+        2000.0 == 2000) is validated itself, not taken for it."""
+        key = (args, tuple(map(type, args)))
         mappers = self.__dict__.get("_mappers")
         if mappers is None:
             mappers = self.__dict__["_mappers"] = {}
