@@ -283,14 +283,20 @@ bool Taylor::solve(int i, double off, double lo, double hi, bool lo_above, doubl
     // A polynomial's value and slope by Horner: ~2p flops per iterate where the generic search
     // evaluated every variable and the field (and located only to sqrt(event_tol), then
     // extrapolated): a tenth of a Tan x Tan return with walls went to locating its events.
+    // The level is taken off the constant term first, as heyoka does with an event's polynomial:
+    // near a root the sum is small, and its rounding then is the small sum's, not |x0|'s (the
+    // impact time of a return with a right-wall impact: 1-2e-15 off, 2-4e-15 in p1 after it).
+    const double c0 = c[0] - off;
     auto fdf = [&](double t, double* d) {
         double v = c[std::size_t(p) * w], dv = 0;
-        for (int k = p - 1; k >= 0; --k) {
+        for (int k = p - 1; k >= 1; --k) {
             dv = dv * t + v;
             v = v * t + c[std::size_t(k) * w];
         }
+        dv = dv * t + v;
+        v = v * t + c0;
         *d = dv;
-        return v - off;
+        return v;
     };
     const double scale = std::max(std::fabs(lo), std::fabs(hi));
     double t = guess >= lo && guess <= hi ? guess : 0.5 * (lo + hi);
