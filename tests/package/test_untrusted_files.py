@@ -213,7 +213,9 @@ def test_flowmap_record_asking_for_an_accuracy_target_is_refused_without_measuri
     calls = []
     real = tolerance.choose_setting
     monkeypatch.setattr(tolerance, "choose_setting", lambda *a, **k: calls.append(a) or real(*a, **k))
-    assert hv.load(genuine["flowmap"]).integrator_options["stepper"] == "taylor" and calls == []  # "auto" as saved: resolved
+    assert (
+        hv.load(genuine["flowmap"]).integrator_options["stepper"] == "taylor" and calls == []
+    )  # "auto" as saved: resolved
     # Before: this 3 KB record ran a work-precision measurement for more than 300 s (it was killed).
     path = _craft(
         genuine["flowmap"],

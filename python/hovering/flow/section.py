@@ -415,9 +415,10 @@ class Section:
             order in shorter steps, in the SIMD lanes beside the other returns); the tighter
             trace is kept once a tenth of the difference is within the band (return time within
             ``rtol * max(1, t)``, each state component within ``rtol * |z| + atol``), else the
-            return gets status IMPRECISE. A return is verified when its steps times its impacts' error
+            return gets status IMPRECISE. A return is verified when its steps times its error
             amplification (the product over impacts of ``2 |a| / (|v| w)``, at least 1 each:
-            a shallow impact's saltation) reach N. -1 (default): N = 128 with ``"taylor"``,
+            a shallow impact's saltation; and the section crossing's ``|V1'(q1)| / |dp1/dt|``, at
+            least 1: a crossing where the coupling nearly cancels V1's force) reach N. -1 (default): N = 128 with ``"taylor"``,
             ``40 (1e-8 / rtol)^(1/p)`` (at least 16) with a GSL stepper of order p (rk8pd: 40 at
             rtol 1e-8, 71 at 1e-10), never with ``"exact"``; 0: no verification; N >= 1: that N.
             ``steps`` counts the steps of every trace. Cost on the README system: 1-2% more steps

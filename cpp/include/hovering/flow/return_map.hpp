@@ -97,8 +97,9 @@ struct FlowOptions {
     int max_impacts = 100;             ///< per return; more ends the orbit with ImpactLimit
     double grazing_tol = 1e-12;        ///< |min distance to a wall| below which an orbit touches it tangentially
     double corner_tol = 1e-10;         ///< distance to the corner below which an impact is a corner hit
-    /// A return whose steps times its impacts' error amplification (the product of each impact's
-    /// 2 |a| / (|v| w), at least 1: a shallow impact's saltation term) reach this is verified:
+    /// A return whose steps times its error amplification (the product of each impact's
+    /// 2 |a| / (|v| w), at least 1: a shallow impact's saltation term; and of the section
+    /// crossing's |V1'(q1)| / |dp1/dt|, at least 1: a shallow crossing) reach this is verified:
     /// traced again at rtol / 100 (and / 10^4 if needed) and the tighter result kept once its
     /// estimated error is within the band (time within rtol max(1, t), each state component within
     /// rtol |z| + atol), else Imprecise. -1 (default): kVerifySteps for "taylor", kVerifyStepsGsl

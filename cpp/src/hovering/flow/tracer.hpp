@@ -126,7 +126,7 @@ private:
         bool seen_negative = false, armed = false, crossed = false;
         bool done = false;  // the return found its end event (section, corner, graze, limit)
         bool over = false;  // step() will take no more steps
-        double amplification = 1;    // product of the impacts' error amplifications (verify_from)
+        double amplification = 1;    // product of the impacts' and the section crossing's error amplifications
         std::array<double, 4> z0{};  // where the return started (verification traces it again)
         double t0[4 * kMaxTangents] = {};  // and its starting tangents
         bool first_crossing = false;
