@@ -206,7 +206,7 @@ ReturnResult ReturnMapper::one(const std::array<double, 4>& z0, FlowWork* work) 
         return r;
     }
     // Lane 0 of a kept group, traced alone: an orbit's bits are the same alone or in a group
-    // (taylor_kernel.hpp), and the group's lane bookkeeping cost ~0.6 us of a one-point return.
+    // (taylor_kernel.hpp), and the group's step loop cost ~1.2 us of a one-point return.
     detail::PooledGroup pooled(pool_.get(), pool_->system(), pool_->options());
     r = pooled->lane(0).trace(z0, false, nullptr);
     if (work) *work = pooled.work();
