@@ -274,8 +274,9 @@ void register_flow(py::module_& m) {
                     throw py::type_error("result_type must be a class whose instances have a __dict__");
                 py::object self = py::reinterpret_steal<py::object>(type->tp_alloc(type, 0));
                 if (!self) throw py::error_already_set();
-                py::dict d = py::reinterpret_steal<py::dict>(PyObject_GenericGetDict(self.ptr(), nullptr));
-                if (!d) throw py::error_already_set();
+                static PyObject* const tmpl = hovering_py::key_template(k);
+                py::dict d = hovering_py::keyed_dict(tmpl);
+                if (PyObject_GenericSetDict(self.ptr(), d.ptr(), nullptr) != 0) throw py::error_already_set();
                 set_item(d, k[0], one(c[0]));
                 set_item(d, k[1], one(c[1]));
                 set_item(d, k[2], z);
@@ -287,7 +288,6 @@ void register_flow(py::module_& m) {
                 set_item(d, k[8], region);
                 set_item(d, k[9], hovering_py::work_dict(work));
                 set_item(d, k[10], py::str(stepper_name(resolve_stepper(rm.options().stepper, s))));
-                for (int i = 11; i < 15; ++i) set_item(d, k[std::size_t(i)], py::none());
                 return self;
             },
             py::arg("h"), py::arg("theta"), py::arg("I"), py::arg("result_type"),

@@ -45,6 +45,25 @@ inline T* array_data(const py::object& a) {
     return reinterpret_cast<T*>(py::detail::array_proxy(a.ptr())->data);
 }
 
+/// A dict of these keys, each None, kept as the template of keyed_dict (made once per call site:
+/// a function-local static, never freed).
+template <std::size_t N>
+inline PyObject* key_template(const std::array<PyObject*, N>& keys) {
+    PyObject* d = PyDict_New();
+    if (!d) throw py::error_already_set();
+    for (PyObject* k : keys)
+        if (PyDict_SetItem(d, k, Py_None) != 0) throw py::error_already_set();
+    return d;
+}
+
+/// A new dict with the template's keys (key_template), each None: a copy takes the template's table
+/// whole, where inserting 15 keys one by one into an empty dict grew it twice.
+inline py::dict keyed_dict(PyObject* tmpl) {
+    PyObject* d = PyDict_Copy(tmpl);
+    if (!d) throw py::error_already_set();
+    return py::reinterpret_steal<py::dict>(d);
+}
+
 /// d[key] = value (key: one of interned()'s).
 inline void set_item(py::dict& d, PyObject* key, const py::object& value) {
     if (PyDict_SetItem(d.ptr(), key, value.ptr()) != 0) throw py::error_already_set();
@@ -54,7 +73,8 @@ inline void set_item(py::dict& d, PyObject* key, const py::object& value) {
 inline py::dict work_dict(const hovering::FlowWork& w) {
     static const auto k = interned({"field_evaluations", "coupling_evaluations", "wall_searches", "section_searches",
                                     "label_operations", "dense_samples", "steps"});
-    py::dict d;
+    static PyObject* const tmpl = key_template(k);
+    py::dict d = keyed_dict(tmpl);
     set_item(d, k[0], py::int_(w.field_evaluations));
     set_item(d, k[1], py::int_(w.coupling_evaluations));
     set_item(d, k[2], py::int_(w.wall_searches));

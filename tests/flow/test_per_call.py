@@ -6,6 +6,7 @@ No timing here (benchmarks/bench_per_call.py measures the costs)."""
 
 from __future__ import annotations
 
+import copy
 import pickle
 
 import numpy as np
@@ -186,5 +187,6 @@ def test_a_used_section_pickles_without_its_kept_mappers():
     sec = paper.section(-0.05)
     sec.return_map(0.3, 0.3)
     back = pickle.loads(pickle.dumps(sec))
-    assert back == sec and "_mappers" not in back.__dict__
+    assert back == sec and "_mappers" not in back.__dict__ and "_last_mapper" not in back.__dict__
+    assert "_last_mapper" not in copy.deepcopy(sec).__dict__
     assert _same(back.return_map(0.3, 0.3).z, sec.return_map(0.3, 0.3).z)
