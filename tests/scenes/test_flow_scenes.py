@@ -412,3 +412,26 @@ def test_a_repeated_coupling_power_is_refused_in_a_file_and_in_a_spec(tmp_path):
         ValueError, match=r"coupling\[1\] = \(2\.0, 1, 1\) repeats the power q1\^1 q2\^1 of coupling\[0\]"
     ):
         spec.build()
+
+
+def test_a_flow_figure_names_the_stepper_that_ran():
+    # The line under a flow figure's title names the integrator as it ran: "auto" resolved on the
+    # system (what FlowMap resolves it to), an explicit stepper as given, an accuracy target as a
+    # target, and a result that records its setting (flow_portrait) by that record.
+    from hovering.plot.common import system_text
+
+    def scene(**integrator):
+        d = _raw("flow_hov_vs_eps")
+        d["integrator"] = integrator
+        return parse_scene(d, "flow_hov_vs_eps.toml", check_output=False)
+
+    auto = scene(rtol=1e-9)
+    ran = hovering.FlowMap(auto.system.build(), auto.h, rtol=1e-9).integrator_options["stepper"]
+    assert ran == "taylor" and system_text(auto).endswith("taylor rtol 1e-09")
+    assert system_text(scene(stepper="rk8pd", rtol=1e-8)).endswith("rk8pd rtol 1e-08")
+    assert system_text(scene(accuracy=1e-9)).endswith("accuracy target 1e-09")
+
+    class Recorded:
+        meta = {"accuracy": {"integrator": {"stepper": "rkf45", "rtol": 3e-7, "atol": 3e-7}}}
+
+    assert system_text(auto, Recorded()).endswith("rkf45 rtol 3e-07")

@@ -261,7 +261,9 @@ class Section:
 
     def __reduce__(self):
         """Pickle as the record (and any other instance attribute but the kept core mappers)."""
-        return reduce_record(self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h", "_mappers", "_last_mapper")})
+        return reduce_record(
+            self, {k: v for k, v in self.__dict__.items() if k not in ("sys", "h", "_mappers", "_last_mapper")}
+        )
 
     #: Distinct option sets whose validated core mapper a section keeps (beyond, it starts afresh).
     _MAX_MAPPERS = 16

@@ -144,13 +144,18 @@ def region_legend(ax, handles) -> None:
         h.set_sizes([25.0])
 
 
-def system_text(scene) -> str:
+def system_text(scene, result=None) -> str:
     """One line under a flow figure's title: potentials, eps, the step's corner, h, the integrator.
+
+    The integrator is named as it ran: the setting the result records (an accuracy target's
+    measured choice), else the scene's stepper with ``auto`` resolved on its system.
 
     Parameters
     ----------
     scene : FlowScene
         The scene.
+    result : SceneResult, optional
+        Its result (``meta["accuracy"]["integrator"]``, where the kind records it).
 
     Returns
     -------
@@ -161,9 +166,14 @@ def system_text(scene) -> str:
     def pot(p):
         return f"{p.kind}({p.omega:g}" + (f", {p.alpha:g})" if p.alpha is not None else ")")
 
+    ran = (((getattr(result, "meta", None) or {}).get("accuracy") or {}).get("integrator")) or {}
+    if "stepper" in ran and "rtol" in ran:
+        integrator = f"{ran['stepper']} rtol {float(ran['rtol']):g}"
+    else:
+        integrator = scene.integrator.label(s.build())
     return (
         rf"$V_1$={pot(s.V1)}, $V_2$={pot(s.V2)}, $\varepsilon={s.eps:g}$, $q_w=({s.qw1:g}, {s.qw2:g})$, "
-        rf"$h={scene.h:g}$, {scene.integrator.stepper} rtol {scene.integrator.rtol:g}"
+        rf"$h={scene.h:g}$, {integrator}"
     )
 
 

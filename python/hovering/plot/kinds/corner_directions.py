@@ -131,5 +131,5 @@ def corner_directions_figure(result: CornerDirectionsResult):
     axd.set_ylabel(r"$K$")
     axd.legend(fontsize=7, loc="lower right", framealpha=0.85)
     axd.set_title(r"(d) corner-singularity curves of $\Sigma_h$, traced back from the corner", fontsize=9)
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig

@@ -82,5 +82,5 @@ def flow_hovering_figure(result: FlowHoveringResult):
     axa.set_title("(b) the same points classified by flow and model", fontsize=9)
     if axa.get_legend_handles_labels()[0]:
         axa.legend(fontsize=7)
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig

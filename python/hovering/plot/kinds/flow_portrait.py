@@ -61,5 +61,5 @@ def flow_portrait_figure(result: FlowPortraitResult):
     hi = max(float(np.nanmax(result.flow.K)), float(np.nanmax(result.model.K)), 0.0)
     d = 0.05 * (hi - lo) if hi > lo else 0.1
     axes[0].set_ylim(lo - d, hi + d)
-    fig.suptitle(scene.title + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + "\n" + system_text(scene, result), fontsize=9)
     return fig

@@ -40,5 +40,5 @@ def ftle_figure(result: FTLEResult):
         ridge = "stable" if f.direction == "forward" else "unstable"
         ax.set_title(f"{f.direction} FTLE, n = {f.n_steps} (ridges: {ridge} manifolds)", fontsize=9)
         fig.colorbar(im, ax=ax, label="FTLE per return")
-    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene)}  [{scene.map}]", fontsize=9)
+    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene, result)}  [{scene.map}]", fontsize=9)
     return fig

@@ -90,7 +90,10 @@ def impact_zone_figure(result: ImpactZoneResult):
         )
         bottom.text(0.02, 0.98, _transit_text(study), transform=bottom.transAxes, fontsize=7, va="top", gid="transit")
     fig.suptitle(
-        scene.title + "\n" + system_text(scene) + f"; the model acts with eps b1 = {scene.system.eps * result.b1:.4g}",
+        scene.title
+        + "\n"
+        + system_text(scene, result)
+        + f"; the model acts with eps b1 = {scene.system.eps * result.b1:.4g}",
         fontsize=9,
     )
     return fig

@@ -61,5 +61,5 @@ def periodic_manifolds_figure(result: PeriodicManifoldsResult):
     ax.set_ylabel(r"$K$")
     if result.orbits:
         ax.legend(fontsize=7, loc="upper right", title=f"period {scene.period}")
-    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene)}  [{scene.map}]", fontsize=9)
+    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene, result)}  [{scene.map}]", fontsize=9)
     return fig

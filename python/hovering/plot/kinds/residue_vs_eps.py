@@ -42,5 +42,5 @@ def residue_figure(result: ResidueResult):
     ax.set_xlabel(r"$\varepsilon$")
     ax.set_ylabel(r"residue $R = (2 - \mathrm{tr}\,M) / 4$")
     ax.legend(fontsize=7)
-    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene)}  [{scene.map}]", fontsize=9)
+    fig.suptitle(f"{scene.title}{quick_mark(result)}\n{system_text(scene, result)}  [{scene.map}]", fontsize=9)
     return fig

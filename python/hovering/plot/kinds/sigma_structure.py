@@ -75,5 +75,5 @@ def sigma_structure_figure(result: SigmaStructureResult):
                 ax.set_title("regions of the band" if c == 0 else "their images", fontsize=9)
             if handles:
                 region_legend(ax, handles)
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig

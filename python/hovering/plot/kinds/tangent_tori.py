@@ -61,5 +61,5 @@ def tangent_tori_figure(result: TangentToriResult):
         ax.set_ylabel(rf"$p_{lab}$")
         ax.set_aspect("equal", adjustable="datalim")
         ax.legend(fontsize=7, loc="upper right")
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig

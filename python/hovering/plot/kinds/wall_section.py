@@ -142,7 +142,7 @@ def wall_section_figure(result: WallSectionResult):
     axz.set_ylim(result.qw2 - zoom, result.qw2 + zoom)
     axz.set_aspect("equal")
     axz.set_title("(d) the same at the corner", fontsize=9)
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig
 
 

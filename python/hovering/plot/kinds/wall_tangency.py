@@ -132,5 +132,5 @@ def wall_tangency_figure(result: WallTangencyResult):
     axz.set_xlim(result.qw1 - 0.15 * span, result.qw1 + 0.45 * span)
     axz.set_ylim(min(p.q2 for p in result.points) - 0.15 * span, max(p.q2 for p in result.points) + 0.15 * span)
     axz.set_title("(c) at the wall: each touches $q_1=q_1^w$", fontsize=9)
-    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene), fontsize=9)
+    fig.suptitle(scene.title + quick_mark(result) + "\n" + system_text(scene, result), fontsize=9)
     return fig

@@ -18,7 +18,7 @@ from ..._core import flow as _core_flow
 from ..._io.serial import saved_as
 from ...diagnostics.tolerance import accurate_flow_map
 from ...flow.potentials import COMPILED, POTENTIAL_KINDS
-from ...flow.section import STEPPERS
+from ...flow.section import STEPPERS, flow_options
 from ...flow.system import Bilinear, Polynomial, StepSystem
 from ...normal.corners import corner_curves
 from ...normal.flowmap import FlowMap
@@ -279,6 +279,26 @@ class IntegratorSpec:
             ``stepper``, ``rtol``, ``atol``.
         """
         return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol)
+
+    def label(self, system: StepSystem) -> str:
+        """What runs, in a figure's words: the stepper (``auto`` resolved on the system, as a
+        :class:`~hovering.FlowMap` resolves it) and rtol, or the accuracy target (whose setting
+        is measured when the map is built: a result records it).
+
+        Parameters
+        ----------
+        system : StepSystem
+            The system the integrator runs on.
+
+        Returns
+        -------
+        str
+            E.g. ``"taylor rtol 1e-10"`` or ``"accuracy target 1e-09"``.
+        """
+        if self.accuracy is not None:
+            return f"accuracy target {self.accuracy:g}"
+        o = flow_options(rtol=self.rtol, atol=self.atol, stepper=self.stepper).resolved_for(system.core)
+        return f"{o.stepper} rtol {self.rtol:g}"
 
     def flow_map(self, system, h: float, coordinates: str = "normal") -> FlowMap:
         """The flow's map with this integrator: the explicit setting, or for an accuracy target the
