@@ -14,6 +14,7 @@
 
 #include "hovering/flow/potential.hpp"
 #include "hovering/sweep/plan.hpp"
+#include "hovering/sweep/plan_build.hpp"
 #include "hovering/sweep/run.hpp"
 #include "testing.hpp"
 
@@ -56,7 +57,7 @@ theory = 0.2
 b1 = 0.5
 h = 1.0
 system = { V1 = { kind = "harmonic", omega = 1.0 }, V2 = { kind = "tan", omega = 1.4, alpha = 0.7 }, coupling = [[1.0, 1, 1]], eps = -0.1, qw1 = -1.0, qw2 = -0.5, geometry = "step" }
-integrator = { stepper = "rk8pd", rtol = 1e-10, atol = 1e-10 }
+integrator = { stepper = "rk8pd", rtol = 1e-10, atol = 1e-10, event_tol = 1e-15, max_steps = 1000000, max_impacts = 100, grazing_tol = 1e-12, corner_tol = 1e-10, verify_steps = -1 }
 )";
 
 std::string tmp(const std::string& name) {
@@ -174,6 +175,41 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
     flow("stepper = \"rk8pd\"", "stepper = \"euler\"",
          "points[0].integrator.stepper = 'euler': allowed: one of 'auto' 'rk8pd'");
     flow("rtol = 1e-10", "rtol = 2.0", "points[0].integrator.rtol = 2: allowed: a finite number in (0, 1)");
+    // The other FlowOptions fields: each explicit, in the core's range, named with its key.
+    flow("verify_steps = -1", "verify_steps = -2", "points[0].integrator.verify_steps = -2: allowed: an integer in [-1, ");
+    flow("max_impacts = 100", "max_impacts = 0", "points[0].integrator.max_impacts = 0: allowed: an integer in [1, 1000000]");
+    flow("max_steps = 1000000", "max_steps = 1.5", "points[0].integrator.max_steps = 1.5: allowed: an integer in [1, ");
+    flow("event_tol = 1e-15", "event_tol = 0.0", "points[0].integrator.event_tol = 0");
+    flow("grazing_tol = 1e-12", "grazing_tol = -1e-12", "points[0].integrator.grazing_tol = -1e-12");
+    flow(", verify_steps = -1", "", "points[0].integrator.verify_steps is missing");
+    {
+        // They reach the flow's options and the checkpoint key (a point with other options is
+        // another point).
+        std::string t = kFlow;
+        const auto at = t.find("verify_steps = -1");
+        REQUIRE(at != std::string::npos);
+        const Plan a = parse_plan(kFlow, "f.toml");
+        const Plan b = parse_plan(t.replace(at, 17, "verify_steps = 0"), "f.toml");
+        CHECK(a.points[0].integrator.verify_steps == -1);
+        CHECK(b.points[0].integrator.verify_steps == 0);
+        CHECK(a.points[0].integrator.max_impacts == 100);
+        CHECK(a.points[0].integrator.event_tol == 1e-15);
+        CHECK(a.points[0].key != b.points[0].key);
+        CHECK(b.points[0].key.find("\"verify_steps\":0") != std::string::npos);
+        // Each field reaches the core's options as written (none left at its default).
+        std::string u = kFlow;
+        const auto line = u.find("integrator = {");
+        REQUIRE(line != std::string::npos);
+        u.replace(line, u.find('\n', line) - line,
+                  "integrator = { stepper = \"rk8pd\", rtol = 1e-9, atol = 1e-8, event_tol = 1e-13, max_steps = 5000, "
+                  "max_impacts = 7, grazing_tol = 1e-11, corner_tol = 1e-6, verify_steps = 9 }");
+        const Plan cp = parse_plan(u, "f.toml");
+        const PlanPoint& c = cp.points[0];
+        const hovering::FlowOptions o = build_options(c.integrator, build_system(c.system, c.system.eps));
+        CHECK((o.stepper == hovering::Stepper::Rk8pd && o.rtol == 1e-9 && o.atol == 1e-8));
+        CHECK((o.event_tol == 1e-13 && o.max_steps == 5000 && o.max_impacts == 7));
+        CHECK((o.grazing_tol == 1e-11 && o.corner_tol == 1e-6 && o.verify_steps == 9));
+    }
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 21]]", "points[0].system.coupling[0] = an array of 3");
     flow("coupling = [[1.0, 1, 1]]", "coupling = [[1.0, 1, 1], [2.0, 1, 1]]", "each (i, j) once");
     flow("kind = \"tan\", omega = 1.4, alpha = 0.7", "kind = \"tan\", omega = 1.4",
@@ -189,8 +225,8 @@ TEST_CASE("bad plans: one message naming the file, the key, the value and what i
          "points[0].system.V2.alpha is not a key of this table");
     flow("qw2 = -0.5", "qw2 = 0.5", "points[0].system.qw2 = 0.5: allowed: a finite number < 0");
     flow("geometry = \"step\"", "geometry = \"box\"", "geometry = 'box': allowed: one of 'none' 'wall' 'step'");
-    flow("integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n",
-         "integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10 }\n[[points.models]]\nname = \"m\"\nK_low = "
+    flow("integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10, event_tol = 1e-15, max_steps = 1000000, max_impacts = 100, grazing_tol = 1e-12, corner_tol = 1e-10, verify_steps = -1 }\n",
+         "integrator = { stepper = \"rk8pd\", rtol = 1e-10, atol = 1e-10, event_tol = 1e-15, max_steps = 1000000, max_impacts = 100, grazing_tol = 1e-12, corner_tol = 1e-10, verify_steps = -1 }\n[[points.models]]\nname = \"m\"\nK_low = "
          "-0.1\n"
          "eps = 0.1\nK = [-1.0, -0.5, 0.0, 0.5]\nOmega = [1.0, 1.0, 1.0]\nJR = [1.0, 1.0, 1.0, 0.0]\n"
          "J1 = [1.0, 0.5, 0.0, 0.0]\nforcing = [1.0]\nK_max = inf\n",

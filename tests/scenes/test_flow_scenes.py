@@ -435,3 +435,26 @@ def test_a_flow_figure_names_the_stepper_that_ran():
         meta = {"accuracy": {"integrator": {"stepper": "rkf45", "rtol": 3e-7, "atol": 3e-7}}}
 
     assert system_text(auto, Recorded()).endswith("rkf45 rtol 3e-07")
+
+
+def test_a_flow_scene_sets_every_integrator_option():
+    # [integrator] takes every option FlowMap takes (the core's defaults where absent), checked
+    # against the core's ranges when the scene is read, before anything is computed.
+    d = _raw("flow_hov_vs_eps")
+    d["integrator"] = {"rtol": 1e-9, "verify_steps": 0, "max_impacts": 7, "corner_tol": 1e-6, "event_tol": 1e-13}
+    s = parse_scene(d, "flow_hov_vs_eps.toml", check_output=False)
+    o = s.integrator.flow_map(s.system.build(), s.h).integrator_options
+    assert (o["verify_steps"], o["max_impacts"], o["corner_tol"], o["event_tol"]) == (0, 7, 1e-6, 1e-13)
+    core = hovering._core.flow.FlowOptions()
+    assert (o["max_steps"], o["grazing_tol"]) == (core.max_steps, core.grazing_tol)
+    for key, value, needle in (
+        ("verify_steps", -2, r"integrator\.verify_steps.*-2.*\[-1, "),
+        ("max_impacts", 0, r"integrator\.max_impacts.*0.*\[1, 1000000\]"),
+        ("max_steps", 2.5, r"integrator\.max_steps"),
+        ("event_tol", 0.0, r"integrator\.event_tol"),
+        ("grazing_tol", -1e-12, r"integrator\.grazing_tol"),
+    ):
+        bad = copy.deepcopy(d)
+        bad["integrator"][key] = value
+        with pytest.raises(ValueError, match=needle):
+            parse_scene(bad, "flow_hov_vs_eps.toml", check_output=False)

@@ -176,3 +176,26 @@ def test_plan_command(tmp_path, capsys, monkeypatch):
     # A plan hovering wrote is replaced (a new plan of the full counts).
     assert main(["plan", str(TRUNC), "-o", "fig_hov_vs_eps.plan.toml"]) == 0
     assert tomllib.loads((tmp_path / "fig_hov_vs_eps.plan.toml").read_text())["points"][0]["n_steps"] == 20000
+
+
+def test_a_flow_scenes_integrator_options_reach_both_programs(sweep_exe, tmp_path):
+    # Every FlowOptions field a scene's [integrator] sets is written into the plan and the point's
+    # key, and both programs integrate with it: with corner_tol = 0.05 (and max_impacts = 1,
+    # verify_steps = 0), orbits that pass within 0.05 of the corner stop there, the rows
+    # differ from the default options' (the options act), and the executable's rows are still
+    # Python's bit for bit under keys both programs agree on.
+    base = flow_scene()
+    ig = dataclasses.replace(base.integrator, max_impacts=1, verify_steps=0, corner_tol=0.05)
+    scene = dataclasses.replace(base, integrator=ig)
+    plan = tmp_path / "p.toml"
+    write_plan(scene, plan, quick=True)
+    for p in tomllib.loads(plan.read_text())["points"]:
+        assert p["integrator"] == {**ig.events(), "stepper": "taylor", "rtol": ig.rtol, "atol": ig.atol}
+    run_exe(sweep_exe, plan, tmp_path / "exe.jsonl")
+    compute(scene, quick=True, checkpoint=tmp_path / "py.jsonl")
+    compute(base, quick=True, checkpoint=tmp_path / "default.jsonl")
+    exe, py, default = (rows_by_key(tmp_path / f"{n}.jsonl") for n in ("exe", "py", "default"))
+    assert len(py) == 2 and exe.keys() == py.keys() and not (py.keys() & default.keys())
+    for k in py:
+        assert same(exe[k], py[k]), (k, exe[k], py[k])
+    assert not same(sorted(py.values(), key=str), sorted(default.values(), key=str))

@@ -46,10 +46,16 @@ struct SystemSpec {
     std::string geometry;  ///< "none", "wall" or "step"
 };
 
-/// The integrator of a flow point (the other FlowOptions keep their defaults).
+/// The integrator of a flow point: every FlowOptions field, each explicit in a plan.
 struct IntegratorSpec {
     Stepper stepper = Stepper::Auto;  ///< parsed from the plan's name (kSteppers)
-    double rtol = 0, atol = 0;         ///< both explicit in a plan
+    double rtol = 0, atol = 0;         ///< tolerances of the step control
+    double event_tol = 0;              ///< FlowOptions::event_tol
+    std::int64_t max_steps = 0;        ///< FlowOptions::max_steps
+    int max_impacts = 0;               ///< FlowOptions::max_impacts
+    double grazing_tol = 0;            ///< FlowOptions::grazing_tol
+    double corner_tol = 0;             ///< FlowOptions::corner_tol
+    std::int64_t verify_steps = 0;     ///< FlowOptions::verify_steps
 };
 
 /// A truncated model of a flow point: a TruncatedFamily by its tables, and the box it samples.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -240,6 +241,13 @@ IntegratorSpec read_integrator(Table& t) {
     it.stepper = parse_stepper(t.string("stepper", std::vector<std::string>(kSteppers.begin(), kSteppers.end())));
     it.rtol = t.real("rtol", 0, 1, true, true, true);
     it.atol = t.real("atol", 0, kInf, true, true);
+    // The core's ranges (FlowOptions::validate), each key named here.
+    it.event_tol = t.real("event_tol", 0, kInf, true, true);
+    it.max_steps = t.integer("max_steps", 1, std::numeric_limits<std::int64_t>::max());
+    it.max_impacts = int(t.integer("max_impacts", 1, 1000000));
+    it.grazing_tol = t.real("grazing_tol", 0, kInf);
+    it.corner_tol = t.real("corner_tol", 0, kInf);
+    it.verify_steps = t.integer("verify_steps", -1, std::numeric_limits<std::int64_t>::max());
     t.done();
     return it;
 }
@@ -291,9 +299,12 @@ std::string point_key(const std::string& kind, const PlanPoint& p) {
                        {"eps", jnum(s.eps)},        {"qw1", jnum(s.qw1)},        {"qw2", jnum(s.qw2)},
                        {"geometry", s.geometry}};
         k["h"] = jnum(p.h);
-        k["integrator"] = {{"stepper", stepper_name(p.integrator.stepper)},
-                           {"rtol", jnum(p.integrator.rtol)},
-                           {"atol", jnum(p.integrator.atol)}};
+        const IntegratorSpec& it = p.integrator;
+        k["integrator"] = {{"stepper", stepper_name(it.stepper)}, {"rtol", jnum(it.rtol)},
+                           {"atol", jnum(it.atol)},           {"event_tol", jnum(it.event_tol)},
+                           {"max_steps", it.max_steps},       {"max_impacts", it.max_impacts},
+                           {"grazing_tol", jnum(it.grazing_tol)}, {"corner_tol", jnum(it.corner_tol)},
+                           {"verify_steps", it.verify_steps}};
         json models = json::array();
         for (const auto& m : p.models)
             models.push_back({{"name", m.name},

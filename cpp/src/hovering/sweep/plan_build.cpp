@@ -36,6 +36,12 @@ FlowOptions build_options(const IntegratorSpec& it, const FlowSystem& s) {
     o.stepper = it.stepper;
     o.rtol = it.rtol;
     o.atol = it.atol;
+    o.event_tol = it.event_tol;
+    o.max_steps = it.max_steps;
+    o.max_impacts = it.max_impacts;
+    o.grazing_tol = it.grazing_tol;
+    o.corner_tol = it.corner_tol;
+    o.verify_steps = it.verify_steps;
     o.validate(s);
     return o.resolved(s);
 }

@@ -24,6 +24,7 @@ from ...normal.corners import corner_curves
 from ...normal.flowmap import FlowMap
 from ..base import Geometry, SceneSpec
 from ..fields import OMIT, choice, custom, real, table
+from ..fields import integer as integer_field
 from ..values import integer, text
 from ..values import real as real_value
 from ..wall import WallFlow, corner_energy
@@ -262,12 +263,43 @@ class IntegratorSpec:
     accuracy : float or None
         An accuracy target instead (``accuracy = 1e-9`` in [integrator]): the map is built at the
         fastest setting measured to reach it (:func:`hovering.diagnostics.accurate_flow_map`).
+    event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps : optional
+        The rest of :class:`~hovering.FlowMap`'s integrator options (``Section.return_map``
+        documents each), with an accuracy target too; default the core's (``FlowOptions{}``:
+        1e-15, 1000000, 100, 1e-12, 1e-10, -1).
     """
 
     stepper: str = choice(_CORE.stepper, STEPPERS)
     rtol: float = real(_CORE.rtol, lo=1e-15, hi=1e-2)
     atol: float = real(_CORE.atol, lo=1e-15, hi=1e-2, default_from=_default_atol)
     accuracy: float | None = real(None, lo=1e-13, hi=1e-2, check=_accuracy_alone)
+    # The ranges are the core's (FlowOptions::validate), the bounds made finite where a TOML
+    # number needs one.
+    event_tol: float = real(_CORE.event_tol, lo=0.0, hi=1.0, lo_open=True)
+    max_steps: int = integer_field(_CORE.max_steps, lo=1, hi=2**62)
+    max_impacts: int = integer_field(_CORE.max_impacts, lo=1, hi=1000000)
+    grazing_tol: float = real(_CORE.grazing_tol, lo=0.0, hi=1.0)
+    corner_tol: float = real(_CORE.corner_tol, lo=0.0, hi=1.0)
+    verify_steps: int = integer_field(_CORE.verify_steps, lo=-1, hi=2**62)
+
+    def events(self) -> dict:
+        """The options besides the stepper and tolerances (what an accuracy target leaves to the
+        scene), as keyword arguments of :class:`~hovering.FlowMap`.
+
+        Returns
+        -------
+        dict
+            ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol``,
+            ``verify_steps``.
+        """
+        return dict(
+            event_tol=self.event_tol,
+            max_steps=self.max_steps,
+            max_impacts=self.max_impacts,
+            grazing_tol=self.grazing_tol,
+            corner_tol=self.corner_tol,
+            verify_steps=self.verify_steps,
+        )
 
     def options(self) -> dict:
         """The explicit setting, as keyword arguments of :class:`~hovering.FlowMap` (with an
@@ -276,9 +308,9 @@ class IntegratorSpec:
         Returns
         -------
         dict
-            ``stepper``, ``rtol``, ``atol``.
+            ``stepper``, ``rtol``, ``atol`` and :meth:`events`.
         """
-        return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol)
+        return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol, **self.events())
 
     def label(self, system: StepSystem) -> str:
         """What runs, in a figure's words: the stepper (``auto`` resolved on the system, as a
@@ -318,7 +350,7 @@ class IntegratorSpec:
         FlowMap
         """
         if self.accuracy is not None:
-            return accurate_flow_map(system, h, self.accuracy, coordinates=coordinates)
+            return accurate_flow_map(system, h, self.accuracy, coordinates=coordinates, **self.events())
         return FlowMap(system, h=h, coordinates=coordinates, **self.options())
 
 
@@ -388,11 +420,12 @@ def _h_above_step(where: str, h: float, reading) -> None:
 
 
 def _integrator_table(ig: IntegratorSpec, kind) -> dict:
-    return (
+    head = (
         {"accuracy": ig.accuracy}
         if ig.accuracy is not None
         else {"stepper": ig.stepper, "rtol": ig.rtol, "atol": ig.atol}
     )
+    return {**head, **ig.events()}
 
 
 @dataclass(frozen=True, kw_only=True)
