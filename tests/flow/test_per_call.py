@@ -158,6 +158,19 @@ def test_bad_one_point_input_is_still_refused_by_name(call, match):
         call(fm, sec, tm)
 
 
+def test_an_option_changed_in_place_is_validated_again():
+    # Section.return_map takes the last call's mapper when every option is the same object; a 0-d
+    # array is the same object after it is changed in place, so it must never be taken that way:
+    # the call after the change integrates at the new tolerance (what a fresh section gives).
+    sec = paper.section(-0.05)
+    r = np.array(1e-10)
+    first = sec.return_map(0.3, 0.3, rtol=r, atol=r)
+    r[...] = 1e-4
+    changed = sec.return_map(0.3, 0.3, rtol=r, atol=r)
+    fresh = paper.section(-0.05).return_map(0.3, 0.3, rtol=1e-4, atol=1e-4)
+    assert _same(changed.z, fresh.z) and not _same(changed.z, first.z)
+
+
 def test_kept_tracers_change_no_result_and_no_work_count():
     # A map keeps its tracers from call to call; a fresh map must give the same numbers, and each
     # call's work counters must count that call only.

@@ -498,7 +498,12 @@ class Section:
         if mapper is None:
             args = (rtol, atol, stepper, event_tol, max_steps, max_impacts, grazing_tol, corner_tol, verify_steps)
             mapper = self._mapper(args)
-            self._last_mapper = (*args, mapper)
+            try:
+                hash(args)
+            except TypeError:  # a mutable option (a 0-d array) can change in place: never taken by identity
+                pass
+            else:
+                self._last_mapper = (*args, mapper)
         if (
             progress is False
             and trajectory_dt is None
