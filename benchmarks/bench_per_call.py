@@ -1,6 +1,7 @@
 """Issue 33, parts 1-2: a user's own loop (one point per call, one long orbit) against heyoka.py.
 
-What is measured (one run, every ratio from this run; process time, best of --repeat; one thread):
+What is measured (one run, every ratio from this run; process time, best of 4 x --repeat short
+rounds: the shared VM slows down in bursts, which the best short round escapes; one thread):
 
 1. Per call. The README system (``hovering.paper.system(-0.05)``, h = 1, rtol = atol = 1e-10) on
    64 fixed points of Sigma_h (phi uniform, K in [-0.1, 0.1]): microseconds per call of each public
@@ -15,7 +16,9 @@ What is measured (one run, every ratio from this run; process time, best of --re
 2. A lone orbit. FlowMap.iterate of ONE orbit (section coordinates, taylor), of eight orbits at
    once (the 8-lane group), and heyoka.py's fastest scalar form ("stream": one propagate_until for
    all returns of the orbit, the section a non-terminal event) from the same start, in rounds of a
-   quarter of --returns returns, the methods interleaved; microseconds per return, best round. Accuracy: the error of the first --check returns of 64 starts
+   quarter of --returns returns (each round the orbit's first returns, at least 500), the methods
+   interleaved; microseconds per return, best round. Rounds of the whole --returns before this
+   change: its numbers are per return all the same, but were taken one method after another. Accuracy: the error of the first --check returns of 64 starts
    against FlowMap taylor at 1e-16, max (median) over starts of max(|wrap(d theta)|, |d I|), for
    ours at rtol 1e-10 and heyoka at tol 1e-10 and 1e-12 (matched accuracy: the heyoka tolerance
    whose error is at or below ours). Lone == group is checked bit for bit (the orbit alone and as one
@@ -269,7 +272,7 @@ def lone_part(args):
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="few calls: a smoke run")
-    ap.add_argument("--repeat", type=int, default=5, help="rounds per measurement (best kept)")
+    ap.add_argument("--repeat", type=int, default=5, help="measurements take 4x this many short rounds (best kept)")
     ap.add_argument("--returns", type=int, default=20000, help="returns of the lone orbit (part 2)")
     ap.add_argument("--parts", default="1,2", help="parts to run: 1 (per call), 2 (lone orbit)")
     args = ap.parse_args(argv)

@@ -171,6 +171,19 @@ def test_an_option_changed_in_place_is_validated_again():
     assert _same(changed.z, fresh.z) and not _same(changed.z, first.z)
 
 
+def test_a_sections_system_and_energy_cannot_be_reassigned():
+    # Its kept mappers integrate the system it was made with: a reassigned sys returned the old
+    # system's images. Both are fixed; other attributes are free.
+    sec = paper.section(-0.05)
+    before = sec.return_map(0.5, 0.3)
+    for name, value in (("sys", paper.system(0.0)), ("h", 1.1)):
+        with pytest.raises(AttributeError, match=rf"Section\.{name} is fixed at construction"):
+            setattr(sec, name, value)
+    sec.note = "mine"
+    assert sec.note == "mine" and _same(sec.return_map(0.5, 0.3).z, before.z)
+    assert _same(copy.copy(sec).return_map(0.5, 0.3).z, before.z)
+
+
 def test_kept_tracers_change_no_result_and_no_work_count():
     # A map keeps its tracers from call to call; a fresh map must give the same numbers, and each
     # call's work counters must count that call only.

@@ -447,6 +447,13 @@ def test_a_flow_scene_sets_every_integrator_option():
     assert (o["verify_steps"], o["max_impacts"], o["corner_tol"], o["event_tol"]) == (0, 7, 1e-6, 1e-13)
     core = hovering._core.flow.FlowOptions()
     assert (o["max_steps"], o["grazing_tol"]) == (core.max_steps, core.grazing_tol)
+    # The wall-section kinds trace with the same options (WallFlow took only the tolerances).
+    from hovering.scenes.kinds._flow import wall_flow
+
+    w = _raw("fig_wallsection")
+    w["integrator"] = dict(d["integrator"])
+    wo = wall_flow(parse_scene(w, "fig_wallsection.toml", check_output=False)).options
+    assert (wo.verify_steps, wo.max_impacts, wo.corner_tol, wo.event_tol, wo.rtol) == (0, 7, 1e-6, 1e-13, 1e-9)
     for key, value, needle in (
         ("verify_steps", -2, r"integrator\.verify_steps.*-2.*\[-1, "),
         ("max_impacts", 0, r"integrator\.max_impacts.*0.*\[1, 1000000\]"),

@@ -199,3 +199,18 @@ def test_a_flow_scenes_integrator_options_reach_both_programs(sweep_exe, tmp_pat
     for k in py:
         assert same(exe[k], py[k]), (k, exe[k], py[k])
     assert not same(sorted(py.values(), key=str), sorted(default.values(), key=str))
+
+
+def test_a_plans_integrator_has_the_readers_types_whatever_a_spec_holds(tmp_path):
+    # A spec built in code may hold an int tolerance or NumPy scalars; the plan (and so both
+    # programs' checkpoint keys) holds floats for tolerances and ints for counts, as TOML the C++
+    # reader takes (an int 0 became the key's 0 in Python and 0.0 in the executable).
+    import numpy as np
+
+    base = flow_scene()
+    ig = dataclasses.replace(base.integrator, corner_tol=0, max_impacts=np.int64(3), event_tol=np.float64(1e-14))
+    plan = tmp_path / "p.toml"
+    write_plan(dataclasses.replace(base, integrator=ig), plan, quick=True)
+    it = tomllib.loads(plan.read_text())["points"][0]["integrator"]
+    assert (it["corner_tol"], it["max_impacts"], it["event_tol"]) == (0.0, 3, 1e-14)
+    assert [type(it[k]) for k in ("corner_tol", "max_impacts", "event_tol")] == [float, int, float]

@@ -237,6 +237,13 @@ class Section:
         # 1e100: far above any physical level, and the potentials' energy questions stay finite.
         self.h = real_number("h", h, hi=1e100, hi_open=False)
 
+    def __setattr__(self, name, value):
+        """``sys`` and ``h`` are fixed at construction: the kept mappers integrate that system, and
+        the hash is theirs (a reassigned ``sys`` gave the old system's returns)."""
+        if name in ("sys", "h") and name in self.__dict__:
+            raise AttributeError(f"Section.{name} is fixed at construction; make a new Section(sys, h)")
+        object.__setattr__(self, name, value)
+
     def __repr__(self) -> str:
         return f"Section({self.sys!r}, h={self.h!r})"
 

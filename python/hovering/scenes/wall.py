@@ -253,7 +253,8 @@ class WallFlow:
     sys : StepSystem
         The step system (its returns give the region labels and the drawn trajectories).
     options : dict
-        Integrator settings ``stepper``, ``rtol``, ``atol`` (as :attr:`FlowMap.integrator_options`).
+        Integrator settings: keyword arguments of :func:`~hovering.flow.section.flow_options`
+        (``stepper``, ``rtol``, ``atol``, ``event_tol``, ... as :attr:`FlowMap.integrator_options`).
 
     Attributes
     ----------
@@ -265,7 +266,7 @@ class WallFlow:
     def __init__(self, sys: StepSystem, options: dict):
         self.sys = sys
         self.smooth = sys.replace(geometry="none")
-        self.options = flow_options(**{k: options[k] for k in ("stepper", "rtol", "atol") if k in options})
+        self.options = flow_options(**options)
         self.options.validate_for(sys.core)
         self.work = {"smooth": {}, "step": {}}
 

@@ -290,15 +290,16 @@ class IntegratorSpec:
         -------
         dict
             ``event_tol``, ``max_steps``, ``max_impacts``, ``grazing_tol``, ``corner_tol``,
-            ``verify_steps``.
+            ``verify_steps``: the counts as Python ints, the tolerances as floats, whatever a spec
+            built in code holds (a plan's checkpoint key has the C++ reader's types).
         """
         return dict(
-            event_tol=self.event_tol,
-            max_steps=self.max_steps,
-            max_impacts=self.max_impacts,
-            grazing_tol=self.grazing_tol,
-            corner_tol=self.corner_tol,
-            verify_steps=self.verify_steps,
+            event_tol=float(self.event_tol),
+            max_steps=int(self.max_steps),
+            max_impacts=int(self.max_impacts),
+            grazing_tol=float(self.grazing_tol),
+            corner_tol=float(self.corner_tol),
+            verify_steps=int(self.verify_steps),
         )
 
     def options(self) -> dict:
@@ -330,7 +331,7 @@ class IntegratorSpec:
         if self.accuracy is not None:
             return f"accuracy target {self.accuracy:g}"
         o = flow_options(rtol=self.rtol, atol=self.atol, stepper=self.stepper).resolved_for(system.core)
-        return f"{o.stepper} rtol {self.rtol:g}"
+        return "exact (closed form)" if o.stepper == "exact" else f"{o.stepper} rtol {self.rtol:g}"
 
     def flow_map(self, system, h: float, coordinates: str = "normal") -> FlowMap:
         """The flow's map with this integrator: the explicit setting, or for an accuracy target the

@@ -177,8 +177,8 @@ def _flow_point(scene: FlowHoveringScene, e: float, n_steps: int, samples: int) 
     fm = scene.integrator.flow_map(build_system(system), scene.h)
     o = fm.integrator_options  # what an accuracy target chose, or the scene's setting
     integrator = {"stepper": o["stepper"], "rtol": float(o["rtol"]), "atol": float(o["atol"])}
-    # Every other option explicit too (a plan holds no default), in the core's order.
-    integrator.update({k: type(v)(o[k]) for k, v in scene.integrator.events().items()})
+    # Every other option explicit too (a plan holds no default): the map's own (the scene's).
+    integrator.update(scene.integrator.events())
     # One box for flow and models, so the same points are classified by each: the default depth
     # (the critical band of eq:hovsetsize), cut to the band every model is defined on.
     deep = default_K_low(fm, -math.inf)  # hovering_area's default box, before a band cuts it
