@@ -523,3 +523,69 @@ def test_flow_scene_runs_with_the_exact_stepper(tmp_path):
     # 300 returns of rk8pd at rtol 1e-12 (~1e-12 each, growing linearly with the shear): 1e-8.
     assert np.nanmax(np.abs(a.K - b.K)) < 1e-8
     assert np.nanmax(np.abs(np.angle(np.exp(1j * (a.phi - b.phi))))) < 1e-8
+
+
+# crosscheck seed 4040: slow, nearly equal frequencies and a strong relative coupling (eps / (w1 w2)
+# = -0.52). From this start q1 has a minimum and a maximum 0.026 apart near t = 12.5, p1 never
+# above 2e-9 between them, inside one step of the linear closed form: its step test (a Hermite
+# bound from the step's ends) saw no sign change, and the return skipped the maximum (t = 22.90
+# after a wall impact, where taylor and rk8pd return at 12.50).
+NEAR_TANGENT = dict(
+    w1=0.2461963825762925,
+    w2=0.23511182418395654,
+    eps=-0.02995548592032522,
+    qw1=-0.7816113624558116,
+    qw2=-0.4861570954416363,
+    h=0.94243852623223,
+    theta=-1.1822020679702354,
+    I=2.5077748627210794,
+)
+
+
+def _numpy_p1(w1, w2, eps, z0, t):
+    """p1(t) of the uncoupled-walls linear flow from z0, by NumPy's eigen-decomposition (independent
+    of the core's normal modes)."""
+    A = np.array([[0, 1, 0, 0], [-(w1**2), 0, -eps, 0], [0, 0, 0, 1], [-eps, 0, -(w2**2), 0]])
+    lam, V = np.linalg.eig(A)
+    c = np.linalg.solve(V, np.asarray(z0, complex))
+    return (V[1] @ (c[:, None] * np.exp(lam[:, None] * t))).real
+
+
+def test_linear_exact_sees_two_sign_changes_of_p1_inside_one_step():
+    p = NEAR_TANGENT
+    sys = hovering.StepSystem(
+        hovering.Harmonic(p["w1"]),
+        hovering.Harmonic(p["w2"]),
+        hovering.Bilinear(),
+        eps=p["eps"],
+        qw1=p["qw1"],
+        qw2=p["qw2"],
+        geometry="wall",
+    )
+    sec = hovering.Section(sys, p["h"])
+    # The start and its neighbours within 1e-5 in theta: the two roots move, merge and part (before
+    # the fix 401 of 401 starts within 1e-6 and 119 of 385 within 1e-5 returned 10 time units late).
+    th = p["theta"] + np.linspace(-1e-5, 1e-5, 41)
+    I = np.full(th.size, p["I"])
+    ex = sec.return_map(th, I, stepper="exact", n_threads=1)
+    ty = sec.return_map(th, I, stepper="taylor", rtol=1e-13, atol=1e-13, n_threads=1)
+    ok = (ex.status == 0) & (ty.status == 0)
+    assert ok.sum() >= 35
+    # Two independent integrators: the same crossing (event_tol-located, 1e-9 in time is loose).
+    assert np.all(np.abs(ex.time - ty.time)[ok] < 1e-9), np.abs(ex.time - ty.time)[ok].max()
+    # Both sides of the merge are in the family: starts whose dip crosses zero (return at 12.5) and
+    # starts whose dip stays below it (return at 22.9, after a wall impact).
+    early = ok & (ex.time < 12.6)
+    assert 5 <= early.sum() <= ok.sum() - 5
+    # And NumPy's closed form of the smooth flow: the first fall of p1 through zero after the start
+    # is the return where the dip crosses zero, and there is none before t = 12.6 where it does
+    # not; on a grid of 1e-7 around t = 12.5 and 1e-3 before it.
+    z0 = sec.point(th, I)
+    t = np.concatenate([np.arange(1e-3, 12.4, 1e-3), np.linspace(12.4, 12.6, 2_000_001)])
+    for k in np.flatnonzero(ok)[::3]:
+        p1 = _numpy_p1(p["w1"], p["w2"], p["eps"], z0[k], t)
+        down = np.flatnonzero((p1[:-1] > 0) & (p1[1:] <= 0))
+        if early[k]:
+            assert down.size and abs(t[down[0]] - ex.time[k]) < 1e-6, (k, t[down[:2]], ex.time[k])
+        else:
+            assert down.size == 0, (k, t[down[:2]], ex.time[k])

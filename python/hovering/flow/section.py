@@ -401,7 +401,8 @@ class Section:
             (each oscillator turns on its own action-angle circle, an impact is an angle jump
             theta -> -theta_w: returns are computed event to event, to rounding, ~1e-15) and for
             Harmonic V1, V2 with a quadratic coupling at any eps (a linear flow, stepped through
-            its normal modes; events located as for the GSL steppers). Other systems raise
+            its normal modes; events located as for the GSL steppers, and a step cut wherever its closed
+            form shows a watched velocity changing sign twice). Other systems raise
             ValueError. ``steps`` then counts events passed (or closed-form steps).
         event_tol : float, optional
             Time accuracy of located events (impacts, section crossing, a wall distance's

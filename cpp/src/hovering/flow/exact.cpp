@@ -91,21 +91,35 @@ double LinearFlow::fastest_rate() const {
 }
 
 void LinearFlow::propagate(const double* y0, double t, double* y1) const {
-    const double q[2] = {y0[0], y0[2]}, p[2] = {y0[1], y0[3]};
-    double x[2], v[2];
     if (!(t == t_last_)) {
-        for (int k = 0; k < 2; ++k) {
-            const double lam = lam_[std::size_t(k)], a = rate_[std::size_t(k)] * t;
-            c_last_[k] = lam > 0 ? std::cos(a) : lam < 0 ? std::cosh(a) : 1.0;
-            s_last_[k] = lam > 0 ? std::sin(a) : lam < 0 ? std::sinh(a) : 0.0;
-        }
+        modes_at(t, c_last_, s_last_);
         t_last_ = t;
     }
+    apply(y0, t, c_last_, s_last_, y1);
+}
+
+void LinearFlow::state_at(const double* y0, double t, double* y1) const {
+    double c[2], sn[2];
+    modes_at(t, c, sn);
+    apply(y0, t, c, sn, y1);
+}
+
+void LinearFlow::modes_at(double t, double* c, double* sn) const {
+    for (int k = 0; k < 2; ++k) {
+        const double lam = lam_[std::size_t(k)], a = rate_[std::size_t(k)] * t;
+        c[k] = lam > 0 ? std::cos(a) : lam < 0 ? std::cosh(a) : 1.0;
+        sn[k] = lam > 0 ? std::sin(a) : lam < 0 ? std::sinh(a) : 0.0;
+    }
+}
+
+void LinearFlow::apply(const double* y0, double t, const double* c_, const double* s_, double* y1) const {
+    const double q[2] = {y0[0], y0[2]}, p[2] = {y0[1], y0[3]};
+    double x[2], v[2];
     for (int k = 0; k < 2; ++k) {
         // Mode k: x'' = -lam x, x = Q^T q.
         const double x0 = Q_[0][k] * q[0] + Q_[1][k] * q[1], v0 = Q_[0][k] * p[0] + Q_[1][k] * p[1];
         const double lam = lam_[std::size_t(k)], s = rate_[std::size_t(k)];
-        const double c = c_last_[k], sn = s_last_[k];
+        const double c = c_[k], sn = s_[k];
         if (lam > 0) {
             x[k] = c * x0 + sn / s * v0;
             v[k] = -s * sn * x0 + c * v0;
@@ -121,6 +135,39 @@ void LinearFlow::propagate(const double* y0, double t, double* y1) const {
     y1[1] = Q_[0][0] * v[0] + Q_[0][1] * v[1];
     y1[2] = Q_[1][0] * x[0] + Q_[1][1] * x[1];
     y1[3] = Q_[1][0] * v[0] + Q_[1][1] * v[1];
+}
+
+double LinearFlow::acceleration(const double* y, int i) const {
+    // -(K q)_i with K = Q diag(lam) Q^T.
+    double a = 0;
+    for (int k = 0; k < 2; ++k) a -= Q_[i][k] * lam_[std::size_t(k)] * (Q_[0][k] * y[0] + Q_[1][k] * y[2]);
+    return a;
+}
+
+void LinearFlow::velocity_derivative_bounds(const double* y0, double h, int i, double* m) const {
+    // p_i = sum_k Q_ik x_k', so p_i' = -sum_k Q_ik lam_k x_k and p_i'' = -sum_k Q_ik lam_k x_k':
+    // each mode's |x_k|, |x_k'| bounded over [0, h] by its amplitude (oscillating), its cosh/sinh
+    // growth (lam < 0) or its line (lam = 0, which adds nothing: lam_k = 0).
+    m[0] = m[1] = 0;
+    for (int k = 0; k < 2; ++k) {
+        const double x0 = Q_[0][k] * y0[0] + Q_[1][k] * y0[2], v0 = Q_[0][k] * y0[1] + Q_[1][k] * y0[3];
+        const double lam = lam_[std::size_t(k)], r = rate_[std::size_t(k)];
+        double X = 0, V = 0;
+        if (lam > 0) {
+            const double A = std::hypot(x0, v0 / r);
+            X = A;
+            V = r * A;
+        } else if (lam < 0) {
+            const double c = std::cosh(r * h), sn = std::sinh(r * h);
+            X = std::fabs(x0) * c + std::fabs(v0) / r * sn;
+            V = r * std::fabs(x0) * sn + std::fabs(v0) * c;
+        }
+        m[0] += std::fabs(Q_[i][k] * lam) * X;
+        m[1] += std::fabs(Q_[i][k] * lam) * V;
+    }
+    // Rounding of the modes and of the states the bounds are compared with.
+    m[0] = m[0] * (1 + 1e-12) + 1e-300;
+    m[1] = m[1] * (1 + 1e-12) + 1e-300;
 }
 
 // ------------------------------------------------------------------------------- angle flow

@@ -10,7 +10,9 @@
 //  - Linear: V1, V2 both Harmonic and a coupling that is a quadratic form (terms q1 q2, q1^2, q2^2;
 //    constants do not move the flow), any eps: q'' = -K q, solved through the normal modes of K
 //    (cos/sin, linear or cosh/sinh for eigenvalues > 0, = 0, < 0). The Tracer steps it as it steps
-//    GSL's steppers, with the closed form as its continuous extension.
+//    GSL's steppers, with the closed form as its continuous extension; a step is halved wherever
+//    the closed form shows a watched velocity changing sign twice (Integrator::linear_ambiguous:
+//    the GSL steppers' Hermite test alone missed a q1 minimum and maximum 0.026 apart).
 
 #include <array>
 #include <limits>
@@ -35,14 +37,23 @@ class LinearFlow {
 public:
     /// The flow of a Linear system (exact_kind == Linear).
     explicit LinearFlow(const FlowSystem& s);
-    /// y1 = exp(A t) y0 for y = (q1, p1, q2, p2).
+    /// y1 = exp(A t) y0 for y = (q1, p1, q2, p2) (the modes at t kept for the next call's t).
     void propagate(const double* y0, double t, double* y1) const;
+    /// propagate() without touching what it keeps (a time inside a step).
+    void state_at(const double* y0, double t, double* y1) const;
     /// The largest |eigenvalue|^(1/2) of K: the fastest rate of the flow.
     double fastest_rate() const;
     /// The eigenvalues of K (ascending).
     const std::array<double, 2>& eigenvalues() const { return lam_; }
+    /// dp_i/dt = -(K q)_i at the state y (i = 0: p1, 1: p2).
+    double acceleration(const double* y, int i) const;
+    /// Bounds of |dp_i/dt| (m[0]) and |d^2 p_i/dt^2| (m[1]) over [0, h] along the flow from y0,
+    /// from each mode's amplitude (its cosh/sinh growth for an eigenvalue < 0), rounding included.
+    void velocity_derivative_bounds(const double* y0, double h, int i, double* m) const;
 
 private:
+    void modes_at(double t, double* c, double* sn) const;  // each mode's (cos, sin) or (cosh, sinh)
+    void apply(const double* y0, double t, const double* c, const double* sn, double* y1) const;
     std::array<double, 2> lam_{}, rate_{};  // eigenvalues, sqrt(|eigenvalue|)
     double Q_[2][2]{};                      // columns: unit eigenvectors
     // The modes' (cos, sin) or (cosh, sinh) at the last t: every full step has the same length

@@ -114,6 +114,9 @@ private:
     // The other steppers: whether the step (y0, d0) -> (y1, d1) of length h may hold two sign
     // changes of a watched velocity, judged on its Hermite interpolant with a margin.
     bool ambiguous(const double* y0, const double* d0, const double* y1, const double* d1, double h) const;
+    // The linear closed form's own test: whether a watched velocity may change sign twice or more
+    // on [0, h] from y0 (exact pieces where it is monotone or has no root; undecided counts as twice).
+    bool linear_ambiguous(const double* y0, const double* d0, const double* y1, const double* d1, double h) const;
     int order_ = 8;                       // one-step methods: the stepper's order, for the step-size rule
     double grow_below_ = 0.43;            // 0.9^order: below this scaled error the step grows
 };
