@@ -435,6 +435,8 @@ def test_a_flow_figure_names_the_stepper_that_ran():
         meta = {"accuracy": {"integrator": {"stepper": "rkf45", "rtol": 3e-7, "atol": 3e-7}}}
 
     assert system_text(auto, Recorded()).endswith("rkf45 rtol 3e-07")
+    Recorded.meta = {"accuracy": {"integrator": {"stepper": "exact", "rtol": 1e-10, "atol": 1e-10}}}
+    assert system_text(auto, Recorded()).endswith("exact (closed form)")  # it ignores rtol
 
 
 def test_a_flow_scene_sets_every_integrator_option():

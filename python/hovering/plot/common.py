@@ -167,10 +167,8 @@ def system_text(scene, result=None) -> str:
         return f"{p.kind}({p.omega:g}" + (f", {p.alpha:g})" if p.alpha is not None else ")")
 
     ran = (((getattr(result, "meta", None) or {}).get("accuracy") or {}).get("integrator")) or {}
-    if ran.get("stepper") == "exact":
-        integrator = "exact (closed form)"  # no tolerance: the flow in closed form
-    elif "stepper" in ran and "rtol" in ran:
-        integrator = f"{ran['stepper']} rtol {float(ran['rtol']):g}"
+    if "stepper" in ran and "rtol" in ran:
+        integrator = scene.integrator.label(ran=ran)
     else:
         integrator = scene.integrator.label(s.build())
     return (

@@ -313,25 +313,34 @@ class IntegratorSpec:
         """
         return dict(stepper=self.stepper, rtol=self.rtol, atol=self.atol, **self.events())
 
-    def label(self, system: StepSystem) -> str:
-        """What runs, in a figure's words: the stepper (``auto`` resolved on the system, as a
-        :class:`~hovering.FlowMap` resolves it) and rtol, or the accuracy target (whose setting
-        is measured when the map is built: a result records it).
+    def label(self, system: StepSystem | None = None, ran: dict | None = None) -> str:
+        """What runs, in a figure's words: the setting a result recorded (``ran``), else the
+        stepper (``auto`` resolved on the system, as a :class:`~hovering.FlowMap` resolves it) and
+        rtol, or the accuracy target (whose setting is measured when the map is built).
 
         Parameters
         ----------
-        system : StepSystem
-            The system the integrator runs on.
+        system : StepSystem, optional
+            The system the integrator runs on (needed without ``ran``).
+        ran : dict, optional
+            A recorded setting with ``stepper`` and ``rtol`` (:attr:`FlowMap.integrator_options`).
 
         Returns
         -------
         str
-            E.g. ``"taylor rtol 1e-10"`` or ``"accuracy target 1e-09"``.
+            E.g. ``"taylor rtol 1e-10"``, ``"exact (closed form)"`` (no tolerance) or
+            ``"accuracy target 1e-09"``.
         """
-        if self.accuracy is not None:
+        if ran is not None:
+            stepper, rtol = ran["stepper"], float(ran["rtol"])
+        elif self.accuracy is not None:
             return f"accuracy target {self.accuracy:g}"
-        o = flow_options(rtol=self.rtol, atol=self.atol, stepper=self.stepper).resolved_for(system.core)
-        return "exact (closed form)" if o.stepper == "exact" else f"{o.stepper} rtol {self.rtol:g}"
+        else:
+            stepper = (
+                flow_options(rtol=self.rtol, atol=self.atol, stepper=self.stepper).resolved_for(system.core).stepper
+            )
+            rtol = self.rtol
+        return "exact (closed form)" if stepper == "exact" else f"{stepper} rtol {rtol:g}"
 
     def flow_map(self, system, h: float, coordinates: str = "normal") -> FlowMap:
         """The flow's map with this integrator: the explicit setting, or for an accuracy target the
