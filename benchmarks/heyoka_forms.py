@@ -74,6 +74,7 @@ class HeyokaFlow:
             raise ValueError(f"only the bilinear and polynomial couplings are written out here, got {s.coupling!r}")
         self.sec, self.sys = sec, s
         self.step = s.geometry == "step"
+        self.last_steps = 0  # batched(): steps taken by its real starts in its last call
         self.vars = q1, p1, q2, p2 = hy.make_vars("q1", "p1", "q2", "p2")
         f1, f2 = _force(s.V1, q1), _force(s.V2, q2)
         if s.eps != 0 and isinstance(s.coupling, Bilinear):
@@ -257,7 +258,7 @@ class HeyokaFlow:
         Z = np.vstack([z0s, np.repeat(z0s[-1:], pad, axis=0)]) if pad else np.asarray(z0s)
         out = np.full((n, 4), np.nan)
         T = 2 * np.pi * m_returns
-        total = 0
+        total = steps = 0
         zero = np.zeros(B)
         t0 = time.perf_counter()
         for g in range(0, len(Z), B):
@@ -272,6 +273,8 @@ class HeyokaFlow:
                     if recs[b]:
                         out[g + b] = recs[b][0]
                     total += len(recs[b])
+                    steps += int(ta.propagate_res[b][3])
+        self.last_steps = steps  # steps of the real starts (not the padding): per-step costs
         return out, total, time.perf_counter() - t0
 
 
