@@ -401,21 +401,26 @@ bool Integrator::ambiguous(const double* y0, const double* d0, const double* y1,
         if (!((watched_ >> w) & 1u)) continue;
         const int qi = 2 * w, pi = qi + 1;
         // The velocity as the derivative of q's quintic Hermite interpolant (q, p, p' at both
-        // ends), in s = tau / h; its distance to the cubic Hermite of p (p, p' at both ends), one
-        // order less accurate, bounds its error: sign changes are counted for P and P -+ that bound.
+        // ends), in s = tau / h. Its distance to the cubic Hermite of p (p, p' at both ends), one
+        // order less accurate, is exactly P4 s^2 (1 - s)^2 (both match p and p' at both ends), and
+        // 64 times that distance, pointwise, bounds P's error: sign changes are counted for P and
+        // P -+ that band. The band vanishes at the ends, whose values are the step's own: a
+        // constant band (the earlier test) lifted an end across zero wherever the band was wider
+        // than the end's velocity, and then saw one root instead of two. rk8pd at rtol 1e-6 thus
+        // stepped over a q1 minimum and maximum 0.011 apart (peak p1 ~1e-7) and returned 10.4
+        // time units late, status OK (tests/flow/test_exact_flow.py, NEAR_TANGENT).
         const double q0 = y0[qi], v0 = h * y0[pi], a0 = h * h * d0[pi];
         const double q1 = y1[qi], v1 = h * y1[pi], a1 = h * h * d1[pi];
         const double c3 = -10 * q0 - 6 * v0 - 1.5 * a0 + 0.5 * a1 - 4 * v1 + 10 * q1;
         const double c4 = 15 * q0 + 8 * v0 + 1.5 * a0 - a1 + 7 * v1 - 15 * q1;
         const double c5 = -6 * q0 - 3 * v0 - 0.5 * a0 + 0.5 * a1 - 3 * v1 + 6 * q1;
-        double P[5] = {v0, a0, 3 * c3, 4 * c4, 5 * c5};  // h times the velocity
-        const double e2 = -3 * v0 - 2 * a0 + 3 * v1 - a1, e3 = 2 * v0 + a0 - 2 * v1 + a1;
-        const double margin = std::fabs(P[2] - e2) + std::fabs(P[3] - e3) + std::fabs(P[4]) +
-                              1e-13 * (std::fabs(v0) + std::fabs(v1));
+        const double P[5] = {v0, a0, 3 * c3, 4 * c4, 5 * c5};  // h times the velocity
+        // 64 |P4| s^2 (1 - s)^2 (peak 4 |P4|, the earlier constant band's width), and rounding.
+        const double band = 64 * std::fabs(P[4]) + 16e-13 * (std::fabs(v0) + std::fabs(v1));
         RootBracket br[2];
-        for (const double shift : {0.0, margin, -margin}) {
-            P[0] = v0 + shift;
-            if (isolate_roots(P, 4, br, 2) == 2) return true;
+        for (const double b : {0.0, band, -band}) {
+            const double Q[5] = {P[0], P[1], P[2] + b, P[3] - 2 * b, P[4] + b};  // P + b s^2 (1 - s)^2
+            if (isolate_roots(Q, 4, br, 2) == 2) return true;
         }
     }
     return false;
