@@ -38,6 +38,11 @@ EXAMPLES = max(int(_FUZZ), 10) if _FUZZ.isdigit() else (200 if _FUZZ else 10)
 
 # time and state tolerance of an OK return against the reference (see the module docstring)
 TOL = 1e-5
+# The same at the loose tolerance LOOSE_RTOL, where a GSL step spans a fifth of a slow period and the
+# step test for two sign changes inside it matters most (it once skipped returns there: see
+# test_exact_flow.py). An OK return at rtol 1e-6 is ~1e-5 off after tens of steps; a skipped or
+# invented crossing > 0.1.
+LOOSE_RTOL, LOOSE_TOL = 1e-6, 1e-3
 COMPARED: list = []  # time differences of the OK returns compared (reported by the last test)
 
 
@@ -69,11 +74,13 @@ def systems(draw):
 
 
 def _steppers(sys, terms):
-    """Every stepper that applies to the system: the GSL ones checked here, Taylor, the closed form."""
-    out = ["rk8pd", "rkck", "taylor"]
+    """(stepper, rtol, tolerance) of every stepper that applies to the system: the GSL ones checked
+    here at the default and a loose tolerance, Taylor, the closed form."""
+    out = [("rk8pd", 1e-10, TOL), ("rkck", 1e-10, TOL), ("taylor", 1e-10, TOL)]
+    out += [("rk8pd", LOOSE_RTOL, LOOSE_TOL), ("rkck", LOOSE_RTOL, LOOSE_TOL)]
     linear = all(isinstance(v, hv.Harmonic) for v in (sys.V1, sys.V2)) and set(terms) <= {(1, 1)}
     if linear:
-        out.append("exact")
+        out.append(("exact", 1e-10, TOL))
     return out
 
 
@@ -101,19 +108,20 @@ def test_every_stepper_returns_the_references_crossing_or_says_it_cannot(drawn):
         refs.append(
             scipy_flow.reference_return(R1, R2, terms, eps, geometry, qw1, qw2, z, t_max=300.0, step_fraction=64)
         )
-    for stepper in _steppers(sys, terms):
-        r = sec.return_map(th, I, stepper=stepper, rtol=1e-10, atol=1e-10, max_steps=200_000, n_threads=1)
+    for stepper, rtol, tol in _steppers(sys, terms):
+        r = sec.return_map(th, I, stepper=stepper, rtol=rtol, atol=rtol, max_steps=200_000, n_threads=1)
         for k, ref in enumerate(refs):
             if r.status[k] != hv.FlowStatus.OK:
                 continue  # the stepper says it is not a return: allowed (the reference may disagree)
-            where = f"{stepper} on {sys!r}, h = {h}, start ({th[k]!r}, {I[k]!r}): {r.time[k]} vs {ref}"
+            where = f"{stepper} at rtol {rtol} on {sys!r}, h = {h}, start ({th[k]!r}, {I[k]!r}): {r.time[k]} vs {ref}"
             if ref["status"] in ("failed", "limit"):
                 continue  # DOP853 gave up (a runaway on a coupling unbounded below): no verdict
             assert ref["status"] == "ok", where
             # the reference knows no chart: an OK return must be the reference's crossing
-            assert abs(r.time[k] - ref["time"]) < TOL, where
-            COMPARED.append(abs(r.time[k] - ref["time"]))
-            assert np.max(np.abs(r.z[k] - ref["z"])) < TOL * max(1.0, np.max(np.abs(ref["z"]))), where
+            assert abs(r.time[k] - ref["time"]) < tol, where
+            if rtol == 1e-10:
+                COMPARED.append(abs(r.time[k] - ref["time"]))
+            assert np.max(np.abs(r.z[k] - ref["z"])) < tol * max(1.0, np.max(np.abs(ref["z"]))), where
             if geometry != "none":
                 assert r.itinerary[k].replace("0", "").replace("u", "") == ref["itinerary"], where
 
