@@ -551,7 +551,8 @@ def _numpy_p1(w1, w2, eps, z0, t):
     return (V[1] @ (c[:, None] * np.exp(lam[:, None] * t))).real
 
 
-def test_linear_exact_sees_two_sign_changes_of_p1_inside_one_step():
+def _near_tangent_section():
+    """Sigma_h of the NEAR_TANGENT system (wall geometry)."""
     p = NEAR_TANGENT
     sys = hovering.StepSystem(
         hovering.Harmonic(p["w1"]),
@@ -562,7 +563,12 @@ def test_linear_exact_sees_two_sign_changes_of_p1_inside_one_step():
         qw2=p["qw2"],
         geometry="wall",
     )
-    sec = hovering.Section(sys, p["h"])
+    return hovering.Section(sys, p["h"])
+
+
+def test_linear_exact_sees_two_sign_changes_of_p1_inside_one_step():
+    p = NEAR_TANGENT
+    sec = _near_tangent_section()
     # The start and its neighbours within 1e-5 in theta: the two roots move, merge and part (before
     # the fix 401 of 401 starts within 1e-6 and 119 of 385 within 1e-5 returned 10 time units late).
     th = p["theta"] + np.linspace(-1e-5, 1e-5, 41)
@@ -603,16 +609,7 @@ def test_gsl_steppers_see_a_q1_minimum_and_maximum_inside_one_long_step(stepper)
     # root of the shifted velocity instead of two; rk8pd returned 29 of the 41 starts 10.4 time
     # units late with status OK (at rtol 1e-8, one). The band now vanishes at the step's ends.
     p = NEAR_TANGENT
-    sys = hovering.StepSystem(
-        hovering.Harmonic(p["w1"]),
-        hovering.Harmonic(p["w2"]),
-        hovering.Bilinear(),
-        eps=p["eps"],
-        qw1=p["qw1"],
-        qw2=p["qw2"],
-        geometry="wall",
-    )
-    sec = hovering.Section(sys, p["h"])
+    sec = _near_tangent_section()
     th = p["theta"] + np.linspace(-1e-5, 1e-5, 41)
     I = np.full(th.size, p["I"])
     ex = sec.return_map(th, I, stepper="exact", n_threads=1)
