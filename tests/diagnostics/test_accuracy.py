@@ -289,3 +289,20 @@ def test_hovering_area_diagram_against_its_largest_setting():
         assert r["seconds"] > 0 and r["unit"] == "call"
     with pytest.raises(ValueError, match="at least two"):
         hovering.work_precision(m, quantity="hovering_area", tolerances=[(400, 250)])
+
+
+def test_the_target_is_measured_with_the_maps_own_event_options():
+    # The setting is measured as the map will run: with max_steps = 5 no return of system(0.05)
+    # completes (13 to 157 steps measured over the ladder's steppers and tolerances), so no setting reaches
+    # the target and the builder says so, instead of measuring at the default max_steps and
+    # returning a map whose every return is a StepLimit. Options reach the chosen row too.
+    with pytest.raises(ValueError, match=r"not reached"):
+        accurate_flow_map(system(0.05), 1.0, 1e-6, coordinates="section", max_steps=5)
+    fm = accurate_flow_map(system(0.05), 1.0, 1e-6, coordinates="section", verify_steps=0, grazing_tol=1e-11)
+    assert fm.accuracy_choice["options"]["verify_steps"] == 0
+    assert fm.accuracy_choice["options"]["grazing_tol"] == 1e-11
+    assert fm.integrator_options["verify_steps"] == 0
+    with pytest.raises(ValueError, match=r"max_steps"):
+        choose_setting(Section(system(0.05), 1.0), 1e-6, options={"max_steps": 0})
+    with pytest.raises(ValueError, match=r"unknown option.*'stepper'"):
+        choose_setting(Section(system(0.05), 1.0), 1e-6, options={"stepper": "rk8pd"})

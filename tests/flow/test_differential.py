@@ -170,6 +170,24 @@ def test_the_issues_strong_coupling_start_returns_at_the_first_maximum():
         assert r.status[0] != hv.FlowStatus.OK or abs(r.time[0] - ref["time"]) < 1e-4, (stepper, r.time[0])
 
 
+def test_the_oracle_gives_up_within_its_budget_of_evaluations():
+    # An orbit whose steps shrink without bound (toward a Tan well's edge, off along a coupling
+    # unbounded below) once ran the oracle for more than 15 minutes and GBs under HOVERING_FUZZ=40.
+    # It now stops with "limit" (no verdict) once its budget is spent: checked here with a budget
+    # below what an ordinary return needs (3,900-6,000 evaluations; the default is 1e6).
+    R = scipy_flow.harmonic(1.0)
+    sec = hv.Section(
+        hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Harmonic(1.0), coupling=hv.Bilinear(), eps=0.05, geometry="wall"), 1.0
+    )
+    z0 = sec.point([0.3], [0.2])[0]
+    full = scipy_flow.reference_return(R, R, "bilinear", 0.05, "wall", -1.0, -0.5, z0, step_fraction=64)
+    assert full["status"] == "ok" and full["evaluations"] > 1000, full
+    cut = scipy_flow.reference_return(
+        R, R, "bilinear", 0.05, "wall", -1.0, -0.5, z0, step_fraction=64, max_evaluations=500
+    )
+    assert cut["status"] == "limit" and cut["evaluations"] == 501 and cut["time"] < full["time"], cut
+
+
 def test_an_ok_return_is_the_point_its_coordinates_name():
     # paper.system(eps=-0.3): some returns end at a maximum of q1 that Sigma_h's chart does not
     # hold (q1 < 0); they are OFF_SECTION, and every OK return maps back onto its own state.

@@ -65,6 +65,10 @@ N_SAMPLE = 32  # samples per accepted step
 MAX_IMPACTS = 10000
 
 
+class _OutOfBudget(Exception):
+    """Raised by the right-hand side once ``max_evaluations`` is spent."""
+
+
 def harmonic(omega):
     """Harmonic potential V(q) = omega^2 q^2 / 2.
 
@@ -176,6 +180,7 @@ def reference_return(
     corner_tol=1e-9,
     grazing_tol=1e-12,
     step_fraction=128,
+    max_evaluations=1_000_000,
 ):
     """One return to Sigma_h = {p1 = 0, dp1/dt < 0} from ``z0``, by DOP853 with robust event search.
 
@@ -202,6 +207,12 @@ def reference_return(
     step_fraction : int
         Every DOP853 step is at most 1/step_fraction of the shortest local period (module
         docstring).  128 puts the error at the rounding floor (~1e-14); 64 is ~2x faster, ~1e-13.
+    max_evaluations : int
+        Budget of right-hand-side evaluations; once spent the status is "limit".  An orbit that
+        runs toward a Tan well's edge or off along a coupling unbounded below shrinks the steps
+        without bound: unbounded, one such start ran for more than 15 minutes and took GBs of
+        dense output.  1e6 evaluations (~20 s; a dense output of at most ~85k steps, ~90 MB of
+        samples) is ~200x what an ordinary return needs (measured: 3,900-6,000 at step_fraction 64).
 
     Returns
     -------
@@ -209,7 +220,8 @@ def reference_return(
         ``status`` ("ok", "corner", "grazing", "limit", "failed"), ``time``, ``z`` (state at the
         end, ndarray (4,)), ``itinerary`` (str of 'R' and '1' in order), ``energy_error``
         (|H(z) - H(z0)|), and also ``crossed`` (True if q1 = qw1 was crossed where the right wall
-        is absent) and ``steps`` (accepted DOP853 steps of the kept pieces).
+        is absent), ``steps`` (accepted DOP853 steps of the kept pieces) and ``evaluations``
+        (right-hand-side evaluations spent).
     """
     if geometry not in ("step", "wall", "none"):
         raise ValueError(f"unknown geometry {geometry!r}")
@@ -221,7 +233,12 @@ def reference_return(
     def force(q1, q2):
         return (-_pot(V1, q1, 1) - eps * _vc(terms, q1, q2, 1, 0), -_pot(V2, q2, 1) - eps * _vc(terms, q1, q2, 0, 1))
 
+    spent = [0]
+
     def rhs(t, y):
+        spent[0] += 1
+        if spent[0] > max_evaluations:
+            raise _OutOfBudget
         f1, f2 = force(y[0], y[2])
         return np.array([y[1], f1, y[3], f2])
 
@@ -267,7 +284,11 @@ def reference_return(
     def finish(status, t, y):
         y = np.asarray(y, float)
         out.update(
-            status=status, time=float(t), z=y.copy(), energy_error=abs(float(energy(V1, V2, coupling, eps, y)) - h0)
+            status=status,
+            time=float(t),
+            z=y.copy(),
+            energy_error=abs(float(energy(V1, V2, coupling, eps, y)) - h0),
+            evaluations=spent[0],
         )
         return out
 
@@ -281,7 +302,12 @@ def reference_return(
         # --- integrate one chunk, refining max_step until every step obeys the cap rule
         while True:
             t_end = min(t + step_fraction * cap, t_max * (1 + 1e-12) + 1e-12)
-            sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=cap)
+            try:
+                sol = solve_ivp(
+                    rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=cap
+                )
+            except _OutOfBudget:
+                return finish("limit", t, y)
             ts = sol.t
             if sol.status != 0 or len(ts) < 2:
                 return finish("failed", t, y)

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._checks import integer, real_number
+from ..flow.section import EVENT_OPTIONS, flow_options
 from ..normal.flowmap import FlowMap
 from .work_precision import _EXACT_ERROR, _best_time, _default_actions, _flow, exact_available, stepper_applies
 
@@ -31,6 +32,7 @@ def choose_setting(
     steppers: Sequence[str] | None = None,
     n_points: int = 16,
     seed: int = 0,
+    options: dict | None = None,
 ) -> dict:
     """The fastest integrator setting measured to reach an accuracy target on this section.
 
@@ -52,6 +54,10 @@ def choose_setting(
         Candidates (default: taylor where it applies, rk8pd, rkck).
     n_points, seed : int, optional
         Starting points of the measurement.
+    options : dict, optional
+        Event options of the map the setting is for (``event_tol``, ``max_steps``, ``max_impacts``,
+        ``grazing_tol``, ``corner_tol``, ``verify_steps``): every run measured uses them, so the
+        cost and error measured are that map's (the reference takes the grazing and corner bands).
 
     Returns
     -------
@@ -66,6 +72,11 @@ def choose_setting(
         For a bad target, or if no candidate reaches it (naming the best error measured).
     """
     accuracy, returns = _target(accuracy, returns)
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(EVENT_OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown option(s) {unknown}; allowed: {', '.join(EVENT_OPTIONS)}")
+    flow_options(**options)  # each value checked (named, with its range) before anything is measured
     if exact_available(section) and accuracy >= _EXACT_ERROR:
         t, _ = _best_time(
             lambda: section.return_map(
@@ -73,6 +84,7 @@ def choose_setting(
                 _default_actions(section, n_points, np.random.default_rng(seed)),
                 stepper="exact",
                 n_threads=1,
+                **options,
             ),
             2,
         )
@@ -82,7 +94,7 @@ def choose_setting(
             "error": _EXACT_ERROR,
             "seconds": t / n_points,
             "unit": "return",
-            "options": {"stepper": "exact"},
+            "options": {"stepper": "exact", **options},
             "reference": "exact (closed-form flow)",
             "returns": returns,
         }
@@ -100,6 +112,7 @@ def choose_setting(
         1,
         False,
         reversal=False,
+        options=options,
     )
     best = wp.fastest(accuracy, None if returns == 1 else returns)
     if best is None:
@@ -115,7 +128,7 @@ def choose_setting(
     if returns > 1:
         out["error"] = best["error_after"][returns]
     out["returns"] = returns
-    out["options"] = {"stepper": best["method"], "rtol": best["tolerance"], "atol": best["tolerance"]}
+    out["options"] = {"stepper": best["method"], "rtol": best["tolerance"], "atol": best["tolerance"], **options}
     out["reference"] = wp.reference["method"]
     return out
 
@@ -176,7 +189,7 @@ def accurate_flow_map(
     # The map at the core's defaults first: every argument checked, and the tangential curve (which
     # does not depend on the integrator setting) measured once, before the measurement of settings.
     plain = FlowMap(sys, h, coordinates=coordinates, curve=curve, **options)
-    choice = choose_setting(plain.section, accuracy, returns)
+    choice = choose_setting(plain.section, accuracy, returns, options=options)
     tol = choice["tolerance"]
     fm = FlowMap(
         sys, h, coordinates=coordinates, curve=plain.curve, stepper=choice["method"], rtol=tol, atol=tol, **options

@@ -338,16 +338,18 @@ def _default_actions(section, n: int, rng) -> np.ndarray:
     return I_max * rng.uniform(0.05, 0.95, n)
 
 
-def _reference_run(section, theta, I, n_threads):
+def _reference_run(section, theta, I, n_threads, classify=None):
     """One return by the reference: exact where available, else the most accurate integrator that
     applies (taylor at rtol 1e-16, order 20; else rk8pd at 1e-14), its own error estimated by its
-    distance to the next tolerance up (1e-15 / 1e-13)."""
+    distance to the next tolerance up (1e-15 / 1e-13). ``classify``: the grazing and corner bands of
+    the runs measured, so that the reference calls the same starts regular."""
+    classify = classify or {}
     if exact_available(section):
-        r = section.return_map(theta, I, stepper="exact", n_threads=n_threads)
+        r = section.return_map(theta, I, stepper="exact", n_threads=n_threads, **classify)
         return r, {"method": "exact (closed-form flow)", "error": 0.0, "stepper": "exact", "rtol": None}
     stepper, rtol, rtol2 = ("taylor", 1e-16, 1e-15) if stepper_applies(section, "taylor") else ("rk8pd", 1e-14, 1e-13)
-    r = section.return_map(theta, I, stepper=stepper, rtol=rtol, atol=rtol, n_threads=n_threads)
-    r2 = section.return_map(theta, I, stepper=stepper, rtol=rtol2, atol=rtol2, n_threads=n_threads)
+    r = section.return_map(theta, I, stepper=stepper, rtol=rtol, atol=rtol, n_threads=n_threads, **classify)
+    r2 = section.return_map(theta, I, stepper=stepper, rtol=rtol2, atol=rtol2, n_threads=n_threads, **classify)
     ok = (r.status == 0) & (r2.status == 0)
     est = float(np.max(_section_distance(r.theta[ok], r.I[ok], r2.theta[ok], r2.I[ok]), initial=0.0))
     return r, {
@@ -379,13 +381,27 @@ def _reverse(fm, theta, I, m: int, n_threads: int):
 
 
 def _flow(
-    section, tolerances, steppers, n_points, returns, repeat, seed, n_threads, progress, reversal=True, external=()
+    section,
+    tolerances,
+    steppers,
+    n_points,
+    returns,
+    repeat,
+    seed,
+    n_threads,
+    progress,
+    reversal=True,
+    external=(),
+    options=None,
 ):
-
+    # options: the event options of the map being chosen for (FlowMap's **options); every run
+    # measured uses them, so the cost and error measured are that map's.
+    options = dict(options or {})
+    classify = {k: options[k] for k in ("grazing_tol", "corner_tol") if k in options}
     rng = np.random.default_rng(seed)
     theta = rng.uniform(-np.pi, np.pi, n_points)
     I = _default_actions(section, n_points, rng)
-    ref, refinfo = _reference_run(section, theta, I, n_threads)
+    ref, refinfo = _reference_run(section, theta, I, n_threads, classify)
     keep = ref.status == 0  # points whose reference return is regular (no corner, graze, ...)
     theta, I = theta[keep], I[keep]
     ref_th, ref_I = ref.theta[keep], ref.I[keep]
@@ -399,6 +415,7 @@ def _flow(
             section.sys,
             section.h,
             coordinates="section",
+            **classify,
             **(
                 {"stepper": "exact"}
                 if refinfo["stepper"] == "exact"
@@ -413,7 +430,8 @@ def _flow(
     for st in steppers:
         for tol in tolerances:
             sec, r = _best_time(
-                lambda: section.return_map(theta, I, rtol=tol, atol=tol, stepper=st, n_threads=n_threads), repeat
+                lambda: section.return_map(theta, I, rtol=tol, atol=tol, stepper=st, n_threads=n_threads, **options),
+                repeat,
             )
             ok = r.status == 0
             # an error below the reference's own cannot be resolved: it is reported as that error
@@ -435,7 +453,7 @@ def _flow(
                 "steps": float(np.mean(r.steps)),
             }
             if long_ms:
-                fm = FlowMap(section.sys, section.h, coordinates="section", rtol=tol, atol=tol, stepper=st)
+                fm = FlowMap(section.sys, section.h, coordinates="section", rtol=tol, atol=tol, stepper=st, **options)
                 row["error_after"] = {1: err}
                 if reversal:
                     bt, bi, alive = _reverse(fm, r.theta, r.I, 1, n_threads)

@@ -25,6 +25,10 @@ __all__ = ["Section", "ReturnMapResult", "FlowStatus", "flow_options", "STEPPERS
 STEPPERS = tuple(_core_flow.STEPPERS)
 
 
+#: The flow's options besides the stepper and its tolerances (how events are located and judged,
+#: and the budgets): what FlowMap and an accuracy target take as ``**options``.
+EVENT_OPTIONS = ("event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol", "verify_steps")
+
 # flow_options' checks: each names its option and the allowed range.
 _OPTION_CHECKS = dict(
     rtol=lambda v: real_number("rtol", v, 1e-16, False, 1, True),

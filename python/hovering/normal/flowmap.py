@@ -22,7 +22,7 @@ from .._enums import Region, wrap
 from .._io.records import reduce_record
 from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar, stop_hook
-from ..flow.section import Section, _threads, flow_options
+from ..flow.section import EVENT_OPTIONS, Section, _threads, flow_options
 from ..flow.system import StepSystem, onset_parameters
 from ..interface import (
     MAX_TRAJECTORY_POINTS,
@@ -210,12 +210,9 @@ class FlowMap(MapAnalyses):
             raise ValueError(f"coordinates must be 'normal' or 'section', got {coordinates!r}")
         self.section = Section(sys, h)
         self.sys, self.h, self.coordinates = sys, self.section.h, coordinates
-        unknown = set(options) - {"event_tol", "max_steps", "max_impacts", "grazing_tol", "corner_tol", "verify_steps"}
+        unknown = set(options) - set(EVENT_OPTIONS)
         if unknown:
-            raise ValueError(
-                f"unknown option(s) {sorted(unknown)}; allowed: event_tol, max_steps, max_impacts, "
-                "grazing_tol, corner_tol, verify_steps"
-            )
+            raise ValueError(f"unknown option(s) {sorted(unknown)}; allowed: {', '.join(EVENT_OPTIONS)}")
         #: What an accuracy target chose (:func:`hovering.diagnostics.accurate_flow_map` sets it;
         #: None without one): the row of the measurement.
         self.accuracy_choice = None
