@@ -277,7 +277,13 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
         auto wall = [&](int gi, double off, Ev cross, Ev graze) {
             const int pi = gi + 1;
             const double g0 = y0[gi] - off, g1 = y[gi] - off;
-            if (g0 > 0 && g1 <= 0) {  // crossing toward the wall
+            // q turns inside the step (a minimum): g may have two roots on it, in and out again.
+            // That case is settled by the minimum below, whatever the sign of g at the end: a
+            // step that ends on the wall's line on the way out (g1 = 0 to rounding, which fixed
+            // steps of a linear flow meet every period T = 8 hmax after an impact) would
+            // otherwise bracket both roots and locate the outgoing one as an impact.
+            const bool turns = y0[pi] < 0 && y[pi] > 0;
+            if (g0 > 0 && g1 <= 0 && !turns) {  // crossing toward the wall
                 if (wall_absent(gi)) {
                     if (gi == 0) note_crossing();  // q1 = qw1 crossed above the step
                     return;
@@ -287,10 +293,11 @@ bool Tracer::step(const std::atomic<bool>* cancel) {
                 ++work_.wall_searches;
                 c.tau = locate(in_, y0, d0, y, d1, gi, off, h, opt.event_tol, c.y);
                 cands_.push_back(c);
-            } else if (g0 > 0 && g1 > 0 && y0[pi] < 0 && y[pi] > 0) {
+            } else if (g0 > 0 && turns) {
                 // Turning inside the step: the minimum of g (p = 0) may dip through the wall even
-                // though g > 0 at both ends (a near-grazing impact a sign test would miss).
-                if (stays_above(gi, off + opt.grazing_tol) || (gi == 2 && wall_absent(2))) return;
+                // though g > 0 at both ends (a near-grazing impact a sign test would miss); with
+                // g <= 0 at the end the first root, before the minimum, is the impact.
+                if ((g1 > 0 && stays_above(gi, off + opt.grazing_tol)) || (gi == 2 && wall_absent(2))) return;
                 double ym[kMaxDim], dm[kMaxDim];
                 ++work_.wall_searches;
                 const double tm = locate(in_, y0, d0, y, d1, pi, 0.0, h, opt.event_tol, ym);
