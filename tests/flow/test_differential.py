@@ -174,7 +174,8 @@ def test_the_oracle_gives_up_within_its_budget_of_evaluations():
     # An orbit whose steps shrink without bound (toward a Tan well's edge, off along a coupling
     # unbounded below) once ran the oracle for more than 15 minutes and GBs under HOVERING_FUZZ=40.
     # It now stops with "limit" (no verdict) once its budget is spent: checked here with a budget
-    # below what an ordinary return needs (3,900-6,000 evaluations; the default is 1e6).
+    # below what an ordinary return needs (3,900-6,000 evaluations; the default is 1e7, and 2e5
+    # per chunk of about a period).
     R = scipy_flow.harmonic(1.0)
     sec = hv.Section(
         hv.StepSystem(V1=hv.Harmonic(1.0), V2=hv.Harmonic(1.0), coupling=hv.Bilinear(), eps=0.05, geometry="wall"), 1.0

@@ -65,8 +65,11 @@ N_SAMPLE = 32  # samples per accepted step
 MAX_IMPACTS = 10000
 
 
+CHUNK_EVALUATIONS = 200_000  # right-hand-side evaluations one chunk may spend (reference_return)
+
+
 class _OutOfBudget(Exception):
-    """Raised by the right-hand side once ``max_evaluations`` is spent."""
+    """Raised by the right-hand side once ``max_evaluations`` (or a chunk's share) is spent."""
 
 
 def harmonic(omega):
@@ -180,7 +183,7 @@ def reference_return(
     corner_tol=1e-9,
     grazing_tol=1e-12,
     step_fraction=128,
-    max_evaluations=1_000_000,
+    max_evaluations=10_000_000,
 ):
     """One return to Sigma_h = {p1 = 0, dp1/dt < 0} from ``z0``, by DOP853 with robust event search.
 
@@ -211,8 +214,10 @@ def reference_return(
         Budget of right-hand-side evaluations; once spent the status is "limit".  An orbit that
         runs toward a Tan well's edge or off along a coupling unbounded below shrinks the steps
         without bound: unbounded, one such start ran for more than 15 minutes and took GBs of
-        dense output.  1e6 evaluations (~20 s; a dense output of at most ~85k steps, ~90 MB of
-        samples) is ~200x what an ordinary return needs (measured: 3,900-6,000 at step_fraction 64).
+        dense output.  1e7 evaluations is ~3 minutes: an ordinary return takes 3,900-6,000 at
+        step_fraction 64, a long chaotic one (t = 54, 128) 1.1e6.  One chunk (about a local
+        period) may spend at most ``CHUNK_EVALUATIONS`` of them, which bounds the dense output
+        held at once (~17k steps, ~20 MB of samples; an ordinary chunk takes ~1,500).
 
     Returns
     -------
@@ -233,11 +238,12 @@ def reference_return(
     def force(q1, q2):
         return (-_pot(V1, q1, 1) - eps * _vc(terms, q1, q2, 1, 0), -_pot(V2, q2, 1) - eps * _vc(terms, q1, q2, 0, 1))
 
-    spent = [0]
+    spent = [0, 0]  # in all, in this chunk
 
     def rhs(t, y):
         spent[0] += 1
-        if spent[0] > max_evaluations:
+        spent[1] += 1
+        if spent[0] > max_evaluations or spent[1] > CHUNK_EVALUATIONS:
             raise _OutOfBudget
         f1, f2 = force(y[0], y[2])
         return np.array([y[1], f1, y[3], f2])
@@ -302,6 +308,7 @@ def reference_return(
         # --- integrate one chunk, refining max_step until every step obeys the cap rule
         while True:
             t_end = min(t + step_fraction * cap, t_max * (1 + 1e-12) + 1e-12)
+            spent[1] = 0
             try:
                 sol = solve_ivp(
                     rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, dense_output=True, max_step=cap
