@@ -229,3 +229,26 @@ def test_the_impact_zones_island_chains_from_a_barrier_scan():
     assert any(np.isin(o.regions, [hv.Region.UPPER, hv.Region.RIGHT]).any() for o in found.orbits)
     with pytest.raises(ValueError, match="orbits must be an IterateResult"):
         hv.dynamics.island_centres(tm, "scan")
+
+
+def test_a_nearly_parabolic_start_is_not_called_converged():
+    # An adversarial pass: near a nearly parabolic fixed point of the flow's map (R ~ -1.4e-7,
+    # Newton's matrix M - I nearly singular) the damped correction let the residual grow
+    # 4.79e-6 -> 4.99e-6 -> 5.19e-6, and "two iterations without halving it, within 1e3 tol"
+    # called that the rounding floor: "converged", 520x tol, where the flow's floor at rtol 1e-11
+    # is ~1e-10. A floor now needs Newton's correction as small as the residual (here it is
+    # large); a converged orbit closes to within 1e3 tol under the map itself.
+    s = hv.StepSystem(
+        hv.Harmonic(0.2883501599780604),
+        hv.Tan(0.3904664669129242, 0.3437536550974594),
+        hv.Polynomial({(1, 3): 0.55, (0, 3): 1.151}),
+        eps=-0.0007,
+        qw1=-3.338674907363699,
+        qw2=-2.6224194265302465,
+        geometry="step",
+    )
+    fm = hv.FlowMap(s, 2.788777826091436, rtol=1e-11)
+    po = hv.periodic_orbit(fm, 1.32246813, 0.23130818, 1)
+    x1 = fm.step(float(po.phi[0]), float(po.K[0]))
+    gap = max(abs(float(hv.wrap(x1[0] - po.phi[0]))), abs(x1[1] - po.K[0]))
+    assert po.status != "converged" and gap > 100 * po.tol, (po.status, gap, po.residuals)

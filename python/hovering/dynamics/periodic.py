@@ -52,8 +52,10 @@ class PeriodicOrbit(Summarized, Saveable):
         Its period n (F^n(x) = x; the smallest period may divide n).
     status : str
         ``"converged"`` (residual below ``tol``, or stalled within 1e3 ``tol`` at the rounding
-        floor of a long hyperbolic orbit: see ``residuals``), ``"max_iterations"``, ``"singular"`` (Newton's
-        matrix could not be solved: a parabolic orbit, multiplier 1), ``"no_root"`` (the symmetric
+        floor of a long hyperbolic orbit, where Newton's correction is as small: see
+        ``residuals``), ``"max_iterations"`` (also where Newton's correction stays far above the
+        residual: a nearly parabolic orbit, multiplier ~1), ``"singular"`` (Newton's matrix could
+        not be solved: a parabolic orbit, multiplier 1), ``"no_root"`` (the symmetric
         search found no sign change), or ``"step_failed"`` (a step of the orbit has no number:
         see ``step_status``).
     step_status : Status
@@ -238,7 +240,15 @@ def _newton(m, phi, K, period, tol, max_iter, segment, n_threads):
             return phi, K, "singular", Status.OK, res, it
         if not np.all(np.isfinite(dx)) or np.linalg.cond(A) > 1e15:
             return phi, K, "singular", Status.OK, res, it
-        # Damped: halve the step until the residual decreases (or 10 halvings).
+        # The rounding floor: where the residual is noise (a long hyperbolic orbit's stretch times
+        # the rounding of a step: 1e-11 at period 233 of the standard map at k = 1), Newton's
+        # correction is as small as the residual itself. A correction far above it is no floor but
+        # a Newton step that cannot make progress: near a parabolic orbit (multiplier ~ 1) the
+        # matrix is nearly singular, the correction huge, and the residual grows along it.
+        at_floor = res[-1] <= 1e3 * tol and float(np.max(np.abs(dx))) <= 1e3 * tol
+        # Damped: halve the step until the residual decreases, or take the 10th halving anyway
+        # (far from the orbit that is how the search moves on: a start 1.9 off the period-5 orbit
+        # of the README's truncated map needs it); only the floor above may end the search early.
         lam = 1.0
         for _ in range(11):
             p1 = wrap(phi + lam * dx[0::2])
@@ -253,10 +263,8 @@ def _newton(m, phi, K, period, tol, max_iter, segment, n_threads):
             return phi, K, "step_failed", _first_bad(seg1.status), res, it
         phi, K, seg, r = p1, k1, seg1, r1
         res.append(float(np.max(np.abs(r))))
-        # The rounding floor: a long hyperbolic orbit's residual stalls where its stretch times
-        # the rounding of a step lies (1e-11 at period 233 of the standard map at k = 1). Two
-        # iterations that did not halve it, within 1e3 tol: that floor, the orbit as good as it gets.
-        if len(res) >= 3 and res[-1] <= 1e3 * tol and res[-1] > 0.5 * res[-3]:
+        # Two iterations that did not halve the residual, at the floor: the orbit as good as it gets.
+        if len(res) >= 3 and at_floor and res[-1] > 0.5 * res[-3]:
             return phi, K, "converged", Status.OK, res, it
     status = "converged" if res[-1] <= tol else "max_iterations"
     return phi, K, status, Status.OK, res, it
