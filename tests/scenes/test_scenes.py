@@ -173,6 +173,9 @@ BAD = [
     # Checked at load, not at savefig after the simulation (issue 11):
     ("fig_hov_vs_eps", ("series", 0, "color"), "C99x", ["series[0].color", "'C99x'", "not a matplotlib colour"]),
     ("fig_epsbig", ("panels", 1, "orbits", 0, "color"), "bluish", ["orbits[0].color", "'bluish'"]),
+    # Text the figure draws: its math parses at load (a bad title once failed after 89 s of work)
+    ("fig_hov_vs_eps", ("title",), "$\\frac{1}{$ of eps", ["title", "does not parse", "mathtext"]),
+    ("fig_epsbig", ("panels", 1, "orbits", 0, "label"), "island $x^$", ["orbits[0].label", "does not parse"]),
     ("fig_smalleps", ("output",), "out/fig.xyz", ["output", "'.xyz'", ".png", ".pdf"]),
     ("fig_smalleps", ("output",), str(SCENE_DIR / "fig_smalleps.toml" / "x.png"), ["output", "is not a directory"]),
     ("fig_smalleps", ("panels",), [{"id": f"p{i}"} for i in range(37)], ["panels", "37 panels", "at most 36"]),
@@ -495,3 +498,12 @@ def test_portrait_coloured_by_region(tmp_path):
         plt.close(s["figure"])
     o = scenes.load_result(tmp_path / "r.npz").panel("a").orbits
     assert o.phi.shape == (6, 101) and o.region.shape == (6, 100)
+
+
+def test_drawn_text_takes_mathtext_that_parses_and_a_literal_dollar():
+    # The other side of the check above: matplotlib's own mathtext decides (what it parses here
+    # it draws), and text with a lone (or escaped) dollar is plain text to it.
+    for title in ("$|HOV|$ against $\\varepsilon$", "costs $5", "price \\$3 and \\$4"):
+        d = _raw("fig_hov_vs_eps")
+        d["title"] = title
+        assert parse_scene(d, SCENE_DIR / "fig_hov_vs_eps.toml").title == title

@@ -124,7 +124,7 @@ class SceneSpec:
     path: Path | None = None
     name: str = "scene"
     kind: str = custom(read=_read_kind, allowed="a registered kind")
-    title: str = text(default_from="name")
+    title: str = text(default_from="name", drawn=True)
     output: Path = custom(read=_read_output, write=lambda p, kind: str(p), allowed="a .png, .pdf, .svg, ... path")
     dpi: int = integer(130, lo=30, hi=1200)
     figsize: tuple | None = size()

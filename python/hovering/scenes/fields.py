@@ -290,7 +290,7 @@ def choice(default=MISSING, choices=(), **opts):
     return _field(default, Param(read, ", ".join(repr(c) for c in choices), **_required(default, opts)))
 
 
-def text(default=MISSING, *, limit: int = v.MAX_TEXT, **opts):
+def text(default=MISSING, *, limit: int = v.MAX_TEXT, drawn: bool = False, **opts):
     """A non-empty string of at most ``limit`` characters.
 
     Parameters
@@ -299,6 +299,9 @@ def text(default=MISSING, *, limit: int = v.MAX_TEXT, **opts):
         The field's default.
     limit : int, optional
         Longest string.
+    drawn : bool, optional
+        The figure shows it (a title, a label): its ``$...$`` math must parse
+        (:func:`~hovering.scenes.values.drawn_text`).
     **opts
         Further :class:`Param` attributes.
 
@@ -308,9 +311,10 @@ def text(default=MISSING, *, limit: int = v.MAX_TEXT, **opts):
     """
 
     def read(where, value, reading):
-        return v.text(where, value, limit=limit)
+        return v.drawn_text(where, value, limit=limit) if drawn else v.text(where, value, limit=limit)
 
-    return _field(default, Param(read, f"a string of at most {limit} characters", **_required(default, opts)))
+    allowed = f"a string of at most {limit} characters" + (" (math between $ signs must parse)" if drawn else "")
+    return _field(default, Param(read, allowed, **_required(default, opts)))
 
 
 def color(default=None, **opts):

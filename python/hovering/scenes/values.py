@@ -274,6 +274,44 @@ def text(where: str, value, choices=None, limit: int = MAX_TEXT) -> str:
     return value
 
 
+def drawn_text(where: str, value, limit: int = MAX_TEXT) -> str:
+    """:func:`text` that matplotlib can draw: its ``$...$`` math parses (checked when the scene is
+    read, not when the figure is drawn after the whole computation).
+
+    Parameters
+    ----------
+    where : str
+        The key, for the message.
+    value : object
+        What the file holds there.
+    limit : int, optional
+        Longest string (default :data:`MAX_TEXT`).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ValueError
+        Naming the key, the value and why matplotlib's mathtext refuses it.
+    """
+    from matplotlib import cbook
+    from matplotlib.mathtext import MathTextParser
+
+    s = text(where, value, limit=limit)
+    if cbook.is_math_text(s):  # an even number of unescaped $: matplotlib parses it as math
+        try:
+            MathTextParser("path").parse(s)
+        except ValueError as e:
+            why = next((line.strip() for line in reversed(str(e).splitlines()) if line.strip()), "")
+            raise ValueError(
+                f"{where} = {value!r}: its math ($...$) does not parse in matplotlib's mathtext ({why}); "
+                "allowed: plain text, or mathtext between $ signs (a literal dollar as \\$)"
+            ) from None
+    return s
+
+
 def color(where: str, value) -> str:
     """A colour matplotlib understands, checked when the scene is read (not at savefig time).
 

@@ -58,7 +58,7 @@ class SeriesSpec:
         the band floor to measure HOV by its definition over the whole band.
     """
 
-    label: str = text()
+    label: str = text(drawn=True)
     Omega0: float | None = map_key("Omega0")
     theta_w: float | None = map_key("theta_w")
     tau0: float = map_key("tau0")

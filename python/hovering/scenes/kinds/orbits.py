@@ -82,7 +82,7 @@ class OrbitSpec:
         Matplotlib colour (default: the next of C5, C6, ...).
     """
 
-    label: str = text()
+    label: str = text(drawn=True)
     K0: float = real()
     phi0: float | None = real(None)
     line: str | None = choice(None, ("L1", "L2"), check=_start)
