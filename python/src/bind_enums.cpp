@@ -34,18 +34,11 @@ void register_enums(py::module_& m) {
         .value("STOPPED", Status::Stopped, "the orbit reached the set of its stop condition (hovering.Above / Below)")
         .value("IMPRECISE", Status::Imprecise, "flow: a return's verified error stayed above its band (FlowOptions.verify_steps)")
         .finalize();
-    py::native_enum<FlowStatus>(m, "FlowStatus", "enum.IntEnum", "Outcome of one return of the flow.")
-        .value("OK", FlowStatus::Ok, "returned to Sigma_h")
-        .value("CORNER", FlowStatus::Corner, "hit the corner of the step (the orbit stops)")
-        .value("GRAZING", FlowStatus::Grazing, "touched a wall tangentially")
-        .value("STEP_LIMIT", FlowStatus::StepLimit, "max_steps reached before returning")
-        .value("NON_FINITE", FlowStatus::NonFinite, "the state became non-finite")
-        .value("IMPACT_LIMIT", FlowStatus::ImpactLimit, "more impacts than max_impacts in one return (chattering)")
-        .value("OFF_SECTION", FlowStatus::OffSection, "the starting point is not on Sigma_h at this energy")
-        .value("INTERRUPTED", FlowStatus::Interrupted, "the batch was interrupted before this return ended")
-        .value("OUTSIDE_WELL", FlowStatus::OutsideWell, "no accepted step keeps the state inside a bounded well")
-        .value("IMPRECISE", FlowStatus::Imprecise, "a verified return's error stayed above its band at rtol / 10^4")
-        .finalize();
+    {
+        py::native_enum<FlowStatus> e(m, "FlowStatus", "enum.IntEnum", "Outcome of one return of the flow.");
+        for (const FlowStatusInfo& f : kFlowStatuses) e.value(f.name, f.status, f.doc);  // the core's one list
+        e.finalize();
+    }
     py::native_enum<TrajectoryPoint>(m, "TrajectoryPoint", "enum.IntEnum", "What a recorded trajectory point is.")
         .value("SAMPLE", TrajectoryPoint::Sample, "uniform sample at t = k dt of the orbit's clock")
         .value("IMPACT_IN", TrajectoryPoint::ImpactIn, "state at an impact before the reflection (on the wall)")

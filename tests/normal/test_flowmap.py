@@ -246,6 +246,18 @@ def test_tangential_curve_says_when_it_is_not_a_graph():
     assert np.isnan(fs.step(0.1, 0.3)[1])
 
 
+def test_a_curve_that_cannot_be_traced_names_the_status_and_the_energy():
+    # h = 1e6 (an adversarial pass): the tangential curve's first trace back ends IMPRECISE; the
+    # message said "(integration status 9)". It names the status as hovering.FlowStatus does, what
+    # that means, the energy and the tolerance of the trace.
+    sys = hv.StepSystem(hv.Harmonic(1.0), hv.Tan(1.4, 0.7), hv.Bilinear(), eps=0.05)
+    with pytest.raises(ValueError) as e:
+        hv.FlowMap(sys, 1e6)
+    msg = str(e.value)
+    assert "h = 1e+06" in msg and "rtol = " in msg, msg
+    assert f"ended {FlowStatus.IMPRECISE.name} ({FlowStatus.IMPRECISE.__doc__})" in msg, msg
+
+
 def test_truncated_model_of_the_system_needs_no_hand_scaling(fm005):
     # fm.truncated(): onset-parameter arcs and the measured forcing. Its first sine coefficient is
     # b1 = 0.564 here: passing eps instead of eps b1 to TruncatedMap would overstate the forcing.

@@ -39,6 +39,19 @@ enum class FlowStatus : std::int8_t {
 /// The orbit outcome (Status) of a return that ended with this FlowStatus.
 Status orbit_status(FlowStatus s);
 
+/// A FlowStatus's name (as hovering.FlowStatus spells it) and meaning.
+struct FlowStatusInfo {
+    FlowStatus status;  ///< the code
+    const char* name;   ///< e.g. "IMPRECISE"
+    const char* doc;    ///< what it means, one line
+};
+
+/// Every FlowStatus in code order: the one list the bindings and the core's messages read.
+extern const std::array<FlowStatusInfo, 10> kFlowStatuses;
+
+/// "NAME (meaning)" of a FlowStatus, for messages.
+std::string describe(FlowStatus s);
+
 /// The integrator of a return, parsed once from its name (parse_stepper) where a name enters the
 /// core (the bindings, the plan reader) and compared as this enum everywhere else.
 enum class Stepper : std::int8_t {

@@ -15,6 +15,25 @@ namespace hovering {
 using detail::bad;
 using detail::kNaN;
 
+const std::array<FlowStatusInfo, 10> kFlowStatuses = {{
+    {FlowStatus::Ok, "OK", "returned to Sigma_h"},
+    {FlowStatus::Corner, "CORNER", "hit the corner of the step (the orbit stops)"},
+    {FlowStatus::Grazing, "GRAZING", "touched a wall tangentially"},
+    {FlowStatus::StepLimit, "STEP_LIMIT", "max_steps reached before returning"},
+    {FlowStatus::NonFinite, "NON_FINITE", "the state became non-finite"},
+    {FlowStatus::ImpactLimit, "IMPACT_LIMIT", "more impacts than max_impacts in one return (chattering)"},
+    {FlowStatus::OffSection, "OFF_SECTION", "the starting point is not on Sigma_h at this energy"},
+    {FlowStatus::Interrupted, "INTERRUPTED", "the batch was interrupted before this return ended"},
+    {FlowStatus::OutsideWell, "OUTSIDE_WELL", "no accepted step keeps the state inside a bounded well"},
+    {FlowStatus::Imprecise, "IMPRECISE", "a verified return's error stayed above its band at rtol / 10^4"},
+}};
+
+std::string describe(FlowStatus s) {
+    const auto i = std::size_t(s);
+    if (i >= kFlowStatuses.size()) return "status " + std::to_string(int(s));
+    return std::string(kFlowStatuses[i].name) + " (" + kFlowStatuses[i].doc + ")";
+}
+
 Status orbit_status(FlowStatus s) {
     switch (s) {
         case FlowStatus::Ok:

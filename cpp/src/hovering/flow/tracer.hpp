@@ -114,6 +114,8 @@ public:
     FlowWork work() const;
     /// The system traced.
     const FlowSystem& system() const { return s_; }
+    /// The options it traces with (resolved: the stepper named, the default atol applied).
+    const FlowOptions& options() const { return o_; }
 
 private:
     enum class Ev { Section, Right, Upper, GrazeRight, GrazeUpper };

@@ -132,8 +132,8 @@ std::pair<double, double> trace_back(detail::Tracer& tr, double h, double s, dou
             ") that Sigma_h's chart does not hold (q1 <= 0, H2 > h, or another root of H = h): the coupling (eps = " +
             fmt(sys.eps) + ") is too strong here");
     if (r.status != FlowStatus::Ok)
-        bad("the tangential curve could not be traced back from wall angle " + fmt(s) + " (integration status " +
-            std::to_string(int(r.status)) + ")");
+        bad("the tangential curve could not be traced back from wall angle " + fmt(s) + " at h = " + fmt(h) +
+            ": the return, traced at rtol = " + fmt(tr.options().rtol) + ", ended " + describe(r.status));
     const double q2 = r.z[2], p2 = -r.z[3];
     const double e2 = 0.5 * p2 * p2 + sys.V2->V(q2);
     return {wrap(sys.V2->angle_on_level(q2, p2, e2)), sys.V2->action(e2)};
