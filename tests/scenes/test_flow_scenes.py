@@ -69,6 +69,16 @@ def test_every_flow_scene_file_loads_and_names_its_effects():
     assert tori.outputs.record == ("trajectory",)
 
 
+def test_flow_portrait_starts_outside_the_band_name_k0_range(tmp_path):
+    # The band is the flow map's, known once it is built (a second): the refusal then names the
+    # scene's key, where it named only K (an adversarial pass gave K0_range = [-1e300, 1e300]).
+    d = _small("flow_portrait")
+    d.update(n_orbits=3, n_steps=50, K0_range=[-1e300, 1e300])
+    with pytest.raises(ValueError, match=r"K0_range = \[-1e\+300, 1e\+300\]: K = -1e\+300 .*allowed"):
+        run_scene(parse_scene(d, "p.toml"), out=tmp_path / "p.png", quick=True)
+    assert not (tmp_path / "p.png").exists()
+
+
 @pytest.mark.e2e
 @pytest.mark.parametrize("name", FLOW_FILES)
 def test_redraw_gives_the_same_figure_without_computing(runs, name, tmp_path, monkeypatch):

@@ -323,6 +323,10 @@ def refuse_foreign(paths, force: bool = False) -> None:
             )
 
 
+#: Longest file or directory name, in bytes (NAME_MAX of Linux's and macOS's file systems).
+_NAME_MAX = 255
+
+
 def output_path(where: str, path, within=None) -> os.PathLike:
     """A figure path checked before any computation: its format is one matplotlib writes and its
     directory exists (or can be created) and is writable.
@@ -360,6 +364,14 @@ def output_path(where: str, path, within=None) -> os.PathLike:
                 f"(.png, .pdf, .svg, ...)"
             )
         p = p.with_suffix(".png")
+    # Each name in the path at most NAME_MAX bytes (255 on Linux and macOS file systems): else
+    # the first open says "[Errno 36] File name too long", naming no key.
+    for part in p.parts:
+        if len(os.fsencode(part)) > _NAME_MAX:
+            raise ValueError(
+                f"{where}: the name {part[:40]!r}... is {len(os.fsencode(part))} bytes long; allowed: at most "
+                f"{_NAME_MAX} bytes per file or directory name"
+            )
     if within is not None:
         real = p.resolve()
         bases = list(dict.fromkeys(Path(b).resolve() for b in within))

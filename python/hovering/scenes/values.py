@@ -158,9 +158,17 @@ def real(where: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> f
             raise ValueError(f"{where}: expression of {len(value)} characters; allowed: at most {_MAX_EXPR}")
         try:
             v = float(evaluate(ast.parse(value, mode="eval")))
-        except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError, RecursionError, MemoryError):
+        except (SyntaxError, ValueError, ZeroDivisionError, OverflowError, TypeError, RecursionError, MemoryError) as e:
+            # why, in a few words: "division by zero", "math domain error", a number too large, ...
+            why = {
+                SyntaxError: "not an expression",
+                ZeroDivisionError: "division by zero",
+                OverflowError: "a number too large for a double",
+                RecursionError: "nested too deeply",
+                MemoryError: "nested too deeply",
+            }.get(type(e), str(e) or type(e).__name__)
             raise ValueError(
-                f"{where}: cannot evaluate {value!r}; allowed: a number or an expression of numbers, "
+                f"{where}: cannot evaluate {value!r} ({why}); allowed: a number or an expression of numbers, "
                 f"pi, OMEGA_G, + - * / ** and sqrt, sin, cos, acos"
             ) from None
     elif isinstance(value, (int, float)):

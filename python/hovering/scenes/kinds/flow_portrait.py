@@ -106,7 +106,10 @@ def compute(scene: FlowPortraitScene, ctx) -> FlowPortraitResult:
     tm = fm.truncated(forcing=scene.model)
     stages.end()
     K0 = np.linspace(scene.K0_range[0], scene.K0_range[1], scene.n_orbits)
-    phi0 = np.asarray(fm.L1(K0), dtype=float)
+    try:  # the band is the flow map's (known once it is built): name the scene's key in the refusal
+        phi0 = np.asarray(fm.L1(K0), dtype=float)
+    except ValueError as e:
+        raise ValueError(f"K0_range = {list(scene.K0_range)}: {e}") from None
     regions = "regions" in scene.outputs.record
     record = ("orbit", "regions") if regions else ("orbit",)
     labels = [f"K0={k:.4g}" for k in K0]
