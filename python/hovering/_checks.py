@@ -32,6 +32,9 @@ __all__ = [
     "require_angles",
     "physical_memory",
     "check_memory",
+    "loaded_array",
+    "loaded_range",
+    "loaded_codes",
 ]
 
 #: Largest |angle| that can be wrapped to [-pi, pi) accurately (2 pi floor(x / 2 pi) loses a turn
@@ -353,6 +356,86 @@ def check_memory(what: str, nbytes: int) -> None:
             f"{what} needs {nbytes / 2**30:.3g} GiB, more than half of this machine's "
             f"{total / 2**30:.3g} GiB: record less, or fewer orbits or steps per call"
         )
+
+
+# ------------------------------------------------------------------------------------------------
+# Arrays read from a file (untrusted): a result's ``_validate_loaded`` checks each against what the
+# computation that makes it could return, before anything uses it.
+
+_KIND_NAMES = {"b": "booleans", "i": "integers", "u": "integers", "f": "floats"}
+
+
+def loaded_array(name: str, a, kinds: str, shape: tuple) -> np.ndarray:
+    """``a`` if it is an array of ``shape`` whose dtype is of ``kinds``, else a ValueError naming it.
+
+    Parameters
+    ----------
+    name : str
+        The field, for the message.
+    a : object
+        The field's value.
+    kinds : str
+        Allowed numpy dtype kinds (``"f"``: floats, ``"iu"``: integers, ``"b"``: bools).
+    shape : tuple
+        Its shape; an entry None matches any length.
+
+    Returns
+    -------
+    ndarray
+
+    Raises
+    ------
+    ValueError
+        Naming the field, the shape and dtype required and those it has.
+    """
+    if (
+        not isinstance(a, np.ndarray)
+        or a.dtype.kind not in kinds
+        or a.ndim != len(shape)
+        or any(want is not None and got != want for got, want in zip(a.shape, shape))
+    ):
+        what = " or ".join(dict.fromkeys(_KIND_NAMES[k] for k in kinds))
+        want = "(" + ", ".join("any" if d is None else str(d) for d in shape) + ("," if len(shape) == 1 else "") + ")"
+        got = f"shape {a.shape}, dtype {a.dtype}" if isinstance(a, np.ndarray) else _short(a)
+        raise ValueError(f"{name} must be an array of {what} of shape {want}, got {got}")
+    return a
+
+
+def loaded_range(name: str, a: np.ndarray, lo: int, hi: int) -> None:
+    """Raise a ValueError naming the first entry of the integer array ``a`` outside ``[lo, hi]``.
+
+    Parameters
+    ----------
+    name : str
+        The field, for the message.
+    a : ndarray
+        Integers (checked by :func:`loaded_array`).
+    lo, hi : int
+        The allowed range.
+    """
+    if a.size and not (lo <= a.min() and a.max() <= hi):
+        i = np.unravel_index(int(np.argmax((a < lo) | (a > hi))), a.shape)
+        raise ValueError(f"{_entry(name, i)} = {a[i]} is out of range; allowed: [{lo}, {hi}]")
+
+
+def loaded_codes(name: str, a: np.ndarray, enum) -> None:
+    """Raise a ValueError naming the first entry of the integer array ``a`` that is no code of ``enum``.
+
+    Parameters
+    ----------
+    name : str
+        The field, for the message.
+    a : ndarray
+        Integers (checked by :func:`loaded_array`).
+    enum : enum.IntEnum
+        The codes' enum (:class:`hovering.Status`, :class:`hovering.Region`, ...): its members are
+        the allowed values.
+    """
+    bad = ~np.isin(a, [int(m) for m in enum])
+    if bad.any():
+        i = np.unravel_index(int(np.argmax(bad)), a.shape)
+        allowed = ", ".join(f"{m.name} ({int(m)})" for m in enum)
+        raise ValueError(f"{_entry(name, i)} = {a[i]} is not a {enum.__name__}; allowed: {allowed}")
 
 
 def _entry(name: str, index: tuple) -> str:

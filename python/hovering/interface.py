@@ -13,10 +13,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from ._checks import _short, check_memory, integer, is_choice, real_number
+from ._checks import _short, check_memory, integer, is_choice, loaded_array, loaded_codes, loaded_range, real_number
 from ._deprecated import moved_method
 from ._display import Summarized, status_counts
-from ._enums import Region, Status, region_mask, status_code
+from ._enums import Region, Status, TrajectoryPoint, region_mask, status_code
 from ._io.serial import Saveable
 from .curve import StopCondition
 
@@ -32,7 +32,15 @@ __all__ = [
     "trajectory_rows",
     "require_map",
     "MAX_TRAJECTORY_POINTS",
+    "MAX_STEPS",
+    "N_REGIONS",
 ]
+
+#: Most steps per orbit, and the largest recording stride, an ``iterate`` call takes.
+MAX_STEPS = 2**53
+#: Regions a return is taken from (every :class:`Region` but NONE): the columns of ``residence``,
+#: the bits of ``visited``.
+N_REGIONS = sum(1 for r in Region if r.value >= 0)
 
 
 @runtime_checkable
@@ -302,6 +310,87 @@ class IterateResult(Summarized, Saveable):
             raise exc
         return res
 
+    def _validate_loaded(self) -> None:
+        """A file's result (untrusted): what ``iterate`` could have returned, or a ValueError naming
+        the field.
+
+        ``n_steps`` and ``every`` as ``iterate`` takes them; each record an array of its dtype kind
+        and of the shape ``n_orbits``, ``n_steps`` and ``every`` give it (:func:`recorded_counts`);
+        codes members of their enums (:class:`Status`, :class:`Region`, :class:`TrajectoryPoint`);
+        step counts within ``[0, n_steps]``; the map a map (or None).
+        """
+        n_steps = integer("n_steps", self.n_steps, 0, MAX_STEPS)
+        every = integer("every", self.every, 1, MAX_STEPS)
+        if self.map is not None:
+            require_map("map", self.map)
+        n = loaded_array("status", self.status, "iu", (None,)).shape[0]
+        states, returns = recorded_counts(n_steps, every)
+        layout = {  # field: (dtype kinds, shape)
+            "phi_final": ("f", (n,)),
+            "K_final": ("f", (n,)),
+            "steps_done": ("iu", (n,)),
+            **dict.fromkeys(("phi", "K", "theta", "I"), ("f", (n, states))),
+            "z": ("f", (n, states, 4)),
+            "region": ("iu", (n, returns)),
+            **dict.fromkeys(("time", "energy_error"), ("f", (n, returns))),
+            "integrator_steps": ("iu", (n, returns)),
+            **dict.fromkeys(("rotation", "K_min", "K_max", "jacobian_r12"), ("f", (n,))),
+            **dict.fromkeys(("exit_step", "stop_step", "visited", "jacobian_status"), ("iu", (n,))),
+            "residence": ("iu", (n, N_REGIONS)),
+            "jacobian_q": ("f", (n, 2, 2)),
+            "jacobian_log": ("f", (n, 2)),
+            "trajectory": ("f", (None, 5)),
+            "trajectory_index": ("iu", (n + 1,)),
+            "trajectory_kind": ("iu", (None,)),
+            "trajectory_truncated": ("b", (n,)),
+        }
+        for name, (kinds, shape) in layout.items():
+            a = getattr(self, name)
+            if a is not None or name in ("phi_final", "K_final", "steps_done"):  # every result has these
+                loaded_array(name, a, kinds, shape)
+        # Recorded together, used together (jacobian(), trajectory_of()): all of a group or none.
+        for group in (
+            ("jacobian_q", "jacobian_log", "jacobian_r12", "jacobian_status"),
+            ("trajectory", "trajectory_index", "trajectory_kind", "trajectory_truncated"),
+        ):
+            given = [g for g in group if getattr(self, g) is not None]
+            if given and len(given) != len(group):
+                raise ValueError(f"{', '.join(group)} are recorded together; the file has only {', '.join(given)}")
+        loaded_codes("status", self.status, Status)
+        loaded_range("steps_done", self.steps_done, 0, n_steps)
+        for name, enum in (("jacobian_status", Status), ("region", Region), ("trajectory_kind", TrajectoryPoint)):
+            if getattr(self, name) is not None:
+                loaded_codes(name, getattr(self, name), enum)
+        for name, lo, hi in (
+            ("exit_step", -1, n_steps),
+            ("stop_step", -1, n_steps),
+            ("integrator_steps", -1, MAX_STEPS),
+            ("visited", 0, 2**N_REGIONS - 1),
+            ("residence", 0, n_steps + 1),  # steps_done returns, and the exiting one
+        ):
+            if getattr(self, name) is not None:
+                loaded_range(name, getattr(self, name), lo, hi)
+        if self.trajectory is not None:
+            rows = self.trajectory.shape[0]
+            loaded_array("trajectory_kind", self.trajectory_kind, "iu", (rows,))  # a kind per row
+            index = self.trajectory_index
+            if index[0] != 0 or index[-1] != rows or np.any(index[1:] < index[:-1]):
+                raise ValueError(
+                    f"trajectory_index must rise from 0 to the {rows} rows of trajectory, got "
+                    f"{int(index[0])}..{int(index[-1])}{'' if np.all(index[1:] >= index[:-1]) else ', not rising'}"
+                )
+        if self.itinerary is not None and (
+            len(self.itinerary) != n
+            or not all(
+                isinstance(row, (list, tuple)) and len(row) == returns and all(isinstance(x, str) for x in row)
+                for row in self.itinerary
+            )
+        ):
+            raise ValueError(f"itinerary must be {n} lists (one per orbit) of {returns} strings (one per return)")
+        if self.work is not None:
+            for k, v in self.work.items():
+                integer(f"work[{_short(k)}]", v, 0, 2**63 - 1)
+
     def trajectory_of(self, i: int) -> np.ndarray:
         """The recorded trajectory of orbit i: rows ``(t, q1, p1, q2, p2)``, shape ``(m_i, 5)`` (a view).
 
@@ -506,7 +595,7 @@ def iterate_arguments(record, allowed, n_steps, exit_regions, stop_on_exit) -> t
         raise ValueError(f"n_steps must be an integer >= 0, got {n_steps!r}") from None
     if n_steps < 0:
         raise ValueError(f"n_steps must be >= 0, got {n_steps}")
-    if n_steps > 2**53:
+    if n_steps > MAX_STEPS:
         raise ValueError(f"n_steps must be <= 2**53, got {n_steps}")
     if isinstance(stop_on_exit, (bool, np.bool_)) is False:
         raise ValueError(f"stop_on_exit must be True or False, got {stop_on_exit!r}")
@@ -548,7 +637,7 @@ def transport_arguments(every, stop) -> tuple:
         k = operator.index(every)
     except TypeError:
         raise ValueError(f"every must be an integer >= 1 (record every k-th state), got {_short(every)}") from None
-    if not 1 <= k <= 2**53:
+    if not 1 <= k <= MAX_STEPS:
         raise ValueError(f"every must be an integer in [1, 2**53] (record every k-th state), got {k}")
     if stop is None:
         return k, 0, None

@@ -396,6 +396,43 @@ def test_archive_directory_and_member_names(tmp_path):
         _refused(hv.load, special, match=r"cannot read .*: not a regular file")
 
 
+def test_every_flipped_byte_loads_or_is_one_value_error(tmp_path):
+    # Before: about 380 of these ~2000 flips raised what zipfile and zlib raise for a damaged
+    # member (zlib.error, NotImplementedError "zip file version 21.0", RuntimeError "... is
+    # encrypted"; numpy's header parser adds tokenize.TokenError on other files), which redraw did
+    # not catch. Every byte of a small result is flipped, alternately all its bits and the lowest
+    # (a zip "encrypted" flag); a flip the zip leaves unchecked (a date, "version made by") may
+    # still load. ~3 s.
+    m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4)
+    good = Path(hv.save(m.iterate([0.1], [-0.1], 2, record=()), tmp_path / "good")).read_bytes()
+    path, refused = tmp_path / "flipped.npz", 0
+    for i in range(len(good)):
+        data = bytearray(good)
+        data[i] ^= (0xFF, 0x01)[i % 2]
+        path.write_bytes(data)
+        try:
+            hv.load(path)
+        except ValueError as e:
+            assert str(e).startswith(str(path)), (i, str(e))
+            refused += 1
+    # Most flips land in CRC-checked data or the zip's records (~80% here): the flips reached the reader.
+    assert refused > len(good) // 2
+
+
+def test_redraw_of_a_damaged_result_is_one_error_line(genuine, tmp_path, capsys):
+    # Before: the "encrypted" flag of a member (bit 0 of its flags in the central directory) made
+    # zipfile raise RuntimeError, and `hovering redraw` printed a traceback with exit status 1.
+    data = bytearray(genuine["result"].read_bytes())
+    data[data.index(b"PK\x01\x02") + 8] |= 0x01  # the first member's general-purpose flags
+    path = tmp_path / "encrypted.npz"
+    path.write_bytes(data)
+    line = _cli(capsys, "redraw", path, "--out", tmp_path / "out.png")
+    assert re.search(
+        rf"{re.escape(str(path))}: array '[^']+': damaged or not written by hovering: .* is encrypted", line
+    ), line
+    assert not (tmp_path / "out.png").exists()
+
+
 def test_non_utf8_and_non_unicode_text(genuine, tmp_path):
     # A lone surrogate is data in a tree (hovering.save takes any str), but not a text to show: a
     # scene's title or an orbit's label with one is refused (printing or drawing it would fail).
@@ -505,6 +542,151 @@ def test_wrong_types_and_values_in_a_result_name_the_file_and_field(name, genuin
     edit, msg = CRAFTED[name]
     path = _craft(genuine["result"], tmp_path / f"{name}.npz", edit)
     err = _refused(load_result, path, match=msg)
+    assert str(err).startswith(f"{path}: ")
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    """Genuine result files: an IterateResult (2 orbits, 10 steps, every 2nd state kept, several
+    records) and a HoveringArea."""
+    d = tmp_path_factory.mktemp("results")
+    m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4)
+    res = m.iterate([0.1, 0.5], [-0.1, 0.1], 10, record=("orbit", "regions", "rotation", "jacobian"), every=2)
+    return {
+        "iterate": Path(hv.save(res, d / "iterate")),
+        "area": Path(hv.save(hv.hovering_area(m, 40, 50), d / "area")),
+    }
+
+
+def _with_arrays(src: Path, dst: Path, arrays: dict) -> Path:
+    """A copy of a genuine result with array members replaced (member name without ``.npy`` -> array)."""
+    members = _members(src)
+    members.update({f"{k}.npy": _npy(a) for k, a in arrays.items()})
+    with zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+    return dst
+
+
+_STATUSES = re.escape(", ".join(f"{s.name} ({int(s)})" for s in hv.Status))  # what the enum has, not a copy
+_REGIONS = re.escape(", ".join(f"{r.name} ({int(r)})" for r in hv.Region))
+
+RESULTS_CRAFTED = {
+    # name: (the file, edit of its tree, arrays replaced, what the error names). Before, each loaded:
+    # later a 0-d status was an IndexError in repr, map=5 an AttributeError, a rotation of 7 values
+    # for 2 orbits made rotation_number return 7 numbers.
+    "status_code": (
+        "iterate",
+        None,
+        {"root.status": np.array([0, 99], np.int8)},
+        rf"root: status\[1\] = 99 is not a Status; allowed: {_STATUSES}$",
+    ),
+    "status_float": (
+        "iterate",
+        None,
+        {"root.status": np.array([0.0, 0.5])},
+        r"root: status must be an array of integers of shape \(any,\), got shape \(2,\), dtype float64",
+    ),
+    "status_0d": ("iterate", None, {"root.status": np.array(0, np.int8)}, r"root: status must be .* got shape \(\)"),
+    "phi_columns": (
+        "iterate",
+        None,
+        {"root.phi": np.zeros((2, 5))},
+        r"root: phi must be an array of floats of shape \(2, 6\), got shape \(2, 5\)",
+    ),
+    "phi_1d": ("iterate", None, {"root.phi": np.zeros(6)}, r"root: phi must be .* \(2, 6\), got shape \(6,\)"),
+    "rotation_length": (
+        "iterate",
+        None,
+        {"root.rotation": np.zeros(7)},
+        r"root: rotation must be an array of floats of shape \(2,\), got shape \(7,\)",
+    ),
+    "region_code": (
+        "iterate",
+        None,
+        {"root.region": np.full((2, 5), 99, np.int8)},
+        rf"root: region\[0, 0\] = 99 is not a Region; allowed: {_REGIONS}$",
+    ),
+    "steps_done": (
+        "iterate",
+        None,
+        {"root.steps_done": np.array([10, 11])},
+        r"root: steps_done\[1\] = 11 is out of range; allowed: \[0, 10\]",
+    ),
+    "n_steps": (
+        "iterate",
+        lambda d: d["tree"]["fields"].update(n_steps=-5),
+        {},
+        r"root: n_steps must be an integer in \[0, \d+\], got -5",
+    ),
+    "map": (
+        "iterate",
+        lambda d: d["tree"]["fields"].update(map=5),
+        {},
+        r"root: map must be a map \(hovering\.TruncatedMap, TruncatedFamily or FlowMap\), got 5",
+    ),
+    "jacobian_part": (
+        "iterate",
+        lambda d: d["tree"]["fields"].update(jacobian_log=None),
+        {},
+        r"root: jacobian_q, jacobian_log, jacobian_r12, jacobian_status are recorded together; the file has only "
+        r"jacobian_q, jacobian_r12, jacobian_status",
+    ),
+    # The box is [-pi, pi) x [K_lo, 0): every area lies in [0, 2 pi |K_lo|] (4.045 for this map's default
+    # K_lo = -0.6438), the error in [0, 3 times that]; the stratified grid of 50 samples has 66 points.
+    "area_negative": (
+        "area",
+        lambda d: d["tree"]["fields"].update(area=-5.0),
+        {},
+        r"root: area must lie in \[0\.0, 4\.04\d*\], got -5\.0",
+    ),
+    "area_huge": (
+        "area",
+        lambda d: d["tree"]["fields"].update(area=1e300),
+        {},
+        r"root: area must lie in \[0\.0, 4\.04\d*\], got 1e\+300",
+    ),
+    "error_negative": (
+        "area",
+        lambda d: d["tree"]["fields"].update(error=-1.0),
+        {},
+        r"root: error must lie in \[0\.0, 12\.13\d*\], got -1\.0",
+    ),
+    "n_samples": (
+        "area",
+        lambda d: d["tree"]["fields"].update(n_samples=-1),
+        {},
+        r"root: n_samples must be an integer in \[1, \d+\], got -1",
+    ),
+    "unresolved": (
+        "area",
+        lambda d: d["tree"]["fields"].update(unresolved=67),
+        {},
+        r"root: unresolved must be an integer in \[0, 66\], got 67",
+    ),
+    "impact_fraction": (
+        "area",
+        lambda d: d["tree"]["fields"].update(impact_fraction_F0=5.0),
+        {},
+        r"root: impact_fraction_F0 must lie in \[0\.0, 1\.0\], got 5\.0",
+    ),
+    "areas": (
+        "area",
+        lambda d: d["tree"]["fields"]["areas"]["__items__"][0].__setitem__(1, -0.5),
+        {},
+        r"root: areas\[10\] must lie in \[0\.0, 4\.04\d*\], got -0\.5",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(RESULTS_CRAFTED))
+def test_results_are_checked_against_what_their_computation_returns(name, results, tmp_path):
+    which, edit, arrays, msg = RESULTS_CRAFTED[name]
+    src = results[which]
+    assert hv.load(src) is not None  # the genuine file passes the checks
+    path = _craft(src, tmp_path / f"{name}.npz", edit or (lambda d: None))
+    path = _with_arrays(path, path, arrays) if arrays else path
+    err = _refused(hv.load, path, match=msg)
     assert str(err).startswith(f"{path}: ")
 
 
@@ -729,8 +911,27 @@ def _edited(src: Path, dst_dir: Path, edit) -> Path:
     return dst_dir / "hov.png"
 
 
-@pytest.mark.parametrize("case", ["area_text", "area_missing", "flag_number", "box_other", "row_list", "count_float"])
+@pytest.mark.parametrize(
+    "case",
+    [
+        "area_text",
+        "area_missing",
+        "flag_number",
+        "box_other",
+        "row_list",
+        "count_float",
+        "area_negative",
+        "area_huge",
+        "error_negative",
+        "samples_negative",
+        "unresolved_huge",
+        "impact_fraction",
+    ],
+)
 def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monkeypatch):
+    # The last six loaded before and were drawn as they were; error = -1 ended the run at the
+    # plot ("'yerr' must not contain negative values"), naming neither file nor line, saving nothing.
+    # An area lies in [0, 2 pi |K_low|] of the point's box, the error in [0, 3 times that].
     edit, msg = {
         "area_text": (
             lambda r: r.update(area="x"),
@@ -744,6 +945,21 @@ def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monk
             r"row\.area must be a number .*, got \[1\.0, .*\]",
         ),
         "count_float": (lambda r: r.update(n_samples=2.5), r"row\.n_samples must be an integer, got 2\.5"),
+        "area_negative": (lambda r: r.update(area=-5.0), r"row\.area must lie in \[0\.0, [\d.]+\], got -5\.0"),
+        "area_huge": (lambda r: r.update(area=1e300), r"row\.area must lie in \[0\.0, [\d.]+\], got 1e\+300"),
+        "error_negative": (lambda r: r.update(error=-1.0), r"row\.error must lie in \[0\.0, [\d.]+\], got -1\.0"),
+        "samples_negative": (
+            lambda r: r.update(n_samples=-3),
+            r"row\.n_samples must be an integer in \[1, \d+\], got -3",
+        ),
+        "unresolved_huge": (
+            lambda r: r.update(unresolved=10**18),
+            r"row\.unresolved must be an integer in \[0, \d+\], got 1000000000000000000",
+        ),
+        "impact_fraction": (
+            lambda r: r.update(impact_fraction_F0=5.0),
+            r"row\.impact_fraction_F0 must lie in \[0\.0, 1\.0\], got 5\.0",
+        ),
     }[case]
     out = _edited(checkpoint[0], tmp_path, edit)
     computed = []
@@ -759,6 +975,29 @@ def test_checkpoint_rows_are_checked_before_use(case, checkpoint, tmp_path, monk
         r"edited or damaged",
     )
     assert computed == [] and not out.exists()
+
+
+@pytest.mark.parametrize("case", ["status", "steps", "visited"])
+def test_checkpoint_pieces_are_checked_before_use(case, tmp_path):
+    # Before: any int8 status and int64 step count was taken: status 99 counted as "unresolved",
+    # steps beyond n_steps as having survived them. Now each names the file, the line and the entry.
+    from hovering.parallel import Executor
+
+    m = hv.TruncatedMap(eps=0.3, Omega0=hv.OMEGA_G, theta_w=3 * np.pi / 4)
+    ck = tmp_path / "pieces.jsonl"
+    kw = dict(n_steps=40, n_samples=50, executor=Executor(workers=1, pieces=2, checkpoint=ck))
+    hv.hovering_area(m, **kw)
+    lines = ck.read_text().splitlines()
+    rec = json.loads(lines[2])  # the first piece, after the header and the provenance line
+    column, value, msg = {
+        "status": (1, 99, rf"row\.outcomes\.status\[0\] = 99 is not a Status; allowed: {_STATUSES}"),
+        "steps": (2, 41, r"row\.outcomes\.steps_done\[0\] = 41 is out of range; allowed: \[0, 40\]"),
+        "visited": (3, -1, r"row\.outcomes\.visited\[0\] = -1 is out of range; allowed: \[0, 31\]"),
+    }[case]
+    rec["row"]["outcomes"][column][0] = value
+    lines[2] = json.dumps(rec)
+    ck.write_text("\n".join(lines) + "\n")
+    _refused(lambda: hv.hovering_area(m, **kw), match=rf"pieces\.jsonl line 3: {msg} \(the file was edited or damaged")
 
 
 def test_checkpoint_genuine_rows_are_reused(checkpoint, tmp_path, monkeypatch):

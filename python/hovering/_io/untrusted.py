@@ -19,7 +19,9 @@ import os
 import re
 import stat
 import struct
+import tokenize
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -76,6 +78,27 @@ TREE_BYTES_PER_CHAR = 64
 _OBJECT_BYTES_PER_ITEM = 64
 #: The dtypes an array member may have: booleans, integers, floats, complex numbers and text.
 _PLAIN_KINDS = "biufcU"
+
+try:
+    from lzma import LZMAError
+except ImportError:  # a Python without lzma: zipfile cannot open an LZMA member either (NotImplementedError)
+    LZMAError = zlib.error
+#: What reading a zip archive and its ``.npy`` members raises, ValueError aside, for a file that is
+#: not one or is damaged: EOFError, OSError (bz2's errors too) and zipfile's BadZipFile (no zip, a
+#: bad CRC), said as they are; and, said to be damage (hovering never writes what causes them),
+#: NotImplementedError (a compression method or zip version zipfile lacks), RuntimeError (a member
+#: marked encrypted), the decompressors' zlib.error and LZMAError, struct.error (a short record),
+#: numpy's header parser's SyntaxError and tokenize.TokenError.
+_UNREADABLE = (EOFError, OSError, zipfile.BadZipFile)
+_DAMAGED = (NotImplementedError, RuntimeError, zlib.error, LZMAError, struct.error, SyntaxError, tokenize.TokenError)
+_DECODE_ERRORS = (ValueError, *_UNREADABLE, *_DAMAGED)
+
+
+def _decode_error(where: str, e: Exception) -> ValueError:
+    """The one ValueError for a failure to read or decode part of an archive at ``where``."""
+    if isinstance(e, (ValueError, *_UNREADABLE)):
+        return ValueError(f"{where}: {e}")
+    return ValueError(f"{where}: damaged or not written by hovering: {e}")
 
 
 def memory_budget() -> int:
@@ -348,8 +371,8 @@ class Archive:
                 raise ValueError(f"{path} is not a hovering result file (a single .npy array, not an NPZ archive)")
             try:
                 members, cd_size = _directory(self._fh, size)
-            except (zipfile.BadZipFile, OSError) as e:
-                raise ValueError(f"{path} is not a hovering result file: {e}") from None
+            except _DECODE_ERRORS as e:
+                raise _decode_error(f"{path} is not a hovering result file", e) from None
             if members > MAX_MEMBERS or cd_size > MAX_DIRECTORY_BYTES:
                 raise ValueError(
                     f"{path}: an archive of {members} members and a directory of {cd_size} bytes; "
@@ -358,8 +381,8 @@ class Archive:
             self._fh.seek(0)
             try:
                 self._zip = zipfile.ZipFile(self._fh)
-            except (zipfile.BadZipFile, OSError, EOFError, ValueError) as e:
-                raise ValueError(f"{path} is not a hovering result file: {e}") from None
+            except _DECODE_ERRORS as e:
+                raise _decode_error(f"{path} is not a hovering result file", e) from None
             names = [i.filename for i in self._zip.infolist()]
             bad = next((n for n in names if not safe_member_name(n)), None)
             if bad is not None:
@@ -421,8 +444,8 @@ class Archive:
             version = np.lib.format.read_magic(buf)
             reader = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
             shape, _, dtype = reader(buf)
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, SyntaxError) as e:
-            raise ValueError(f"{where}: {e}") from None
+        except _DECODE_ERRORS as e:
+            raise _decode_error(where, e) from None
         if not plain_dtype(dtype):
             raise ValueError(
                 f"{where}: dtype {dtype.str!r} is refused; allowed: booleans, integers, floats, complex "
@@ -451,8 +474,8 @@ class Archive:
         try:
             with self._zip.open(self.files[key]) as f:
                 return np.lib.format.read_array(f, allow_pickle=False)
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile) as e:
-            raise ValueError(f"{self.path}: array {key[:80]!r}: {e}") from None
+        except _DECODE_ERRORS as e:
+            raise _decode_error(f"{self.path}: array {key[:80]!r}", e) from None
 
 
 # The NPZ format of hovering.save: its name and the member holding the JSON tree. Here, not in

@@ -17,26 +17,51 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._arrays import unique
-from .._checks import MAX_SEED, check_memory, flag, integer, random_seed, real_number, thread_count
+from .._checks import (
+    MAX_SEED,
+    check_memory,
+    flag,
+    integer,
+    loaded_array,
+    loaded_codes,
+    loaded_range,
+    random_seed,
+    real_number,
+    thread_count,
+)
 from .._core import analysis as _core_analysis
 from .._core import truncated as _core_truncated
 from .._deprecated import renamed_keywords
 from .._display import Summarized
+from .._enums import Status
 from .._io.serial import Saveable
 from .._progress import check_progress, progress_bar, stop_hook
-from ..interface import require_map
+from ..interface import MAX_STEPS, N_REGIONS, require_map
 from ..parallel.checkpoint import Checkpoint
 from ..parallel.executor import Executor, from_old_arguments, run_pieces
 from ..parallel.executor import executor as open_executor
 from .orbits import classify_orbits
 from .zone import impact_zone_floor
 
-__all__ = ["HoveringArea", "HoveringComponents", "hovering_area", "default_K_low", "default_depth"]
+__all__ = [
+    "HoveringArea",
+    "HoveringComponents",
+    "hovering_area",
+    "default_K_low",
+    "default_depth",
+    "check_estimate",
+    "MAX_SAMPLES",
+]
 
 _log = logging.getLogger(__name__)
 
 #: Names of the per-sample codes of :attr:`HoveringArea.component` (code = index).
 COMPONENTS = ("none", "band", "islands", "under_floor")
+
+#: Most samples :func:`hovering_area` takes.
+MAX_SAMPLES = 2**53
+#: Most doublings of the default box's depth (:func:`hovering_area`'s ``deepen``).
+MAX_DEEPEN = 64
 
 #: Points of the recorded orbit that classifies an island chain: classify_orbits needs 32 points
 #: per island, so chains up to period 64 are found.
@@ -237,7 +262,32 @@ class HoveringArea(Summarized, Saveable):
     seed: int | None = None
 
     def _validate_loaded(self) -> None:
-        """A file's seed (untrusted): None or an integer seed, as ``rng=`` takes it."""
+        """A file's estimate (untrusted): what :func:`hovering_area` could have returned, or a
+        ValueError naming the field, its value and the allowed range.
+
+        The box ``(phi_lo, phi_hi, K_lo, K_hi)`` finite with ``lo < hi``; the estimate's numbers
+        within what its box allows (:func:`check_estimate`), ``areas`` too; the kept points, when
+        kept, one per sample; the seed None or an integer seed, as ``rng=`` takes it.
+        """
+        if not isinstance(self.box, tuple) or len(self.box) != 4:
+            raise ValueError(f"box must be a tuple (phi_lo, phi_hi, K_lo, K_hi), got {self.box!r:.80}")
+        phi_lo, phi_hi, K_lo, K_hi = (real_number(f"box[{i}]", v) for i, v in enumerate(self.box))
+        box_area = (phi_hi - phi_lo) * (K_hi - K_lo)
+        if not (phi_lo < phi_hi and K_lo < K_hi and math.isfinite(box_area)):
+            raise ValueError(f"box = {self.box} must have phi_lo < phi_hi, K_lo < K_hi and a finite area")
+        names = ("area", "error", "sampling_error", "iteration_error", "area_both_sides", "impact_fraction_F0")
+        check_estimate({k: getattr(self, k) for k in names + ("n_samples", "unresolved")}, box_area)
+        for N, a in self.areas.items():
+            integer("an iteration count (key) of areas", N, 0, MAX_STEPS)
+            _area(f"areas[{N}]", a, box_area)
+        integer("deepened", self.deepened, 0, MAX_DEEPEN)
+        for name, kinds in (("phi", "f"), ("K", "f"), ("hovering", "b"), ("both_sides", "b"), ("period", "iu")):
+            if getattr(self, name) is not None:
+                loaded_array(name, getattr(self, name), kinds, (self.n_samples,))
+        if self.component is not None:
+            loaded_range(
+                "component", loaded_array("component", self.component, "iu", (self.n_samples,)), 0, len(COMPONENTS) - 1
+            )
         if self.seed is not None:
             integer("seed", self.seed, 0, MAX_SEED)
 
@@ -270,6 +320,46 @@ class HoveringArea(Summarized, Saveable):
         from .._io.interop import hovering_area_dataset
 
         return hovering_area_dataset(self)
+
+
+def _area(name: str, value, box_area: float, times: int = 1) -> None:
+    """``value`` a finite number in ``[0, times * box_area]``, or a ValueError naming it and the range."""
+    # A fraction <= 1 of the box's area (count / n times it) may round an ulp above it.
+    real_number(name, value, lo=0.0, lo_open=False, hi=times * box_area * (1 + 1e-12), hi_open=False)
+
+
+def check_estimate(e: dict, box_area: float) -> None:
+    """Check the numbers of an area estimate read from a file (a :class:`HoveringArea`'s fields, a
+    sweep's checkpointed row) against what the estimate can be.
+
+    The core's estimate counts samples of a box of area ``box_area``: every area (``area``,
+    ``area_N2``, ``area_N4``, ``area_both_sides``) and ``sampling_error`` (``box_area sqrt(max(p (1 -
+    p), 1 / n) / n)``) lie in ``[0, box_area]``, so does ``iteration_error`` (the fall of the area
+    from N/2 to N iterates), and ``error = 2 sampling_error + iteration_error`` in ``[0, 3
+    box_area]``; ``impact_fraction_F0`` is a fraction, ``n_samples`` at least 1 (the stratified
+    grid has at most twice the samples asked for), ``unresolved`` at most ``n_samples``.
+    ``area_both_sides`` may be NaN (files written before it was measured).
+
+    Parameters
+    ----------
+    e : dict
+        Field name -> value; only the names above that it holds are checked.
+    box_area : float
+        Area of the sampled box.
+
+    Raises
+    ------
+    ValueError
+        Naming the first field out of range, its value and the range.
+    """
+    for name in ("area", "area_N2", "area_N4", "area_both_sides", "sampling_error", "iteration_error", "error"):
+        if name in e and not (name == "area_both_sides" and isinstance(e[name], float) and math.isnan(e[name])):
+            _area(name, e[name], box_area, 3 if name == "error" else 1)
+    if "impact_fraction_F0" in e:
+        real_number("impact_fraction_F0", e["impact_fraction_F0"], lo=0.0, lo_open=False, hi=1.0, hi_open=False)
+    n = integer("n_samples", e["n_samples"], 1, 2 * MAX_SAMPLES) if "n_samples" in e else None
+    if "unresolved" in e:
+        integer("unresolved", e["unresolved"], 0, 2 * MAX_SAMPLES if n is None else n)
 
 
 def _stratified(samples: int, K_low: float, seed: int, lo: int = 0, hi: int | None = None) -> tuple:
@@ -379,8 +469,10 @@ def _piece_key(m, n_steps, K_low, seed, samples, lo, hi, map_key=None) -> dict:
     }
 
 
-def _piece_arrays(row, n: int) -> tuple:
-    """A checkpointed piece (untrusted): four lists of n integers, each within its array's dtype."""
+def _piece_arrays(row, n: int, n_steps: int) -> tuple:
+    """A checkpointed piece (untrusted): four lists of n integers, each within its array's dtype and
+    what the core's outcomes hold: statuses of :class:`Status`, steps done in ``[0, n_steps]``,
+    visited regions as bits of :class:`Region`'s codes."""
     names, dtypes = ("status_F0", "status", "steps_done", "visited"), (np.int8, np.int8, np.int64, np.int8)
     if not isinstance(row, dict) or not isinstance(row.get("outcomes"), list) or len(row["outcomes"]) != 4:
         raise ValueError(
@@ -396,6 +488,10 @@ def _piece_arrays(row, n: int) -> tuple:
         ):
             raise ValueError(f"row.outcomes.{name} must be {n} integers within {np.dtype(dt).name}")
         out.append(arr.astype(dt))
+    loaded_codes("row.outcomes.status_F0", out[0], Status)
+    loaded_codes("row.outcomes.status", out[1], Status)
+    loaded_range("row.outcomes.steps_done", out[2], 0, n_steps)
+    loaded_range("row.outcomes.visited", out[3], 0, 2**N_REGIONS - 1)
     return tuple(out)
 
 
@@ -418,9 +514,9 @@ def _distributed(m, n, n_steps, K_low, seed, samples, n_threads, bar, spec: Exec
             row = None
             if store is not None:
                 key = _piece_key(m, n_steps, K_low, seed, samples, lo, hi, map_key)
-                row = store.get(key, lambda r, n=hi - lo: _piece_arrays(r, n))
+                row = store.get(key, lambda r, n=hi - lo: _piece_arrays(r, n, n_steps))
             if row is not None:
-                out[i] = _piece_arrays(row, hi - lo)
+                out[i] = _piece_arrays(row, hi - lo, n_steps)
                 bar.advance(2 * (hi - lo) * n_steps)
             else:
                 todo.append(i)
@@ -673,10 +769,10 @@ def hovering_area(
     """
     require_map("m", m)
     n_steps = integer("n_steps", n_steps, 4, 2**53)
-    samples = integer("n_samples", n_samples, 1, 2**53)
+    samples = integer("n_samples", n_samples, 1, MAX_SAMPLES)
     keep_points = flag("keep_points", keep_points)
     components = flag("components", components)
-    deepen = integer("deepen", deepen, 0, 64)
+    deepen = integer("deepen", deepen, 0, MAX_DEEPEN)
     seed = random_seed(rng)
     n_threads = thread_count(n_threads)
     progress = check_progress(progress)

@@ -6,12 +6,14 @@ an executor.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 
 import numpy as np
 
-from ...analysis.hovering import hovering_area
+from ..._checks import real_number
+from ...analysis.hovering import check_estimate, hovering_area
 from ...normal.flowmap import FlowMap
 from ...parallel.checkpoint import check_row
 from ...parallel.executor import Executor, run_pieces
@@ -115,15 +117,28 @@ _MODEL_ROW = dict(area=float, error=float, agree=float, K_low=float)
 
 
 def _row_check(kind: str, point: dict) -> Callable:
-    """A check of a checkpointed row (untrusted): the fields its reader takes, and the point's own box."""
+    """A check of a checkpointed row (untrusted): the fields its reader takes, the point's own box (and
+    each model's), the estimates' numbers within what those boxes allow
+    (:func:`hovering.analysis.hovering.check_estimate`)."""
     fields = dict(_ROW)
+    models = point["models"] if kind == "flow_hovering_area" else ()
     if kind == "flow_hovering_area":
-        fields.update(b1=float, models=(tuple(m["name"] for m in point["models"]), _MODEL_ROW))
+        fields.update(b1=float, models=(tuple(m["name"] for m in models), _MODEL_ROW))
 
     def check(row):
         check_row(row, fields)
-        if row["K_low"] != point["K_low"]:
-            raise ValueError(f"row.K_low = {row['K_low']!r} is not the point's K_low = {point['K_low']!r}")
+        estimates = [("row", row, point["K_low"])]
+        estimates += [(f"row.models.{m['name']}", row["models"][m["name"]], m["K_low"]) for m in models]
+        for where, est, K_low in estimates:
+            if est["K_low"] != K_low:
+                raise ValueError(f"{where}.K_low = {est['K_low']!r} is not the point's K_low = {K_low!r}")
+            try:
+                check_estimate(est, 2 * math.pi * -K_low)  # the box [-pi, pi) x [K_low, 0)
+                if "agree" in est and not math.isnan(est["agree"]):  # NaN: the model sampled another box
+                    real_number("agree", est["agree"], lo=0.0, lo_open=False, hi=1.0, hi_open=False)
+            except ValueError as e:
+                raise ValueError(f"{where}.{e}") from None
+        real_number("row.seconds", row["seconds"], lo=0.0, lo_open=False)
 
     return check
 
