@@ -116,3 +116,12 @@ def test_an_orbit_that_escapes_keeps_the_exponent_of_its_steps():
     assert ly.status.tolist() == [hv.Status.ESCAPED, hv.Status.OK]
     assert 0 < ly.steps_done[0] < 1000 and ly.steps_done[1] == 1000
     assert np.isfinite(ly.exponents[0, 0])
+
+
+def test_ftle_field_refuses_a_grid_too_large_for_memory_before_allocating_it():
+    # 1e5 x 1e5 starts used to reach np.meshgrid: MemoryError "Unable to allocate 74.5 GiB", or on
+    # an overcommitting OS the allocation itself. At 512 bytes a start the grid needs ~4.7 TiB,
+    # more than half of any machine this runs on; the check comes before any array of its size.
+    m = hv.TruncatedMap(eps=0.5, Omega0=0.3, theta_w=2.0)
+    with pytest.raises(ValueError, match=r"ftle_field over a 100000 x 100000 grid .* more than half"):
+        hv.ftle_field(m, np.linspace(-3, 3, 10**5), np.linspace(0.5, 2.5, 10**5), 10)

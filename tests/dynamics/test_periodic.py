@@ -151,6 +151,9 @@ def test_a_failed_search_is_a_status_not_an_exception():
         (dict(line="0"), r"line, K_bracket and winding are for a symmetric search"),
         (dict(segment=3, period=4), r"segment = 3 must divide the period 4"),
         (dict(max_iter=0), r"max_iter must be an integer in \[1, 1000\]"),
+        # a flag, like every other: 'yes' (truthy) used to run a symmetric search
+        (dict(symmetric="yes"), r"symmetric must be True or False, got 'yes'"),
+        (dict(symmetric=1), r"symmetric must be True or False, got 1"),
     ],
 )
 def test_bad_input(kw, match):

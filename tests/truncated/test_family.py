@@ -343,3 +343,79 @@ def test_good_table_builds():
     fam = TruncatedFamily(t["eps"], t["K"], t["Omega"], t["JR"], t["J1"], K_max=0.5)
     assert fam.valid_band()[1] == 0.5
     assert fam.valid_band()[0] == pytest.approx(-2.0, abs=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------
+# Size, speed and resolution of the tables
+
+
+def _counting(fn):
+    """fn, counting its calls (.calls) and whether any took an array (.arrays)."""
+
+    def wrapped(k):
+        wrapped.calls += 1
+        wrapped.arrays += np.ndim(k) > 0
+        return fn(k)
+
+    wrapped.calls = wrapped.arrays = 0
+    return wrapped
+
+
+def test_a_grid_beyond_MAX_GRID_is_refused_before_anything_is_sampled_or_built():
+    # 1e6 points took 12 s and 0.5 GB in the core, Ctrl-C unheard; MAX_GRID is the sweep plans' limit.
+    from hovering.truncated.maps import MAX_GRID
+
+    assert MAX_GRID == 100_000
+    n = MAX_GRID // 2 + 1
+    K = np.concatenate([np.linspace(-1.0, 0.0, n), np.linspace(0.0, 1.0, n)[1:]])  # MAX_GRID + 1 points
+    Om = _counting(lambda k: 3.0 + 0 * k)
+    with pytest.raises(ValueError, match=r"K has 100001 grid points; allowed: at most MAX_GRID = 100000"):
+        TruncatedFamily(0.1, K, Om, np.ones_like(K), np.sqrt(np.maximum(-K, 0.0)))
+    assert Om.calls == 0
+
+
+def test_a_vectorised_callable_is_called_once_with_the_whole_grid():
+    # Each Python call cost ~1 us a grid point (~0.3 s of a MAX_GRID build); a function of one
+    # float still works, called per point after its call on the array fails.
+    t = _table()
+    K = t["K"]
+    Om = _counting(lambda k: PAPER["Omega0"] + k)
+    JR = _counting(lambda k: 2 * (np.pi - PAPER["theta_w"]) + 0.5 * np.minimum(k, 0.0))
+    J1 = _counting(lambda k: 0.5 * 2 * np.sqrt(max(-k, 0.0)))  # max(): one float only
+    fam = TruncatedFamily(t["eps"], K, Om, JR, J1)
+    assert (Om.calls, Om.arrays, JR.calls, JR.arrays) == (1, 1, 1, 1)
+    assert J1.calls == 1 + K.size and J1.arrays == 1
+    ref_fam = TruncatedFamily(t["eps"], K, t["Omega"], t["JR"], t["J1"])
+    for a, b in zip(fam._tables, ref_fam._tables):
+        assert np.array_equal(a, b)  # the same doubles either way
+
+
+def test_family_K_max_none_is_a_named_error():
+    t = _table()
+    # Used to be "float() argument must be a string or a real number, not 'NoneType'" (TypeError).
+    with pytest.raises(ValueError, match=r"K_max must be a real number, got None"):
+        TruncatedFamily(t["eps"], t["K"], t["Omega"], t["JR"], t["J1"], K_max=None)
+
+
+@pytest.mark.parametrize(
+    "change,match",
+    [
+        # the band (-2, 1) is 3 tall: |eps| max|f| up to 2^43 x 3 = 2.64e13
+        (
+            dict(eps=1e14),
+            r"eps = 100000000000000\.0 with the forcing's max\|f\| <= 1 kicks K .*allowed: \|eps\| max\|f\| <= 2\.63883e\+13",
+        ),
+        (dict(eps=1e4, forcing=(1e10, -1e10)), r"max\|f\| <= 2e\+10 kicks K .*\|eps\| <= 1319\.41 with this forcing"),
+        # J_1 = 1e-14 sqrt(-K) <= 1.4e-14 rad: never 2^-41 = 4.5e-13 wide
+        (dict(J1=lambda t: 1e-14 * np.sqrt(np.maximum(-t["K"], 0.0))), r"J_1 opens to at most 1\.4\de-14 rad"),
+    ],
+)
+def test_family_tables_below_double_precision_resolution_are_refused(change, match):
+    t = _table()
+    kw = {"forcing": change.pop("forcing")} if "forcing" in change else {}
+    for key, v in change.items():
+        t[key] = v(t) if callable(v) else v
+    with pytest.raises(ValueError, match=r"below double-precision resolution"):
+        TruncatedFamily(t["eps"], t["K"], t["Omega"], t["JR"], t["J1"], **kw)
+    with pytest.raises(ValueError, match=match):
+        TruncatedFamily(t["eps"], t["K"], t["Omega"], t["JR"], t["J1"], **kw)

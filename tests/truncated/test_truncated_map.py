@@ -451,6 +451,80 @@ def test_bad_constructor_arguments(override, match):
         hovering.TruncatedMap(**p, **kw)
 
 
+# Maps whose band below K = 0 is below double-precision resolution, and what the message must name:
+# the parameter, its value and the bound (the TruncatedMap docstring's Notes). Each used to be
+# built; tau0 = 1e308 then measured hovering_area 0 +- 1.3e-303 against a theory of 0.764.
+UNRESOLVED = [
+    (dict(tau0=1e308), r"floor .* is set by tau0 = 1e\+308.*allowed: \|tau0\| <= 4\.84e\+30"),
+    (dict(tau0=-1e308), r"set by tau0 = -1e\+308.*allowed: \|tau0\| <= 4\.84e\+30"),
+    (dict(tau1=1e308), r"set by tau1 = 1e\+308: \|J_R\|.*allowed: tau1 <= 7\.6e\+24"),
+    (dict(lam=5e-324), r"J_1 opens to at most 1\.98e-323 rad.*allowed: lam >= 1\.28e-13"),
+    (dict(lam=1e300), r"the band has no part below K = 0 .*\|J_0\|.*lam = 1e\+300.*allowed: .*smaller lam"),
+    (dict(theta_w=5e-324), r"no part below K = 0 .*theta_w = 5e-324.*allowed: a larger theta_w"),
+    (dict(Omega0=-1e6), r"no part below K = 0 .*tau0 = 1\.0.*allowed: \|Omega0\| < 1e6"),
+    (dict(eps=1e308), r"eps = 1e\+308 .* kicks K .*allowed: \|eps\| max\|f\| <= 8\.79609e\+18"),
+    (dict(eps=-1e19), r"eps = -1e\+19 .*allowed: .*\|eps\| <= 8\.79609e\+18"),
+]
+
+
+@pytest.mark.parametrize("override,match", UNRESOLVED, ids=[str(c[0]) for c in UNRESOLVED])
+def test_a_band_below_double_precision_resolution_is_refused(override, match):
+    p = dict(PARAM_SETS["paper_eps+0.3"], **override)
+    with pytest.raises(ValueError, match=r"below double-precision resolution"):
+        hovering.TruncatedMap(**p)
+    with pytest.raises(ValueError, match=match):
+        hovering.TruncatedMap(**p)
+
+
+def test_the_resolution_bounds_lie_where_the_docstring_says():
+    # Each bound is checked on both sides, 1% away (far above the few roundings of the band's
+    # ends, far below the factor of 2^10 the rules leave before resolution is really gone), and
+    # the accepted map's J_1 is measured through the core's own arcs() just above the floor.
+    p = dict(PARAM_SETS["paper_eps+0.3"])  # tau1 = lam = 0.5, theta_w = 3 pi / 4: floor -pi
+    need = (2.0**-41 / (2 * p["lam"])) ** 2  # the depth where 2 lam sqrt(-K) reaches 2^-41
+    room = 1e6 + p["Omega0"]  # the rotation bound's floor: -(1e6 + Omega0) / tau0
+    # tau0 (eps = 0: the kick rule does not apply), ~2e31 lam^2 as documented
+    bound = room / need
+    assert 2e31 * 0.25 * 0.9 < bound < 2e31 * 0.25 * 1.1
+    m = hovering.TruncatedMap(**dict(p, eps=0.0, tau0=0.99 * bound))
+    lo = m.valid_band()[0]
+    assert m.arcs(lo * (1 - 2**-20))["len_1"] >= 2.0**-41
+    with pytest.raises(ValueError, match=r"J_1 opens to at most 4\.5\de-13 rad"):
+        hovering.TruncatedMap(**dict(p, eps=0.0, tau0=1.01 * bound))
+    # lam >= 2^-42 / sqrt(-K_lo), with the floor -pi set by |J_R|
+    lam_min = 2.0**-42 / math.sqrt(math.pi)
+    m = hovering.TruncatedMap(**dict(p, lam=1.01 * lam_min))
+    assert m.valid_band()[0] == -math.pi and m.arcs(-math.pi * (1 - 2**-20))["len_1"] >= 2.0**-41
+    with pytest.raises(ValueError, match=r"allowed: tau1 <= 0\.49 with these theta_w and lam, or lam >= 1\.28e-13"):
+        hovering.TruncatedMap(**dict(p, lam=0.99 * lam_min))
+    # eps: 2^43 x the band's height
+    lo, hi = hovering.TruncatedMap(**p).valid_band()
+    eps_max = 2.0**43 * (hi - lo)
+    assert hovering.TruncatedMap(**dict(p, eps=-0.99 * eps_max)).eps == -0.99 * eps_max
+    with pytest.raises(ValueError, match=r"kicks K"):
+        hovering.TruncatedMap(**dict(p, eps=1.01 * eps_max))
+
+
+@pytest.mark.parametrize("value", ["1", True, np.bool_(True), None, 1j, [1.0], np.array([1.0, 2.0])])
+def test_K_max_is_checked_like_every_parameter(value):
+    # Used to go through float(): '1' and True gave K_max = 1, None a TypeError's message.
+    p = dict(PARAM_SETS["paper_eps+0.3"])
+    with pytest.raises(ValueError, match=r"K_max must be a real number"):
+        hovering.TruncatedMap(**p, K_max=value)
+    K, Om, JR, J1 = _paper_family()._tables
+    with pytest.raises(ValueError, match=r"K_max must be a real number"):
+        hovering.TruncatedFamily(0.3, K, Om, JR, J1, K_max=value)
+    # while inf, in any of its real-number forms, is no cap, and any positive real is one
+    uncapped = hovering.TruncatedMap(**p).valid_band()[1]  # where the rotation reaches 1e6
+    for top in (math.inf, np.float64(np.inf), np.array(np.inf), 2, np.float32(0.5)):
+        assert hovering.TruncatedMap(**p, K_max=top).valid_band()[1] == min(float(top), uncapped)
+
+
+def _paper_family():
+    grid = np.concatenate([-(np.linspace(2.0, 0.0, 21) ** 2), np.linspace(0.0, 1.0, 11)[1:]])
+    return hovering.TruncatedFamily.from_map(make_map(PARAM_SETS["paper_eps+0.3"]), grid)
+
+
 _LO = -np.pi  # band floor of the paper's parameters: -2 (pi - theta_w) / tau1
 
 

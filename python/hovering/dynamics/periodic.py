@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import _short, integer, is_choice, real_number
+from .._checks import _short, flag, integer, is_choice, real_number
 from .._display import Summarized
 from .._enums import Region, Status, wrap
 from .._io.serial import Saveable
@@ -531,7 +531,7 @@ def periodic_orbit(
     ------
     ValueError
         For a map that is not one, a period outside [1, 100000], non-finite phi or K, a bad tol,
-        max_iter, line, bracket or segment.
+        max_iter, line, bracket or segment, or a ``symmetric`` that is not True or False.
 
     Examples
     --------
@@ -552,6 +552,7 @@ def periodic_orbit(
     period, tol, max_iter, n_threads = _check_common(m, period, tol, max_iter, n_threads)
     phi = real_number("phi", phi, lo=-1e6, hi=1e6)
     K = real_number("K", K)
+    symmetric = flag("symmetric", symmetric)  # 'yes' or 0 would pick a search silently
     if segment is not None:
         segment = integer("segment", segment, 1, period)
     _segments(period, segment)  # the segment check, before any work

@@ -566,6 +566,12 @@ class FlowMap(MapAnalyses):
         Returns
         -------
         Region or ndarray of int8
+            A :class:`Region` for scalar input, else an int8 array of its codes; ``Region.NONE``
+            (-1) where the point has no return: outside :meth:`valid_band` (no point of the
+            section has that K) or where the return failed. :meth:`returns` gives the reason as
+            a :class:`FlowStatus` (``OFF_SECTION``, ``STEP_LIMIT``, ...) and :meth:`step` NaN
+            there. The truncated maps raise instead for a K outside their band, where they are
+            not defined.
         """
         if plain_point(phi, K):  # one point: as step()
             return Region(self._core.step1(phi, K, False)[3])

@@ -14,6 +14,8 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from .._checks import (
+    MAX_ANGLE,
+    _real_value,
     check_memory,
     forcing_array,
     is_choice,
@@ -43,9 +45,68 @@ __all__ = ["TruncatedMap", "TruncatedFamily", "IterateResult"]
 
 _RECORD_KEYS = ("orbit", "regions", "rotation", "visited", "extrema", "residence", "jacobian")
 
+#: Most points of a :class:`TruncatedFamily`'s K grid: the sweep plans' limit on a model's tables
+#: (the core's plan reader, kMaxTable), so every family a plan can hold can be built here and no
+#: other. The core samples the splines ~200 times per grid point to find the band, holding the GIL,
+#: at ~7-14 us a point: 1e5 points take ~1 s (2 shared cores), 1e6 took 12 s and 0.5 GB.
+MAX_GRID = 100_000
+
+#: Narrowest J_1 the band below K = 0 must open, in rad: 2^10 roundings of an angle in [-pi, pi)
+#: (ulp(pi) = 2^-51). J_1 is the arc that opens below the tangency (|J_1| = 2 lam sqrt(-K) for
+#: TruncatedMap); one that never holds more than a few doubles is an arc no point can be placed in,
+#: the model's impacting part below double-precision resolution.
+_MIN_J1 = 2.0**-41
+
+#: A step K + eps f(phibar) rounds K by up to 2^-53 |eps| max|f|; the band must be at least 2^10
+#: such roundings tall (2^-43 |eps| max|f|), else a K in it keeps no digits through one step.
+_KICK_ROUNDINGS = 2.0**-43
+
+
+def _band_top(value) -> float:
+    """The ``K_max`` argument: a real number > 0 or ``inf`` (no cap), checked as every parameter is
+    (no strings, bools or None: :func:`hovering._checks.real_number`'s types), or a ValueError
+    naming it and the range (0, inf]."""
+    v = _real_value("K_max", value)
+    if not v > 0:  # NaN too
+        raise ValueError(f"K_max must be > 0 (or inf: no cap), got {v}")
+    return v
+
 
 class _MapAPI(MapAnalyses):
     """Methods shared by every member of the truncated family (mixed into the compiled classes)."""
+
+    def _require_resolved(self, who: str, widest_J1: float, f_max: float, explain) -> None:
+        """Refuse a band below double-precision resolution (both classes' constructors, after the core
+        has found the band): J_1 must open to ``_MIN_J1`` inside it, and the band must be
+        ``_KICK_ROUNDINGS`` of a kick ``|eps| f_max`` tall (``f_max`` bounds ``|f|``).
+        ``explain()`` gives, for the message, what sets the band's floor and what would let J_1 open."""
+        lo, hi = self.valid_band()
+        if not widest_J1 >= _MIN_J1:
+            floor, fix = explain()
+            depth = 0.0 if lo == 0 else -lo
+            where = (
+                f"the band has no part below K = 0 (its lower end {lo!r} is set by {floor})"
+                if depth == 0
+                else f"the band below K = 0 is {depth:.3g} deep (its floor {lo!r} is set by {floor}), and J_1 "
+                f"opens to at most {widest_J1:.3g} rad in it"
+            )
+            raise ValueError(
+                f"{who}: {where}: J_1, the arc that opens below the tangency, must reach {_MIN_J1:.3g} rad (2^-41: "
+                f"2^10 roundings of an angle) somewhere in the band, or no point can ever lie in it (the map's "
+                f"impacting part is below double-precision resolution); allowed: {fix}"
+            )
+        kick = abs(self.eps) * f_max  # may overflow to inf: refused below, as it should be
+        height = hi - lo
+        if kick * _KICK_ROUNDINGS > height:
+            floor = explain()[0]
+            raise ValueError(
+                f"{who}: eps = {self.eps!r} with the forcing's max|f| <= {f_max:.6g} kicks K by up to {kick:.3g} per "
+                f"step, and a step rounds K by ~2^-53 of the kick, but the band ({lo!r}, {hi!r}) is only "
+                f"{height:.3g} tall: below double-precision resolution (it must hold 2^10 roundings of a kick); "
+                f"allowed: |eps| max|f| <= {height / _KICK_ROUNDINGS:.6g} for this band (2^43 x its height), i.e. "
+                f"|eps| <= {height / _KICK_ROUNDINGS / f_max:.6g} with this forcing, or a taller band (its floor is "
+                f"set by {floor})"
+            )
 
     def step(self, phi, K):
         """One forward step ``(phi, K) -> (phibar, Kbar)``.
@@ -180,7 +241,15 @@ class _MapAPI(MapAnalyses):
         Returns
         -------
         Region or ndarray of int8
-            A :class:`Region` for scalar input, else an int8 array of region codes.
+            A :class:`Region` for scalar input, else an int8 array of region codes: BESIDE, ABOVE,
+            UPPER or RIGHT (never ``Region.NONE``: every point of the band has its arc).
+
+        Raises
+        ------
+        ValueError
+            For a non-finite value or a K outside :meth:`valid_band`, as :meth:`step` (the map is
+            not defined there; :meth:`hovering.FlowMap.region` answers ``Region.NONE`` instead,
+            as its steps answer a status).
         """
         p, k, scalar = point_pair(phi, K, "region")
         r, _ = self._region_rotation(p, k, "region")
@@ -197,6 +266,11 @@ class _MapAPI(MapAnalyses):
         Returns
         -------
         ndarray or float
+
+        Raises
+        ------
+        ValueError
+            For a non-finite value or a K outside :meth:`valid_band`, as :meth:`region`.
         """
         p, k, scalar = point_pair(phi, K, "rotation")
         _, w = self._region_rotation(p, k, "rotation")
@@ -434,7 +508,9 @@ class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     Parameters
     ----------
     eps : float
-        Perturbation amplitude (any finite value; the paper studies |eps| <= 0.92).
+        Perturbation amplitude: any finite value with ``|eps| <= 2^43 (K_hi - K_lo)`` for the band
+        ``(K_lo, K_hi)`` of :meth:`valid_band` (see Notes; the paper studies |eps| <= 0.92).
+        0 is F_0.
     Omega0 : float
         Rotation at the tangency circle, ``|Omega0| <= 1e6``. The band also ends where
         ``|Omega0 + tau0 K|`` reaches 1e6: one step rounds phi + Omega, and the 2 pi n it
@@ -443,19 +519,49 @@ class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     theta_w : float
         Wall angle, in the open interval (0, pi).
     tau0 : float, optional
-        Twist (default 1).
+        Twist (default 1): any finite value (0: no twist) for which the band below K = 0 is
+        resolved (see Notes): with the rotation bound setting the band's floor at
+        ``-(1e6 +- Omega0) / |tau0|``, ``|tau0| <~ 2e31 lam^2``.
     tau1 : float, optional
-        Twist of the upper-wall reflection (default 0.5).
+        Twist of the upper-wall reflection (default 0.5): any finite value for which the band
+        below K = 0 is resolved (see Notes); where |J_R| closes first, at ``K = -2 (pi -
+        theta_w) / tau1``, ``tau1 <~ 4e25 (pi - theta_w) lam^2``.
     lam : float, optional
-        Square-root coefficient, > 0 (default 0.5).
+        Square-root coefficient, > 0 (default 0.5), large enough that J_1 opens in the band (see
+        Notes): ``lam >= 2^-42 / sqrt(-K_lo)``; and small enough that J_0, which closes near
+        ``sqrt(-K) = theta_w / lam``, leaves a band below K = 0 that does.
     K_max : float, optional
-        Upper end of the band (default +inf: F_eps is the shifted standard map for K >= 0).
+        Upper end of the band, in (0, inf] (default inf: F_eps is the shifted standard map for
+        K >= 0).
 
     Raises
     ------
     ValueError
-        Naming the parameter and its allowed range, for non-finite values, |Omega0| > 1e6,
-        theta_w outside (0, pi), lam <= 0 or K_max <= 0.
+        Naming the parameter, its value and the allowed range, for a value that is not a real
+        number (a string, bool or None), non-finite parameters (K_max may be inf), |Omega0| > 1e6,
+        theta_w outside (0, pi), lam <= 0, K_max <= 0, or a band below double-precision
+        resolution (Notes; the message names the parameter that sets the band's floor and the
+        bound it must meet).
+
+    Notes
+    -----
+    The map is defined on the band of :meth:`valid_band`, where all three arcs have lengths in
+    (0, 2 pi) and the rotation stays within 1e6. Two things must be resolvable in double
+    precision there, or every analysis of the model would report rounding as structure:
+
+    * J_1, the arc that opens below the tangency, must reach ``2^-41`` rad (``4.5e-13``: 2^10
+      roundings of an angle in [-pi, pi)) inside the band, i.e. ``2 lam sqrt(-K_lo) >= 2^-41``
+      (``-K_lo``: the band's depth below 0). A band that ends before (e.g. ``tau0 = 1e308``:
+      depth 1e-302, J_1 at most 1e-151 rad), or a J_1 too thin for any band (``lam = 5e-324``),
+      is an impacting part no point can lie in.
+    * A step ``K + eps sin(phibar)`` rounds K by up to ``2^-53 |eps|``; the band must be at
+      least 2^10 such roundings tall, ``K_hi - K_lo >= 2^-43 |eps|``, or no K in it keeps a digit
+      through one step (``eps = 1e308``).
+
+    Both are invariant under the rescaling ``K -> c K`` (eps -> c eps, tau0 -> tau0 / c, tau1 ->
+    tau1 / c, lam -> lam / sqrt(c)), as the map is: they bound the parameters together, not in
+    units of K. Denormal eps, tau0 or tau1 are accepted, as 0 is (F_0, no twist): they differ from
+    it only by the roundings they cause.
 
     Examples
     --------
@@ -476,11 +582,55 @@ class TruncatedMap(_MapAPI, _core_truncated.TruncatedMap):
     def __init__(self, eps, Omega0, theta_w, tau0=1.0, tau1=0.5, lam=0.5, K_max=math.inf):
         vals = {"eps": eps, "Omega0": Omega0, "theta_w": theta_w, "tau0": tau0, "tau1": tau1, "lam": lam}
         vals = {name: real_number(name, v) for name, v in vals.items()}
-        try:
-            K_max = float(K_max)
-        except (TypeError, ValueError):
-            raise ValueError(f"K_max must be a real number > 0, got {K_max!r}") from None
+        K_max = _band_top(K_max)
         _core_truncated.TruncatedMap.__init__(self, **vals, K_max=K_max)
+        depth = -self.valid_band()[0]
+        self._require_resolved("TruncatedMap", 2 * self.lam * math.sqrt(max(depth, 0.0)), 1.0, self._floor)
+
+    def _floor(self) -> tuple:
+        """What sets the band's lower end, in words, and what would let J_1 reach _MIN_J1 above it
+        (for the message of :meth:`_require_resolved`; the core computes the band itself)."""
+        Om, th, t0, t1, lam = self.Omega0, self.theta_w, self.tau0, self.tau1, self.lam
+        half = _MIN_J1 / (2 * lam)
+        need = half * half  # the depth at which 2 lam sqrt(-K) reaches _MIN_J1 (inf, not an error, on overflow)
+        bound = (lambda x: x / need) if need > 0 else (lambda x: math.inf)  # noqa: E731 - lam ~1e300: need underflows
+        cands = []  # (floor, what sets it, the bound that would move it below -need)
+        if t0 != 0:
+            room = MAX_ANGLE + Om if t0 > 0 else MAX_ANGLE - Om
+            cands.append(
+                (
+                    -room / abs(t0),
+                    f"tau0 = {t0!r}: the rotation bound |Omega0 + tau0 K| <= 1e6",
+                    f"|tau0| <= {bound(room):.3g} with these Omega0 and lam"
+                    if room > 0
+                    else f"|Omega0| < 1e6 (Omega0 = {Om!r} leaves no rotation below K = 0), or tau0 = 0",
+                )
+            )
+        if t1 > 0:
+            cands.append(
+                (
+                    -2 * (math.pi - th) / t1,
+                    f"tau1 = {t1!r}: |J_R| = 2 (pi - theta_w) + tau1 K closes",
+                    f"tau1 <= {bound(2 * (math.pi - th)):.3g} with these theta_w and lam",
+                )
+            )
+        disc = lam * lam - 2 * t1 * th
+        if disc >= 0:
+            s1 = 2 * th / (lam + math.sqrt(disc))
+            cands.append(
+                (
+                    -s1 * s1,
+                    f"|J_0| = 2 theta_w - tau1 K - 2 lam sqrt(-K) closing (theta_w = {th!r}, tau1 = {t1!r}, lam = {lam!r})",
+                    "a larger theta_w, or a smaller lam or |tau1|",
+                )
+            )
+        what, fix = ("the arcs", "a deeper band") if not cands else max(cands, key=lambda c: c[0])[1:]
+        depth = -self.valid_band()[0]
+        if depth > 0 and not what.startswith("|J_0|"):  # (where J_0 closes first, lam moves the floor)
+            lam_fix = f"lam >= {_MIN_J1 / (2 * math.sqrt(depth)):.3g} with this band"
+            # lam so small that J_1 stays thinner than _MIN_J1 in any band: only lam helps
+            fix = lam_fix if math.isinf(need) else f"{fix}, or {lam_fix}"
+        return what, fix
 
     def __repr__(self) -> str:
         return (
@@ -584,11 +734,25 @@ def _angles(name: str, phi):
 
 def _as_table(name: str, values, K: np.ndarray) -> np.ndarray:
     if callable(values):
-        values = [values(k) for k in K]
+        values = _sampled(values, K)
     a = real_array(name, values)
     if a.shape != K.shape:
         raise ValueError(f"{name} must have the shape of K {K.shape}, got {a.shape}")
     return a
+
+
+def _sampled(fn, K: np.ndarray):
+    """``fn`` on the grid: one call with the whole grid when fn works on arrays (returns real numbers
+    of the grid's shape), else one call per point (a function of one float, e.g. with ``if k < 0``
+    or ``math.sqrt``, which fails on an array). Three tables called per point took ~0.3 s of a
+    1.1-1.4 s build at MAX_GRID points."""
+    try:
+        out = np.asarray(fn(K.copy()))  # a copy: fn must not see (or change) the tables' own grid
+    except Exception:  # noqa: BLE001 - any failure on an array means: call it per point
+        out = None
+    if out is not None and out.shape == K.shape and out.dtype.kind in "iuf":
+        return out
+    return [fn(k) for k in K]
 
 
 class TruncatedFamily(_MapAPI, _core_truncated.TruncatedFamily):
@@ -602,22 +766,29 @@ class TruncatedFamily(_MapAPI, _core_truncated.TruncatedFamily):
     Parameters
     ----------
     eps : float
-        Forcing amplitude eps_1.
+        Forcing amplitude eps_1: finite, with ``|eps| sum_k |b_k| <= 2^43 (K_hi - K_lo)`` for the
+        band ``(K_lo, K_hi)`` (the kick a step resolves, see :class:`TruncatedMap`).
     K : array_like
-        Strictly increasing grid containing 0, with >= 3 points K <= 0 and max K > 0.
+        Strictly increasing grid containing 0, with >= 3 points K <= 0 and max K > 0, and at most
+        100,000 points (``MAX_GRID``): the sweep plans' limit; the core builds ~1e5 points a
+        second, holding the GIL (Ctrl-C waits for it).
     Omega, JR, J1 : array_like or callable
-        Values on the grid (or functions of K sampled on it). JR and J1 are used only for K <= 0;
-        J1 must vanish at K = 0. ``|Omega| <= 1e6`` (see :class:`TruncatedMap`); the band also
-        ends where the spline through Omega first exceeds it between the grid points.
+        Values on the grid, or functions of K: one called with the whole grid (an array) when it
+        returns an array of the grid's shape, else once per grid point. JR and J1 are used only
+        for K <= 0; J1 must vanish at K = 0 and reach ``2^-41`` rad inside the band (J_1 is
+        resolved, see :class:`TruncatedMap`). ``|Omega| <= 1e6`` (see :class:`TruncatedMap`); the
+        band also ends where the spline through Omega first exceeds it between the grid points.
     forcing : sequence of float, optional
         Sine coefficients ``b_1, b_2, ...`` of f (default ``(1.0,)``: f = sin).
     K_max : float, optional
-        Upper end of the band (default: the top of the grid).
+        Upper end of the band, in (0, inf] (default inf: the top of the grid).
 
     Raises
     ------
     ValueError
-        For malformed tables (naming the offending entry) or tables with no valid band below 0.
+        For malformed tables (naming the offending entry), more than 100,000 grid points
+        (before anything is sampled or built), tables with no valid band below 0 or one below
+        double-precision resolution, or a K_max that is not a real number in (0, inf].
     """
 
     def __init__(self, eps, K, Omega, JR, J1, forcing=(1.0,), K_max=math.inf):
@@ -625,11 +796,31 @@ class TruncatedFamily(_MapAPI, _core_truncated.TruncatedFamily):
         Kg = real_array("K", K)
         if Kg.ndim != 1:
             raise ValueError(f"K must be a 1-D grid, got shape {Kg.shape}")
-        tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]
+        if Kg.size > MAX_GRID:  # before the tables are sampled and the core builds (GIL held, ~10 us a point)
+            raise ValueError(
+                f"K has {Kg.size} grid points; allowed: at most MAX_GRID = {MAX_GRID} (the sweep plans' limit; "
+                "the core's build takes ~10 us a point and cannot be interrupted)"
+            )
         b = forcing_array(forcing)
-        _core_truncated.TruncatedFamily.__init__(self, eps, list(Kg), *(list(t) for t in tabs), list(b), float(K_max))
+        K_max = _band_top(K_max)
+        tabs = [_as_table(n, v, Kg) for n, v in (("Omega", Omega), ("JR", JR), ("J1", J1))]
+        # Lists of Python floats: what the binding's std::vector<double> converts fastest (list(K)'s
+        # NumPy scalars took ~20% longer, an ndarray ~50%: both go element by element).
+        _core_truncated.TruncatedFamily.__init__(self, eps, Kg.tolist(), *(t.tolist() for t in tabs), b.tolist(), K_max)
         self._tables = (Kg.copy(), *(t.copy() for t in tabs))
-        self._K_max = float(K_max)
+        self._K_max = K_max
+        lo = self.valid_band()[0]
+        inside = (Kg > lo) & (Kg < 0)
+        near_floor = lo * (1 - 2**-20) if lo * (1 - 2**-20) > lo else float(np.nextafter(lo, 0.0))
+        # J_1's widest in the band from the table's values inside it and the spline just above the
+        # floor: a lower bound of the spline's maximum, so only a J_1 thin everywhere is refused.
+        widest = max(float(np.max(np.abs(tabs[2][inside]), initial=0.0)), float(self.arcs(near_floor)["len_1"]))
+        self._require_resolved(
+            "TruncatedFamily",
+            widest,
+            float(np.sum(np.abs(b))),
+            lambda: ("the tables' arcs", "J1 tables that open J_1 wider before the band's floor"),
+        )
 
     def forcing_at(self, phi):
         """The forcing ``f(phi) = sum_k b_k sin(k phi)``.
@@ -737,7 +928,7 @@ class TruncatedFamily(_MapAPI, _core_truncated.TruncatedFamily):
         -------
         TruncatedFamily
         """
-        Kg = np.asarray(K, dtype=float)
+        Kg = real_array("K", K)
         neg = np.minimum(Kg, 0.0)
         s = np.sqrt(-neg)
         Omega = m.Omega0 + m.tau0 * Kg
