@@ -9,6 +9,7 @@ the terms of the time average, and their spread gives the error of the mean (bat
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,9 @@ from . import _tangent as T
 __all__ = ["LyapunovResult", "lyapunov", "FTLEField", "ftle_field"]
 
 MAX_STEPS = 10**10
+#: Angle of lyapunov()'s first tangent vector from the angle axis, in rad (any value away from
+#: 0 and pi / 2 and pi: not a coordinate direction).
+_FRAME_ANGLE = 1.0
 
 #: Memory of one start of :func:`ftle_field`, counted at most: its meshgrid coordinates, the
 #: iteration's records (final state, status, Jacobian product in QR form: ~100 bytes), and the
@@ -120,7 +124,8 @@ def lyapunov(m, phi, K, n_steps: int, *, n_blocks: int = 20, transient: int = 0,
     The orbits are followed ``n_steps`` steps (after ``transient`` unmeasured ones) in
     ``n_blocks`` blocks; each block is one batched ``iterate`` with the Jacobian product (C++,
     threaded), carried on from the last block's frame (Benettin's QR method). lambda_1 is the
-    growth rate of a tangent vector, lambda_2 that of areas minus lambda_1: their sum is the
+    growth rate of a tangent vector (started 1 rad off the axes: the angle axis is a regular
+    orbit's neutral direction), lambda_2 that of areas minus lambda_1: their sum is the
     mean ``log det J``, 0 for an area-preserving map, reported as measured.
 
     Parameters
@@ -177,7 +182,13 @@ def lyapunov(m, phi, K, n_steps: int, *, n_blocks: int = 20, transient: int = 0,
         r = m.iterate(p, k, transient, record=(), n_threads=n_threads)
         p, k, status = r.phi_final.copy(), r.K_final.copy(), np.asarray(r.status, dtype=np.int8).copy()
     phi0, K0 = p.copy(), k.copy()
-    Q = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
+    # The first tangent vector starts 1 rad off the axes, not along the angle's: in the maps'
+    # action-angle coordinates that axis is a twist's neutral direction (J e1 = e1 where the orbit
+    # is regular), whose growth a regular orbit's lambda_1 then reported: ~0 or below, under
+    # lambda_2 (-0.0040 +- 0.0008 against +0.0040 over 500 returns of a flow map in section
+    # coordinates), where any other start grows like the twist, log(n tau) / n.
+    c, s_ = math.cos(_FRAME_ANGLE), math.sin(_FRAME_ANGLE)
+    Q = np.broadcast_to(np.array([[c, -s_], [s_, c]]), (n, 2, 2)).copy()
     logs = np.zeros((n, 2))
     steps = np.zeros(n, dtype=np.int64)
     base = n_steps // n_blocks
