@@ -338,7 +338,8 @@ def check_estimate(e: dict, box_area: float) -> None:
     from N/2 to N iterates), and ``error = 2 sampling_error + iteration_error`` in ``[0, 3
     box_area]``; ``impact_fraction_F0`` is a fraction, ``n_samples`` at least 1 (the stratified
     grid has at most twice the samples asked for), ``unresolved`` at most ``n_samples``.
-    ``area_both_sides`` may be NaN (files written before it was measured).
+    Each of these numbers may be NaN: no estimate (a sweep's point that gave none, a file written
+    before ``area_both_sides`` was measured), which the summaries print as ``nan``.
 
     Parameters
     ----------
@@ -352,10 +353,14 @@ def check_estimate(e: dict, box_area: float) -> None:
     ValueError
         Naming the first field out of range, its value and the range.
     """
+
+    def given(name):  # present, and not the NaN of "no estimate"
+        return name in e and not (isinstance(e[name], float) and math.isnan(e[name]))
+
     for name in ("area", "area_N2", "area_N4", "area_both_sides", "sampling_error", "iteration_error", "error"):
-        if name in e and not (name == "area_both_sides" and isinstance(e[name], float) and math.isnan(e[name])):
+        if given(name):
             _area(name, e[name], box_area, 3 if name == "error" else 1)
-    if "impact_fraction_F0" in e:
+    if given("impact_fraction_F0"):
         real_number("impact_fraction_F0", e["impact_fraction_F0"], lo=0.0, lo_open=False, hi=1.0, hi_open=False)
     n = integer("n_samples", e["n_samples"], 1, 2 * MAX_SAMPLES) if "n_samples" in e else None
     if "unresolved" in e:
